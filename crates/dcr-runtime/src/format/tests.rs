@@ -1,0 +1,192 @@
+//! Round-trip, determinism and hostile-input tests of the `.modes` format.
+
+use super::*;
+use std::io::Cursor;
+use std::path::Path;
+
+/// A small valid base: a unit right tetrahedron surface with 2 synthetic modes.
+pub(crate) fn tiny_base() -> ModesFile {
+    let m = 2;
+    let ns = 4;
+    let modes = (0..ns * 3 * m).map(|i| 0.01 * (i as f64 + 1.0)).collect();
+    ModesFile {
+        eigenvalues: vec![100.0, 400.0],
+        surface_vertices: vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, 1.0],
+        ],
+        surface_triangles: vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
+        surface_to_volume: vec![0, 1, 2, 3],
+        modes,
+        material: MaterialSi {
+            youngs: 1e9,
+            poisson: 0.3,
+            density: 700.0,
+        },
+        rayleigh: [10.0, 1e-7],
+        fixed_nodes: vec![],
+        residuals: vec![1e-12, 2e-12],
+        meta: ModesMeta {
+            format_version: FORMAT_VERSION,
+            tool_version: "test".into(),
+            source_hash: "sha256:00".into(),
+            params_hash: "sha256:11".into(),
+            bake_params: serde_json::json!({"modes": 2}),
+            volume_nodes: 4,
+            volume_tets: 1,
+            rigid_modes_excluded: 6,
+            mass_kg: 700.0 / 6.0,
+            reoriented_tets: 0,
+        },
+        precision: ModesPrecision::F64,
+    }
+}
+
+#[test]
+fn round_trip_is_exact_and_deterministic() {
+    let dir = tempfile::tempdir().unwrap();
+    let a = dir.path().join("a.modes");
+    let b = dir.path().join("b.modes");
+    let base = tiny_base();
+    base.write_atomic(&a).unwrap();
+    base.write_atomic(&b).unwrap();
+    assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
+    let back = ModesFile::read(&a).unwrap();
+    assert_eq!(back, base);
+    // No temporary file is left behind.
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 2);
+}
+
+#[test]
+fn f32_storage_rounds_modes_only() {
+    let mut base = tiny_base();
+    base.precision = ModesPrecision::F32;
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("f.modes");
+    base.write_atomic(&p).unwrap();
+    let back = ModesFile::read(&p).unwrap();
+    assert_eq!(back.precision, ModesPrecision::F32);
+    for (x, y) in back.modes.iter().zip(&base.modes) {
+        assert!((x - y).abs() <= 1e-7 * y.abs());
+        assert_ne!(x.to_bits(), 0);
+    }
+    assert_eq!(back.eigenvalues, base.eigenvalues);
+}
+
+#[test]
+fn every_truncation_is_a_clean_error() {
+    let bytes = tiny_base().to_bytes().unwrap();
+    for cut in (0..bytes.len()).step_by(7) {
+        let r = ModesFile::read_from(Cursor::new(&bytes[..cut]), Path::new("cut.modes"));
+        let err = r.expect_err("a truncated archive must not read");
+        assert!(err.to_string().starts_with("cut.modes"), "{err}");
+    }
+}
+
+#[test]
+fn flipped_bytes_never_panic() {
+    let bytes = tiny_base().to_bytes().unwrap();
+    for i in (0..bytes.len()).step_by(3) {
+        let mut b = bytes.clone();
+        b[i] ^= 0xA5;
+        let _ = ModesFile::read_from(Cursor::new(&b[..]), Path::new("flip.modes"));
+    }
+}
+
+#[test]
+fn nan_and_mismatch_are_rejected() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("bad.modes");
+    let mut base = tiny_base();
+    base.modes[5] = f64::NAN;
+    let err = base.write_atomic(&p).unwrap_err().to_string();
+    assert!(
+        err.contains("non-finite mode value at vertex 0, axis 2, mode 1"),
+        "{err}"
+    );
+    assert!(!p.exists(), "nothing is written for invalid content");
+
+    let mut base = tiny_base();
+    base.modes.pop();
+    assert!(base
+        .write_atomic(&p)
+        .unwrap_err()
+        .to_string()
+        .contains("ns×3×m"));
+
+    let mut base = tiny_base();
+    base.surface_triangles[1][2] = 9;
+    assert!(base
+        .write_atomic(&p)
+        .unwrap_err()
+        .to_string()
+        .contains("triangle 1"));
+
+    let mut base = tiny_base();
+    base.meta.format_version = 99;
+    assert!(matches!(
+        base.write_atomic(&p),
+        Err(FormatError::Version { found: 99, .. })
+    ));
+}
+
+#[test]
+fn missing_entry_is_named() {
+    // Archive with only a version entry.
+    let opts =
+        zip::write::SimpleFileOptions::default().compression_method(zip::CompressionMethod::Stored);
+    let mut npz = ndarray_npy::NpzWriter::new_with_options(Cursor::new(Vec::new()), opts);
+    npz.add_array(
+        "format_version",
+        &ndarray::Array0::from_elem((), FORMAT_VERSION),
+    )
+    .unwrap();
+    let bytes = npz.finish().unwrap().into_inner();
+    let err = ModesFile::read_from(Cursor::new(bytes), Path::new("x.modes")).unwrap_err();
+    assert!(
+        matches!(err, FormatError::Missing { entry: "meta", .. }),
+        "{err}"
+    );
+}
+
+#[test]
+fn hostile_header_is_not_allocated() {
+    // An eigenvalues entry whose header declares 10^12 elements but carries 16 bytes.
+    let mut npy = Vec::new();
+    let header = "{'descr': '<f8', 'fortran_order': False, 'shape': (1000000000000,), }";
+    let mut h = header.to_string();
+    while (10 + h.len() + 1) % 64 != 0 {
+        h.push(' ');
+    }
+    h.push('\n');
+    npy.extend_from_slice(b"\x93NUMPY\x01\x00");
+    npy.extend_from_slice(&(h.len() as u16).to_le_bytes());
+    npy.extend_from_slice(h.as_bytes());
+    npy.extend_from_slice(&[0u8; 16]);
+    let base = tiny_base();
+    let good = base.to_bytes().unwrap();
+    let mut zin = zip::ZipArchive::new(Cursor::new(good)).unwrap();
+    let opts =
+        zip::write::SimpleFileOptions::default().compression_method(zip::CompressionMethod::Stored);
+    let mut w = zip::ZipWriter::new(Cursor::new(Vec::new()));
+    for i in 0..zin.len() {
+        let mut f = zin.by_index(i).unwrap();
+        let name = f.name().to_string();
+        w.start_file(name.as_str(), opts).unwrap();
+        if name == "eigenvalues.npy" {
+            std::io::Write::write_all(&mut w, &npy).unwrap();
+        } else {
+            std::io::copy(&mut f, &mut w).unwrap();
+        }
+    }
+    let bytes = w.finish().unwrap().into_inner();
+    let err = ModesFile::read_from(Cursor::new(bytes), Path::new("h.modes"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("eigenvalues") && err.contains("bytes"),
+        "{err}"
+    );
+}

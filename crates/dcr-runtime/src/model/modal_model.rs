@@ -1,0 +1,237 @@
+//! [`ModalModel`]: a validated base, its surface BVH and the per-vertex data every query reuses.
+
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, OnceLock};
+
+use parry3d_f64::math::Vector;
+use parry3d_f64::query::PointQueryWithLocation;
+use parry3d_f64::shape::TriMesh;
+
+use super::{LoadError, SurfacePoint};
+use crate::attenuation::{GeodesicError, HeatGeodesic};
+use crate::format::ModesFile;
+use crate::math::{add, cross, norm, normalize, scale, sub};
+
+/// An immutable modal model shared (via `Arc`) by every object instance that uses the same base.
+///
+/// Object frame = the base's frame (m). Mass-normalised modes: U has units m·kg^-1/2, so a
+/// reduced impulse `r = Uᵀ f` is in kg^1/2·m/s and `q` in kg^1/2·m.
+#[derive(Debug)]
+pub struct ModalModel {
+    base: ModesFile,
+    omega: Vec<f64>,
+    normals: Vec<[f64; 3]>,
+    normal_rows: Vec<f64>,
+    trimesh: TriMesh,
+    bbox_diagonal: f64,
+    mean_edge_length: f64,
+    heat: OnceLock<Result<HeatGeodesic, GeodesicError>>,
+}
+
+impl ModalModel {
+    /// Reads and validates a `.modes` file and builds the model.
+    ///
+    /// # Errors
+    /// [`LoadError`] naming the file: unreadable, truncated, mismatched shapes, NaN, or a surface
+    /// the BVH cannot be built from.
+    pub fn load(path: &Path) -> Result<Arc<ModalModel>, LoadError> {
+        let base = ModesFile::read(path)?;
+        Self::build(base, path).map(Arc::new)
+    }
+
+    /// Builds a model from an in-memory base, validating it first (errors name `<memory>`).
+    ///
+    /// # Errors
+    /// As [`ModalModel::load`].
+    pub fn from_base(base: ModesFile) -> Result<ModalModel, LoadError> {
+        Self::build(base, Path::new("<memory>"))
+    }
+
+    fn build(base: ModesFile, path: &Path) -> Result<ModalModel, LoadError> {
+        base.validate(path)?;
+        let invalid = |detail: String| LoadError::Invalid {
+            path: PathBuf::from(path),
+            detail,
+        };
+        let ns = base.num_surface_vertices();
+        let m = base.num_modes();
+        let omega: Vec<f64> = base.eigenvalues.iter().map(|l| l.sqrt()).collect();
+        let x = &base.surface_vertices;
+        let mut normals = vec![[0.0; 3]; ns];
+        let mut edge_sum = 0.0;
+        for t in &base.surface_triangles {
+            let [a, b, c] = t.map(|i| i as usize);
+            let n = cross(sub(x[b], x[a]), sub(x[c], x[a]));
+            for v in [a, b, c] {
+                normals[v] = add(normals[v], n);
+            }
+            edge_sum += norm(sub(x[b], x[a])) + norm(sub(x[c], x[b])) + norm(sub(x[a], x[c]));
+        }
+        let mean_edge_length = edge_sum / (3.0 * base.surface_triangles.len() as f64);
+        for n in &mut normals {
+            *n = normalize(*n);
+        }
+        let mut normal_rows = vec![0.0; ns * m];
+        for v in 0..ns {
+            let n = normals[v];
+            for axis in 0..3 {
+                let row = &base.modes[(v * 3 + axis) * m..(v * 3 + axis + 1) * m];
+                for (o, u) in normal_rows[v * m..(v + 1) * m].iter_mut().zip(row) {
+                    *o += n[axis] * u;
+                }
+            }
+        }
+        let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+        for p in x {
+            for k in 0..3 {
+                lo[k] = lo[k].min(p[k]);
+                hi[k] = hi[k].max(p[k]);
+            }
+        }
+        let bbox_diagonal = norm(sub(hi, lo));
+        let verts: Vec<Vector> = x.iter().map(|p| Vector::new(p[0], p[1], p[2])).collect();
+        let trimesh = TriMesh::new(verts, base.surface_triangles.clone())
+            .map_err(|e| invalid(format!("surface BVH: {e:?}")))?;
+        if trimesh.num_triangles() != base.surface_triangles.len() {
+            return Err(invalid("the BVH dropped surface triangles".into()));
+        }
+        Ok(ModalModel {
+            base,
+            omega,
+            normals,
+            normal_rows,
+            trimesh,
+            bbox_diagonal,
+            mean_edge_length,
+            heat: OnceLock::new(),
+        })
+    }
+
+    /// The validated base this model was built from.
+    pub fn base(&self) -> &ModesFile {
+        &self.base
+    }
+
+    /// Number of modes m.
+    pub fn num_modes(&self) -> usize {
+        self.omega.len()
+    }
+
+    /// Number of surface vertices ns.
+    pub fn num_vertices(&self) -> usize {
+        self.normals.len()
+    }
+
+    /// Undamped angular frequencies ω_j = √λ_j (rad/s), ascending.
+    pub fn omega(&self) -> &[f64] {
+        &self.omega
+    }
+
+    /// Area-weighted outward unit vertex normals (object frame), one per surface vertex
+    /// (`[0, 0, 0]` for a vertex no triangle uses).
+    pub fn vertex_normals(&self) -> &[[f64; 3]] {
+        &self.normals
+    }
+
+    /// Row-major (ns, m) table of `n_vᵀ U_v` (m·kg^-1/2): normal displacement of vertex v per unit
+    /// modal coordinate (paper Eq. 11 rows).
+    pub fn normal_mode_rows(&self) -> &[f64] {
+        &self.normal_rows
+    }
+
+    /// Diagonal of the surface's axis-aligned bounding box (m).
+    pub fn bounding_box_diagonal(&self) -> f64 {
+        self.bbox_diagonal
+    }
+
+    /// Mean surface edge length (m).
+    pub fn mean_edge_length(&self) -> f64 {
+        self.mean_edge_length
+    }
+
+    /// The three vertex indices of surface triangle `t`.
+    pub fn triangle(&self, t: u32) -> [usize; 3] {
+        self.base.surface_triangles[t as usize].map(|i| i as usize)
+    }
+
+    /// Projects `p` (object frame, m) onto the surface with the BVH; `None` if the surface is
+    /// farther than `max_distance` (m). Never snaps a far point.
+    pub fn project(&self, p: [f64; 3], max_distance: f64) -> Option<SurfacePoint> {
+        if !(p.iter().all(|x| x.is_finite()) && max_distance >= 0.0) {
+            return None;
+        }
+        let q = Vector::new(p[0], p[1], p[2]);
+        let (_, (tri, loc)) =
+            self.trimesh.project_local_point_and_get_location_with_max_dist(q, false, max_distance)?;
+        let mut bary = loc.barycentric_coordinates()?;
+        for b in &mut bary {
+            *b = b.clamp(0.0, 1.0);
+        }
+        let s = bary[0] + bary[1] + bary[2];
+        if !(s > 0.0) {
+            return None;
+        }
+        bary = bary.map(|b| b / s);
+        let sp = self.surface_point(tri, bary, p);
+        (sp.distance <= max_distance).then_some(sp)
+    }
+
+    /// Builds the [`SurfacePoint`] at barycentric `bary` of triangle `tri`; `distance` is measured
+    /// from `query` (m).
+    pub fn surface_point(&self, tri: u32, bary: [f64; 3], query: [f64; 3]) -> SurfacePoint {
+        let vs = self.triangle(tri);
+        let x = &self.base.surface_vertices;
+        let mut point = [0.0; 3];
+        let mut n = [0.0; 3];
+        for (i, &v) in vs.iter().enumerate() {
+            point = add(point, scale(x[v], bary[i]));
+            n = add(n, scale(self.normals[v], bary[i]));
+        }
+        let mut normal = normalize(n);
+        if normal == [0.0; 3] {
+            normal = normalize(cross(sub(x[vs[1]], x[vs[0]]), sub(x[vs[2]], x[vs[0]])));
+        }
+        SurfacePoint {
+            triangle: tri,
+            bary,
+            point,
+            normal,
+            distance: norm(sub(query, point)),
+        }
+    }
+
+    /// Reduced impulse `r += Uᵀ H (d·λ)` (paper Eq. 9) of an impulse `lambda` (N·s) along unit
+    /// `direction` (object frame) applied at `sp`; `r` has length m.
+    pub fn add_reduced_impulse(&self, sp: &SurfacePoint, direction: [f64; 3], lambda: f64, r: &mut [f64]) {
+        let m = self.num_modes();
+        for (i, v) in self.triangle(sp.triangle).into_iter().enumerate() {
+            for axis in 0..3 {
+                let c = sp.bary[i] * direction[axis] * lambda;
+                if c != 0.0 {
+                    let row = &self.base.modes[(v * 3 + axis) * m..(v * 3 + axis + 1) * m];
+                    for (o, u) in r.iter_mut().zip(row) {
+                        *o += c * u;
+                    }
+                }
+            }
+        }
+    }
+
+    /// Contact row `w = nᵀ Σ_i b_i U_i` (m·kg^-1/2, length m) at `sp` with its interpolated
+    /// normal: `w·q` is the normal displacement of the contact point.
+    pub fn contact_row(&self, sp: &SurfacePoint, w: &mut [f64]) {
+        w.iter_mut().for_each(|x| *x = 0.0);
+        self.add_reduced_impulse(sp, sp.normal, 1.0, w);
+    }
+
+    /// The heat-method geodesic solver of this surface, factored on first use and shared by
+    /// every instance using the model.
+    ///
+    /// # Errors
+    /// The [`GeodesicError`] from building it (e.g. degenerate triangles, unused vertices).
+    pub fn heat_geodesic(&self) -> Result<&HeatGeodesic, &GeodesicError> {
+        self.heat
+            .get_or_init(|| HeatGeodesic::new(&self.base.surface_vertices, &self.base.surface_triangles))
+            .as_ref()
+    }
+}

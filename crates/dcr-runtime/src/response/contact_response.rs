@@ -1,0 +1,19 @@
+//! [`ContactResponse`]: what one resting contact receives this step.
+
+/// The distant response at one resting contact for the step.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ContactResponse {
+    /// The resting contact's id.
+    pub id: u64,
+    /// Mapped surface point (m, object frame); the query point when not mapped.
+    pub point: [f64; 3],
+    /// Outward surface normal (object frame): the resting body is pushed along +normal.
+    /// `[0, 0, 0]` when not mapped.
+    pub normal: [f64; 3],
+    /// Peak normal displacement over the step (m, Eq. 11 / 13; Eq. 15 × s for attenuation).
+    pub peak_displacement: f64,
+    /// Velocity change along +normal (m/s, Eq. 12 / 13 / 16): `peak_displacement / h`.
+    pub delta_v: f64,
+    /// `false`: the contact is farther than `max_map_distance` from the surface: zero response.
+    pub mapped: bool,
+}

@@ -1,0 +1,627 @@
+//! [`DistantResponse`]: one object instance's per-step distant collision response.
+//!
+//! Modal method (paper Eq. 9–13): the step's impacts (impulse ≥ threshold) are mapped to the
+//! surface and summed into one reduced impulse `r = Σ Uᵀ H_c d_c λ_c` applied at t = 0; the
+//! exact mode filters give q(k) at t = k·h/S, k = 1..S, S = ⌈h/T⌉; each resting contact's peak
+//! `d = max_k |w_c · q(k)|` (or Eq. 13 per node) gives Δv = d/h. Without carry-over the filters
+//! start from rest every step, so q(k) = g(kT) ∘ r with the impulse-response table g_j(kT)
+//! precomputed at set-up; the per-step work is one dense multiply-max over S × m × contacts.
+//!
+//! Attenuation method (Eq. 14–16): Δx_c = q̂ᵀ h_c λ_N per impact, Δv_p = Σ_c s(r_cp) Δx_c / h.
+
+use std::sync::Arc;
+
+use super::peak_kernel::{peak_abs_projection, BLOCK};
+use super::{ContactResponse, ForceInput, Impact, Method, ParamsError, ResponseParams, RestingContact, StepInfo, Variant};
+use crate::attenuation::{AmplitudeKind, AttenuationParams, DistanceCache, DistanceKind, HeatWorkspace};
+use crate::filter::{damping_ratio, samples_per_step, ModalBank};
+use crate::mapping::ContactCache;
+use crate::math::{dot, norm, normalize, sub};
+use crate::model::{ModalModel, SurfacePoint};
+
+/// Largest number of filter samples per step accepted.
+const MAX_SAMPLES: f64 = 1e6;
+
+const UNMAPPED: u32 = u32::MAX;
+
+/// Attenuation-method state.
+#[derive(Debug)]
+struct AttenuationState {
+    params: AttenuationParams,
+    /// Local amplitude q̂ per surface vertex (m per N·s).
+    amplitude: Vec<f64>,
+    /// Mean amplitude for [`AmplitudeKind::Mean`] / `MeanOver`.
+    mean: f64,
+    fields: DistanceCache,
+    ws: Option<HeatWorkspace>,
+    /// This step's applied impacts: surface point and local displacement Δx_c (m).
+    hits: Vec<(SurfacePoint, f64)>,
+}
+
+impl std::fmt::Debug for HeatWorkspace {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("HeatWorkspace")
+    }
+}
+
+/// The distant collision response of one object instance (paper §4.2–4.5).
+///
+/// Set up once per object ([`DistantResponse::new`]); call [`DistantResponse::step`] once per
+/// rigid-body step with the step's new impacts and the current resting contacts. After warm-up
+/// (buffers are sized at set-up and grown on first sight of more contacts) a step does not
+/// allocate. Everything is in the object frame of the model (m, s, N·s).
+///
+/// ```
+/// use std::sync::Arc;
+/// use dcr_runtime::{testing, DistantResponse, Impact, ModalModel, ResponseParams, RestingContact};
+///
+/// // A synthetic 1 m × 0.6 m plate base (8 modes); real bases come from `ModalModel::load`.
+/// let model = Arc::new(ModalModel::from_base(testing::plate_base())?);
+/// let mut resp = DistantResponse::new(model, ResponseParams::default())?;
+/// // A 2 N·s hit pushing into the plate (−z) at its middle; a box resting near a corner.
+/// let impacts = [Impact { point: [0.5, 0.3, 0.0], direction: [0.0, 0.0, -1.0], impulse: 2.0 }];
+/// let resting = [RestingContact { id: 7, point: [0.9, 0.5, 0.001] }];
+/// let out = resp.step(&impacts, &resting);
+/// assert!(out[0].mapped && out[0].delta_v > 0.0);
+/// // Eq. 17–18: the impulse for a 1 kg box (no rotation) along the contact normal.
+/// let m_eff = dcr_runtime::effective_mass(1.0, [[0.0; 3]; 3], [0.0; 3], out[0].normal);
+/// let j = dcr_runtime::response_impulse(m_eff, out[0].delta_v, out[0].normal);
+/// assert!(j[2] > 0.0);
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+#[derive(Debug)]
+pub struct DistantResponse {
+    model: Arc<ModalModel>,
+    params: ResponseParams,
+    m: usize,
+    samples: usize,
+    period: f64,
+    max_map: f64,
+    bank: ModalBank,
+    /// g_j(kT), row-major samples × m.
+    g_table: Vec<f64>,
+    /// g_j(h) and ġ_j(h): the state at the end of a reset step per unit impulse.
+    g_end: Vec<f64>,
+    g_dot_end: Vec<f64>,
+    q_table: Vec<f64>,
+    r: Vec<f64>,
+    f: Vec<f64>,
+    tmp_q: Vec<f64>,
+    tmp_v: Vec<f64>,
+    cache: ContactCache,
+    slots: Vec<u32>,
+    chan: Vec<u32>,
+    w_step: Vec<f64>,
+    peaks: Vec<f64>,
+    out: Vec<ContactResponse>,
+    step_index: u64,
+    asleep: bool,
+    energy_ref: f64,
+    info: StepInfo,
+    att: Option<AttenuationState>,
+}
+
+fn invalid(field: &'static str, detail: impl Into<String>) -> ParamsError {
+    ParamsError::Invalid {
+        field,
+        detail: detail.into(),
+    }
+}
+
+impl DistantResponse {
+    /// Sets up the filters (and, for attenuation, the local amplitudes and distance solver).
+    ///
+    /// # Errors
+    /// [`ParamsError`] for a non-positive or non-finite h, sampling, threshold, map distance,
+    /// negative Rayleigh coefficients, more than 10⁶ samples per step, invalid attenuation
+    /// parameters, or a surface the heat method cannot factor.
+    pub fn new(model: Arc<ModalModel>, params: ResponseParams) -> Result<Self, ParamsError> {
+        let p = &params;
+        if !(p.h.is_finite() && p.h > 0.0) {
+            return Err(invalid("h", format!("{} s (must be finite and > 0)", p.h)));
+        }
+        let rayleigh = p.rayleigh.unwrap_or(model.base().rayleigh);
+        if !rayleigh.iter().all(|x| x.is_finite() && *x >= 0.0) {
+            return Err(invalid("rayleigh", format!("{rayleigh:?} (must be finite and ≥ 0)")));
+        }
+        if !(p.impact_threshold >= 0.0 && p.impact_threshold.is_finite()) {
+            return Err(invalid("impact_threshold", format!("{} N·s", p.impact_threshold)));
+        }
+        let max_map = if p.max_map_distance.is_nan() {
+            0.05 * model.bounding_box_diagonal()
+        } else {
+            p.max_map_distance
+        };
+        if !(max_map >= 0.0) {
+            return Err(invalid("max_map_distance", format!("{max_map} m")));
+        }
+        if !(p.sleep_energy_rel >= 0.0 && p.sleep_energy_rel.is_finite()) {
+            return Err(invalid("sleep_energy_rel", format!("{}", p.sleep_energy_rel)));
+        }
+        let omega = model.omega();
+        let m = omega.len();
+        let omega_max = omega[m - 1];
+        let t_req = p.sampling.period(omega_max);
+        if !(t_req.is_finite() && t_req > 0.0) {
+            return Err(invalid("sampling", format!("{:?} gives T = {t_req} s", p.sampling)));
+        }
+        if p.h / t_req > MAX_SAMPLES {
+            return Err(ParamsError::TooManySamples { samples: (p.h / t_req).ceil() });
+        }
+        let samples = samples_per_step(p.h, t_req);
+        let period = p.h / samples as f64;
+        let xi: Vec<f64> = omega.iter().map(|&w| damping_ratio(w, rayleigh)).collect();
+        let bank = ModalBank::new(omega, &xi, period);
+        let mut g_table = vec![0.0; samples * m];
+        for k in 0..samples {
+            for (j, f) in bank.filters().iter().enumerate() {
+                g_table[k * m + j] = f.impulse_response((k + 1) as f64 * period);
+            }
+        }
+        let g_end = g_table[(samples - 1) * m..].to_vec();
+        let g_dot_end: Vec<f64> = bank
+            .filters()
+            .iter()
+            .zip(&g_end)
+            .map(|(f, g)| f.free_response(p.h) - 2.0 * f.xi * f.omega * g)
+            .collect();
+        let att = match &p.method {
+            Method::Modal => None,
+            Method::Attenuation(a) => Some(Self::attenuation_setup(&model, a, &g_table, samples)?),
+        };
+        let remap_tolerance = 0.01 * model.mean_edge_length();
+        Ok(DistantResponse {
+            m,
+            samples,
+            period,
+            max_map,
+            bank,
+            g_table,
+            g_end,
+            g_dot_end,
+            q_table: vec![0.0; samples * m],
+            r: vec![0.0; m],
+            f: vec![0.0; m],
+            tmp_q: vec![0.0; m],
+            tmp_v: vec![0.0; m],
+            cache: ContactCache::new(m, remap_tolerance),
+            slots: Vec::new(),
+            chan: Vec::new(),
+            w_step: Vec::new(),
+            peaks: Vec::new(),
+            out: Vec::new(),
+            step_index: 0,
+            asleep: true,
+            energy_ref: 0.0,
+            info: StepInfo::default(),
+            att,
+            model,
+            params,
+        })
+    }
+
+    fn attenuation_setup(
+        model: &ModalModel,
+        a: &AttenuationParams,
+        g_table: &[f64],
+        samples: usize,
+    ) -> Result<AttenuationState, ParamsError> {
+        use crate::attenuation::AttenuationLaw;
+        let finite_nonneg = |x: f64| x.is_finite() && x >= 0.0;
+        match a.law {
+            AttenuationLaw::Full { alpha, beta, r0 } => {
+                if !(finite_nonneg(alpha) && finite_nonneg(beta) && r0.is_finite() && r0 > 0.0) {
+                    return Err(invalid("attenuation law", format!("{:?}", a.law)));
+                }
+            }
+            AttenuationLaw::Simplified { c, beta } => {
+                if !(finite_nonneg(c) && finite_nonneg(beta)) {
+                    return Err(invalid("attenuation law", format!("{:?}", a.law)));
+                }
+            }
+        }
+        let m = model.num_modes();
+        let ns = model.num_vertices();
+        let rows = model.normal_mode_rows();
+        // q̂_v = max_k |Σ_j (n_vᵀU_v)_j² g_j(kT)|: unit normal impulse at v, seen at v (§4.4).
+        let mut amplitude = vec![0.0; ns];
+        let mut sq = vec![0.0; m];
+        for (v, amp) in amplitude.iter_mut().enumerate() {
+            for (s, x) in sq.iter_mut().zip(&rows[v * m..(v + 1) * m]) {
+                *s = x * x;
+            }
+            let mut peak = 0.0f64;
+            for k in 0..samples {
+                let y: f64 = g_table[k * m..(k + 1) * m].iter().zip(&sq).map(|(g, s)| g * s).sum();
+                peak = peak.max(y.abs());
+            }
+            *amp = peak;
+        }
+        let mean = match &a.amplitude {
+            AmplitudeKind::PerVertex => 0.0,
+            AmplitudeKind::Mean => amplitude.iter().sum::<f64>() / ns as f64,
+            AmplitudeKind::MeanOver(subset) => {
+                if subset.is_empty() {
+                    return Err(invalid("amplitude", "MeanOver subset is empty"));
+                }
+                if let Some(bad) = subset.iter().find(|&&v| v as usize >= ns) {
+                    return Err(invalid("amplitude", format!("MeanOver names vertex {bad} ≥ {ns}")));
+                }
+                subset.iter().map(|&v| amplitude[v as usize]).sum::<f64>() / subset.len() as f64
+            }
+        };
+        let ws = match a.distance {
+            DistanceKind::Heat => {
+                let heat = model.heat_geodesic().map_err(|e| ParamsError::Geodesic(e.to_string()))?;
+                Some(heat.workspace())
+            }
+            DistanceKind::Euclidean => None,
+        };
+        let capacity = if a.distance == DistanceKind::Heat { a.cache_capacity } else { 1 };
+        Ok(AttenuationState {
+            params: a.clone(),
+            amplitude,
+            mean,
+            fields: DistanceCache::new(ns, capacity),
+            ws,
+            hits: Vec::new(),
+        })
+    }
+
+    /// The shared model.
+    pub fn model(&self) -> &Arc<ModalModel> {
+        &self.model
+    }
+
+    /// The parameters as given.
+    pub fn params(&self) -> &ResponseParams {
+        &self.params
+    }
+
+    /// Filter samples per rigid-body step, S = ⌈h/T⌉ (relative tolerance 1e-9).
+    pub fn samples_per_step(&self) -> usize {
+        self.samples
+    }
+
+    /// Effective filter period T_eff = h/S (s).
+    pub fn substep(&self) -> f64 {
+        self.period
+    }
+
+    /// The mapping distance in use (m): the parameter, or 5% of the bounding-box diagonal.
+    pub fn max_map_distance(&self) -> f64 {
+        self.max_map
+    }
+
+    /// Local amplitudes q̂_v (m per N·s of normal impulse) per surface vertex (attenuation
+    /// method only; the §4.3 peak procedure at the impacted vertex itself).
+    pub fn local_amplitudes(&self) -> Option<&[f64]> {
+        self.att.as_ref().map(|a| &a.amplitude[..])
+    }
+
+    /// Counters of the last step.
+    pub fn last_step_info(&self) -> StepInfo {
+        self.info
+    }
+
+    /// Number of resting contacts currently cached.
+    pub fn cached_contacts(&self) -> usize {
+        self.cache.len()
+    }
+
+    /// Modal energy ½ Σ (q̇² + ω² q²) of the filter state at the end of the last step
+    /// (J for the mass-normalised base). 0 for the attenuation method.
+    pub fn modal_energy(&self) -> f64 {
+        self.bank.energy()
+    }
+
+    /// Modal displacements q (kg^1/2·m) at the end of the last step.
+    pub fn modal_state(&self) -> &[f64] {
+        self.bank.q()
+    }
+
+    /// The last step's modal displacement samples q(k), k = 1..S (row-major S × m), valid when
+    /// the bank was active (modal method).
+    pub fn modal_samples(&self) -> &[f64] {
+        &self.q_table
+    }
+
+    /// Returns the filters to rest (and wakes nothing); cached contacts and distance fields are
+    /// kept (they depend only on geometry).
+    pub fn reset(&mut self) {
+        self.bank.reset();
+        self.asleep = true;
+        self.energy_ref = 0.0;
+        self.q_table.iter_mut().for_each(|x| *x = 0.0);
+    }
+
+    /// One rigid-body step with the step's new `impacts` and the current `resting` contacts;
+    /// returns one [`ContactResponse`] per resting contact in the same order, valid until the
+    /// next call. Does not allocate after warm-up.
+    pub fn step(&mut self, impacts: &[Impact], resting: &[RestingContact]) -> &[ContactResponse] {
+        self.step_with_forces(impacts, &[], resting)
+    }
+
+    /// As [`DistantResponse::step`], plus forces held constant over the step (zero-order hold,
+    /// modal method only; the attenuation method ignores them and counts them in
+    /// [`StepInfo::forces_ignored`]).
+    pub fn step_with_forces(
+        &mut self,
+        impacts: &[Impact],
+        forces: &[ForceInput],
+        resting: &[RestingContact],
+    ) -> &[ContactResponse] {
+        self.step_index += 1;
+        self.info = StepInfo::default();
+        let step = self.step_index;
+        {
+            let att = &mut self.att;
+            self.cache.evict_unseen(step, self.params.evict_after_steps, |s| {
+                if let Some(a) = att.as_mut() {
+                    a.fields.invalidate(s);
+                }
+            });
+        }
+        self.slots.clear();
+        for rc in resting {
+            let (s, mapped_now) = self.cache.lookup(&self.model, rc.id, rc.point, step, self.max_map);
+            if mapped_now {
+                self.info.contacts_mapped_now += 1;
+                if let Some(a) = self.att.as_mut() {
+                    a.fields.invalidate(s);
+                }
+            }
+            if self.cache.slot(s).surface.is_none() {
+                self.info.contacts_unmapped += 1;
+            }
+            self.slots.push(s);
+        }
+        if self.att.is_some() {
+            self.step_attenuation(impacts, forces, resting);
+        } else {
+            self.step_modal(impacts, forces, resting);
+        }
+        &self.out
+    }
+
+    fn accept(&mut self, impulse: f64) -> bool {
+        let ok = impulse.is_finite() && impulse > 0.0 && impulse >= self.params.impact_threshold;
+        if !ok {
+            self.info.impacts_below_threshold += 1;
+        }
+        ok
+    }
+
+    fn step_modal(&mut self, impacts: &[Impact], forces: &[ForceInput], resting: &[RestingContact]) {
+        let m = self.m;
+        let model = Arc::clone(&self.model);
+        self.r.iter_mut().for_each(|x| *x = 0.0);
+        let mut have_impulse = false;
+        for imp in impacts {
+            if !self.accept(imp.impulse) {
+                continue;
+            }
+            match model.project(imp.point, self.max_map) {
+                Some(sp) => {
+                    model.add_reduced_impulse(&sp, normalize(imp.direction), imp.impulse, &mut self.r);
+                    have_impulse = true;
+                    self.info.impacts_applied += 1;
+                }
+                None => self.info.impacts_unmapped += 1,
+            }
+        }
+        self.f.iter_mut().for_each(|x| *x = 0.0);
+        let mut have_force = false;
+        for fi in forces {
+            if fi.force == [0.0; 3] || !fi.force.iter().all(|x| x.is_finite()) {
+                continue;
+            }
+            match model.project(fi.point, self.max_map) {
+                Some(sp) => {
+                    model.add_reduced_impulse(&sp, fi.force, 1.0, &mut self.f);
+                    have_force = true;
+                    self.info.forces_applied += 1;
+                }
+                None => self.info.forces_ignored += 1,
+            }
+        }
+
+        // Channels: one per mapped contact (PerContact) or one per corner vertex (PerNode).
+        let per_node = self.params.variant == Variant::PerNode;
+        let width = if per_node { 3 } else { 1 };
+        self.chan.clear();
+        let mut nmapped = 0u32;
+        for &s in &self.slots {
+            if self.cache.slot(s).surface.is_some() {
+                self.chan.push(nmapped);
+                nmapped += 1;
+            } else {
+                self.chan.push(UNMAPPED);
+            }
+        }
+        let nch = (nmapped as usize * width).div_ceil(BLOCK) * BLOCK;
+        if self.w_step.len() < nch * m {
+            self.w_step.resize(nch * m, 0.0);
+        }
+        if self.peaks.len() < nch {
+            self.peaks.resize(nch, 0.0);
+        }
+        let w = &mut self.w_step[..nch * m];
+        w.iter_mut().for_each(|x| *x = 0.0);
+        let rows = model.normal_mode_rows();
+        for (&s, &c) in self.slots.iter().zip(&self.chan) {
+            if c == UNMAPPED {
+                continue;
+            }
+            if per_node {
+                let sp = self.cache.slot(s).surface.expect("mapped");
+                for (corner, v) in model.triangle(sp.triangle).into_iter().enumerate() {
+                    let col = c as usize * 3 + corner;
+                    for (j, x) in rows[v * m..(v + 1) * m].iter().enumerate() {
+                        w[j * nch + col] = *x;
+                    }
+                }
+            } else {
+                for (j, x) in self.cache.row(s).iter().enumerate() {
+                    w[j * nch + c as usize] = *x;
+                }
+            }
+        }
+
+        let carry = self.params.carry_over;
+        if !carry {
+            self.bank.reset();
+            self.asleep = false;
+        }
+        let active = have_impulse || have_force || (carry && !self.asleep);
+        let peaks = &mut self.peaks[..nch];
+        if active {
+            let s = self.samples;
+            if !carry && !have_force {
+                for (qk, gk) in self.q_table.chunks_exact_mut(m).zip(self.g_table.chunks_exact(m)) {
+                    for ((q, g), r) in qk.iter_mut().zip(gk).zip(&self.r) {
+                        *q = g * r;
+                    }
+                }
+                for j in 0..m {
+                    self.tmp_q[j] = self.g_end[j] * self.r[j];
+                    self.tmp_v[j] = self.g_dot_end[j] * self.r[j];
+                }
+                self.bank.set_state(&self.tmp_q, &self.tmp_v);
+            } else {
+                if have_impulse {
+                    self.bank.apply_impulse(&self.r);
+                }
+                let force = if have_force { Some(&self.f[..]) } else { None };
+                self.bank.run(s, force, &mut self.q_table);
+            }
+            if nch > 0 {
+                peak_abs_projection(&self.q_table, s, m, &self.w_step[..nch * m], nch, peaks);
+            }
+            if carry {
+                self.asleep = false;
+                if have_impulse {
+                    self.energy_ref = 0.5 * self.r.iter().map(|x| x * x).sum::<f64>();
+                }
+                let e = self.bank.energy();
+                if have_force {
+                    self.energy_ref = self.energy_ref.max(e);
+                } else if e <= self.params.sleep_energy_rel * self.energy_ref {
+                    self.asleep = true;
+                    self.bank.reset();
+                }
+            }
+        } else {
+            peaks.iter_mut().for_each(|x| *x = 0.0);
+            self.q_table.iter_mut().for_each(|x| *x = 0.0);
+            self.info.asleep = carry;
+        }
+
+        let h = self.params.h;
+        self.out.clear();
+        for ((rc, &s), &c) in resting.iter().zip(&self.slots).zip(&self.chan) {
+            let cached = self.cache.slot(s);
+            let resp = match cached.surface {
+                Some(sp) if c != UNMAPPED => {
+                    let d = if per_node {
+                        (0..3).map(|i| sp.bary[i] * self.peaks[c as usize * 3 + i]).sum()
+                    } else {
+                        self.peaks[c as usize]
+                    };
+                    ContactResponse {
+                        id: rc.id,
+                        point: sp.point,
+                        normal: sp.normal,
+                        peak_displacement: d,
+                        delta_v: d / h,
+                        mapped: true,
+                    }
+                }
+                _ => unmapped_response(rc),
+            };
+            self.out.push(resp);
+        }
+    }
+
+    fn step_attenuation(&mut self, impacts: &[Impact], forces: &[ForceInput], resting: &[RestingContact]) {
+        let model = Arc::clone(&self.model);
+        let step = self.step_index;
+        let h = self.params.h;
+        self.info.forces_ignored += forces.iter().filter(|f| f.force != [0.0; 3]).count() as u32;
+        let mut hits = std::mem::take(&mut self.att.as_mut().expect("attenuation").hits);
+        hits.clear();
+        for imp in impacts {
+            if !self.accept(imp.impulse) {
+                continue;
+            }
+            let Some(sp) = model.project(imp.point, self.max_map) else {
+                self.info.impacts_unmapped += 1;
+                continue;
+            };
+            let att = self.att.as_ref().expect("attenuation");
+            // λ_N: the impulse's component along the surface normal (q̂ is per unit normal impulse).
+            let lambda_n = imp.impulse * dot(normalize(imp.direction), sp.normal).abs();
+            let amp = match att.params.amplitude {
+                AmplitudeKind::PerVertex => {
+                    let vs = model.triangle(sp.triangle);
+                    (0..3).map(|i| sp.bary[i] * att.amplitude[vs[i]]).sum()
+                }
+                _ => att.mean,
+            };
+            hits.push((sp, amp * lambda_n));
+            self.info.impacts_applied += 1;
+        }
+        let att = self.att.as_mut().expect("attenuation");
+        let law = att.params.law;
+        let distance = att.params.distance;
+        self.out.clear();
+        for (rc, &s) in resting.iter().zip(&self.slots) {
+            let Some(sp) = self.cache.slot(s).surface else {
+                self.out.push(unmapped_response(rc));
+                continue;
+            };
+            let mut total = 0.0;
+            if !hits.is_empty() {
+                match distance {
+                    DistanceKind::Euclidean => {
+                        for (hp, dx) in &hits {
+                            total += law.factor(norm(sub(hp.point, sp.point))) * dx;
+                        }
+                    }
+                    DistanceKind::Heat => {
+                        let heat = model.heat_geodesic().expect("checked at set-up");
+                        let ws = att.ws.as_mut().expect("heat workspace");
+                        let before = att.fields.computed;
+                        let field = att.fields.get(s, step, |out| heat.distances_from_point_with(&sp, out, ws));
+                        for (hp, dx) in &hits {
+                            let vs = model.triangle(hp.triangle);
+                            let r: f64 = (0..3).map(|i| hp.bary[i] * field[vs[i]]).sum();
+                            total += law.factor(r) * dx;
+                        }
+                        self.info.distance_fields_computed += (att.fields.computed - before) as u32;
+                    }
+                }
+            }
+            self.out.push(ContactResponse {
+                id: rc.id,
+                point: sp.point,
+                normal: sp.normal,
+                peak_displacement: total,
+                delta_v: total / h,
+                mapped: true,
+            });
+        }
+        att.hits = hits;
+    }
+}
+
+fn unmapped_response(rc: &RestingContact) -> ContactResponse {
+    ContactResponse {
+        id: rc.id,
+        point: rc.point,
+        normal: [0.0; 3],
+        peak_displacement: 0.0,
+        delta_v: 0.0,
+        mapped: false,
+    }
+}

@@ -1,0 +1,26 @@
+//! The per-object distant response (paper §4.2–4.5): impacts in, per-resting-contact peak normal
+//! displacement and velocity change out (Eq. 9–13 modal, Eq. 14–16 attenuation), and the
+//! impulse conversion of Eq. 17–19.
+
+mod contact_response;
+mod distant_response;
+mod effective_mass;
+mod force_input;
+mod impact;
+mod peak_kernel;
+mod response_params;
+mod resting_contact;
+mod step_info;
+
+pub use contact_response::ContactResponse;
+pub use distant_response::DistantResponse;
+pub use effective_mass::{effective_mass, response_impulse};
+pub use force_input::ForceInput;
+pub use impact::Impact;
+pub use peak_kernel::peak_abs_projection;
+pub use response_params::{Method, ParamsError, ResponseParams, Variant};
+pub use resting_contact::RestingContact;
+pub use step_info::StepInfo;
+
+#[cfg(test)]
+mod tests;

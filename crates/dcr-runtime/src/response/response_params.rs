@@ -1,0 +1,92 @@
+//! [`ResponseParams`] and the method / variant choices.
+
+use crate::attenuation::AttenuationParams;
+use crate::filter::Sampling;
+
+/// How the peak at a contact is formed from the modal response (paper §4.3).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Variant {
+    /// Peak of the contact's own interpolated row: `max_k |nᵀ Σ_i b_i U_i q(k)|` (default).
+    #[default]
+    PerContact,
+    /// Eq. 13: per-vertex peaks `d_i = max_k |n_iᵀ U_i q(k)|`, then `Δv = Σ b_i d_i / h`.
+    PerNode,
+}
+
+/// Which distant-response model is used.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub enum Method {
+    /// Modal vibration (Eq. 9–13) (default).
+    #[default]
+    Modal,
+    /// Spatial attenuation of a local amplitude (Eq. 14–16).
+    Attenuation(AttenuationParams),
+}
+
+/// Parameters of a [`crate::DistantResponse`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct ResponseParams {
+    /// Rigid-body time step h (s). Default 0.01.
+    pub h: f64,
+    /// Filter period choice. Default [`Sampling::PaperT`].
+    pub sampling: Sampling,
+    /// Rayleigh damping [α0 (1/s), α1 (s)]; `None` (default) uses the base's.
+    pub rayleigh: Option<[f64; 2]>,
+    /// Impacts with impulse below this (N·s) are ignored (§4.5). Default 1e-3 N·s.
+    pub impact_threshold: f64,
+    /// Farthest a point may be from the surface and still be mapped (m). Default `NaN` =
+    /// automatic: 5% of the base's bounding-box diagonal.
+    pub max_map_distance: f64,
+    /// Peak variant. Default [`Variant::PerContact`].
+    pub variant: Variant,
+    /// Response model. Default [`Method::Modal`].
+    pub method: Method,
+    /// `false` (default): the filters restart from rest every step (§4.5). `true`: the state
+    /// runs on across steps and the bank sleeps when its energy falls below
+    /// `sleep_energy_rel` × the energy injected by the last impact.
+    pub carry_over: bool,
+    /// Relative sleep threshold for `carry_over`. Default 1e-12.
+    pub sleep_energy_rel: f64,
+    /// Cached resting contacts unseen for more than this many steps are evicted. Default 120.
+    pub evict_after_steps: u32,
+}
+
+impl Default for ResponseParams {
+    fn default() -> Self {
+        ResponseParams {
+            h: 0.01,
+            sampling: Sampling::PaperT,
+            rayleigh: None,
+            impact_threshold: 1e-3,
+            max_map_distance: f64::NAN,
+            variant: Variant::PerContact,
+            method: Method::Modal,
+            carry_over: false,
+            sleep_energy_rel: 1e-12,
+            evict_after_steps: 120,
+        }
+    }
+}
+
+/// Invalid [`ResponseParams`] (reported by [`crate::DistantResponse::new`], never per step).
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum ParamsError {
+    /// A parameter is out of range.
+    #[error("invalid {field}: {detail}")]
+    Invalid {
+        /// Parameter name.
+        field: &'static str,
+        /// What is wrong.
+        detail: String,
+    },
+    /// The sampling asks for more filter samples per step than supported (10⁶).
+    #[error("{samples} filter samples per step (h/T) exceed the limit of 1000000")]
+    TooManySamples {
+        /// S = ⌈h/T⌉.
+        samples: f64,
+    },
+    /// The heat-method operators could not be built for this surface.
+    #[error("heat geodesics: {0}")]
+    Geodesic(String),
+}

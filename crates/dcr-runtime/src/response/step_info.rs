@@ -1,0 +1,24 @@
+//! [`StepInfo`]: counters of the last step (diagnostics).
+
+/// What the last `step` did.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct StepInfo {
+    /// Impacts applied (impulse ≥ threshold and mapped).
+    pub impacts_applied: u32,
+    /// Impacts ignored because their impulse was below the threshold (or not finite).
+    pub impacts_below_threshold: u32,
+    /// Impacts ignored because they were farther than `max_map_distance` from the surface.
+    pub impacts_unmapped: u32,
+    /// Forces applied (mapped, non-zero; modal method only).
+    pub forces_applied: u32,
+    /// Forces ignored (unmapped, or the attenuation method, which has no force input).
+    pub forces_ignored: u32,
+    /// Resting contacts mapped (or re-mapped) this step (cache misses).
+    pub contacts_mapped_now: u32,
+    /// Resting contacts beyond `max_map_distance` (zero response).
+    pub contacts_unmapped: u32,
+    /// Heat-method distance fields computed this step (attenuation cache misses).
+    pub distance_fields_computed: u32,
+    /// The filter bank was asleep (carry-over mode): no work, zero output.
+    pub asleep: bool,
+}

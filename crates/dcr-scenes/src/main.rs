@@ -1,0 +1,173 @@
+//! `dcr-scenes`: run a scene headless, or print Table 1 with our numbers beside the paper's.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use anyhow::{bail, Context, Result};
+use clap::{Parser, Subcommand, ValueEnum};
+use dcr_scenes::runner::{run_scene, table1, MethodChoice, RunParams, Table1Params};
+use dcr_scenes::scene::SceneDesc;
+use dcr_scenes::{repo_root, SCENES};
+
+#[derive(Parser)]
+#[command(name = "dcr-scenes", about = "The paper's Table 1 scenes, headless on rapier3d-f64")]
+struct Cli {
+    #[command(subcommand)]
+    cmd: Cmd,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum OnOff {
+    On,
+    Off,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum MethodArg {
+    Modal,
+    Attenuation,
+}
+
+#[derive(Subcommand)]
+enum Cmd {
+    /// Run one scene (a name in scenes/ or a path to a scene JSON file).
+    Run {
+        /// Scene name (dinner, roof, scaffold, lowrider, rockfall, washing) or JSON path.
+        scene: String,
+        /// Simulated seconds (default: the scene's).
+        #[arg(long)]
+        seconds: Option<f64>,
+        /// Distant collision response on or off.
+        #[arg(long, value_enum, default_value = "on")]
+        dcr: OnOff,
+        /// Response method for every elastic object (default: each object's own).
+        #[arg(long, value_enum)]
+        method: Option<MethodArg>,
+        /// Attenuation exponent β (implies --method attenuation).
+        #[arg(long)]
+        beta: Option<f64>,
+        /// Output directory (default out/SCENE).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Bases directory (default out/bases).
+        #[arg(long)]
+        bases: Option<PathBuf>,
+    },
+    /// Bake missing/stale bases, run every scene on and off, print Table 1.
+    Table1 {
+        /// One JSON object instead of the text table.
+        #[arg(long)]
+        json: bool,
+        /// Override every scene's length (s).
+        #[arg(long)]
+        seconds: Option<f64>,
+        /// Only these scenes (comma separated).
+        #[arg(long, value_delimiter = ',')]
+        scenes: Option<Vec<String>>,
+        /// Bases directory (default out/bases).
+        #[arg(long)]
+        bases: Option<PathBuf>,
+    },
+}
+
+fn scene_path(root: &std::path::Path, s: &str) -> PathBuf {
+    if s.ends_with(".json") {
+        PathBuf::from(s)
+    } else {
+        root.join("scenes").join(format!("{s}.json"))
+    }
+}
+
+fn real_main() -> Result<()> {
+    let cli = Cli::parse();
+    let root = repo_root();
+    match cli.cmd {
+        Cmd::Run { scene, seconds, dcr, method, beta, out, bases } => {
+            let path = scene_path(&root, &scene);
+            if !path.exists() {
+                bail!("no scene {scene:?} ({} does not exist; scenes: {})", path.display(), SCENES.join(", "));
+            }
+            let desc = SceneDesc::read(&path)?;
+            let method = match (method, beta) {
+                (_, Some(b)) => MethodChoice::AttenuationBeta(b),
+                (Some(MethodArg::Attenuation), None) => MethodChoice::Attenuation,
+                (Some(MethodArg::Modal), None) => MethodChoice::Modal,
+                (None, None) => MethodChoice::Scene,
+            };
+            if let Some(s) = seconds {
+                if !(s.is_finite() && s > 0.0) {
+                    bail!("--seconds must be positive, got {s}");
+                }
+            }
+            let out_dir = out.unwrap_or_else(|| root.join("out").join(&desc.name));
+            let report = run_scene(
+                &desc,
+                &RunParams {
+                    seconds,
+                    dcr: matches!(dcr, OnOff::On),
+                    method,
+                    root: root.clone(),
+                    bases_dir: bases.unwrap_or_else(|| root.join("out").join("bases")),
+                    out_dir: Some(out_dir.clone()),
+                    progress: true,
+                },
+            )?;
+            println!("{} dcr {} ({} steps): {}", report.scene, if report.dcr { "on" } else { "off" }, report.steps, out_dir.display());
+            for (k, (v, u)) in &report.outcomes {
+                println!("  {k:28} {v:10.3} {u}");
+            }
+            for m in &report.models {
+                println!(
+                    "  model {:8} impacts {:4} queries {:4} distant contacts (max) {:3} query µs median {} p99 {}",
+                    m.model,
+                    m.stats.impacts,
+                    m.queries,
+                    m.distant_contacts,
+                    m.query_us_median.map_or("-".into(), |v| format!("{v:.1}")),
+                    m.query_us_p99.map_or("-".into(), |v| format!("{v:.1}"))
+                );
+            }
+            println!(
+                "  rapier {:.1} ms, adapter {:.1} ms ({:.2}% of step); energy injected {:.4e} J, dissipated {:.4e} J",
+                report.rapier_ms,
+                report.adapter_ms,
+                100.0 * report.dcr_share_of_step,
+                report.injected_ke,
+                report.dissipated
+            );
+            println!("  trajectory {}", report.trajectory_hash);
+        }
+        Cmd::Table1 { json, seconds, scenes, bases } => {
+            let scenes = scenes.unwrap_or_else(|| SCENES.iter().map(|s| s.to_string()).collect());
+            for s in &scenes {
+                if !SCENES.contains(&s.as_str()) {
+                    bail!("unknown scene {s:?} (scenes: {})", SCENES.join(", "));
+                }
+            }
+            let (text, value) = table1(&Table1Params {
+                scenes,
+                seconds,
+                root: root.clone(),
+                bases_dir: bases.unwrap_or_else(|| root.join("out").join("bases")),
+                scaffold_betas: vec![0.5, 1.0, 2.0],
+            })
+            .context("table1")?;
+            if json {
+                println!("{}", serde_json::to_string_pretty(&value)?);
+            } else {
+                print!("{text}");
+            }
+        }
+    }
+    Ok(())
+}
+
+fn main() -> ExitCode {
+    match real_main() {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("dcr-scenes: error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}

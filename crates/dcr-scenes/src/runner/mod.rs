@@ -1,0 +1,14 @@
+//! The headless runner: build a scene's world, step it with the response on or off, record
+//! trajectories and timings, measure the scene's outcome figures, write NPZ + JSON.
+
+mod bases;
+mod outcomes;
+mod run;
+mod table1;
+mod trajectory;
+
+pub use bases::{base_path, bake_params, ensure_base};
+pub use outcomes::{measure_outcome, unit_of};
+pub use run::{run_scene, MethodChoice, ModelReport, RunParams, RunReport};
+pub use table1::{paper_rows, table1, PaperRow, Table1Params};
+pub use trajectory::Trajectory;

@@ -1,0 +1,195 @@
+//! `dcr-scenes table1`: every scene on and off, our Table 1 columns beside the paper's.
+
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+use anyhow::Result;
+use serde_json::{json, Value};
+
+use crate::runner::{run_scene, MethodChoice, RunParams, RunReport};
+use crate::scene::SceneDesc;
+
+/// One row of the paper's Table 1.
+#[derive(Clone, Copy, Debug)]
+pub struct PaperRow {
+    /// Scene.
+    pub scene: &'static str,
+    /// Model.
+    pub model: &'static str,
+    /// Surface vertices.
+    pub vertices: usize,
+    /// Surface triangles.
+    pub triangles: usize,
+    /// Modes.
+    pub modes: usize,
+    /// Rigid step (s).
+    pub h: f64,
+    /// IIR step (s).
+    pub t: f64,
+    /// Distant contacts.
+    pub contacts: usize,
+    /// Compute time per query (ms, i9-9980HK).
+    pub ms: f64,
+}
+
+/// The paper's Table 1.
+pub fn paper_rows() -> Vec<PaperRow> {
+    let r = |scene, model, vertices, triangles, t, contacts, ms| PaperRow {
+        scene,
+        model,
+        vertices,
+        triangles,
+        modes: 20,
+        h: 1e-2,
+        t,
+        contacts,
+        ms,
+    };
+    vec![
+        r("dinner", "table", 966, 1928, 4.9e-4, 41, 3.8),
+        r("roof", "roof", 1002, 2000, 7.0e-3, 7, 0.8),
+        r("scaffold", "scaffold", 5384, 10776, 3.0e-3, 58, 27.5),
+        r("lowrider", "ground", 1570, 3136, 3.1e-4, 40, 5.6),
+        r("rockfall", "cliff", 7182, 14360, 4.0e-3, 24, 18.1),
+        r("washing", "floor", 360, 716, 1.7e-4, 26, 1.1),
+        r("washing", "fridge", 250, 496, 8.6e-5, 6, 0.2),
+    ]
+}
+
+/// Settings of a `table1` run.
+#[derive(Clone, Debug)]
+pub struct Table1Params {
+    /// Scene names, in order.
+    pub scenes: Vec<String>,
+    /// Override of every scene's run length (s).
+    pub seconds: Option<f64>,
+    /// Repository root.
+    pub root: PathBuf,
+    /// Bases directory.
+    pub bases_dir: PathBuf,
+    /// Also run the scaffold with attenuation at these β.
+    pub scaffold_betas: Vec<f64>,
+}
+
+fn fmt_opt(x: Option<f64>, scale: f64, prec: usize) -> String {
+    x.map_or("-".into(), |v| format!("{:.*}", prec, v * scale))
+}
+
+/// Runs every scene on and off and returns (text table, JSON object).
+///
+/// # Errors
+/// Any run's failure.
+pub fn table1(p: &Table1Params) -> Result<(String, Value)> {
+    let paper = paper_rows();
+    let mut entries = Vec::new();
+    let mut text = String::new();
+    text.push_str(&format!(
+        "{:9} {:8} {:>12} {:>13} {:>9} {:>6} {:>15} {:>10} {:>22} {:>8}\n",
+        "scene", "model", "vertices", "triangles", "modes", "h", "T (s)", "contacts", "query ms med/p99", "share"
+    ));
+    text.push_str(&format!("{:9} {:8} {:>12} {:>13} {:>9} {:>6} {:>15} {:>10} {:>22} {:>8}\n", "", "", "ours/paper", "ours/paper", "", "", "ours/paper", "ours/paper", "ours (paper mean)", "of step"));
+    let mut outcome_lines = String::new();
+    for name in &p.scenes {
+        let desc = SceneDesc::read(&p.root.join("scenes").join(format!("{name}.json")))?;
+        let run = |dcr: bool, method: MethodChoice| -> Result<RunReport> {
+            eprintln!("[dcr-scenes] table1: {name} dcr {}", if dcr { "on" } else { "off" });
+            run_scene(
+                &desc,
+                &RunParams {
+                    seconds: p.seconds,
+                    dcr,
+                    method,
+                    root: p.root.clone(),
+                    bases_dir: p.bases_dir.clone(),
+                    out_dir: None,
+                    progress: true,
+                },
+            )
+        };
+        let on = run(true, MethodChoice::Scene)?;
+        let off = run(false, MethodChoice::Scene)?;
+        let mut outcomes = serde_json::Map::new();
+        for (k, (v, unit)) in &on.outcomes {
+            let off_v = off.outcomes.get(k).map(|x| x.0);
+            outcomes.insert(k.clone(), json!({"on": v, "off": off_v, "unit": unit}));
+            outcome_lines.push_str(&format!(
+                "  {:9} {:28} on {:>10.3}  off {:>10.3} {}\n",
+                name,
+                k,
+                v,
+                off_v.unwrap_or(f64::NAN),
+                unit
+            ));
+        }
+        outcome_lines.push_str(&format!(
+            "  {:9} {:28} injected {:.4e} J <= dissipated {:.4e} J: {}\n",
+            name,
+            "energy (on)",
+            on.injected_ke,
+            on.dissipated,
+            on.injected_ke <= on.dissipated
+        ));
+        let mut extra = Vec::new();
+        if name == "scaffold" {
+            for &beta in &p.scaffold_betas {
+                let r = run(true, MethodChoice::AttenuationBeta(beta))?;
+                let outs: BTreeMap<_, _> = r.outcomes.iter().map(|(k, (v, u))| (k.clone(), json!({"value": v, "unit": u}))).collect();
+                for (k, (v, u)) in &r.outcomes {
+                    outcome_lines.push_str(&format!("  {:9} {:28} attenuation beta {beta}: {v:.3} {u}\n", name, k));
+                }
+                let m = &r.models[0];
+                extra.push(json!({"beta": beta, "outcomes": outs, "query_us_median": m.query_us_median, "query_us_p99": m.query_us_p99}));
+            }
+        }
+        for m in &on.models {
+            let pr = paper.iter().find(|r| r.scene == name.as_str() && r.model == m.model);
+            text.push_str(&format!(
+                "{:9} {:8} {:>12} {:>13} {:>9} {:>6} {:>15} {:>10} {:>22} {:>7.1}%\n",
+                name,
+                m.model,
+                format!("{}/{}", m.surface_vertices, pr.map_or(0, |r| r.vertices)),
+                format!("{}/{}", m.surface_triangles, pr.map_or(0, |r| r.triangles)),
+                format!("{}/{}", m.modes, pr.map_or(0, |r| r.modes)),
+                on.h,
+                format!("{}/{:.1e}", fmt_opt(m.iir_t, 1.0, 6), pr.map_or(0.0, |r| r.t)),
+                format!("{}/{}", m.distant_contacts, pr.map_or(0, |r| r.contacts)),
+                format!(
+                    "{}/{} ({})",
+                    fmt_opt(m.query_us_median, 1e-3, 3),
+                    fmt_opt(m.query_us_p99, 1e-3, 3),
+                    pr.map_or(0.0, |r| r.ms)
+                ),
+                100.0 * on.dcr_share_of_step
+            ));
+            entries.push(json!({
+                "name": name,
+                "model": m.model,
+                "surface_vertices": m.surface_vertices,
+                "surface_triangles": m.surface_triangles,
+                "modes": m.modes,
+                "method": m.method,
+                "h": on.h,
+                "iir_T": m.iir_t,
+                "samples_per_step": m.samples_per_step,
+                "distant_contacts": m.distant_contacts,
+                "queries": m.queries,
+                "impacts": m.stats.impacts,
+                "query_us_median": m.query_us_median,
+                "query_us_p99": m.query_us_p99,
+                "dcr_share_of_step": on.dcr_share_of_step,
+                "rapier_ms": on.rapier_ms,
+                "adapter_ms": on.adapter_ms,
+                "seconds": on.seconds,
+                "outcomes": outcomes,
+                "energy": {"injected_ke_j": m.stats.injected_ke, "dissipated_j": m.stats.dissipated},
+                "attenuation_runs": extra,
+                "trajectory_hash_on": on.trajectory_hash,
+                "trajectory_hash_off": off.trajectory_hash,
+                "paper": pr.map(|r| json!({"vertices": r.vertices, "triangles": r.triangles, "modes": r.modes, "h": r.h, "iir_T": r.t, "distant_contacts": r.contacts, "compute_ms": r.ms})),
+            }));
+        }
+    }
+    text.push_str("\noutcomes (response on vs off):\n");
+    text.push_str(&outcome_lines);
+    Ok((text, json!({"scenes": entries})))
+}

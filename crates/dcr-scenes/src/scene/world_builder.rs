@@ -1,0 +1,205 @@
+//! Builds a rapier3d-f64 [`PhysicsWorld`] from a [`SceneDesc`]: elastic objects (static or
+//! dynamic, trimesh or primitive proxies), props with their masses, compliant joints.
+
+use std::collections::HashMap;
+use std::path::Path;
+
+use anyhow::{bail, Context, Result};
+use rapier3d_f64::prelude::*;
+use rapier3d_f64::math::{Pose, Rotation, Vector};
+
+use super::scene_desc::{name_matches, BodyKind, ColliderDesc, PoseDesc, SceneDesc, ShapeDesc};
+
+/// One body of the built world.
+#[derive(Clone, Debug)]
+pub struct BodyInfo {
+    /// Name (props with copies: `name_i`).
+    pub name: String,
+    /// Rapier handle.
+    pub handle: RigidBodyHandle,
+    /// Index into [`SceneDesc::elastic`] if this body carries a modal base.
+    pub elastic: Option<usize>,
+    /// Dynamic (recorded in the trajectory)?
+    pub dynamic: bool,
+}
+
+/// The rapier world of a scene plus the name ↔ handle bookkeeping.
+pub struct BuiltWorld {
+    /// The world (h, gravity, bodies, colliders, joints).
+    pub world: PhysicsWorld,
+    /// Every body, elastic objects first, in scene order.
+    pub bodies: Vec<BodyInfo>,
+    /// Collider → index into `bodies`.
+    pub collider_body: HashMap<ColliderHandle, usize>,
+    /// Elastic object i → index into `bodies`.
+    pub elastic_body: Vec<usize>,
+}
+
+impl BuiltWorld {
+    /// Index into `bodies` of the body named `name`.
+    pub fn body_index(&self, name: &str) -> Option<usize> {
+        self.bodies.iter().position(|b| b.name == name)
+    }
+}
+
+/// A pose from its description (translation m, rotation scaled axis in degrees).
+pub fn pose_from_desc(p: &PoseDesc) -> Pose {
+    let r = p.rotation_deg;
+    let axis = Vector::new(r[0].to_radians(), r[1].to_radians(), r[2].to_radians());
+    Pose::from_parts(Vector::new(p.translation[0], p.translation[1], p.translation[2]), Rotation::from_scaled_axis(axis))
+}
+
+fn v3(a: [f64; 3]) -> Vector {
+    Vector::new(a[0], a[1], a[2])
+}
+
+fn shape_builder(shape: &ShapeDesc) -> Result<ColliderBuilder> {
+    Ok(match shape {
+        ShapeDesc::Cuboid { half_extents: h } => ColliderBuilder::cuboid(h[0], h[1], h[2]),
+        ShapeDesc::Ball { radius } => ColliderBuilder::ball(*radius),
+        ShapeDesc::Cylinder { half_height, radius } => ColliderBuilder::cylinder(*half_height, *radius),
+        ShapeDesc::Cone { half_height, radius } => ColliderBuilder::cone(*half_height, *radius),
+        ShapeDesc::Capsule { half_height, radius } => ColliderBuilder::capsule_y(*half_height, *radius),
+        ShapeDesc::ConvexHull { points } => {
+            let pts: Vec<Vector> = points.iter().map(|p| v3(*p)).collect();
+            match ColliderBuilder::convex_hull(&pts) {
+                Some(b) => b,
+                None => bail!("convex hull of {} points is degenerate", points.len()),
+            }
+        }
+    })
+}
+
+fn collider_volume(c: &ColliderDesc) -> Result<f64> {
+    let b = shape_builder(&c.shape)?.density(1.0).build();
+    Ok(b.mass())
+}
+
+/// Builds the world. `root` is the repository root (mesh paths are relative to it).
+///
+/// # Errors
+/// Unreadable meshes, degenerate shapes, joints naming unknown bodies.
+pub fn build_world(desc: &SceneDesc, root: &Path) -> Result<BuiltWorld> {
+    let mut world = PhysicsWorld::new();
+    world.gravity = v3(desc.gravity);
+    world.integration_parameters.dt = desc.h;
+    let mut bodies = Vec::new();
+    let mut collider_body = HashMap::new();
+    let mut elastic_body = Vec::new();
+
+    for (ei, e) in desc.elastic.iter().enumerate() {
+        let pose = pose_from_desc(&e.pose);
+        let (rb, dynamic) = match &e.body {
+            BodyKind::Static => (RigidBodyBuilder::fixed().pose(pose), false),
+            BodyKind::Dynamic { .. } => (RigidBodyBuilder::dynamic().pose(pose).can_sleep(false), true),
+        };
+        let handle = world.insert_body(rb);
+        let idx = bodies.len();
+        let mut builders = Vec::new();
+        match &e.colliders {
+            None => {
+                if dynamic {
+                    bail!("elastic object {}: a dynamic body needs primitive `colliders`", e.name);
+                }
+                let mesh_path = root.join(&e.mesh);
+                let mesh = modal_bake::mesh::read_mesh(&mesh_path)
+                    .with_context(|| format!("reading mesh {}", mesh_path.display()))?;
+                let (_, tris) = modal_bake::bake::extract_surface(&mesh);
+                let verts: Vec<Vector> = mesh.nodes.iter().map(|p| v3(*p)).collect();
+                let idx_tris: Vec<[u32; 3]> = tris.iter().map(|t| [t[0] as u32, t[1] as u32, t[2] as u32]).collect();
+                let b = ColliderBuilder::trimesh_with_flags(verts.clone(), idx_tris.clone(), TriMeshFlags::FIX_INTERNAL_EDGES)
+                    .or_else(|_| ColliderBuilder::trimesh(verts, idx_tris))
+                    .map_err(|err| anyhow::anyhow!("trimesh of {}: {err:?}", e.name))?;
+                builders.push(b);
+            }
+            Some(cs) => {
+                let vol: f64 = cs.iter().map(collider_volume).sum::<Result<f64>>()?;
+                let density = match &e.body {
+                    BodyKind::Dynamic { mass } => mass / vol,
+                    BodyKind::Static => 1.0,
+                };
+                for c in cs {
+                    builders.push(shape_builder(&c.shape)?.position(pose_from_desc(&c.offset)).density(density));
+                }
+            }
+        }
+        for b in builders {
+            let ch = world.insert_collider(b.friction(e.friction).restitution(desc.restitution), Some(handle));
+            collider_body.insert(ch, idx);
+        }
+        bodies.push(BodyInfo { name: e.name.clone(), handle, elastic: Some(ei), dynamic });
+        elastic_body.push(idx);
+    }
+
+    for p in &desc.props {
+        let vol: f64 = p.colliders.iter().map(collider_volume).sum::<Result<f64>>()?;
+        if !(vol > 0.0 && p.mass > 0.0) {
+            bail!("prop {}: mass and collider volume must be positive", p.name);
+        }
+        let density = p.mass / vol;
+        let frame = match &p.relative_to {
+            None => Pose::IDENTITY,
+            Some(name) => {
+                let e = desc.elastic.iter().find(|e| &e.name == name);
+                let Some(e) = e else { bail!("prop {}: relative_to names no elastic object {name}", p.name) };
+                pose_from_desc(&e.pose)
+            }
+        };
+        let base = pose_from_desc(&p.pose);
+        let copies: Vec<([f64; 3], String)> = if p.copies.is_empty() {
+            vec![([0.0; 3], p.name.clone())]
+        } else {
+            p.copies.iter().enumerate().map(|(i, t)| (*t, format!("{}_{i}", p.name))).collect()
+        };
+        for (t, name) in copies {
+            let mut pose = base;
+            pose.translation += v3(t);
+            let pose = frame * pose;
+            let rb = if p.fixed { RigidBodyBuilder::fixed() } else { RigidBodyBuilder::dynamic() };
+            let rb = rb
+                .pose(pose)
+                .linvel(v3(p.linvel))
+                .angvel(v3(p.angvel))
+                .linear_damping(p.linear_damping)
+                .angular_damping(p.angular_damping)
+                .ccd_enabled(p.ccd);
+            let handle = world.insert_body(rb);
+            let idx = bodies.len();
+            for c in &p.colliders {
+                let b = shape_builder(&c.shape)?
+                    .position(pose_from_desc(&c.offset))
+                    .density(density)
+                    .friction(p.friction)
+                    .restitution(desc.restitution);
+                let ch = world.insert_collider(b, Some(handle));
+                collider_body.insert(ch, idx);
+            }
+            bodies.push(BodyInfo { name, handle, elastic: None, dynamic: !p.fixed });
+        }
+    }
+
+    for j in &desc.joints {
+        let i1 = bodies.iter().position(|b| b.name == j.body1).with_context(|| format!("joint: no body {}", j.body1))?;
+        let children: Vec<usize> =
+            (0..bodies.len()).filter(|&i| name_matches(&j.body2, &bodies[i].name)).collect();
+        if children.is_empty() {
+            bail!("joint: no body matches {}", j.body2);
+        }
+        for i2 in children {
+            let p1 = *world.bodies[bodies[i1].handle].position();
+            let p2 = *world.bodies[bodies[i2].handle].position();
+            // The hinge sits at the same offset from every child's initial centre. The axis is
+            // taken in both bodies' frames as given: bodies joined start unrotated.
+            let anchor = p2.translation + v3(j.anchor_offset);
+            let axis1 = v3(j.axis).normalize();
+            let joint = RevoluteJointBuilder::new(axis1)
+                .local_anchor1(p1.inverse_transform_point(anchor))
+                .local_anchor2(p2.inverse_transform_point(anchor))
+                .motor_position(0.0, j.stiffness, j.damping)
+                .contacts_enabled(false);
+            world.insert_impulse_joint(bodies[i1].handle, bodies[i2].handle, joint);
+        }
+    }
+
+    Ok(BuiltWorld { world, bodies, collider_body, elastic_body })
+}

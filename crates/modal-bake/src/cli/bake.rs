@@ -1,0 +1,189 @@
+//! `modal-bake bake`.
+
+use std::path::PathBuf;
+use std::time::Duration;
+
+use anyhow::Context;
+use clap::Args;
+use indicatif::{ProgressBar, ProgressStyle};
+use modal_bake::bake::{
+    self, BakeParams, BakeReport, BakeStage, MaterialSi, ModeRequest, ModesPrecision,
+};
+
+use super::parse;
+
+/// Options that determine a base (shared by `bake` and `check`).
+#[derive(Args, Clone, Debug)]
+pub struct BakeOptions {
+    /// Young's modulus E (Pa).
+    #[arg(long, value_name = "PA", default_value_t = 1.1e9)]
+    pub youngs: f64,
+    /// Poisson ratio ν (−1 < ν < 0.5).
+    #[arg(long, value_name = "NU", default_value_t = 0.3)]
+    pub poisson: f64,
+    /// Density ρ (kg/m³).
+    #[arg(long, value_name = "KG_M3", default_value_t = 770.0)]
+    pub density: f64,
+    /// Number of lowest elastic modes to keep [default: 20].
+    #[arg(long, value_name = "N", conflicts_with = "max_freq")]
+    pub modes: Option<usize>,
+    /// Keep every elastic mode below this frequency (Hz) instead of a count.
+    #[arg(long, value_name = "HZ")]
+    pub max_freq: Option<f64>,
+    /// Fix every node of this named physical group (repeatable). Nothing fixed: free-free,
+    /// the six rigid-body modes are detected and excluded.
+    #[arg(long, value_name = "NAME")]
+    pub fixed: Vec<String>,
+    /// Default Rayleigh damping stored in the base: α0 (1/s), α1 (s).
+    #[arg(long, value_name = "A0,A1", value_parser = parse::pair, default_value = "10,1e-7")]
+    pub rayleigh: [f64; 2],
+    /// Lumped (diagonal) mass instead of the consistent mass.
+    #[arg(long)]
+    pub lumped: bool,
+    /// Store the surface mode shapes as 32-bit floats (half the file size).
+    #[arg(long)]
+    pub f32: bool,
+}
+
+impl BakeOptions {
+    pub fn params(&self) -> BakeParams {
+        BakeParams {
+            material: MaterialSi {
+                youngs: self.youngs,
+                poisson: self.poisson,
+                density: self.density,
+            },
+            modes: match self.max_freq {
+                Some(f) => ModeRequest::MaxFreqHz(f),
+                None => ModeRequest::Count(self.modes.unwrap_or(20)),
+            },
+            fixed: self.fixed.clone(),
+            rayleigh: self.rayleigh,
+            lumped: self.lumped,
+            precision: if self.f32 {
+                ModesPrecision::F32
+            } else {
+                ModesPrecision::F64
+            },
+        }
+    }
+}
+
+#[derive(Args)]
+pub struct BakeArgs {
+    /// Tetrahedral mesh: gmsh .msh (2.2 or 4.1, ASCII or binary) or meshio-style .json.
+    pub mesh: PathBuf,
+    /// Output base (written atomically: nothing is left behind on failure).
+    #[arg(short = 'o', long = "out", value_name = "OUT.modes")]
+    pub out: PathBuf,
+    #[command(flatten)]
+    pub options: BakeOptions,
+    /// Print seconds per stage (read, assemble, factor, eigensolve, write).
+    #[arg(long)]
+    pub timings: bool,
+    /// Print the bake report as one JSON object on stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// A spinner per stage, a bar for the eigensolve; hidden when stderr is not a terminal.
+struct Progress {
+    bar: ProgressBar,
+}
+
+impl Progress {
+    fn new() -> Progress {
+        let bar = ProgressBar::new_spinner();
+        bar.enable_steady_tick(Duration::from_millis(120));
+        Progress { bar }
+    }
+
+    fn update(&mut self, stage: BakeStage) {
+        match stage {
+            BakeStage::Read => self.bar.set_message("reading mesh"),
+            BakeStage::Assemble => self.bar.set_message("assembling K and M"),
+            BakeStage::Eigensolve(p) => {
+                if self.bar.length().is_none() {
+                    self.bar.set_style(
+                        ProgressStyle::with_template(
+                            "{spinner} eigensolve [{bar:30}] {pos}/{len} modes converged ({msg})",
+                        )
+                        .unwrap_or_else(|_| ProgressStyle::default_bar())
+                        .progress_chars("=> "),
+                    );
+                    self.bar.set_length(p.requested as u64);
+                }
+                self.bar.set_position(p.converged.min(p.requested) as u64);
+                self.bar
+                    .set_message(format!("Lanczos step {}", p.iteration));
+            }
+            BakeStage::Write => {
+                self.bar.set_style(ProgressStyle::default_spinner());
+                self.bar.set_message("writing");
+            }
+        }
+    }
+}
+
+pub fn run(args: &BakeArgs) -> anyhow::Result<()> {
+    let params = args.options.params();
+    let mut progress = Progress::new();
+    let report = bake::bake_file(&args.mesh, &params, &args.out, &mut |s| progress.update(s));
+    progress.bar.finish_and_clear();
+    let report = report
+        .with_context(|| format!("baking {} failed; nothing was written", args.mesh.display()))?;
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        print_report(&args.out, &report);
+    }
+    if args.timings {
+        eprintln!(
+            "timings (s): read {:.3}  assemble {:.3}  factor {:.3}  eigensolve {:.3}  write {:.3}  total {:.3}",
+            report.read_s,
+            report.assemble_s,
+            report.factor_s,
+            report.eigensolve_s,
+            report.write_s,
+            report.read_s + report.assemble_s + report.factor_s + report.eigensolve_s + report.write_s
+        );
+    }
+    Ok(())
+}
+
+fn print_report(out: &std::path::Path, r: &BakeReport) {
+    println!("wrote {}", out.display());
+    println!(
+        "  mesh: {} nodes, {} tets, {} free dofs, mass {:.6} kg",
+        r.nodes, r.tets, r.free_dofs, r.mass_kg
+    );
+    for n in &r.notes {
+        println!("  note: {n}");
+    }
+    if r.reoriented_tets > 0 {
+        println!("  reoriented {} inverted tetrahedra", r.reoriented_tets);
+    }
+    if r.rigid_modes_excluded > 0 {
+        println!(
+            "  free-free: {} rigid-body modes detected (|λ| ≤ {:.2e} rad²/s²) and excluded",
+            r.rigid_modes_excluded,
+            r.rigid_eigenvalues
+                .iter()
+                .fold(0.0f64, |a, l| a.max(l.abs()))
+        );
+    } else {
+        println!("  fixed nodes: {}", r.fixed_nodes);
+    }
+    println!(
+        "  surface: {} vertices, {} triangles",
+        r.surface_vertices, r.surface_triangles
+    );
+    let worst = r.residuals.iter().fold(0.0f64, |a, &b| a.max(b));
+    println!(
+        "  {} modes, {:.3} Hz … {:.3} Hz, worst relative residual {:.1e}",
+        r.modes,
+        r.frequencies_hz.first().copied().unwrap_or(0.0),
+        r.frequencies_hz.last().copied().unwrap_or(0.0),
+        worst
+    );
+}

@@ -1,0 +1,100 @@
+//! `modal-bake info`.
+
+use std::fmt::Write as _;
+use std::path::PathBuf;
+
+use anyhow::Context;
+use clap::Args;
+use dcr_runtime::format::ModesFile;
+
+#[derive(Args)]
+pub struct InfoArgs {
+    /// A .modes base.
+    pub file: PathBuf,
+    /// One JSON object on stdout instead of the summary.
+    #[arg(long)]
+    pub json: bool,
+}
+
+pub fn run(args: &InfoArgs) -> anyhow::Result<()> {
+    let base = ModesFile::read(&args.file)
+        .with_context(|| format!("cannot read {}", args.file.display()))?;
+    let freqs = base.frequencies_hz();
+    if args.json {
+        let v = serde_json::json!({
+            "file": args.file.display().to_string(),
+            "format_version": base.meta.format_version,
+            "tool_version": base.meta.tool_version,
+            "source_hash": base.meta.source_hash,
+            "params_hash": base.meta.params_hash,
+            "modes": base.num_modes(),
+            "eigenvalues": base.eigenvalues,
+            "frequencies_hz": freqs,
+            "residuals": base.residuals,
+            "surface_vertices": base.num_surface_vertices(),
+            "surface_triangles": base.surface_triangles.len(),
+            "volume_nodes": base.meta.volume_nodes,
+            "volume_tets": base.meta.volume_tets,
+            "fixed_nodes": base.fixed_nodes.len(),
+            "rigid_modes_excluded": base.meta.rigid_modes_excluded,
+            "mass_kg": base.meta.mass_kg,
+            "material": {"youngs_pa": base.material.youngs, "poisson": base.material.poisson, "density_kg_m3": base.material.density},
+            "rayleigh": base.rayleigh,
+            "precision": base.precision,
+            "bake_params": base.meta.bake_params,
+        });
+        super::emit(&format!("{}\n", serde_json::to_string_pretty(&v)?));
+        return Ok(());
+    }
+    let mut out = String::new();
+    writeln!(
+        out,
+        "{}  (format v{}, {})",
+        args.file.display(),
+        base.meta.format_version,
+        base.meta.tool_version
+    )?;
+    writeln!(
+        out,
+        "  material: E {:.4e} Pa, ν {}, ρ {} kg/m³; mass {:.6} kg",
+        base.material.youngs, base.material.poisson, base.material.density, base.meta.mass_kg
+    )?;
+    writeln!(
+        out,
+        "  volume mesh: {} nodes, {} tets; {}",
+        base.meta.volume_nodes,
+        base.meta.volume_tets,
+        if base.fixed_nodes.is_empty() {
+            format!(
+                "free-free ({} rigid modes excluded)",
+                base.meta.rigid_modes_excluded
+            )
+        } else {
+            format!("{} fixed nodes", base.fixed_nodes.len())
+        }
+    )?;
+    writeln!(
+        out,
+        "  surface: {} vertices, {} triangles; mode shapes stored as {:?}",
+        base.num_surface_vertices(),
+        base.surface_triangles.len(),
+        base.precision
+    )?;
+    writeln!(
+        out,
+        "  Rayleigh damping: α0 {} 1/s, α1 {} s",
+        base.rayleigh[0], base.rayleigh[1]
+    )?;
+    writeln!(out, "  geometry hash: {}", base.meta.source_hash)?;
+    writeln!(out, "  {} modes:", base.num_modes())?;
+    writeln!(out, "     #   freq (Hz)      λ (rad²/s²)    residual")?;
+    for (j, (&l, f)) in base.eigenvalues.iter().zip(&freqs).enumerate() {
+        writeln!(
+            out,
+            "  {j:4}  {f:12.4}  {l:14.6e}  {:9.1e}",
+            base.residuals[j]
+        )?;
+    }
+    super::emit(&out);
+    Ok(())
+}

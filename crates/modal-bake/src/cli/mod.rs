@@ -1,0 +1,55 @@
+//! Command-line front end: one file per subcommand.
+
+mod bake;
+mod check;
+mod info;
+mod parse;
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+/// Bake linear-FEM modal bases (.modes) from tetrahedral meshes and inspect them.
+///
+/// Units are SI throughout: metres, kilograms, seconds, pascals, newton-seconds.
+#[derive(Parser)]
+#[command(name = "modal-bake", version, about, long_about = None, propagate_version = true)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Bake MESH (gmsh MSH 2.2/4.1 ASCII or binary, or meshio JSON) into OUT.modes.
+    #[command(allow_negative_numbers = true)]
+    Bake(bake::BakeArgs),
+    /// Print a readable summary of a .modes file (or one JSON object with --json).
+    Info(info::InfoArgs),
+    /// Exit 0 if OUT.modes is up to date for MESH and the options, 1 if stale or missing,
+    /// 2 on an error (unreadable mesh, bad options).
+    #[command(allow_negative_numbers = true)]
+    Check(check::CheckArgs),
+}
+
+/// Writes `s` to stdout; a closed pipe (`modal-bake info x | head`) is not an error.
+pub fn emit(s: &str) {
+    use std::io::Write;
+    let _ = std::io::stdout().lock().write_all(s.as_bytes());
+}
+
+pub fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Bake(a) => bake::run(&a).map(|()| ExitCode::SUCCESS),
+        Command::Info(a) => info::run(&a).map(|()| ExitCode::SUCCESS),
+        Command::Check(a) => return check::run(&a),
+    };
+    match result {
+        Ok(code) => code,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}

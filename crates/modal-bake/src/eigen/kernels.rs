@@ -1,0 +1,150 @@
+//! Small deterministic kernels: symmetric sparse × dense products, dense symmetric eigen,
+//! small Cholesky, the start-block PRNG.
+
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::evd::{self_adjoint_evd, self_adjoint_evd_scratch, ComputeEigenvectors};
+use faer::sparse::SparseColMat;
+use faer::{Accum, Mat, MatMut, MatRef, Par, Spec};
+use faer::reborrow::ReborrowMut;
+use rayon::prelude::*;
+
+/// Rows per parallel task in [`sym_spmm`]; a fixed constant so the work split (and so the
+/// result) never depends on the thread count (each output row is computed by one task anyway).
+const SPMM_ROWS_PER_TASK: usize = 2048;
+
+/// `y = A x` for a symmetric `A` stored with both triangles (column `i` of the CSC arrays is
+/// read as row `i`). Each output entry is one sequential dot product: deterministic, and
+/// parallel over rows.
+pub(crate) fn sym_spmm(a: &SparseColMat<usize, f64>, x: MatRef<'_, f64>, mut y: MatMut<'_, f64>) {
+    let n = a.nrows();
+    let b = x.ncols();
+    assert!(x.nrows() == n && y.nrows() == n && y.ncols() == b);
+    let (ptr, rows, vals) = (a.symbolic().col_ptr(), a.symbolic().row_idx(), a.val());
+    // Row-major copy of x so one row's b entries are contiguous.
+    let mut xr = vec![0.0f64; n * b];
+    xr.par_chunks_mut(SPMM_ROWS_PER_TASK * b).enumerate().for_each(|(t, chunk)| {
+        let r0 = t * SPMM_ROWS_PER_TASK;
+        for (ri, row) in chunk.chunks_mut(b).enumerate() {
+            for (c, v) in row.iter_mut().enumerate() {
+                *v = x[(r0 + ri, c)];
+            }
+        }
+    });
+    let mut yr = vec![0.0f64; n * b];
+    yr.par_chunks_mut(SPMM_ROWS_PER_TASK * b).enumerate().for_each(|(t, chunk)| {
+        let r0 = t * SPMM_ROWS_PER_TASK;
+        for (ri, out) in chunk.chunks_mut(b).enumerate() {
+            let i = r0 + ri;
+            for p in ptr[i]..ptr[i + 1] {
+                let v = vals[p];
+                let xrow = &xr[rows[p] * b..rows[p] * b + b];
+                for (o, &xv) in out.iter_mut().zip(xrow) {
+                    *o += v * xv;
+                }
+            }
+        }
+    });
+    for c in 0..b {
+        let col = y.rb_mut().col_mut(c);
+        for (i, v) in col.iter_mut().enumerate() {
+            *v = yr[i * b + c];
+        }
+    }
+}
+
+/// `dst (+)= alpha · lhs · rhs` with faer's dense kernel at parallelism `par`.
+pub(crate) fn gemm(
+    dst: MatMut<'_, f64>,
+    accum: Accum,
+    lhs: MatRef<'_, f64>,
+    rhs: MatRef<'_, f64>,
+    alpha: f64,
+    par: Par,
+) {
+    faer::linalg::matmul::matmul(dst, accum, lhs, rhs, alpha, par);
+}
+
+/// Eigen-decomposition of a small symmetric matrix (both triangles filled): eigenvalues
+/// ascending and the orthonormal eigenvectors. Sequential (bit-reproducible).
+pub(crate) fn sym_eig(a: MatRef<'_, f64>) -> Result<(Vec<f64>, Mat<f64>), String> {
+    let n = a.nrows();
+    let mut s = faer::diag::Diag::<f64>::zeros(n);
+    let mut u = Mat::<f64>::zeros(n, n);
+    let mut mem = MemBuffer::new(self_adjoint_evd_scratch::<f64>(
+        n,
+        ComputeEigenvectors::Yes,
+        Par::Seq,
+        Spec::default(),
+    ));
+    self_adjoint_evd(
+        a,
+        s.as_mut(),
+        Some(u.as_mut()),
+        Par::Seq,
+        MemStack::new(&mut mem),
+        Spec::default(),
+    )
+    .map_err(|e| format!("dense symmetric eigensolver failed: {e:?}"))?;
+    let vals = (0..n).map(|i| s[i]).collect();
+    Ok((vals, u))
+}
+
+/// In-place lower Cholesky of a small SPD matrix (upper part left as is). Returns the index of
+/// the first pivot ≤ `rel_tol`·(original diagonal) on failure.
+pub(crate) fn small_cholesky(mut a: MatMut<'_, f64>, rel_tol: f64) -> Result<(), usize> {
+    let n = a.nrows();
+    for j in 0..n {
+        let orig = a[(j, j)];
+        let mut d = orig;
+        for k in 0..j {
+            d -= a[(j, k)] * a[(j, k)];
+        }
+        if !(d > rel_tol * orig.abs()) || !d.is_finite() || d <= 0.0 {
+            return Err(j);
+        }
+        let l = d.sqrt();
+        a[(j, j)] = l;
+        for i in j + 1..n {
+            let mut s = a[(i, j)];
+            for k in 0..j {
+                s -= a[(i, k)] * a[(j, k)];
+            }
+            a[(i, j)] = s / l;
+        }
+    }
+    Ok(())
+}
+
+/// Inverse of a small lower-triangular matrix (forward substitution on the identity).
+pub(crate) fn lower_inverse(l: MatRef<'_, f64>) -> Mat<f64> {
+    let n = l.nrows();
+    let mut x = Mat::<f64>::zeros(n, n);
+    for c in 0..n {
+        for i in c..n {
+            let mut s = if i == c { 1.0 } else { 0.0 };
+            for k in c..i {
+                s -= l[(i, k)] * x[(k, c)];
+            }
+            x[(i, c)] = s / l[(i, i)];
+        }
+    }
+    x
+}
+
+/// splitmix64 (Steele, Lea, Flood 2014): the fixed-seed generator of the start block.
+pub(crate) struct SplitMix64(pub u64);
+
+impl SplitMix64 {
+    pub fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+
+    /// Uniform in [−1, 1).
+    pub fn next_sym(&mut self) -> f64 {
+        ((self.next_u64() >> 11) as f64) * (2.0 / (1u64 << 53) as f64) - 1.0
+    }
+}

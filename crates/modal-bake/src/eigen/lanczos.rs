@@ -1,0 +1,644 @@
+//! Shift-invert block Lanczos with full M-reorthogonalisation and thick restart
+//! (see the module docs of [`crate::eigen`]).
+
+use std::f64::consts::PI;
+use std::time::Instant;
+
+use faer::sparse::SparseColMat;
+use faer::{Accum, Mat, MatMut, MatRef, Par};
+
+use super::kernels::{gemm, lower_inverse, small_cholesky, sym_eig, sym_spmm, SplitMix64};
+use super::shift_invert::{shifted, ShiftInvert};
+use super::{EigenError, EigenInfo, EigenParams, EigenProgress, EigenResult};
+
+/// Problems with at most this many dofs beyond the Krylov basis size are solved densely.
+const DENSE_MARGIN: usize = 16;
+
+/// Breakdown threshold: a new direction whose M-norm after orthogonalisation is below this
+/// fraction of its norm before is treated as lying in the current basis.
+const BREAKDOWN: f64 = 1e-12;
+
+/// A pair whose relative residual is within this factor of its rounding floor counts as
+/// converged even above `tol` (see [`Residual`]).
+pub(crate) const FLOOR_FACTOR: f64 = 8.0;
+
+pub(crate) fn solve(
+    k: &SparseColMat<usize, f64>,
+    m: &SparseColMat<usize, f64>,
+    params: &EigenParams,
+    progress: &mut dyn FnMut(EigenProgress),
+) -> Result<EigenResult, EigenError> {
+    let n = k.nrows();
+    check_input(k, m, params)?;
+    let sigma = params.shift;
+    let lam_lim = params.max_freq_hz.map(|f| (2.0 * PI * f).powi(2));
+    let threads = if params.threads == 0 { 2 } else { params.threads };
+    let par = Par::rayon(threads);
+    let mut info = EigenInfo { shift: sigma, ..Default::default() };
+    if params.nev == 0 && lam_lim.is_none() {
+        return Ok(EigenResult {
+            eigenvalues: vec![],
+            vectors: Mat::zeros(n, 0),
+            residuals: vec![],
+            residual_floors: vec![],
+            info,
+        });
+    }
+    let b = params.block.min(n).max(1);
+    let ncv0 = krylov_dim(params, params.nev.max(1), b);
+    if n <= ncv0 + b + DENSE_MARGIN {
+        return solve_dense(k, m, params, lam_lim, info, progress);
+    }
+
+    // --- factorization of A = K − σM -------------------------------------------------------
+    let t0 = Instant::now();
+    let fac = {
+        let a = shifted(k, m, sigma);
+        ShiftInvert::new(&a, par)?
+    };
+    info.factor_seconds = t0.elapsed().as_secs_f64();
+    info.factor_nnz = fac.factor_nnz();
+    let t1 = Instant::now();
+
+    // --- Lanczos state ----------------------------------------------------------------------
+    let mut ncv = ncv0;
+    let mut cap = ncv + b;
+    let mut v = Mat::<f64>::zeros(n, cap);
+    let mut mv = Mat::<f64>::zeros(n, cap);
+    let mut h = Mat::<f64>::zeros(cap, cap);
+    let mut rng = SplitMix64(params.seed);
+    let mut solve_buf = fac.solve_buffer(b);
+
+    {
+        let mut z = Mat::<f64>::zeros(n, b);
+        for j in 0..b {
+            for i in 0..n {
+                z[(i, j)] = rng.next_sym();
+            }
+        }
+        // Start in the range of T (z ← A⁻¹Mz): a random block is white noise whose
+        // high-frequency content would otherwise survive in the Ritz vectors (Ericsson & Ruhe
+        // 1980) and, amplified by K, dominate their residuals.
+        let mut mz = Mat::<f64>::zeros(n, b);
+        sym_spmm(m, z.as_ref(), mz.as_mut());
+        z.copy_from(&mz);
+        fac.solve_in_place(z.as_mut(), &mut solve_buf);
+        info.block_solves += 1;
+        sym_spmm(m, z.as_ref(), mz.as_mut());
+        let pre: Vec<f64> = (0..b).map(|j| m_norm(z.as_ref(), mz.as_ref(), j)).collect();
+        orthonormalize(&mut z, &mut mz, v.as_ref().subcols(0, 0), mv.as_ref().subcols(0, 0), &pre, m, &mut rng, par)?;
+        v.as_mut().subcols_mut(0, b).copy_from(&z);
+        mv.as_mut().subcols_mut(0, b).copy_from(&mz);
+    }
+    let mut kk = 0usize; // Rayleigh–Ritz size; the newest block sits at kk..kk+b
+    let mut trigger = params.tol;
+    let mut last_explicit: Option<(usize, f64)> = None;
+
+    loop {
+        // --- expand: Z = T W = A⁻¹ M W, M-orthogonalise against the basis ------------------
+        let nb = kk + b;
+        let mut z = mv.as_ref().subcols(kk, b).to_owned();
+        fac.solve_in_place(z.as_mut(), &mut solve_buf);
+        info.block_solves += 1;
+        let mut c = Mat::<f64>::zeros(nb, b);
+        for _pass in 0..2 {
+            let mut cp = Mat::<f64>::zeros(nb, b);
+            gemm(cp.as_mut(), Accum::Replace, mv.as_ref().subcols(0, nb).transpose(), z.as_ref(), 1.0, par);
+            gemm(z.as_mut(), Accum::Add, v.as_ref().subcols(0, nb), cp.as_ref(), -1.0, par);
+            c += &cp;
+        }
+        h.as_mut().submatrix_mut(0, kk, nb, b).copy_from(&c);
+        let mut mz = Mat::<f64>::zeros(n, b);
+        sym_spmm(m, z.as_ref(), mz.as_mut());
+        let pre: Vec<f64> = (0..b)
+            .map(|j| {
+                let cn: f64 = (0..nb).map(|i| c[(i, j)] * c[(i, j)]).sum();
+                (cn + m_norm(z.as_ref(), mz.as_ref(), j).powi(2)).sqrt()
+            })
+            .collect();
+        let r = orthonormalize(
+            &mut z,
+            &mut mz,
+            v.as_ref().subcols(0, nb),
+            mv.as_ref().subcols(0, nb),
+            &pre,
+            m,
+            &mut rng,
+            par,
+        )?;
+        v.as_mut().subcols_mut(nb, b).copy_from(&z);
+        mv.as_mut().subcols_mut(nb, b).copy_from(&mz);
+        h.as_mut().submatrix_mut(nb, kk, b, b).copy_from(&r);
+        kk = nb;
+        info.iterations += 1;
+        info.krylov_dim = info.krylov_dim.max(kk);
+
+        // --- Rayleigh–Ritz on H = VᵀMTV ----------------------------------------------------
+        let hk = symmetrized(h.as_ref().submatrix(0, 0, kk, kk));
+        let (theta_asc, s_asc) = sym_eig(hk.as_ref()).map_err(EigenError::Dense)?;
+        // Descending θ = ascending λ.
+        let order: Vec<usize> = (0..kk).rev().collect();
+        let theta: Vec<f64> = order.iter().map(|&i| theta_asc[i]).collect();
+        let lam: Vec<f64> =
+            theta.iter().map(|&t| if t > 0.0 { sigma + 1.0 / t } else { f64::INFINITY }).collect();
+        let r_last = h.as_ref().submatrix(kk, kk - b, b, b).to_owned();
+        let est: Vec<f64> = order
+            .iter()
+            .zip(&theta)
+            .map(|(&i, &t)| {
+                let mut s2 = 0.0;
+                for row in 0..b {
+                    let mut acc = 0.0;
+                    for col in 0..b {
+                        acc += r_last[(row, col)] * s_asc[(kk - b + col, i)];
+                    }
+                    s2 += acc * acc;
+                }
+                s2.sqrt() / t.abs()
+            })
+            .collect();
+
+        // --- how many pairs are wanted -----------------------------------------------------
+        let (wanted, below, capped) = match lam_lim {
+            None => (params.nev.min(n), 0, false),
+            Some(lim) => {
+                let below = lam.iter().take_while(|&&l| l < lim).count();
+                let capped = below >= params.max_modes;
+                let w = if capped { params.max_modes } else { (below + 1).max(params.nev) };
+                (w.min(n), below, capped)
+            }
+        };
+        let conv = est.iter().take(wanted.min(kk)).filter(|&&e| e <= params.tol).count();
+        progress(EigenProgress { converged: conv, requested: wanted, iteration: info.iterations });
+
+        let ready = wanted <= kk
+            && est.iter().take(wanted).all(|&e| e <= trigger)
+            && (lam_lim.is_none() || capped || below < kk);
+        let out_of_steps = info.block_solves >= params.max_iters;
+        if ready || out_of_steps {
+            let sel = select_cols(s_asc.as_ref(), &order[..wanted.min(kk)]);
+            let (vals, u, res) = finalize(k, m, &fac, v.as_ref().subcols(0, kk), mv.as_ref().subcols(0, kk), sel.as_ref(), sigma, par)?;
+            let worst = res.iter().map(|r| r.rel).fold(0.0, f64::max);
+            if std::env::var("DCR_DBG").is_ok() { eprintln!("it {} check: vals {:?}\n res {:?}\n ratio {:?}\n est {:?}", info.iterations, &vals, res.iter().map(|r| format!("{:.1e}", r.rel)).collect::<Vec<_>>(), res.iter().map(|r| format!("{:.1}", r.rel / r.floor)).collect::<Vec<_>>(), &est[..wanted.min(kk)]); }
+            let good = res.iter().filter(|r| r.converged(params.tol)).count();
+            if good == res.len() && wanted <= kk {
+                info.solve_seconds = t1.elapsed().as_secs_f64();
+                info.capped = capped;
+                return Ok(trim_and_sign(vals, u, res, lam_lim, params, info));
+            }
+            last_explicit = Some((good, worst));
+            if out_of_steps {
+                return Err(EigenError::NotConverged {
+                    converged: good,
+                    requested: wanted,
+                    worst_residual: worst,
+                });
+            }
+            // The estimate was optimistic: demand a smaller one before the next check.
+            trigger *= 1e-2;
+        }
+        let _ = last_explicit;
+
+        // --- make room: grow (max-frequency mode) or thick-restart --------------------------
+        let need = krylov_dim(params, wanted, b);
+        if need > ncv {
+            ncv = need;
+            let new_cap = ncv + b;
+            grow(&mut v, n, new_cap);
+            grow(&mut mv, n, new_cap);
+            let mut h2 = Mat::<f64>::zeros(new_cap, new_cap);
+            h2.as_mut().submatrix_mut(0, 0, cap, cap).copy_from(&h);
+            h = h2;
+            cap = new_cap;
+        }
+        if kk + 2 * b > cap {
+            // Keep the best p Ritz vectors plus the newest block.
+            let p = (wanted + (kk - wanted) / 2).min(ncv - b).max(wanted.min(ncv - b));
+            let sp = select_cols(s_asc.as_ref(), &order[..p]);
+            let mut nv = Mat::<f64>::zeros(n, p);
+            let mut nmv = Mat::<f64>::zeros(n, p);
+            gemm(nv.as_mut(), Accum::Replace, v.as_ref().subcols(0, kk), sp.as_ref(), 1.0, par);
+            gemm(nmv.as_mut(), Accum::Replace, mv.as_ref().subcols(0, kk), sp.as_ref(), 1.0, par);
+            let w = v.as_ref().subcols(kk, b).to_owned();
+            let mw = mv.as_ref().subcols(kk, b).to_owned();
+            v.as_mut().subcols_mut(0, p).copy_from(&nv);
+            mv.as_mut().subcols_mut(0, p).copy_from(&nmv);
+            v.as_mut().subcols_mut(p, b).copy_from(&w);
+            mv.as_mut().subcols_mut(p, b).copy_from(&mw);
+            let mut coupling = Mat::<f64>::zeros(b, p);
+            gemm(coupling.as_mut(), Accum::Replace, r_last.as_ref(), sp.as_ref().subrows(kk - b, b), 1.0, Par::Seq);
+            h.fill(0.0);
+            for i in 0..p {
+                h[(i, i)] = theta[i];
+            }
+            h.as_mut().submatrix_mut(p, 0, b, p).copy_from(&coupling);
+            kk = p;
+            info.restarts += 1;
+        }
+    }
+}
+
+fn check_input(
+    k: &SparseColMat<usize, f64>,
+    m: &SparseColMat<usize, f64>,
+    params: &EigenParams,
+) -> Result<(), EigenError> {
+    let n = k.nrows();
+    let bad = |s: String| Err(EigenError::InvalidInput(s));
+    if k.ncols() != n || m.nrows() != n || m.ncols() != n {
+        return bad(format!(
+            "K is {}x{}, M is {}x{}; both must be square and equal",
+            k.nrows(),
+            k.ncols(),
+            m.nrows(),
+            m.ncols()
+        ));
+    }
+    if params.nev > n {
+        return bad(format!("nev = {} exceeds the problem size {n}", params.nev));
+    }
+    if params.block == 0 {
+        return bad("block size must be at least 1".into());
+    }
+    if !(params.tol > 0.0 && params.tol.is_finite()) {
+        return bad(format!("tolerance must be positive, got {}", params.tol));
+    }
+    if !params.shift.is_finite() {
+        return bad(format!("shift must be finite, got {}", params.shift));
+    }
+    if let Some(f) = params.max_freq_hz {
+        if !(f > 0.0 && f.is_finite()) {
+            return bad(format!("max frequency must be positive, got {f} Hz"));
+        }
+    }
+    Ok(())
+}
+
+/// Krylov basis size for `wanted` pairs: the parameter, or max(2·wanted, wanted + 3b), at
+/// least wanted + 2b, rounded up to a multiple of b.
+fn krylov_dim(params: &EigenParams, wanted: usize, b: usize) -> usize {
+    let base = params.krylov_dim.unwrap_or_else(|| (2 * wanted).max(wanted + 3 * b));
+    let d = base.max(wanted + 2 * b);
+    d.div_ceil(b) * b
+}
+
+fn m_norm(z: MatRef<'_, f64>, mz: MatRef<'_, f64>, j: usize) -> f64 {
+    let s: f64 = z.col(j).iter().zip(mz.col(j).iter()).map(|(a, b)| a * b).sum();
+    s.max(0.0).sqrt()
+}
+
+fn symmetrized(a: MatRef<'_, f64>) -> Mat<f64> {
+    let n = a.nrows();
+    Mat::from_fn(n, n, |i, j| 0.5 * (a[(i, j)] + a[(j, i)]))
+}
+
+fn select_cols(s: MatRef<'_, f64>, cols: &[usize]) -> Mat<f64> {
+    Mat::from_fn(s.nrows(), cols.len(), |i, j| s[(i, cols[j])])
+}
+
+fn grow(a: &mut Mat<f64>, n: usize, cols: usize) {
+    let mut b = Mat::<f64>::zeros(n, cols);
+    b.as_mut().subcols_mut(0, a.ncols()).copy_from(&*a);
+    *a = b;
+}
+
+/// M-orthonormalises the columns of `z` (already M-orthogonal to `v`) in place, keeping
+/// `mz = M z`; returns R with z_before = z_after · R (upper triangular). Cholesky-QR twice; on
+/// breakdown (a column with norm below [`BREAKDOWN`]·`pre`) column-wise Gram–Schmidt with
+/// random replacement.
+#[allow(clippy::too_many_arguments)]
+fn orthonormalize(
+    z: &mut Mat<f64>,
+    mz: &mut Mat<f64>,
+    v: MatRef<'_, f64>,
+    mv: MatRef<'_, f64>,
+    pre: &[f64],
+    m: &SparseColMat<usize, f64>,
+    rng: &mut SplitMix64,
+    par: Par,
+) -> Result<Mat<f64>, EigenError> {
+    let b = z.ncols();
+    let healthy = (0..b).all(|j| m_norm(z.as_ref(), mz.as_ref(), j) > BREAKDOWN * pre[j] && pre[j] > 0.0);
+    if healthy {
+        let mut r_total = Mat::<f64>::identity(b, b);
+        let mut ok = true;
+        for _pass in 0..2 {
+            let mut g = Mat::<f64>::zeros(b, b);
+            gemm(g.as_mut(), Accum::Replace, z.as_ref().transpose(), mz.as_ref(), 1.0, Par::Seq);
+            let mut g = symmetrized(g.as_ref());
+            if small_cholesky(g.as_mut(), 1e-14).is_err() {
+                ok = false;
+                break;
+            }
+            let l = Mat::from_fn(b, b, |i, j| if i >= j { g[(i, j)] } else { 0.0 });
+            let li = lower_inverse(l.as_ref());
+            let mut tmp = Mat::<f64>::zeros(z.nrows(), b);
+            gemm(tmp.as_mut(), Accum::Replace, z.as_ref(), li.as_ref().transpose(), 1.0, par);
+            *z = tmp;
+            let mut tmp = Mat::<f64>::zeros(z.nrows(), b);
+            gemm(tmp.as_mut(), Accum::Replace, mz.as_ref(), li.as_ref().transpose(), 1.0, par);
+            *mz = tmp;
+            r_total = l.transpose() * &r_total;
+        }
+        if ok {
+            return Ok(r_total);
+        }
+    }
+    // Column-wise fallback (rare: Krylov breakdown or a nearly dependent block).
+    let n = z.nrows();
+    let mut r = Mat::<f64>::zeros(b, b);
+    for j in 0..b {
+        let mut replaced = false;
+        for attempt in 0..3 {
+            let reference = if replaced { m_norm(z.as_ref(), mz.as_ref(), j) } else { pre[j] };
+            for _pass in 0..2 {
+                if v.ncols() > 0 {
+                    let mut c = Mat::<f64>::zeros(v.ncols(), 1);
+                    gemm(c.as_mut(), Accum::Replace, mv.transpose(), z.as_ref().subcols(j, 1), 1.0, par);
+                    gemm(z.as_mut().subcols_mut(j, 1), Accum::Add, v, c.as_ref(), -1.0, par);
+                    gemm(mz.as_mut().subcols_mut(j, 1), Accum::Add, mv, c.as_ref(), -1.0, par);
+                }
+                for i in 0..j {
+                    let c: f64 = mz.col(i).iter().zip(z.col(j).iter()).map(|(a, b)| a * b).sum();
+                    let (zi, mzi) = (z.col(i).to_owned(), mz.col(i).to_owned());
+                    for (t, s) in z.as_mut().col_mut(j).iter_mut().zip(zi.iter()) {
+                        *t -= c * s;
+                    }
+                    for (t, s) in mz.as_mut().col_mut(j).iter_mut().zip(mzi.iter()) {
+                        *t -= c * s;
+                    }
+                    if !replaced {
+                        r[(i, j)] += c;
+                    }
+                }
+            }
+            let nrm = m_norm(z.as_ref(), mz.as_ref(), j);
+            if nrm > BREAKDOWN * reference && reference > 0.0 {
+                if !replaced {
+                    r[(j, j)] = nrm;
+                }
+                for t in z.as_mut().col_mut(j).iter_mut() {
+                    *t /= nrm;
+                }
+                for t in mz.as_mut().col_mut(j).iter_mut() {
+                    *t /= nrm;
+                }
+                break;
+            }
+            if attempt == 2 {
+                return Err(EigenError::InvalidInput(
+                    "Krylov space exhausted: the problem is too small for the requested basis".into(),
+                ));
+            }
+            // Replace by a fresh random direction; the Lanczos relation gets a zero column.
+            replaced = true;
+            for i in 0..j + 1 {
+                r[(i, j)] = 0.0;
+            }
+            for i in 0..n {
+                z[(i, j)] = rng.next_sym();
+            }
+            let zj = z.as_ref().subcols(j, 1).to_owned();
+            sym_spmm(m, zj.as_ref(), mz.as_mut().subcols_mut(j, 1));
+        }
+    }
+    Ok(r)
+}
+
+/// Ritz vectors U = V S, purified by one more shift-invert step (U ← A⁻¹MU, one multi-RHS
+/// solve: it damps the high-frequency rounding noise that Gram–Schmidt leaves in the basis and
+/// that K amplifies by λ_max/λ in the residual; Nour-Omid, Parlett, Ericsson & Jensen 1987),
+/// then Rayleigh–Ritz of (K, M) on span(U). Returns ascending λ, the M-orthonormal vectors and
+/// their relative residuals.
+#[allow(clippy::too_many_arguments)]
+fn finalize(
+    k: &SparseColMat<usize, f64>,
+    m: &SparseColMat<usize, f64>,
+    fac: &ShiftInvert,
+    v: MatRef<'_, f64>,
+    mv: MatRef<'_, f64>,
+    s: MatRef<'_, f64>,
+    sigma: f64,
+    par: Par,
+) -> Result<(Vec<f64>, Mat<f64>, Vec<Residual>), EigenError> {
+    let n = v.nrows();
+    let w = s.ncols();
+    let mut u = Mat::<f64>::zeros(n, w);
+    gemm(u.as_mut(), Accum::Replace, mv, s, 1.0, par);
+    let mut buf = fac.solve_buffer(w);
+    fac.solve_in_place(u.as_mut(), &mut buf);
+    if std::env::var("DCR_P2").is_ok() { let mut t = Mat::<f64>::zeros(n, w); sym_spmm(m, u.as_ref(), t.as_mut()); fac.solve_in_place(t.as_mut(), &mut buf); for j in 0..w { let s: f64 = t.col(j).iter().map(|x| x * x).sum::<f64>().sqrt(); t.as_mut().col_mut(j).iter_mut().for_each(|x| *x /= s); } u = t; }
+    let _ = v;
+    let mut mu = Mat::<f64>::zeros(n, w);
+    sym_spmm(m, u.as_ref(), mu.as_mut());
+    for j in 0..w {
+        let nrm = m_norm(u.as_ref(), mu.as_ref(), j);
+        if nrm > 0.0 {
+            let inv = 1.0 / nrm;
+            u.as_mut().col_mut(j).iter_mut().for_each(|x| *x *= inv);
+            mu.as_mut().col_mut(j).iter_mut().for_each(|x| *x *= inv);
+        }
+    }
+    let mut ku = Mat::<f64>::zeros(n, w);
+    sym_spmm(k, u.as_ref(), ku.as_mut());
+    rayleigh_ritz(k, m, u, mu, ku, sigma, par)
+}
+
+#[allow(clippy::too_many_arguments)]
+fn rayleigh_ritz(
+    k: &SparseColMat<usize, f64>,
+    m: &SparseColMat<usize, f64>,
+    u: Mat<f64>,
+    mu: Mat<f64>,
+    ku: Mat<f64>,
+    sigma: f64,
+    par: Par,
+) -> Result<(Vec<f64>, Mat<f64>, Vec<Residual>), EigenError> {
+    let w = u.ncols();
+    let mut g = Mat::<f64>::zeros(w, w);
+    let mut a = Mat::<f64>::zeros(w, w);
+    gemm(g.as_mut(), Accum::Replace, u.as_ref().transpose(), mu.as_ref(), 1.0, par);
+    gemm(a.as_mut(), Accum::Replace, u.as_ref().transpose(), ku.as_ref(), 1.0, par);
+    let mut g = symmetrized(g.as_ref());
+    let a = symmetrized(a.as_ref());
+    small_cholesky(g.as_mut(), 0.0)
+        .map_err(|j| EigenError::Dense(format!("Ritz vectors not M-independent (pivot {j})")))?;
+    let l = Mat::from_fn(w, w, |i, j| if i >= j { g[(i, j)] } else { 0.0 });
+    let li = lower_inverse(l.as_ref());
+    let c = symmetrized((&li * &a * li.transpose()).as_ref());
+    let (vals, q) = sym_eig(c.as_ref()).map_err(EigenError::Dense)?;
+    let x = li.transpose() * &q;
+    let apply = |y: &Mat<f64>| {
+        let mut o = Mat::<f64>::zeros(y.nrows(), w);
+        gemm(o.as_mut(), Accum::Replace, y.as_ref(), x.as_ref(), 1.0, par);
+        o
+    };
+    let _ = (mu, ku);
+    let u = apply(&u);
+    let res = residuals(k, m, u.as_ref(), &vals, sigma);
+    Ok((vals, u, res))
+}
+
+/// Relative residual of each pair and its rounding floor, as
+/// `(‖Ku − λMu‖, ‖Ku‖ + |σ|‖Mu‖, ε(‖|K||u|‖ + |λ|‖|M||u|‖))` (2-norms): the last term is the
+/// size of the rounding error committed when K u and M u are evaluated in double precision,
+/// below which no residual can be resolved.
+pub(crate) struct Residual {
+    pub rel: f64,
+    pub floor: f64,
+}
+
+impl Residual {
+    /// Converged: below `tol`, or within [`FLOOR_FACTOR`] of the rounding floor.
+    pub fn converged(&self, tol: f64) -> bool {
+        self.rel <= tol.max(FLOOR_FACTOR * self.floor)
+    }
+}
+
+fn residuals(
+    k: &SparseColMat<usize, f64>,
+    m: &SparseColMat<usize, f64>,
+    u: MatRef<'_, f64>,
+    lam: &[f64],
+    sigma: f64,
+) -> Vec<Residual> {
+    let (n, w) = (u.nrows(), u.ncols());
+    let mut ku = Mat::<f64>::zeros(n, w);
+    let mut mu = Mat::<f64>::zeros(n, w);
+    sym_spmm(k, u, ku.as_mut());
+    sym_spmm(m, u, mu.as_mut());
+    let abs = |a: &SparseColMat<usize, f64>| {
+        SparseColMat::new(a.symbolic().to_owned().unwrap(), a.val().iter().map(|x| x.abs()).collect())
+    };
+    let ua = Mat::from_fn(n, w, |i, j| u[(i, j)].abs());
+    let mut aku = Mat::<f64>::zeros(n, w);
+    let mut amu = Mat::<f64>::zeros(n, w);
+    sym_spmm(&abs(k), ua.as_ref(), aku.as_mut());
+    sym_spmm(&abs(m), ua.as_ref(), amu.as_mut());
+    (0..w)
+        .map(|j| {
+            let l = lam[j];
+            let (mut r2, mut k2, mut m2, mut ak2, mut am2) = (0.0, 0.0, 0.0, 0.0, 0.0);
+            for i in 0..n {
+                let (kv, mvv) = (ku[(i, j)], mu[(i, j)]);
+                let r = kv - l * mvv;
+                r2 += r * r;
+                k2 += kv * kv;
+                m2 += mvv * mvv;
+                ak2 += aku[(i, j)] * aku[(i, j)];
+                am2 += amu[(i, j)] * amu[(i, j)];
+            }
+            let den = (k2.sqrt() + sigma.abs() * m2.sqrt()).max(f64::MIN_POSITIVE);
+            Residual {
+                rel: r2.sqrt() / den,
+                floor: f64::EPSILON * (ak2.sqrt() + l.abs() * am2.sqrt()) / den,
+            }
+        })
+        .collect()
+}
+
+/// Drops the verification pair in max-frequency mode and applies the sign convention.
+fn trim_and_sign(
+    vals: Vec<f64>,
+    u: Mat<f64>,
+    res: Vec<Residual>,
+    lam_lim: Option<f64>,
+    params: &EigenParams,
+    info: EigenInfo,
+) -> EigenResult {
+    let keep = match lam_lim {
+        None => vals.len(),
+        Some(lim) => {
+            let below = vals.iter().take_while(|&&l| l < lim).count();
+            below.max(params.nev).min(params.max_modes).min(vals.len())
+        }
+    };
+    let mut vectors = u.as_ref().subcols(0, keep).to_owned();
+    normalize_signs(vectors.as_mut());
+    EigenResult {
+        eigenvalues: vals[..keep].to_vec(),
+        vectors,
+        residuals: res[..keep].iter().map(|r| r.rel).collect(),
+        residual_floors: res[..keep].iter().map(|r| r.floor).collect(),
+        info,
+    }
+}
+
+/// Flips each column so that its entry of largest magnitude (first on ties) is positive.
+fn normalize_signs(mut u: MatMut<'_, f64>) {
+    for j in 0..u.ncols() {
+        let mut best = 0.0f64;
+        let mut sign = 1.0;
+        for x in u.rb().col(j).iter() {
+            if x.abs() > best {
+                best = x.abs();
+                sign = x.signum();
+            }
+        }
+        if sign < 0.0 {
+            for x in u.rb_mut().col_mut(j).iter_mut() {
+                *x = -*x;
+            }
+        }
+    }
+}
+
+use faer::reborrow::{Reborrow, ReborrowMut};
+
+/// Dense generalized solve for tiny problems: Cholesky of M, symmetric eigen of L⁻¹KL⁻ᵀ.
+fn solve_dense(
+    k: &SparseColMat<usize, f64>,
+    m: &SparseColMat<usize, f64>,
+    params: &EigenParams,
+    lam_lim: Option<f64>,
+    mut info: EigenInfo,
+    progress: &mut dyn FnMut(EigenProgress),
+) -> Result<EigenResult, EigenError> {
+    let t1 = Instant::now();
+    let n = k.nrows();
+    let kd = k.to_dense();
+    let mut md = m.to_dense();
+    let md_copy = md.clone();
+    small_cholesky(md.as_mut(), 0.0)
+        .map_err(|j| EigenError::InvalidInput(format!("M is not positive definite (pivot {j})")))?;
+    let l = Mat::from_fn(n, n, |i, j| if i >= j { md[(i, j)] } else { 0.0 });
+    let li = lower_inverse(l.as_ref());
+    let c = symmetrized((&li * &kd * li.transpose()).as_ref());
+    let (vals, q) = sym_eig(c.as_ref()).map_err(EigenError::Dense)?;
+    let wanted = match lam_lim {
+        None => params.nev,
+        Some(lim) => {
+            let below = vals.iter().take_while(|&&l| l < lim).count();
+            info.capped = below > params.max_modes;
+            below.max(params.nev).min(params.max_modes)
+        }
+    }
+    .min(n);
+    let u = li.transpose() * q.as_ref().subcols(0, wanted);
+    let mu = &md_copy * &u;
+    let ku = &kd * &u;
+    let (vals, u, res) = rayleigh_ritz(k, m, u, mu, ku, params.shift, Par::Seq)?;
+    info.dense = true;
+    info.iterations = 1;
+    info.krylov_dim = n;
+    info.solve_seconds = t1.elapsed().as_secs_f64();
+    let good = res.iter().filter(|r| r.converged(params.tol)).count();
+    progress(EigenProgress { converged: good, requested: wanted, iteration: 1 });
+    if good < res.len() {
+        return Err(EigenError::NotConverged {
+            converged: good,
+            requested: wanted,
+            worst_residual: res.iter().map(|r| r.rel).fold(0.0, f64::max),
+        });
+    }
+    let keep = vals.len();
+    let mut vectors = u;
+    normalize_signs(vectors.as_mut());
+    Ok(EigenResult {
+        eigenvalues: vals[..keep].to_vec(),
+        vectors,
+        residuals: res.iter().map(|r| r.rel).collect(),
+        residual_floors: res.iter().map(|r| r.floor).collect(),
+        info,
+    })
+}

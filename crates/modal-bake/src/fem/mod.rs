@@ -1,0 +1,19 @@
+//! Linear FEM assembly: P1 (4-node tetrahedron) isotropic linear elasticity, SI units
+//! (paper §4.1, Eq. 5: the K and M of M ü + D u̇ + K u = f).
+//!
+//! - [`assemble_stiffness`]: K (N/m), [`assemble_mass`]: M (kg), consistent or lumped.
+//!   Dofs are node-major (`3·node + axis`), matrices are stored with both triangles, rows
+//!   sorted. Summation order is fixed, so the matrices are bit-identical for any thread count.
+//! - [`DofMap`] / [`reduce_fixed`]: clamp nodes (restrict K, M to the free dofs, expand modes
+//!   back with zeros).
+//! - [`rigid_body_modes`]: the 6-dimensional null space of the free-free K.
+//!
+//! Unsupported: anisotropic or heterogeneous materials, quadratic (tet10) elements.
+
+mod assembly;
+mod dof_map;
+mod material;
+
+pub use assembly::{assemble_mass, assemble_stiffness, rigid_body_modes};
+pub use dof_map::{reduce_fixed, DofMap, DofMapError};
+pub use material::{Material, MaterialError};

@@ -1,0 +1,182 @@
+//! Shared back end of the readers: collects nodes and elements, then builds a [`TetMesh`] in
+//! canonical form (nodes by ascending tag, nodes outside every tetrahedron dropped, 0-based).
+
+use std::collections::BTreeMap;
+
+use super::mesh_error::{Location, MeshError, MeshErrorKind};
+use super::tet_mesh::TetMesh;
+
+/// Nodes and elements as read, before canonicalisation. Element node references are indices
+/// into the tag-sorted node table.
+#[derive(Debug, Default)]
+pub(crate) struct MeshBuilder {
+    tags: Vec<u64>,
+    coords: Vec<[f64; 3]>,
+    /// `Some(first)` when the sorted tags are exactly `first, first+1, ...`.
+    dense_first: Option<u64>,
+    tets: Vec<(u64, [usize; 4])>,
+    triangles: Vec<[usize; 3]>,
+    groups: BTreeMap<String, Vec<usize>>,
+    skipped: Vec<(String, u64)>,
+}
+
+impl MeshBuilder {
+    /// Sets the node table from `(tag, position)` pairs in any order.
+    ///
+    /// # Errors
+    /// The first duplicated tag.
+    pub fn set_nodes(&mut self, mut nodes: Vec<(u64, [f64; 3])>) -> Result<(), MeshErrorKind> {
+        nodes.sort_by_key(|n| n.0);
+        if let Some(w) = nodes.windows(2).find(|w| w[0].0 == w[1].0) {
+            return Err(MeshErrorKind::DuplicateNode { node: w[0].0 });
+        }
+        self.tags = nodes.iter().map(|n| n.0).collect();
+        self.coords = nodes.iter().map(|n| n.1).collect();
+        self.dense_first = match (self.tags.first(), self.tags.last()) {
+            (Some(&first), Some(&last))
+                if (last - first).checked_add(1) == Some(self.tags.len() as u64) =>
+            {
+                Some(first)
+            }
+            _ => None,
+        };
+        Ok(())
+    }
+
+    /// Index of node `tag` in the sorted table.
+    pub fn node_index(&self, tag: u64) -> Option<usize> {
+        match self.dense_first {
+            Some(first) => {
+                let i = tag.checked_sub(first)?;
+                (i < self.tags.len() as u64).then_some(i as usize)
+            }
+            None => self.tags.binary_search(&tag).ok(),
+        }
+    }
+
+    /// Adds a tetrahedron with element id `id` (node table indices).
+    pub fn push_tet(&mut self, id: u64, nodes: [usize; 4]) {
+        self.tets.push((id, nodes));
+    }
+
+    /// Adds a triangle (node table indices).
+    pub fn push_triangle(&mut self, nodes: [usize; 3]) {
+        self.triangles.push(nodes);
+    }
+
+    /// Adds node table indices to group `name` (created if new).
+    pub fn add_to_group(&mut self, name: &str, nodes: &[usize]) {
+        match self.groups.get_mut(name) {
+            Some(g) => g.extend_from_slice(nodes),
+            None => {
+                self.groups.insert(name.to_string(), nodes.to_vec());
+            }
+        }
+    }
+
+    /// Counts `n` skipped elements described by `what` (one note per distinct `what`).
+    pub fn skip(&mut self, what: &str, n: u64) {
+        match self.skipped.iter_mut().find(|s| s.0 == what) {
+            Some(s) => s.1 += n,
+            None => self.skipped.push((what.to_string(), n)),
+        }
+    }
+
+    /// Builds the canonical [`TetMesh`].
+    ///
+    /// Tetrahedra are ordered by their node indices (lexicographically, ties by element id)
+    /// and exact repeats (same nodes in the same order, as MSH 2.2 writes for an element of two
+    /// physical groups) removed, keeping the smallest element id; triangles likewise sorted and
+    /// deduplicated. Element order in the file therefore does not matter.
+    ///
+    /// # Errors
+    /// [`MeshErrorKind::NoTets`] when there is no tetrahedron.
+    pub fn finish(mut self, file: &str) -> Result<TetMesh, MeshError> {
+        if self.tets.is_empty() {
+            return Err(MeshError::new(file, Location::None, MeshErrorKind::NoTets));
+        }
+        let mut notes = Vec::new();
+        for (what, n) in &self.skipped {
+            notes.push(format!("skipped {n} {what}"));
+        }
+        // Canonical element order: by node indices (which follow node tags), so the order in
+        // which a file lists its elements does not matter; ties by element id.
+        self.tets.sort_unstable_by_key(|&(id, t)| (t, id));
+        let before = self.tets.len();
+        self.tets.dedup_by_key(|t| t.1);
+        if self.tets.len() < before {
+            notes.push(format!(
+                "removed {} duplicated tetrahedra (same nodes in the same order)",
+                before - self.tets.len()
+            ));
+        }
+        self.triangles.sort_unstable();
+        self.triangles.dedup();
+
+        const UNUSED: usize = usize::MAX;
+        let mut new_index = vec![UNUSED; self.tags.len()];
+        for (_, t) in &self.tets {
+            for &v in t {
+                new_index[v] = 0;
+            }
+        }
+        let mut nodes = Vec::with_capacity(self.tags.len());
+        for (v, slot) in new_index.iter_mut().enumerate() {
+            if *slot != UNUSED {
+                *slot = nodes.len();
+                nodes.push(self.coords[v]);
+            }
+        }
+        let dropped = self.tags.len() - nodes.len();
+        if dropped > 0 {
+            notes.push(format!(
+                "dropped {dropped} nodes not referenced by any tetrahedron"
+            ));
+        }
+        let tets = self
+            .tets
+            .iter()
+            .map(|(_, t)| t.map(|v| new_index[v]))
+            .collect();
+        let tet_ids = self.tets.iter().map(|(id, _)| *id).collect();
+
+        let mut triangles = Vec::with_capacity(self.triangles.len());
+        for tri in &self.triangles {
+            if tri.iter().all(|&v| new_index[v] != UNUSED) {
+                triangles.push(tri.map(|v| new_index[v]));
+            }
+        }
+        if triangles.len() < self.triangles.len() {
+            notes.push(format!(
+                "dropped {} triangles with nodes outside the tetrahedra",
+                self.triangles.len() - triangles.len()
+            ));
+        }
+
+        let mut groups = BTreeMap::new();
+        for (name, members) in self.groups {
+            let mut set: Vec<usize> = members
+                .into_iter()
+                .map(|v| new_index[v])
+                .filter(|&v| v != UNUSED)
+                .collect();
+            set.sort_unstable();
+            set.dedup();
+            if set.is_empty() {
+                notes.push(format!(
+                    "group {name:?} has no node on the tetrahedral mesh"
+                ));
+            }
+            groups.insert(name, set);
+        }
+
+        Ok(TetMesh {
+            nodes,
+            tets,
+            tet_ids,
+            triangles,
+            groups,
+            notes,
+        })
+    }
+}

@@ -1,0 +1,212 @@
+//! The error every mesh reader and mesh check returns: file, location and kind.
+
+use std::fmt;
+
+/// Where in the input a [`MeshError`] was found.
+#[derive(Clone, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum Location {
+    /// The whole file (or no file: a check on an in-memory mesh).
+    None,
+    /// 1-based line number in an ASCII file (or an ASCII header line of a binary file).
+    Line(usize),
+    /// 0-based byte offset in binary data.
+    Byte(usize),
+    /// An element tag (MSH) or 1-based tetrahedron index (JSON), for semantic errors.
+    Element(u64),
+    /// A path into a JSON document, e.g. `cells[1].data[3]`.
+    Path(String),
+}
+
+/// A mesh that could not be read or fails a check, with the file name and a location.
+///
+/// Displays like `data/bad/nan_coordinate.msh:17: non-finite coordinate in node 5`.
+#[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct MeshError {
+    /// The file (display name) the error is in; empty for checks on an in-memory mesh.
+    pub file: String,
+    /// Where in the file.
+    pub location: Location,
+    /// What went wrong.
+    pub kind: MeshErrorKind,
+}
+
+/// What went wrong while reading or checking a mesh.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum MeshErrorKind {
+    /// The file could not be read.
+    #[error("cannot read file: {0}")]
+    Io(String),
+    /// Neither `$MeshFormat` nor a JSON object, and no known extension.
+    #[error("unrecognised mesh format (expected gmsh .msh or meshio-style .json)")]
+    UnknownFormat,
+    /// An MSH version other than 2.2 or 4.1.
+    #[error("unsupported MSH version {0} (supported: 2.2 and 4.1)")]
+    UnsupportedVersion(String),
+    /// A binary data-size other than supported (8 for 2.2; 4 or 8 for 4.1).
+    #[error("unsupported data-size {0} in $MeshFormat")]
+    UnsupportedDataSize(u64),
+    /// The binary endianness check integer is neither 1 little- nor big-endian.
+    #[error("bad endianness check integer {0:#010x} (expected 1)")]
+    BadEndianness(u32),
+    /// The file ends where more data was expected.
+    #[error("truncated file: expected {0}")]
+    Truncated(&'static str),
+    /// A field that should be a number is not.
+    #[error("expected {expected}, found {found:?}")]
+    NotANumber {
+        /// What kind of number was expected ("integer", "coordinate").
+        expected: &'static str,
+        /// The text found instead (shortened).
+        found: String,
+    },
+    /// A keyword or value other than the one the format requires.
+    #[error("expected {expected}, found {found:?}")]
+    Unexpected {
+        /// What the format requires here.
+        expected: String,
+        /// What the file holds (shortened).
+        found: String,
+    },
+    /// A node coordinate is NaN or infinite.
+    #[error("non-finite coordinate in node {node}")]
+    NonFiniteCoordinate {
+        /// The node tag (MSH) or 0-based point index (JSON).
+        node: u64,
+    },
+    /// Two nodes share one tag.
+    #[error("duplicate node tag {node}")]
+    DuplicateNode {
+        /// The repeated node tag.
+        node: u64,
+    },
+    /// An element names a node the file does not define.
+    #[error("element {element} names node {node}, which does not exist")]
+    MissingNode {
+        /// The element tag (MSH) or 1-based index within its cell block (JSON).
+        element: u64,
+        /// The missing node tag (MSH) or point index (JSON).
+        node: u64,
+    },
+    /// A binary element block of a gmsh element type this reader does not know the size of.
+    #[error("unsupported gmsh element type {0} in binary data")]
+    UnsupportedElementType(i64),
+    /// A declared count larger than the rest of the file can hold, or one that overflows.
+    #[error("declared {what} count {count} exceeds what the file can hold")]
+    CountTooLarge {
+        /// What is counted ("nodes", "elements", ...).
+        what: &'static str,
+        /// The declared count.
+        count: u64,
+    },
+    /// A section total that disagrees with the sum of its blocks.
+    #[error("declared {what} count {declared}, but the blocks hold {found}")]
+    CountMismatch {
+        /// What is counted.
+        what: &'static str,
+        /// The count in the section header.
+        declared: u64,
+        /// The count actually present.
+        found: u64,
+    },
+    /// A required section is absent (or out of order).
+    #[error("missing section {0}")]
+    MissingSection(&'static str),
+    /// The file holds no 4-node tetrahedra.
+    #[error("no 4-node tetrahedra in the mesh (tet4 only; second-order elements are skipped)")]
+    NoTets,
+    /// The JSON text does not parse.
+    #[error("invalid JSON: {0}")]
+    Json(String),
+    /// A JSON value of the wrong type or shape (ragged rows, wrong lengths, ...).
+    #[error("{0}")]
+    Shape(String),
+    /// A negative node index in JSON cells.
+    #[error("negative node index {0}")]
+    NegativeIndex(i64),
+    /// A tetrahedron of (near-)zero or NaN volume.
+    #[error(
+        "degenerate tetrahedron {element}: |volume| {volume:e} m³ below {threshold:e} m³ \
+         (relative tolerance × mean tet volume)"
+    )]
+    DegenerateTet {
+        /// The element id (see [`crate::mesh::TetMesh::tet_ids`]).
+        element: u64,
+        /// Its signed volume (m³), possibly NaN.
+        volume: f64,
+        /// The threshold it fell below (m³).
+        threshold: f64,
+    },
+    /// A group name the mesh does not have.
+    #[error(
+        "no node group named {name:?}; available groups: {}",
+        available_list(available)
+    )]
+    UnknownGroup {
+        /// The requested name.
+        name: String,
+        /// The names the mesh has, sorted.
+        available: Vec<String>,
+    },
+}
+
+fn available_list(names: &[String]) -> String {
+    if names.is_empty() {
+        "(none)".to_string()
+    } else {
+        names.join(", ")
+    }
+}
+
+impl MeshError {
+    /// A new error in `file` at `location`.
+    pub fn new(file: impl Into<String>, location: Location, kind: MeshErrorKind) -> MeshError {
+        MeshError {
+            file: file.into(),
+            location,
+            kind,
+        }
+    }
+
+    /// What went wrong.
+    pub fn kind(&self) -> &MeshErrorKind {
+        &self.kind
+    }
+}
+
+impl std::error::Error for MeshError {}
+
+impl fmt::Display for MeshError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let mut sep = "";
+        if !self.file.is_empty() {
+            write!(f, "{}", self.file)?;
+            sep = ": ";
+        }
+        match &self.location {
+            Location::None => {}
+            Location::Line(line) if !self.file.is_empty() => write!(f, ":{line}")?,
+            Location::Line(line) => write!(f, "line {line}")?,
+            Location::Byte(offset) => write!(f, "{sep}byte {offset}")?,
+            Location::Element(id) => write!(f, "{sep}element {id}")?,
+            Location::Path(path) => write!(f, "{sep}{path}")?,
+        }
+        if self.file.is_empty() && self.location == Location::None {
+            write!(f, "{}", self.kind)
+        } else {
+            write!(f, ": {}", self.kind)
+        }
+    }
+}
+
+/// Shortens `text` for an error message (at most 40 characters, lossy UTF-8).
+pub(crate) fn shorten(text: &[u8]) -> String {
+    let s = String::from_utf8_lossy(&text[..text.len().min(40)]).into_owned();
+    if text.len() > 40 {
+        s + "…"
+    } else {
+        s
+    }
+}

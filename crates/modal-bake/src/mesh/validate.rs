@@ -1,0 +1,137 @@
+//! Checks on a [`TetMesh`] before assembly: orientation, degenerate tetrahedra, connectivity
+//! and group look-up.
+
+use super::mesh_error::{Location, MeshError, MeshErrorKind};
+use super::tet_mesh::{signed_volume, TetMesh};
+
+/// Default relative volume tolerance for [`TetMesh::orient_tets`]: a tetrahedron whose
+/// |volume| is below this fraction of the mean tetrahedron volume is degenerate.
+pub const DEFAULT_DEGENERATE_REL_TOL: f64 = 1e-10;
+
+impl TetMesh {
+    /// Makes every tetrahedron positively oriented ([`signed_volume`] > 0) by swapping its
+    /// last two nodes where the volume is negative; returns how many were flipped.
+    ///
+    /// `rel_tol` (dimensionless, [`DEFAULT_DEGENERATE_REL_TOL`] is a good default) sets the
+    /// degeneracy threshold `rel_tol × mean |volume|` (m³). The mesh is left unchanged on error.
+    ///
+    /// # Errors
+    /// [`MeshErrorKind::DegenerateTet`] for the first tetrahedron whose |volume| is below the
+    /// threshold or NaN, located at its element id ([`TetMesh::tet_ids`]).
+    ///
+    /// ```
+    /// use modal_bake::mesh::TetMesh;
+    /// let mut m = TetMesh::structured_box([1, 1, 1], [1.0, 1.0, 1.0]);
+    /// m.tets[0].swap(0, 1);
+    /// assert_eq!(m.orient_tets(1e-10).unwrap(), 1);
+    /// ```
+    pub fn orient_tets(&mut self, rel_tol: f64) -> Result<usize, MeshError> {
+        let volumes: Vec<f64> = self
+            .tets
+            .iter()
+            .map(|t| {
+                signed_volume(
+                    self.nodes[t[0]],
+                    self.nodes[t[1]],
+                    self.nodes[t[2]],
+                    self.nodes[t[3]],
+                )
+            })
+            .collect();
+        if volumes.is_empty() {
+            return Ok(0);
+        }
+        let degenerate = |i: usize, volume: f64, threshold: f64| {
+            let element = self.tet_ids.get(i).copied().unwrap_or(i as u64 + 1);
+            MeshError::new(
+                "",
+                Location::Element(element),
+                MeshErrorKind::DegenerateTet {
+                    element,
+                    volume,
+                    threshold,
+                },
+            )
+        };
+        // Non-finite volumes first: they would poison the mean.
+        if let Some(i) = volumes.iter().position(|v| !v.is_finite()) {
+            return Err(degenerate(i, volumes[i], f64::NAN));
+        }
+        let mean = volumes.iter().map(|v| v.abs()).sum::<f64>() / volumes.len() as f64;
+        let threshold = rel_tol * mean;
+        if let Some(i) = volumes
+            .iter()
+            .position(|&v| v == 0.0 || v.abs() < threshold)
+        {
+            return Err(degenerate(i, volumes[i], threshold));
+        }
+        let mut flipped = 0;
+        for (t, &v) in self.tets.iter_mut().zip(&volumes) {
+            if v < 0.0 {
+                t.swap(2, 3);
+                flipped += 1;
+            }
+        }
+        Ok(flipped)
+    }
+
+    /// Number of connected components of the tetrahedra (two tetrahedra are connected when
+    /// they share a node), by union–find over tetrahedron nodes. Nodes in no tetrahedron are
+    /// not counted. A mesh for baking should have exactly 1.
+    ///
+    /// ```
+    /// use modal_bake::mesh::TetMesh;
+    /// assert_eq!(TetMesh::structured_box([2, 1, 1], [1.0, 1.0, 1.0]).connected_components(), 1);
+    /// ```
+    pub fn connected_components(&self) -> usize {
+        let n = self.nodes.len();
+        let mut parent: Vec<usize> = (0..n).collect();
+        fn find(parent: &mut [usize], mut v: usize) -> usize {
+            while parent[v] != v {
+                parent[v] = parent[parent[v]];
+                v = parent[v];
+            }
+            v
+        }
+        let mut used = vec![false; n];
+        for t in &self.tets {
+            for &v in t {
+                used[v] = true;
+            }
+            let r0 = find(&mut parent, t[0]);
+            for &v in &t[1..] {
+                let r = find(&mut parent, v);
+                if r != r0 {
+                    parent[r] = r0;
+                }
+            }
+        }
+        (0..n)
+            .filter(|&v| used[v] && find(&mut parent, v) == v)
+            .count()
+    }
+
+    /// The sorted 0-based node indices of group `name`.
+    ///
+    /// # Errors
+    /// [`MeshErrorKind::UnknownGroup`] listing the available group names.
+    ///
+    /// ```
+    /// use modal_bake::mesh::TetMesh;
+    /// let m = TetMesh::structured_box([1, 1, 1], [1.0, 1.0, 1.0]);
+    /// assert_eq!(m.group_nodes("zmin").unwrap().len(), 4);
+    /// assert!(m.group_nodes("clamp").unwrap_err().to_string().contains("xmax"));
+    /// ```
+    pub fn group_nodes(&self, name: &str) -> Result<&[usize], MeshError> {
+        self.groups.get(name).map(Vec::as_slice).ok_or_else(|| {
+            MeshError::new(
+                "",
+                Location::None,
+                MeshErrorKind::UnknownGroup {
+                    name: name.to_string(),
+                    available: self.groups.keys().cloned().collect(),
+                },
+            )
+        })
+    }
+}

@@ -1,0 +1,143 @@
+//! End-to-end tests of the `modal-bake` binary: byte-identical bases across input forms and
+//! runs, `check` exit codes, `info --json` keys, and the bad-input corpus (clear error naming
+//! the file and location, non-zero exit, no panic, no output left behind).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_modal-bake"))
+}
+
+fn data(rel: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data").join(rel)
+}
+
+fn run(args: &[&str]) -> Output {
+    bin().args(args).output().expect("modal-bake runs")
+}
+
+fn bake(mesh: &Path, out: &Path, extra: &[&str]) -> Output {
+    let mut a = vec!["bake", mesh.to_str().unwrap(), "-o", out.to_str().unwrap()];
+    a.extend_from_slice(extra);
+    run(&a)
+}
+
+#[test]
+fn every_input_form_gives_a_byte_identical_base_and_rebaking_is_identical() {
+    let dir = tempfile::tempdir().unwrap();
+    let forms = [
+        "meshes/cube_v22.msh",
+        "meshes/cube_v22_bin.msh",
+        "meshes/cube_v41.msh",
+        "meshes/cube_v41_bin.msh",
+        "meshes/cube_cell_sets.json",
+        "meshes/cube_gmsh_physical.json",
+    ];
+    let mut first: Option<Vec<u8>> = None;
+    for (i, f) in forms.iter().enumerate() {
+        let out = dir.path().join(format!("{i}.modes"));
+        let o = bake(&data(f), &out, &["--fixed", "bottom", "--modes", "8"]);
+        assert!(o.status.success(), "{f}: {}", String::from_utf8_lossy(&o.stderr));
+        let bytes = std::fs::read(&out).unwrap();
+        match &first {
+            None => first = Some(bytes),
+            Some(b) => assert!(b == &bytes, "{f} gives a different base than {}", forms[0]),
+        }
+    }
+    // Twice, same file: bit-identical.
+    let again = dir.path().join("again.modes");
+    assert!(bake(&data(forms[2]), &again, &["--fixed", "bottom", "--modes", "8"]).status.success());
+    assert!(first.unwrap() == std::fs::read(&again).unwrap());
+}
+
+#[test]
+fn check_exit_codes_follow_staleness() {
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = data("meshes/cube_v41.msh");
+    let out = dir.path().join("c.modes");
+    let m = mesh.to_str().unwrap();
+    let o = out.to_str().unwrap();
+    assert_eq!(run(&["check", m, o, "--modes", "6"]).status.code(), Some(1), "missing → 1");
+    assert!(bake(&mesh, &out, &["--modes", "6"]).status.success());
+    assert_eq!(run(&["check", m, o, "--modes", "6"]).status.code(), Some(0), "fresh → 0");
+    assert_eq!(run(&["check", m, o, "--modes", "7"]).status.code(), Some(1), "other params → 1");
+    assert_eq!(run(&["check", m, o, "--modes", "6", "--youngs", "2e9"]).status.code(), Some(1));
+    // Same geometry in another form is still up to date (hash of parsed geometry, not bytes).
+    let json = data("meshes/cube_cell_sets.json");
+    assert_eq!(run(&["check", json.to_str().unwrap(), o, "--modes", "6"]).status.code(), Some(0));
+    let bad = data("bad/truncated.msh");
+    assert_eq!(run(&["check", bad.to_str().unwrap(), o]).status.code(), Some(2), "unreadable mesh → 2");
+    std::fs::write(&out, b"garbage").unwrap();
+    assert_eq!(run(&["check", m, o, "--modes", "6"]).status.code(), Some(1), "corrupt base → stale");
+}
+
+#[test]
+fn info_json_has_the_documented_keys() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("c.modes");
+    assert!(bake(&data("meshes/cube_v41.msh"), &out, &["--modes", "5"]).status.success());
+    let o = run(&["info", out.to_str().unwrap(), "--json"]);
+    assert!(o.status.success());
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["modes"], 5);
+    assert_eq!(v["frequencies_hz"].as_array().unwrap().len(), 5);
+    assert_eq!(v["eigenvalues"].as_array().unwrap().len(), 5);
+    assert_eq!(v["format_version"], 1);
+    assert_eq!(v["rigid_modes_excluded"], 6, "free-free cube: six rigid modes excluded");
+    assert!(v["surface_vertices"].as_u64().unwrap() > 0);
+    assert!(v["surface_triangles"].as_u64().unwrap() > 0);
+    assert!(v["source_hash"].as_str().unwrap().starts_with("sha256:"));
+    // f = √λ / 2π for every mode.
+    for (f, l) in v["frequencies_hz"].as_array().unwrap().iter().zip(v["eigenvalues"].as_array().unwrap()) {
+        let (f, l) = (f.as_f64().unwrap(), l.as_f64().unwrap());
+        assert!((f - l.sqrt() / (2.0 * std::f64::consts::PI)).abs() <= 1e-12 * f);
+    }
+}
+
+/// Each bad input: exit ≠ 0, no panic, a message naming the file (and where), no output file.
+#[test]
+fn bad_inputs_fail_cleanly_with_located_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let cases: &[(&str, &[&str], &str)] = &[
+        ("bad/truncated.msh", &[], "truncated.msh:"),
+        ("bad/non_numeric.msh", &[], "non_numeric.msh:"),
+        ("bad/nan_coordinate.msh", &[], "nan_coordinate.msh:"),
+        ("bad/inf_coordinate.msh", &[], "inf_coordinate.msh:"),
+        ("bad/missing_node.msh", &[], "missing_node.msh"),
+        ("bad/zero_volume.msh", &[], "zero_volume.msh"),
+        ("bad/no_tets.msh", &[], "no_tets.msh"),
+        ("bad/huge_count.msh", &[], "huge_count.msh"),
+        ("bad/two_pieces.msh", &[], "disconnected"),
+        ("bad/bad_shape.json", &[], "bad_shape.json"),
+        ("bad/negative_index.json", &[], "negative_index.json"),
+        ("bad/not_a_mesh.msh", &[], "not_a_mesh.msh"),
+        ("meshes/cube_v41.msh", &["--fixed", "no_such_group"], "no_such_group"),
+        ("meshes/cube_v41.msh", &["--youngs", "-5"], "material"),
+        ("meshes/cube_v41.msh", &["--modes", "0"], "--modes"),
+        ("meshes/cube_v41.msh", &["--modes", "100000"], "modes"),
+        ("meshes/cube_v41.msh", &["--rayleigh", "nan,1"], "rayleigh"),
+    ];
+    for (i, (file, extra, needle)) in cases.iter().enumerate() {
+        let out = dir.path().join(format!("bad{i}.modes"));
+        let o = bake(&data(file), &out, extra);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success(), "{file} {extra:?} must fail");
+        assert_ne!(o.status.code(), Some(101), "{file}: panicked: {err}");
+        assert!(!err.contains("panicked"), "{file}: {err}");
+        assert!(err.contains(needle), "{file} {extra:?}: message `{err}` should mention `{needle}`");
+        assert!(!out.exists(), "{file}: output left behind");
+    }
+    // Nothing half-written: no temporary files either.
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+}
+
+#[test]
+fn an_inverted_tet_is_reoriented_and_counted() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("inv.modes");
+    let o = bake(&data("bad/inverted_tet.msh"), &out, &["--modes", "2", "--json"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["reoriented_tets"], 1);
+}

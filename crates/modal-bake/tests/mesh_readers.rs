@@ -1,0 +1,540 @@
+//! Mesh readers over the committed corpus (`data/meshes`, `data/bad`, made by
+//! `scripts/gen_test_meshes.py`): every form of one geometry reads to the same canonical mesh,
+//! counts match gmsh's, every bad input is a clean located error, and no prefix or byte flip
+//! of a valid file panics.
+
+use std::path::PathBuf;
+
+use modal_bake::mesh::{
+    read_json, read_mesh, read_mesh_bytes, read_msh, read_msh_bytes, signed_volume, Location,
+    MeshError, MeshErrorKind, TetMesh, DEFAULT_DEGENERATE_REL_TOL,
+};
+
+fn data(rel: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../data")
+        .join(rel)
+}
+
+fn read_ok(rel: &str) -> TetMesh {
+    read_mesh(&data(rel)).unwrap_or_else(|e| panic!("{rel}: {e}"))
+}
+
+fn read_err(rel: &str) -> MeshError {
+    match read_mesh(&data(rel)) {
+        Ok(m) => panic!("{rel} read fine ({} tets), expected an error", m.tets.len()),
+        Err(e) => e,
+    }
+}
+
+/// 1-based line of the first line of `rel` that starts with `prefix`.
+fn line_of(rel: &str, prefix: &str) -> usize {
+    let text = std::fs::read_to_string(data(rel)).unwrap();
+    1 + text
+        .lines()
+        .position(|l| l.starts_with(prefix))
+        .unwrap_or_else(|| panic!("{rel} has no line starting with {prefix:?}"))
+}
+
+const CUBE_FORMS: [&str; 6] = [
+    "meshes/cube_v41.msh",
+    "meshes/cube_v22.msh",
+    "meshes/cube_v41_bin.msh",
+    "meshes/cube_v22_bin.msh",
+    "meshes/cube_cell_sets.json",
+    "meshes/cube_gmsh_physical.json",
+];
+
+// Expectation: MSH 2.2/4.1 ASCII/binary and both JSON group layouts give the same canonical
+// mesh — node positions bit for bit, tets, triangles and groups — so a bake is byte-identical.
+#[test]
+fn all_cube_forms_give_identical_meshes() {
+    let reference = read_ok(CUBE_FORMS[0]);
+    for form in &CUBE_FORMS[1..] {
+        let m = read_ok(form);
+        assert_eq!(m.nodes.len(), reference.nodes.len(), "{form}: node count");
+        for (i, (a, b)) in m.nodes.iter().zip(&reference.nodes).enumerate() {
+            assert_eq!(a.map(f64::to_bits), b.map(f64::to_bits), "{form}: node {i}");
+        }
+        assert_eq!(m.tets, reference.tets, "{form}: tets");
+        assert_eq!(m.triangles, reference.triangles, "{form}: triangles");
+        assert_eq!(m.groups, reference.groups, "{form}: groups");
+        if form.ends_with(".msh") {
+            assert_eq!(m.tet_ids, reference.tet_ids, "{form}: element tags");
+        } else {
+            // JSON ids are 1-based positions in the file, listed in canonical tet order.
+            let mut ids = m.tet_ids.clone();
+            ids.sort_unstable();
+            let positions: Vec<u64> = (1..=m.tets.len() as u64).collect();
+            assert_eq!(ids, positions, "{form}: JSON tet ids are 1-based positions");
+        }
+    }
+}
+
+// Expectation: node, tet, triangle and group sizes equal what gmsh reported when it wrote the
+// files (data/meshes/cube_counts.json).
+#[test]
+fn cube_counts_match_gmsh() {
+    let counts: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(data("meshes/cube_counts.json")).unwrap()).unwrap();
+    for form in CUBE_FORMS {
+        let m = read_ok(form);
+        assert_eq!(
+            m.nodes.len() as u64,
+            counts["nodes"].as_u64().unwrap(),
+            "{form}"
+        );
+        assert_eq!(
+            m.tets.len() as u64,
+            counts["tets"].as_u64().unwrap(),
+            "{form}"
+        );
+        assert_eq!(
+            m.triangles.len() as u64,
+            counts["triangles_in_groups"].as_u64().unwrap(),
+            "{form}"
+        );
+        let groups = counts["groups"].as_object().unwrap();
+        let names: Vec<&String> = groups.keys().collect();
+        assert_eq!(
+            m.groups.keys().collect::<Vec<_>>(),
+            names,
+            "{form}: group names"
+        );
+        for (name, n) in groups {
+            assert_eq!(
+                m.groups[name].len() as u64,
+                n.as_u64().unwrap(),
+                "{form}: {name}"
+            );
+        }
+        assert!(
+            (m.volume() - 1.0).abs() < 1e-12,
+            "{form}: volume {}",
+            m.volume()
+        );
+        assert_eq!(m.connected_components(), 1);
+    }
+}
+
+// Expectation: groups are the right node sets in the right places, unnamed groups are named
+// by tag, and skipped element types leave one note each.
+#[test]
+fn cube_groups_geometry_and_notes() {
+    let m = read_ok("meshes/cube_v41.msh");
+    for &v in &m.groups["bottom"] {
+        assert_eq!(m.nodes[v][2], 0.0);
+    }
+    for &v in &m.groups["top"] {
+        assert_eq!(m.nodes[v][2], 1.0);
+    }
+    for &v in &m.groups["77"] {
+        assert_eq!(m.nodes[v][0], 0.0);
+    }
+    assert_eq!(m.nodes[m.groups["corner"][0]], [0.0, 0.0, 0.0]);
+    let on_z0 = m.nodes.iter().filter(|x| x[2] == 0.0).count();
+    assert_eq!(m.groups["bottom"].len(), on_z0);
+    for g in m.groups.values() {
+        assert!(g.windows(2).all(|w| w[0] < w[1]), "sorted, deduplicated");
+    }
+    for form in ["meshes/cube_v41.msh", "meshes/cube_v22_bin.msh"] {
+        let m = read_ok(form);
+        assert!(
+            m.notes
+                .contains(&"skipped 1 elements of gmsh type 15 (1-node point)".to_string()),
+            "{form}: {:?}",
+            m.notes
+        );
+        assert!(
+            m.notes
+                .iter()
+                .any(|n| n.contains("gmsh type 1 (2-node line)")),
+            "{form}: {:?}",
+            m.notes
+        );
+    }
+}
+
+// Expectation: the cantilever beam is 1.0 × 0.1 × 0.1 m, positively oriented as gmsh writes
+// it, one piece, clamped at x = 0.
+#[test]
+fn beam_reads_with_clamp_group() {
+    let mut m = read_msh(&data("meshes/beam.msh")).unwrap();
+    assert!((m.volume() - 0.01).abs() < 1e-12);
+    assert_eq!(m.orient_tets(DEFAULT_DEGENERATE_REL_TOL).unwrap(), 0);
+    assert_eq!(m.connected_components(), 1);
+    let clamp = m.group_nodes("clamp").unwrap();
+    assert!(clamp.len() >= 9);
+    assert!(clamp.iter().all(|&v| m.nodes[v][0] == 0.0));
+    assert!(m.group_nodes("volume").unwrap().len() == m.nodes.len());
+    let max = m
+        .nodes
+        .iter()
+        .fold([f64::MIN; 3], |a, x| [0, 1, 2].map(|k| a[k].max(x[k])));
+    assert_eq!(max, [1.0, 0.1, 0.1]);
+}
+
+// Expectation: canonical form does not depend on node order or tag numbering in the file,
+// and drops nodes that no tetrahedron uses (with a note).
+#[test]
+fn canonical_form_ignores_node_order_and_drops_unused_nodes() {
+    let ordered = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n5\n1 0 0 0\n2 1 0 0\n\
+                   3 0 1 0\n4 0 0 1\n5 1 1 1\n$EndNodes\n$Elements\n2\n\
+                   1 4 0 1 2 3 4\n2 4 0 2 3 4 5\n$EndElements\n";
+    // Same geometry: tags ×10, listed backwards, plus an unused node 25 in the middle.
+    let shuffled = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n6\n50 1 1 1\n40 0 0 1\n\
+                    25 9 9 9\n30 0 1 0\n20 1 0 0\n10 0 0 0\n$EndNodes\n$Elements\n2\n\
+                    2 4 0 20 30 40 50\n1 4 0 10 20 30 40\n$EndElements\n";
+    let a = read_msh_bytes(ordered.as_bytes(), "ordered.msh").unwrap();
+    let b = read_msh_bytes(shuffled.as_bytes(), "shuffled.msh").unwrap();
+    assert_eq!(a.nodes, b.nodes);
+    assert_eq!(a.tets, b.tets);
+    assert_eq!(a.tet_ids, vec![1, 2]);
+    assert!(
+        b.notes.iter().any(|n| n.contains("dropped 1 nodes")),
+        "{:?}",
+        b.notes
+    );
+}
+
+/// Asserts `e` is located at `location` and its message starts with the file name.
+fn assert_located(e: &MeshError, rel: &str, location: Location) {
+    assert_eq!(e.location, location, "{rel}: {e}");
+    let shown = e.to_string();
+    assert!(
+        shown.starts_with(&data(rel).display().to_string()),
+        "message does not name the file: {shown}"
+    );
+}
+
+// Expectation: each defect of data/bad gives its own error kind, located by line (ASCII) or
+// element, with a message that names the file.
+#[test]
+fn bad_msh_files_give_located_errors() {
+    let e = read_err("bad/nan_coordinate.msh");
+    assert_eq!(e.kind, MeshErrorKind::NonFiniteCoordinate { node: 5 });
+    let line = line_of("bad/nan_coordinate.msh", "5 1.0 nan");
+    assert_located(&e, "bad/nan_coordinate.msh", Location::Line(line));
+    let expected = format!(
+        "{}:{line}: non-finite coordinate in node 5",
+        data("bad/nan_coordinate.msh").display()
+    );
+    assert_eq!(e.to_string(), expected);
+
+    let e = read_err("bad/inf_coordinate.msh");
+    assert_eq!(e.kind, MeshErrorKind::NonFiniteCoordinate { node: 2 });
+
+    let e = read_err("bad/non_numeric.msh");
+    assert!(
+        matches!(&e.kind, MeshErrorKind::NotANumber { found, .. } if found == "1.O"),
+        "{e}"
+    );
+    let line = line_of("bad/non_numeric.msh", "3 0.0 1.O");
+    assert_located(&e, "bad/non_numeric.msh", Location::Line(line));
+
+    let e = read_err("bad/truncated.msh");
+    assert!(matches!(e.kind, MeshErrorKind::Truncated(_)), "{e}");
+
+    let e = read_err("bad/missing_node.msh");
+    assert_eq!(
+        e.kind,
+        MeshErrorKind::MissingNode {
+            element: 6,
+            node: 99
+        }
+    );
+    let line = line_of("bad/missing_node.msh", "6 4 ");
+    assert_located(&e, "bad/missing_node.msh", Location::Line(line));
+    assert!(e.to_string().contains("element 6 names node 99"), "{e}");
+
+    let e = read_err("bad/no_tets.msh");
+    assert_eq!(e.kind, MeshErrorKind::NoTets);
+    let e = read_err("bad/second_order_only.msh");
+    assert_eq!(e.kind, MeshErrorKind::NoTets);
+
+    let e = read_err("bad/huge_count.msh");
+    assert_eq!(
+        e.kind,
+        MeshErrorKind::CountTooLarge {
+            what: "nodes",
+            count: 1_000_000_000_000
+        }
+    );
+    assert_located(
+        &e,
+        "bad/huge_count.msh",
+        Location::Line(line_of("bad/huge_count.msh", "1000000000000")),
+    );
+
+    let e = read_err("bad/bad_version.msh");
+    assert_eq!(e.kind, MeshErrorKind::UnsupportedVersion("3.0".into()));
+    assert_located(&e, "bad/bad_version.msh", Location::Line(2));
+
+    let e = read_err("bad/missing_elements.msh");
+    assert_eq!(e.kind, MeshErrorKind::MissingSection("$Elements"));
+
+    let e = read_err("bad/duplicate_node.msh");
+    assert_eq!(e.kind, MeshErrorKind::DuplicateNode { node: 3 });
+
+    let e = read_err("bad/not_a_mesh.msh");
+    assert!(matches!(e.kind, MeshErrorKind::MissingSection(_)), "{e}");
+}
+
+// Expectation: JSON with wrong shapes, types, ragged rows, negative or dangling indices is a
+// clean error located by a JSON path (or a line for syntax errors).
+#[test]
+fn bad_json_files_give_located_errors() {
+    let path = |p: &str| Location::Path(p.to_string());
+    let e = read_err("bad/bad_shape.json");
+    assert!(matches!(e.kind, MeshErrorKind::Shape(_)), "{e}");
+    assert_located(&e, "bad/bad_shape.json", path("points[2]"));
+
+    let e = read_err("bad/ragged.json");
+    assert!(matches!(e.kind, MeshErrorKind::Shape(_)), "{e}");
+    assert_located(&e, "bad/ragged.json", path("cells[0].data[1]"));
+
+    let e = read_err("bad/wrong_type.json");
+    assert!(matches!(e.kind, MeshErrorKind::Shape(_)), "{e}");
+    assert_located(&e, "bad/wrong_type.json", path("points[1][0]"));
+
+    let e = read_err("bad/negative_index.json");
+    assert_eq!(e.kind, MeshErrorKind::NegativeIndex(-3));
+    assert_located(&e, "bad/negative_index.json", path("cells[0].data[1][2]"));
+
+    let e = read_json(&data("bad/missing_node.json")).unwrap_err();
+    assert_eq!(
+        e.kind,
+        MeshErrorKind::MissingNode {
+            element: 2,
+            node: 9
+        }
+    );
+
+    let e = read_err("bad/cells_not_list.json");
+    assert!(matches!(e.kind, MeshErrorKind::Shape(_)), "{e}");
+
+    let e = read_err("bad/syntax_error.json");
+    assert!(matches!(e.kind, MeshErrorKind::Json(_)), "{e}");
+    assert_located(&e, "bad/syntax_error.json", Location::Line(2));
+}
+
+// Expectation: an inverted tet reads fine and orient_tets flips exactly it; a flat tet is an
+// error naming its element tag; two disjoint pieces count as two components.
+#[test]
+fn orientation_degeneracy_and_components() {
+    let mut m = read_ok("bad/inverted_tet.msh");
+    assert_eq!(m.orient_tets(DEFAULT_DEGENERATE_REL_TOL).unwrap(), 1);
+    for t in &m.tets {
+        assert!(signed_volume(m.nodes[t[0]], m.nodes[t[1]], m.nodes[t[2]], m.nodes[t[3]]) > 0.0);
+    }
+    assert_eq!(m.orient_tets(DEFAULT_DEGENERATE_REL_TOL).unwrap(), 0);
+
+    let mut m = read_ok("bad/zero_volume.msh");
+    let before = m.clone();
+    let e = m.orient_tets(DEFAULT_DEGENERATE_REL_TOL).unwrap_err();
+    assert!(
+        matches!(e.kind, MeshErrorKind::DegenerateTet { element: 7, .. }),
+        "{e}"
+    );
+    assert_eq!(e.location, Location::Element(7));
+    assert!(e.to_string().starts_with("element 7: degenerate"), "{e}");
+    assert_eq!(m, before, "mesh unchanged on error");
+
+    let mut nan = read_ok("bad/inverted_tet.msh");
+    nan.nodes[0][0] = f64::NAN;
+    assert!(nan.orient_tets(DEFAULT_DEGENERATE_REL_TOL).is_err());
+
+    let m = read_ok("bad/two_pieces.msh");
+    assert_eq!(m.connected_components(), 2);
+    assert_eq!(read_ok("bad/inverted_tet.msh").connected_components(), 1);
+}
+
+// Expectation: asking for a missing group lists the groups there are.
+#[test]
+fn unknown_group_lists_available_names() {
+    let m = read_ok("meshes/cube_v22.msh");
+    let e = m.group_nodes("clamp").unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "no node group named \"clamp\"; available groups: 77, bottom, corner, edge, top, volume"
+    );
+    assert_eq!(m.group_nodes("top").unwrap(), m.groups["top"].as_slice());
+}
+
+/// Position just after the first occurrence of `needle` in `hay`.
+fn after(hay: &[u8], needle: &[u8]) -> usize {
+    hay.windows(needle.len()).position(|w| w == needle).unwrap() + needle.len()
+}
+
+// Expectation: binary count fields are distrusted too: a 10^12 node count is refused before
+// any allocation, and a wrong endianness word is reported at its byte offset.
+#[test]
+fn binary_counts_and_endianness_are_checked() {
+    let orig = std::fs::read(data("meshes/cube_v41_bin.msh")).unwrap();
+    let mut bytes = orig.clone();
+    let at = after(&bytes, b"$Nodes\n");
+    // numEntityBlocks, numNodes, minTag, maxTag (size_t, little-endian).
+    bytes[at + 8..at + 16].copy_from_slice(&1_000_000_000_000u64.to_le_bytes());
+    let e = read_msh_bytes(&bytes, "huge.msh").unwrap_err();
+    assert_eq!(
+        e.kind,
+        MeshErrorKind::CountTooLarge {
+            what: "nodes",
+            count: 1_000_000_000_000
+        }
+    );
+    assert_eq!(e.location, Location::Byte(at));
+
+    let mut bytes = orig.clone();
+    let at = after(&bytes, b"4.1 1 8\n");
+    bytes[at..at + 4].copy_from_slice(&2u32.to_le_bytes());
+    let e = read_msh_bytes(&bytes, "endian.msh").unwrap_err();
+    assert_eq!(e.kind, MeshErrorKind::BadEndianness(2));
+    assert_eq!(
+        e.to_string(),
+        format!("endian.msh: byte {at}: bad endianness check integer 0x00000002 (expected 1)")
+    );
+}
+
+// Expectation: the same mesh written big-endian (every 4/8-byte binary value byte-swapped)
+// reads to the same canonical mesh. Built here from the little-endian 2.2 file by walking its
+// documented layout.
+#[test]
+fn big_endian_msh22_matches_little_endian() {
+    let le = std::fs::read(data("meshes/cube_v22_bin.msh")).unwrap();
+    let mut be = le.clone();
+    let swap = |b: &mut [u8], at: usize, n: usize| b[at..at + n].reverse();
+    let rd = |b: &[u8], at: usize| i32::from_le_bytes(b[at..at + 4].try_into().unwrap());
+    let at = after(&le, b"2.2 1 8\n");
+    swap(&mut be, at, 4);
+    let nodes_at = after(&le, b"$Nodes\n");
+    let nl = nodes_at + le[nodes_at..].iter().position(|&c| c == b'\n').unwrap();
+    let n: usize = std::str::from_utf8(&le[nodes_at..nl])
+        .unwrap()
+        .parse()
+        .unwrap();
+    let mut p = nl + 1;
+    for _ in 0..n {
+        swap(&mut be, p, 4);
+        for k in 0..3 {
+            swap(&mut be, p + 4 + 8 * k, 8);
+        }
+        p += 28;
+    }
+    let el_at = after(&le, b"$Elements\n");
+    let nl = el_at + le[el_at..].iter().position(|&c| c == b'\n').unwrap();
+    let total: usize = std::str::from_utf8(&le[el_at..nl])
+        .unwrap()
+        .parse()
+        .unwrap();
+    let mut p = nl + 1;
+    let mut read = 0;
+    while read < total {
+        let (ty, follow, ntags) = (rd(&le, p), rd(&le, p + 4), rd(&le, p + 8));
+        for k in 0..3 {
+            swap(&mut be, p + 4 * k, 4);
+        }
+        p += 12;
+        let nn = match ty {
+            15 => 1,
+            1 => 2,
+            2 => 3,
+            4 => 4,
+            other => panic!("unexpected type {other}"),
+        };
+        for _ in 0..follow as usize * (1 + ntags as usize + nn) {
+            swap(&mut be, p, 4);
+            p += 4;
+        }
+        read += follow as usize;
+    }
+    assert_ne!(be, le);
+    let a = read_msh_bytes(&le, "le.msh").unwrap();
+    let b = read_msh_bytes(&be, "be.msh").unwrap();
+    assert_eq!(a, b);
+}
+
+/// Reads `bytes` and fails the test with `what` if the reader panics.
+fn must_not_panic(bytes: &[u8], name: &str, what: &str) {
+    let r = std::panic::catch_unwind(|| {
+        let _ = read_mesh_bytes(bytes, name);
+    });
+    assert!(r.is_ok(), "{name}: reader panicked on {what}");
+}
+
+// Expectation: every prefix (every ~50th byte) and many single-byte corruptions of every
+// valid file give Ok or Err, never a panic or runaway allocation.
+#[test]
+fn truncation_and_byte_flips_never_panic() {
+    let mut files: Vec<&str> = CUBE_FORMS.to_vec();
+    files.push("meshes/beam.msh");
+    let mut prefixes_ok = 0;
+    for rel in files {
+        let bytes = std::fs::read(data(rel)).unwrap();
+        let name = rel.rsplit('/').next().unwrap();
+        for cut in (0..bytes.len()).step_by(47) {
+            must_not_panic(&bytes[..cut], name, &format!("prefix of {cut} bytes"));
+            if read_mesh_bytes(&bytes[..cut], name).is_ok() {
+                prefixes_ok += 1;
+            }
+        }
+        for (i, at) in (0..bytes.len()).step_by(53).enumerate() {
+            for flip in [0xFFu8, 0x01, 0x80] {
+                let mut b = bytes.clone();
+                b[at] ^= flip;
+                must_not_panic(&b, name, &format!("byte {at} ^ {flip:#x}"));
+            }
+            // Also a digit, a minus sign and a huge byte run in a count-sized window.
+            let mut b = bytes.clone();
+            b[at] = [b'9', b'-', b'.', b'$'][i % 4];
+            must_not_panic(&b, name, &format!("byte {at} replaced"));
+            if at + 8 <= b.len() {
+                b[at..at + 8].copy_from_slice(&[0x7F; 8]);
+                must_not_panic(&b, name, &format!("8 bytes at {at} set to 0x7f"));
+            }
+        }
+    }
+    // Truncated files must fail (a prefix cut just before trailing newlines may still read).
+    assert!(
+        prefixes_ok <= 7,
+        "{prefixes_ok} prefixes read as complete meshes"
+    );
+}
+
+// Regression: MSH 2.2 has one physical tag per element, so gmsh writes an element of two
+// physical groups twice under different tags. It must count once and join both groups.
+#[test]
+fn msh22_element_in_two_groups_is_one_tet() {
+    let text = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$PhysicalNames\n1\n3 2 \"b\"\n\
+                $EndPhysicalNames\n$Nodes\n4\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n$EndNodes\n\
+                $Elements\n2\n7 4 2 1 1 1 2 3 4\n8 4 2 2 1 1 2 3 4\n$EndElements\n";
+    let m = read_msh_bytes(text.as_bytes(), "two_groups.msh").unwrap();
+    assert_eq!(m.tets, vec![[0, 1, 2, 3]]);
+    assert_eq!(m.tet_ids, vec![7]);
+    assert_eq!(m.groups["1"], vec![0, 1, 2, 3]);
+    assert_eq!(m.groups["b"], vec![0, 1, 2, 3]);
+    assert!(
+        m.notes.iter().any(|n| n.contains("removed 1 duplicated")),
+        "{:?}",
+        m.notes
+    );
+}
+
+// Expectation: a NaN in binary node data is reported at the byte offset of its node record.
+#[test]
+fn binary_nan_is_located_by_byte_offset() {
+    let mut bytes = std::fs::read(data("meshes/cube_v22_bin.msh")).unwrap();
+    let at = after(&bytes, b"$Nodes\n");
+    let first = at + bytes[at..].iter().position(|&c| c == b'\n').unwrap() + 1;
+    // Third node record: int tag + 3 doubles = 28 bytes each; poison its y.
+    let record = first + 2 * 28;
+    let tag = i32::from_le_bytes(bytes[record..record + 4].try_into().unwrap()) as u64;
+    bytes[record + 12..record + 20].copy_from_slice(&f64::NAN.to_le_bytes());
+    let e = read_msh_bytes(&bytes, "nan_bin.msh").unwrap_err();
+    assert_eq!(e.kind, MeshErrorKind::NonFiniteCoordinate { node: tag });
+    assert_eq!(e.location, Location::Byte(record));
+    assert_eq!(
+        e.to_string(),
+        format!("nan_bin.msh: byte {record}: non-finite coordinate in node {tag}")
+    );
+}
