@@ -10,7 +10,10 @@
 //! No boundary-condition averaging (open surfaces get the natural Neumann condition).
 
 use faer::dyn_stack::{MemBuffer, MemStack};
-use faer::sparse::linalg::cholesky::{factorize_symbolic_cholesky, LltRef, SymbolicCholesky};
+use faer::sparse::linalg::cholesky::{
+    factorize_symbolic_cholesky, CholeskySymbolicParams, LltRef, SymbolicCholesky,
+};
+use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::{SparseColMat, Triplet};
 use faer::{Conj, MatMut, Par, Side};
 
@@ -44,6 +47,9 @@ pub enum GeodesicError {
     #[error("sparse Cholesky failed: {0}")]
     Factorization(String),
 }
+
+/// Simplicial vs supernodal choice for the shared symbolic factorisation.
+const SUPERNODAL: SupernodalThreshold = SupernodalThreshold::FORCE_SUPERNODAL;
 
 struct Factor {
     values: Vec<f64>,
@@ -91,7 +97,7 @@ impl HeatGeodesic {
         }
         let mut mass = vec![0.0; n];
         let mut grad_area = Vec::with_capacity(triangles.len());
-        let mut trip: Vec<Triplet<usize, usize, f64>> = Vec::with_capacity(triangles.len() * 9);
+        let mut trip: Vec<Triplet<usize, usize, f64>> = Vec::with_capacity(triangles.len() * 9 + n);
         let mut edge_sum = 0.0;
         for (f, tri) in triangles.iter().enumerate() {
             if tri.iter().any(|&i| i as usize >= n) {
@@ -124,8 +130,7 @@ impl HeatGeodesic {
                 let cot = -dot(e[j], e[k]) / two_a;
                 let w = 0.5 * cot;
                 let (a, b) = (tri[j] as usize, tri[k] as usize);
-                trip.push(Triplet::new(a, b, -w));
-                trip.push(Triplet::new(b, a, -w));
+                trip.push(Triplet::new(a.max(b), a.min(b), -w));
                 trip.push(Triplet::new(a, a, w));
                 trip.push(Triplet::new(b, b, w));
             }
@@ -133,27 +138,37 @@ impl HeatGeodesic {
         let mean_edge = edge_sum / (3.0 * triangles.len() as f64);
         let t = mean_edge * mean_edge;
         let eps = 1e-8 / t;
-        let lap_len = trip.len();
-        let build = |a: f64, b: f64, trip: &mut Vec<Triplet<usize, usize, f64>>| {
-            trip.truncate(lap_len);
-            for (i, &mi) in mass.iter().enumerate() {
-                trip.push(Triplet::new(i, i, b * mi));
-            }
-            let scaled: Vec<Triplet<usize, usize, f64>> = trip
-                .iter()
-                .enumerate()
-                .map(|(idx, tr)| if idx < lap_len { Triplet::new(tr.row, tr.col, a * tr.val) } else { *tr })
-                .collect();
-            SparseColMat::<usize, f64>::try_new_from_triplets(n, n, &scaled)
-                .map_err(|e| GeodesicError::Factorization(format!("{e:?}")))
+        // L (lower triangle) once; both operators share its pattern and differ on the diagonal.
+        for i in 0..n {
+            trip.push(Triplet::new(i, i, 0.0));
+        }
+        let lap = SparseColMat::<usize, f64>::try_new_from_triplets(n, n, &trip)
+            .map_err(|e| GeodesicError::Factorization(format!("{e:?}")))?;
+        let diag: Vec<usize> = {
+            let (col_ptr, row_idx) = (lap.symbolic().col_ptr(), lap.symbolic().row_idx());
+            (0..n)
+                .map(|j| (col_ptr[j]..col_ptr[j + 1]).find(|&k| row_idx[k] == j).expect("diagonal present"))
+                .collect()
         };
-        let heat_mat = build(t, 1.0, &mut trip)?;
-        let poisson_mat = build(1.0, eps, &mut trip)?;
+        let with_diag = |a: f64, b: f64| {
+            let mut mat = lap.clone();
+            let vals = mat.val_mut();
+            vals.iter_mut().for_each(|x| *x *= a);
+            for (i, &k) in diag.iter().enumerate() {
+                vals[k] += b * mass[i];
+            }
+            mat
+        };
+        let heat_mat = with_diag(t, 1.0);
+        let poisson_mat = with_diag(1.0, eps);
         let symbolic = factorize_symbolic_cholesky(
             heat_mat.symbolic(),
             Side::Lower,
             Default::default(),
-            Default::default(),
+            CholeskySymbolicParams {
+                supernodal_flop_ratio_threshold: SUPERNODAL,
+                ..Default::default()
+            },
         )
         .map_err(|e| GeodesicError::Factorization(format!("{e:?}")))?;
         let par = Par::Seq;

@@ -1,1 +1,131 @@
+//! Heat-method geodesics against closed forms, attenuation law clamping, distance-field cache.
 
+use super::*;
+use crate::math::{dot, norm, sub};
+use crate::testing::{icosphere, plate_grid};
+
+/// Flat plate: heat distances stay within one mean edge length of the Euclidean distance.
+#[test]
+fn plate_geodesic_is_euclidean_within_an_edge() {
+    let (v, t) = plate_grid(40, 30, 2.0, 1.5);
+    let heat = HeatGeodesic::new(&v, &t).unwrap();
+    let edge = heat.mean_edge_length();
+    let mut out = vec![0.0; v.len()];
+    for src in [0, 20 * 41 + 15, 15 * 41 + 20, v.len() - 1] {
+        heat.distances_from_vertex(src, &mut out);
+        let mut worst = 0.0f64;
+        for (i, d) in out.iter().enumerate() {
+            worst = worst.max((d - norm(sub(v[i], v[src]))).abs());
+        }
+        assert!(worst <= edge, "source {src}: worst error {worst} > edge {edge}");
+        assert_eq!(out[src], 0.0);
+    }
+}
+
+/// Sphere: heat distances follow the great-circle distance R·acos(x̂·ŷ) (heat-method accuracy:
+/// mean error ≤ 1.5% and max ≤ 4% of πR), and are nearly symmetric.
+#[test]
+fn sphere_geodesic_matches_great_circle_and_is_symmetric() {
+    let r = 1.3;
+    let (v, t) = icosphere(4, r);
+    let heat = HeatGeodesic::new(&v, &t).unwrap();
+    let mut out = vec![0.0; v.len()];
+    let half = std::f64::consts::PI * r;
+    let sources = [0usize, 17, 500, 2000];
+    let mut fields = Vec::new();
+    for &src in &sources {
+        heat.distances_from_vertex(src, &mut out);
+        let (mut sum, mut worst) = (0.0, 0.0f64);
+        for (i, d) in out.iter().enumerate() {
+            let c = (dot(v[i], v[src]) / (r * r)).clamp(-1.0, 1.0);
+            let e = (d - r * c.acos()).abs();
+            sum += e;
+            worst = worst.max(e);
+        }
+        let mean = sum / v.len() as f64;
+        assert!(mean <= 0.015 * half, "mean error {mean} vs πR {half}");
+        assert!(worst <= 0.04 * half, "max error {worst} vs πR {half}");
+        fields.push(out.clone());
+    }
+    for a in 0..sources.len() {
+        for b in 0..sources.len() {
+            let (dab, dba) = (fields[a][sources[b]], fields[b][sources[a]]);
+            assert!((dab - dba).abs() <= 0.01 * half, "d({a},{b}) {dab} vs {dba}");
+        }
+    }
+}
+
+/// A source inside a triangle: distance 0 there, and the field interpolates between its
+/// vertices' fields; no-allocation workspace path agrees with the convenience call.
+#[test]
+fn point_source_is_consistent() {
+    let (v, t) = plate_grid(20, 20, 1.0, 1.0);
+    let heat = HeatGeodesic::new(&v, &t).unwrap();
+    let tri = t[100];
+    let sp = crate::SurfacePoint {
+        triangle: 100,
+        bary: [1.0, 0.0, 0.0],
+        point: v[tri[0] as usize],
+        normal: [0.0, 0.0, 1.0],
+        distance: 0.0,
+    };
+    let mut a = vec![0.0; v.len()];
+    let mut b = vec![0.0; v.len()];
+    heat.distances_from_point(&sp, &mut a);
+    heat.distances_from_vertex(tri[0] as usize, &mut b);
+    let mut ws = heat.workspace();
+    let mut c = vec![0.0; v.len()];
+    heat.distances_from_point_with(&sp, &mut c, &mut ws);
+    for i in 0..v.len() {
+        assert!((a[i] - b[i]).abs() < 1e-12 && a[i] == c[i]);
+    }
+}
+
+#[test]
+fn degenerate_and_empty_surfaces_are_errors() {
+    assert!(matches!(HeatGeodesic::new(&[], &[]), Err(GeodesicError::Empty)));
+    let v = [[0.0; 3], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]];
+    assert!(matches!(HeatGeodesic::new(&v, &[[0, 1, 2]]), Err(GeodesicError::Degenerate { .. })));
+    assert!(matches!(HeatGeodesic::new(&v, &[[0, 1, 5]]), Err(GeodesicError::BadIndex { .. })));
+}
+
+/// s(r) follows Eq. 14 / the §4.5 form beyond r0 and is clamped inside r0.
+#[test]
+fn attenuation_law_values_and_clamping() {
+    let full = AttenuationLaw::Full {
+        alpha: 0.5,
+        beta: 1.0,
+        r0: 0.2,
+    };
+    assert_eq!(full.factor(0.0), 1.0);
+    assert_eq!(full.factor(0.2), 1.0);
+    let r: f64 = 1.7;
+    assert!((full.factor(r) - (-0.5 * (r - 0.2)).exp() * (r / 0.2).powf(-1.0)).abs() < 1e-15);
+    let simple = AttenuationLaw::Simplified { c: 0.8, beta: 0.5 };
+    assert_eq!(simple.factor(0.3), 0.8);
+    assert!((simple.factor(4.0) - 0.4).abs() < 1e-15);
+}
+
+/// LRU distance cache: capacity 2, three contacts in turn → misses; hits when repeated.
+#[test]
+fn distance_cache_is_bounded_lru() {
+    let mut cache = DistanceCache::new(4, 2);
+    let mut calls = 0;
+    let mut get = |cache: &mut DistanceCache, slot: u32, step: u64| {
+        let v = cache.get(slot, step, |out| {
+            calls += 1;
+            out.iter_mut().for_each(|x| *x = slot as f64);
+        })[0];
+        assert_eq!(v, slot as f64);
+    };
+    get(&mut cache, 0, 1);
+    get(&mut cache, 1, 2);
+    get(&mut cache, 0, 3); // hit
+    get(&mut cache, 2, 4); // evicts slot 1 (least recently used)
+    get(&mut cache, 0, 5); // hit
+    get(&mut cache, 1, 6); // miss again
+    assert_eq!(cache.computed, 4);
+    cache.invalidate(0);
+    get(&mut cache, 0, 7);
+    assert_eq!(cache.computed, 5);
+}

@@ -186,7 +186,6 @@ impl DcrAdapter {
     pub fn after_step(&mut self, built: &mut BuiltWorld) -> StepStats {
         let t0 = Instant::now();
         let mut out = StepStats::default();
-        let step = self.step;
         for si in 0..self.slots.len() {
             self.collect(si, built);
             let slot = &mut self.slots[si];
@@ -225,7 +224,6 @@ impl DcrAdapter {
             }
         }
         self.step += 1;
-        let _ = step;
         out.adapter_us = t0.elapsed().as_secs_f64() * 1e6;
         out
     }

@@ -1,8 +1,7 @@
-//! The response engine the adapter talks to: `dcr_runtime`'s public surface.
-//!
-//! TEMPORARY: while `dcr_runtime::DistantResponse` is being written, this re-exports a minimal
-//! stand-in built from the runtime's existing pieces (`ModalModel`, `ModalBank`), with the
-//! same contract. Replace the body of this file with `pub use dcr_runtime::{...}` when the
-//! runtime's response lands.
+//! The response engine the adapter talks to: `dcr_runtime`'s public surface, re-exported
+//! in one place so the rest of the crate names one module.
 
-pub use super::engine_standin::*;
+pub use dcr_runtime::{
+    effective_mass, response_impulse, AmplitudeKind, AttenuationLaw, AttenuationParams, ContactResponse,
+    DistanceKind, DistantResponse, Impact, Method, ModalModel, ResponseParams, RestingContact,
+};

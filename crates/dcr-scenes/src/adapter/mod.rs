@@ -9,7 +9,6 @@
 mod contact_key;
 mod dcr_adapter;
 pub mod engine;
-mod engine_standin;
 
 pub use contact_key::contact_key;
 pub use dcr_adapter::{AdapterParams, DcrAdapter, ModelStats, StepStats};

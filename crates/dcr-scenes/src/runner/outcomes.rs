@@ -27,7 +27,7 @@ fn qangle_deg(q: [f64; 4]) -> f64 {
 pub fn unit_of(kind: &str) -> &'static str {
     match kind {
         "max_lift" | "max_slide" => "mm",
-        "max_tilt" | "max_sway" => "deg",
+        "max_tilt" | "max_sway" | "sway_range" => "deg",
         "count_fallen" | "count_moved" => "bodies",
         _ => "",
     }
@@ -79,6 +79,30 @@ pub fn measure_outcome(o: &OutcomeDesc, traj: &Trajectory) -> Option<f64> {
                         None => traj.rot(k, b),
                     };
                     best = best.max(qangle_deg(qmul(qconj(q0), q)));
+                }
+            }
+        }
+        "sway_range" => {
+            // Range (max − min) over time of the signed hinge-free rotation angle of each body
+            // relative to `relative_to`, measured from its start; constant sag drops out.
+            let rel = o.relative_to.as_ref().and_then(|r| traj.names.iter().position(|n| n == r));
+            for &b in &bodies {
+                let relq = |k: usize| match rel {
+                    Some(r) => qmul(qconj(traj.rot(k, r)), traj.rot(k, b)),
+                    None => traj.rot(k, b),
+                };
+                let q0 = relq(0);
+                let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+                for &k in &rows {
+                    let d = qmul(qconj(q0), relq(k));
+                    // Signed angle about the rotation's own dominant axis sign convention.
+                    let s = if d[0] + d[1] + d[2] >= 0.0 { 1.0 } else { -1.0 };
+                    let a = s * qangle_deg(d);
+                    lo = lo.min(a);
+                    hi = hi.max(a);
+                }
+                if hi >= lo {
+                    best = best.max(hi - lo);
                 }
             }
         }

@@ -206,7 +206,7 @@ pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
                 method,
                 ..ResponseParams::default()
             };
-            Some(DistantResponse::new(model, rp))
+            Some(DistantResponse::new(model, rp).map_err(|err| anyhow::anyhow!("response of {}: {err}", e.name))?)
         } else {
             None
         };

@@ -354,6 +354,7 @@ pub struct OutcomeDesc {
     /// `max_tilt` (deg: largest rotation from the start pose),
     /// `count_fallen` (bodies whose centre dropped more than `threshold` m),
     /// `max_sway` (deg: largest rotation relative to `relative_to` from the start),
+    /// `sway_range` (deg: range over time of the rotation relative to `relative_to`),
     /// `count_moved` (bodies displaced more than `threshold` m).
     pub kind: String,
     /// Bodies (name or prefix glob).

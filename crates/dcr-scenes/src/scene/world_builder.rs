@@ -189,14 +189,19 @@ pub fn build_world(desc: &SceneDesc, root: &Path) -> Result<BuiltWorld> {
             let p1 = *world.bodies[bodies[i1].handle].position();
             let p2 = *world.bodies[bodies[i2].handle].position();
             // The hinge sits at the same offset from every child's initial centre. The axis is
-            // taken in both bodies' frames as given: bodies joined start unrotated.
+            // taken in both bodies' frames as given: the parent starts unrotated and a child
+            // may only start rotated about the hinge axis itself.
             let anchor = p2.translation + v3(j.anchor_offset);
             let axis1 = v3(j.axis).normalize();
-            let joint = RevoluteJointBuilder::new(axis1)
+            let mut joint = RevoluteJointBuilder::new(axis1)
                 .local_anchor1(p1.inverse_transform_point(anchor))
                 .local_anchor2(p2.inverse_transform_point(anchor))
-                .motor_position(0.0, j.stiffness, j.damping)
-                .contacts_enabled(false);
+                .motor_model(MotorModel::ForceBased)
+                .contacts_enabled(false)
+                .build();
+            // The spring's rest angle is the initial relative angle (a leaf starts at rest).
+            let rest = joint.angle(&p1.rotation, &p2.rotation);
+            joint.set_motor_position(rest, j.stiffness, j.damping);
             world.insert_impulse_joint(bodies[i1].handle, bodies[i2].handle, joint);
         }
     }

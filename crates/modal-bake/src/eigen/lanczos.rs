@@ -100,6 +100,7 @@ pub(crate) fn solve(
         let mut z = mv.as_ref().subcols(kk, b).to_owned();
         fac.solve_in_place(z.as_mut(), &mut solve_buf);
         info.block_solves += 1;
+        let tp0 = Instant::now();
         let mut c = Mat::<f64>::zeros(nb, b);
         for _pass in 0..2 {
             let mut cp = Mat::<f64>::zeros(nb, b);
@@ -131,6 +132,7 @@ pub(crate) fn solve(
         h.as_mut().submatrix_mut(nb, kk, b, b).copy_from(&r);
         kk = nb;
         info.iterations += 1;
+        let tp1 = Instant::now();
         info.krylov_dim = info.krylov_dim.max(kk);
 
         // --- Rayleigh–Ritz on H = VᵀMTV ----------------------------------------------------
@@ -169,8 +171,10 @@ pub(crate) fn solve(
             }
         };
         let conv = est.iter().take(wanted.min(kk)).filter(|&&e| e <= params.tol).count();
+        if std::env::var("DCR_DBG").is_ok() { eprintln!("it {} kk {} est {:?}", info.iterations, kk, est.iter().take(wanted.min(kk)).map(|e| format!("{e:.0e}")).collect::<Vec<_>>()); }
         progress(EigenProgress { converged: conv, requested: wanted, iteration: info.iterations });
 
+        if std::env::var("DCR_DBG").is_ok() { eprintln!("orth {:.3}s rr {:.3}s", (tp1 - tp0).as_secs_f64(), tp1.elapsed().as_secs_f64()); }
         let ready = wanted <= kk
             && est.iter().take(wanted).all(|&e| e <= trigger)
             && (lam_lim.is_none() || capped || below < kk);
@@ -427,7 +431,6 @@ fn finalize(
     gemm(u.as_mut(), Accum::Replace, mv, s, 1.0, par);
     let mut buf = fac.solve_buffer(w);
     fac.solve_in_place(u.as_mut(), &mut buf);
-    if std::env::var("DCR_P2").is_ok() { let mut t = Mat::<f64>::zeros(n, w); sym_spmm(m, u.as_ref(), t.as_mut()); fac.solve_in_place(t.as_mut(), &mut buf); for j in 0..w { let s: f64 = t.col(j).iter().map(|x| x * x).sum::<f64>().sqrt(); t.as_mut().col_mut(j).iter_mut().for_each(|x| *x /= s); } u = t; }
     let _ = v;
     let mut mu = Mat::<f64>::zeros(n, w);
     sym_spmm(m, u.as_ref(), mu.as_mut());

@@ -224,6 +224,8 @@ pub fn solve_lowest(
 /// let s = default_shift(&mesh, &Material::new(1e9, 0.3, 1000.0).unwrap());
 /// assert!((s + 1e-2 * 1e6).abs() < 1e-6);
 /// ```
+const SHIFT_COEFF: f64 = 0.5;
+
 pub fn default_shift(mesh: &TetMesh, mat: &Material) -> f64 {
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 3];
@@ -237,7 +239,7 @@ pub fn default_shift(mesh: &TetMesh, mat: &Material) -> f64 {
     let l = ext.iter().cloned().fold(0.0, f64::max);
     let t = ext.iter().cloned().filter(|&e| e > 0.0).fold(f64::INFINITY, f64::min);
     if !(l > 0.0) || !t.is_finite() {
-        return -1e-2 * mat.bar_speed_squared();
+        return -SHIFT_COEFF * mat.bar_speed_squared();
     }
-    -1e-2 * mat.bar_speed_squared() * t * t / (l * l * l * l)
+    -SHIFT_COEFF * mat.bar_speed_squared() * t * t / (l * l * l * l)
 }

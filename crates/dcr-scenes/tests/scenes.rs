@@ -1,0 +1,150 @@
+//! Scene regression tests: every paper §5.1 example shows its described effect with the
+//! distant collision response on and not with it off; runs are deterministic; the kinetic
+//! energy the responses inject stays below the energy the impacts dissipated.
+//!
+//! Short runs (each scene's `test_seconds`). Bases are baked once per test binary into
+//! `CARGO_TARGET_TMPDIR/bases` (rebaked only when stale, by content hash).
+//! Run with `cargo test --release -p dcr-scenes`.
+
+use std::path::PathBuf;
+use std::sync::OnceLock;
+
+use dcr_scenes::runner::{ensure_base, run_scene, MethodChoice, RunParams, RunReport};
+use dcr_scenes::scene::SceneDesc;
+use dcr_scenes::{repo_root, SCENES};
+
+fn bases() -> &'static PathBuf {
+    static BASES: OnceLock<PathBuf> = OnceLock::new();
+    BASES.get_or_init(|| {
+        let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("bases");
+        let root = repo_root();
+        for s in SCENES {
+            let desc = SceneDesc::read(&root.join("scenes").join(format!("{s}.json"))).expect("scene reads");
+            for e in &desc.elastic {
+                ensure_base(&root, &dir, e).expect("base bakes");
+            }
+        }
+        dir
+    })
+}
+
+fn scene(name: &str) -> SceneDesc {
+    SceneDesc::read(&repo_root().join("scenes").join(format!("{name}.json"))).expect("scene reads")
+}
+
+fn run(desc: &SceneDesc, dcr: bool, method: MethodChoice) -> RunReport {
+    run_scene(
+        desc,
+        &RunParams {
+            seconds: desc.test_seconds,
+            dcr,
+            method,
+            root: repo_root(),
+            bases_dir: bases().clone(),
+            out_dir: None,
+            progress: false,
+        },
+    )
+    .expect("scene runs")
+}
+
+fn outcome(r: &RunReport, name: &str) -> f64 {
+    r.outcomes.get(name).unwrap_or_else(|| panic!("{}: no outcome {name}", r.scene)).0
+}
+
+/// Runs a scene on and off, checks energy sanity on the "on" run, returns both.
+fn on_off(name: &str) -> (RunReport, RunReport) {
+    let desc = scene(name);
+    let on = run(&desc, true, MethodChoice::Scene);
+    let off = run(&desc, false, MethodChoice::Scene);
+    assert!(on.injected_ke.is_finite() && on.dissipated.is_finite());
+    assert!(
+        on.injected_ke <= on.dissipated,
+        "{name}: responses injected {} J, more than the {} J the impacts dissipated",
+        on.injected_ke,
+        on.dissipated
+    );
+    assert!(on.dissipated > 0.0, "{name}: no impact dissipated energy (no impacts detected?)");
+    assert_eq!(off.injected_ke, 0.0, "{name}: the off run must not inject anything");
+    (on, off)
+}
+
+/// Dinner: the pot's impact makes the plates jump more than 1 mm, only with the response.
+#[test]
+fn dinner_plates_lift_only_with_response() {
+    let (on, off) = on_off("dinner");
+    let (a, b) = (outcome(&on, "plates_max_lift"), outcome(&off, "plates_max_lift"));
+    assert!(a > 1.0, "plates lift {a} mm with the response (want > 1 mm)");
+    assert!(b < 0.1, "plates lift {b} mm without the response (want ~0)");
+    assert!(on.models[0].distant_contacts >= 20, "dinner: {} distant contacts", on.models[0].distant_contacts);
+}
+
+/// Roof: the wrench near its friction limit slides far more with the response.
+#[test]
+fn roof_wrench_slides_more_with_response() {
+    let (on, off) = on_off("roof");
+    let (a, b) = (outcome(&on, "wrench_slide"), outcome(&off, "wrench_slide"));
+    assert!(a > 5.0 && a > 10.0 * b, "wrench slides {a} mm on vs {b} mm off");
+    assert!(on.models[0].queries >= 2, "the toolbox should hit the roof at least twice (queries {})", on.models[0].queries);
+}
+
+/// Scaffold: tools on the top deck jump only with the response; with spatial attenuation
+/// the lower deck's response shrinks as β grows (more local).
+#[test]
+fn scaffold_tools_jump_and_attenuation_localises() {
+    let (on, off) = on_off("scaffold");
+    let (a, b) = (outcome(&on, "top_tools_max_lift"), outcome(&off, "top_tools_max_lift"));
+    assert!(a > 1.0 && b < 0.1, "top tools lift {a} mm on vs {b} mm off");
+    let desc = scene("scaffold");
+    let low = |beta: f64| {
+        let r = run(&desc, true, MethodChoice::AttenuationBeta(beta));
+        outcome(&r, "ladder_max_lift")
+    };
+    let (l05, l2) = (low(0.5), low(2.0));
+    assert!(l05 > l2, "ladder (lower deck) lift β=0.5 {l05} mm should exceed β=2 {l2} mm");
+}
+
+/// Low-rider: the post stacked on another topples only with the response.
+#[test]
+fn lowrider_top_post_topples_only_with_response() {
+    let (on, off) = on_off("lowrider");
+    let (a, b) = (outcome(&on, "top_post_tilt"), outcome(&off, "top_post_tilt"));
+    assert!(a > 45.0, "top post tilts {a}° with the response (want topple, > 45°)");
+    assert!(b < 5.0, "top post tilts {b}° without the response (want upright)");
+    assert!(outcome(&on, "cones_max_lift") > outcome(&off, "cones_max_lift"));
+}
+
+/// Rockfall: rocks balanced on the cliff fall only with the response.
+#[test]
+fn rockfall_rocks_fall_only_with_response() {
+    let (on, off) = on_off("rockfall");
+    let (a, b) = (outcome(&on, "rocks_fallen"), outcome(&off, "rocks_fallen"));
+    assert!(a >= 1.0, "{a} rocks fell with the response");
+    assert_eq!(b, 0.0, "{b} rocks fell without the response");
+}
+
+/// Washing: floor → fridge → plant: the fridge's model receives the floor's responses as
+/// impacts and the leaves sway more with the response.
+#[test]
+fn washing_leaves_sway_through_fridge_only_with_response() {
+    let (on, off) = on_off("washing");
+    let fridge = on.models.iter().find(|m| m.model == "fridge").expect("fridge model");
+    assert!(fridge.stats.chained_impacts > 0, "the fridge received no impacts from the floor's responses");
+    assert!(fridge.queries > 0);
+    let (a, b) = (outcome(&on, "leaves_sway_range"), outcome(&off, "leaves_sway_range"));
+    assert!(a > 0.1 && a > 10.0 * b, "leaves sway {a}° on vs {b}° off");
+    assert!(outcome(&on, "bottles_max_tilt") > outcome(&off, "bottles_max_tilt"));
+}
+
+/// Determinism: the same scene run twice gives bit-identical trajectories (on and off).
+#[test]
+fn same_scene_twice_gives_same_trajectory() {
+    for name in ["dinner", "washing"] {
+        let desc = scene(name);
+        for dcr in [true, false] {
+            let a = run(&desc, dcr, MethodChoice::Scene);
+            let b = run(&desc, dcr, MethodChoice::Scene);
+            assert_eq!(a.trajectory_hash, b.trajectory_hash, "{name} dcr {dcr}: trajectories differ");
+        }
+    }
+}
