@@ -34,4 +34,6 @@ pub fn repo_root() -> PathBuf {
 }
 
 /// The six scenes of the paper's §5.1, in Table 1 order.
-pub const SCENES: [&str; 6] = ["dinner", "roof", "scaffold", "lowrider", "rockfall", "washing"];
+pub const SCENES: [&str; 6] = [
+    "dinner", "roof", "scaffold", "lowrider", "rockfall", "washing",
+];

@@ -10,7 +10,10 @@ use dcr_scenes::scene::SceneDesc;
 use dcr_scenes::{repo_root, SCENES};
 
 #[derive(Parser)]
-#[command(name = "dcr-scenes", about = "The paper's Table 1 scenes, headless on rapier3d-f64")]
+#[command(
+    name = "dcr-scenes",
+    about = "The paper's Table 1 scenes, headless on rapier3d-f64"
+)]
 struct Cli {
     #[command(subcommand)]
     cmd: Cmd,
@@ -82,10 +85,22 @@ fn real_main() -> Result<()> {
     let cli = Cli::parse();
     let root = repo_root();
     match cli.cmd {
-        Cmd::Run { scene, seconds, dcr, method, beta, out, bases } => {
+        Cmd::Run {
+            scene,
+            seconds,
+            dcr,
+            method,
+            beta,
+            out,
+            bases,
+        } => {
             let path = scene_path(&root, &scene);
             if !path.exists() {
-                bail!("no scene {scene:?} ({} does not exist; scenes: {})", path.display(), SCENES.join(", "));
+                bail!(
+                    "no scene {scene:?} ({} does not exist; scenes: {})",
+                    path.display(),
+                    SCENES.join(", ")
+                );
             }
             let desc = SceneDesc::read(&path)?;
             let method = match (method, beta) {
@@ -112,7 +127,13 @@ fn real_main() -> Result<()> {
                     progress: true,
                 },
             )?;
-            println!("{} dcr {} ({} steps): {}", report.scene, if report.dcr { "on" } else { "off" }, report.steps, out_dir.display());
+            println!(
+                "{} dcr {} ({} steps): {}",
+                report.scene,
+                if report.dcr { "on" } else { "off" },
+                report.steps,
+                out_dir.display()
+            );
             for (k, (v, u)) in &report.outcomes {
                 println!("  {k:28} {v:10.3} {u}");
             }
@@ -137,7 +158,12 @@ fn real_main() -> Result<()> {
             );
             println!("  trajectory {}", report.trajectory_hash);
         }
-        Cmd::Table1 { json, seconds, scenes, bases } => {
+        Cmd::Table1 {
+            json,
+            seconds,
+            scenes,
+            bases,
+        } => {
             let scenes = scenes.unwrap_or_else(|| SCENES.iter().map(|s| s.to_string()).collect());
             for s in &scenes {
                 if !SCENES.contains(&s.as_str()) {

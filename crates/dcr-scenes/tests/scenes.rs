@@ -19,7 +19,8 @@ fn bases() -> &'static PathBuf {
         let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("bases");
         let root = repo_root();
         for s in SCENES {
-            let desc = SceneDesc::read(&root.join("scenes").join(format!("{s}.json"))).expect("scene reads");
+            let desc = SceneDesc::read(&root.join("scenes").join(format!("{s}.json")))
+                .expect("scene reads");
             for e in &desc.elastic {
                 ensure_base(&root, &dir, e).expect("base bakes");
             }
@@ -49,7 +50,10 @@ fn run(desc: &SceneDesc, dcr: bool, method: MethodChoice) -> RunReport {
 }
 
 fn outcome(r: &RunReport, name: &str) -> f64 {
-    r.outcomes.get(name).unwrap_or_else(|| panic!("{}: no outcome {name}", r.scene)).0
+    r.outcomes
+        .get(name)
+        .unwrap_or_else(|| panic!("{}: no outcome {name}", r.scene))
+        .0
 }
 
 /// Runs a scene on and off, checks energy sanity on the "on" run, returns both.
@@ -64,8 +68,14 @@ fn on_off(name: &str) -> (RunReport, RunReport) {
         on.injected_ke,
         on.dissipated
     );
-    assert!(on.dissipated > 0.0, "{name}: no impact dissipated energy (no impacts detected?)");
-    assert_eq!(off.injected_ke, 0.0, "{name}: the off run must not inject anything");
+    assert!(
+        on.dissipated > 0.0,
+        "{name}: no impact dissipated energy (no impacts detected?)"
+    );
+    assert_eq!(
+        off.injected_ke, 0.0,
+        "{name}: the off run must not inject anything"
+    );
     (on, off)
 }
 
@@ -73,10 +83,20 @@ fn on_off(name: &str) -> (RunReport, RunReport) {
 #[test]
 fn dinner_plates_lift_only_with_response() {
     let (on, off) = on_off("dinner");
-    let (a, b) = (outcome(&on, "plates_max_lift"), outcome(&off, "plates_max_lift"));
-    assert!(a > 1.0, "plates lift {a} mm with the response (want > 1 mm)");
+    let (a, b) = (
+        outcome(&on, "plates_max_lift"),
+        outcome(&off, "plates_max_lift"),
+    );
+    assert!(
+        a > 1.0,
+        "plates lift {a} mm with the response (want > 1 mm)"
+    );
     assert!(b < 0.1, "plates lift {b} mm without the response (want ~0)");
-    assert!(on.models[0].distant_contacts >= 20, "dinner: {} distant contacts", on.models[0].distant_contacts);
+    assert!(
+        on.models[0].distant_contacts >= 20,
+        "dinner: {} distant contacts",
+        on.models[0].distant_contacts
+    );
 }
 
 /// Roof: the wrench near its friction limit slides far more with the response.
@@ -84,8 +104,15 @@ fn dinner_plates_lift_only_with_response() {
 fn roof_wrench_slides_more_with_response() {
     let (on, off) = on_off("roof");
     let (a, b) = (outcome(&on, "wrench_slide"), outcome(&off, "wrench_slide"));
-    assert!(a > 5.0 && a > 10.0 * b, "wrench slides {a} mm on vs {b} mm off");
-    assert!(on.models[0].queries >= 2, "the toolbox should hit the roof at least twice (queries {})", on.models[0].queries);
+    assert!(
+        a > 5.0 && a > 10.0 * b,
+        "wrench slides {a} mm on vs {b} mm off"
+    );
+    assert!(
+        on.models[0].queries >= 2,
+        "the toolbox should hit the roof at least twice (queries {})",
+        on.models[0].queries
+    );
 }
 
 /// Scaffold: tools on the top deck jump only with the response; with spatial attenuation
@@ -93,7 +120,10 @@ fn roof_wrench_slides_more_with_response() {
 #[test]
 fn scaffold_tools_jump_and_attenuation_localises() {
     let (on, off) = on_off("scaffold");
-    let (a, b) = (outcome(&on, "top_tools_max_lift"), outcome(&off, "top_tools_max_lift"));
+    let (a, b) = (
+        outcome(&on, "top_tools_max_lift"),
+        outcome(&off, "top_tools_max_lift"),
+    );
     assert!(a > 1.0 && b < 0.1, "top tools lift {a} mm on vs {b} mm off");
     let desc = scene("scaffold");
     let low = |beta: f64| {
@@ -101,16 +131,28 @@ fn scaffold_tools_jump_and_attenuation_localises() {
         outcome(&r, "ladder_max_lift")
     };
     let (l05, l2) = (low(0.5), low(2.0));
-    assert!(l05 > l2, "ladder (lower deck) lift β=0.5 {l05} mm should exceed β=2 {l2} mm");
+    assert!(
+        l05 > l2,
+        "ladder (lower deck) lift β=0.5 {l05} mm should exceed β=2 {l2} mm"
+    );
 }
 
 /// Low-rider: the post stacked on another topples only with the response.
 #[test]
 fn lowrider_top_post_topples_only_with_response() {
     let (on, off) = on_off("lowrider");
-    let (a, b) = (outcome(&on, "top_post_tilt"), outcome(&off, "top_post_tilt"));
-    assert!(a > 45.0, "top post tilts {a}° with the response (want topple, > 45°)");
-    assert!(b < 5.0, "top post tilts {b}° without the response (want upright)");
+    let (a, b) = (
+        outcome(&on, "top_post_tilt"),
+        outcome(&off, "top_post_tilt"),
+    );
+    assert!(
+        a > 45.0,
+        "top post tilts {a}° with the response (want topple, > 45°)"
+    );
+    assert!(
+        b < 5.0,
+        "top post tilts {b}° without the response (want upright)"
+    );
     assert!(outcome(&on, "cones_max_lift") > outcome(&off, "cones_max_lift"));
 }
 
@@ -128,10 +170,20 @@ fn rockfall_rocks_fall_only_with_response() {
 #[test]
 fn washing_leaves_sway_through_fridge_only_with_response() {
     let (on, off) = on_off("washing");
-    let fridge = on.models.iter().find(|m| m.model == "fridge").expect("fridge model");
-    assert!(fridge.stats.chained_impacts > 0, "the fridge received no impacts from the floor's responses");
+    let fridge = on
+        .models
+        .iter()
+        .find(|m| m.model == "fridge")
+        .expect("fridge model");
+    assert!(
+        fridge.stats.chained_impacts > 0,
+        "the fridge received no impacts from the floor's responses"
+    );
     assert!(fridge.queries > 0);
-    let (a, b) = (outcome(&on, "leaves_sway_range"), outcome(&off, "leaves_sway_range"));
+    let (a, b) = (
+        outcome(&on, "leaves_sway_range"),
+        outcome(&off, "leaves_sway_range"),
+    );
     assert!(a > 0.1 && a > 10.0 * b, "leaves sway {a}° on vs {b}° off");
     assert!(outcome(&on, "bottles_max_tilt") > outcome(&off, "bottles_max_tilt"));
 }
@@ -144,7 +196,33 @@ fn same_scene_twice_gives_same_trajectory() {
         for dcr in [true, false] {
             let a = run(&desc, dcr, MethodChoice::Scene);
             let b = run(&desc, dcr, MethodChoice::Scene);
-            assert_eq!(a.trajectory_hash, b.trajectory_hash, "{name} dcr {dcr}: trajectories differ");
+            assert_eq!(
+                a.trajectory_hash, b.trajectory_hash,
+                "{name} dcr {dcr}: trajectories differ"
+            );
+        }
+    }
+}
+
+/// Every scene file parses, names existing meshes, builds a world and records bodies.
+#[test]
+fn every_scene_file_builds() {
+    let root = repo_root();
+    for name in SCENES {
+        let desc = scene(name);
+        assert_eq!(desc.name, name);
+        let built = dcr_scenes::scene::build_world(&desc, &root).expect("world builds");
+        assert_eq!(built.elastic_body.len(), desc.elastic.len());
+        assert!(
+            built.bodies.iter().filter(|b| b.dynamic).count() >= 2,
+            "{name}: too few dynamic bodies"
+        );
+        for e in &desc.elastic {
+            assert!(
+                root.join(&e.mesh).exists(),
+                "{name}: missing mesh {}",
+                e.mesh
+            );
         }
     }
 }

@@ -48,8 +48,8 @@ pub enum GeodesicError {
     Factorization(String),
 }
 
-/// Simplicial vs supernodal choice for the shared symbolic factorisation.
-const SUPERNODAL: SupernodalThreshold = SupernodalThreshold::FORCE_SUPERNODAL;
+/// Simplicial factors: measured faster to solve than supernodal ones on ~5k-vertex surfaces.
+const SUPERNODAL: SupernodalThreshold = SupernodalThreshold::FORCE_SIMPLICIAL;
 
 struct Factor {
     values: Vec<f64>,
@@ -91,6 +91,14 @@ impl HeatGeodesic {
     /// [`GeodesicError`] for an empty surface, bad indices, degenerate triangles, or a failed
     /// factorisation (e.g. unused vertices).
     pub fn new(vertices: &[[f64; 3]], triangles: &[[u32; 3]]) -> Result<Self, GeodesicError> {
+        Self::with_threshold(vertices, triangles, SUPERNODAL)
+    }
+
+    pub(crate) fn with_threshold(
+        vertices: &[[f64; 3]],
+        triangles: &[[u32; 3]],
+        threshold: SupernodalThreshold,
+    ) -> Result<Self, GeodesicError> {
         let n = vertices.len();
         if n == 0 || triangles.is_empty() {
             return Err(GeodesicError::Empty);
@@ -166,7 +174,7 @@ impl HeatGeodesic {
             Side::Lower,
             Default::default(),
             CholeskySymbolicParams {
-                supernodal_flop_ratio_threshold: SUPERNODAL,
+                supernodal_flop_ratio_threshold: threshold,
                 ..Default::default()
             },
         )
@@ -201,6 +209,11 @@ impl HeatGeodesic {
             solve_req,
             mean_edge,
         })
+    }
+
+    /// Stored values of the Cholesky factor (fill), for diagnostics.
+    pub fn factor_len(&self) -> usize {
+        self.symbolic.len_val()
     }
 
     /// Number of vertices.

@@ -32,6 +32,7 @@ pub struct ContactCache {
     remap_tolerance: f64,
     /// Number of mappings computed (first sights and re-maps).
     pub misses: u64,
+    generation: u64,
 }
 
 impl ContactCache {
@@ -46,7 +47,14 @@ impl ContactCache {
             m,
             remap_tolerance,
             misses: 0,
+            generation: 0,
         }
+    }
+
+    /// Incremented whenever a slot's content changes (mapping, re-mapping, eviction): equal
+    /// generations and slot lists mean every row read from the cache is unchanged.
+    pub fn generation(&self) -> u64 {
+        self.generation
     }
 
     /// Number of live cached contacts.
@@ -114,6 +122,7 @@ impl ContactCache {
 
     fn map_into(&mut self, model: &ModalModel, s: u32, point: [f64; 3], max_distance: f64) {
         self.misses += 1;
+        self.generation += 1;
         let sp = model.project(point, max_distance);
         let c = &mut self.slots[s as usize];
         c.query = point;
@@ -130,6 +139,7 @@ impl ContactCache {
         for (s, c) in self.slots.iter_mut().enumerate() {
             if c.live && step.saturating_sub(c.last_seen) > u64::from(after) {
                 c.live = false;
+                self.generation += 1;
                 self.map.remove(&c.id);
                 self.free.push(s as u32);
                 on_evict(s as u32);
@@ -139,6 +149,7 @@ impl ContactCache {
 
     /// Forgets every contact (storage is kept).
     pub fn clear(&mut self) {
+        self.generation += 1;
         self.map.clear();
         self.free.clear();
         for (s, c) in self.slots.iter_mut().enumerate().rev() {

@@ -29,7 +29,12 @@ pub struct AdapterParams {
 
 impl Default for AdapterParams {
     fn default() -> Self {
-        AdapterParams { enabled: true, fresh_steps: 2, settle_steps: 3, restitution: 0.15 }
+        AdapterParams {
+            enabled: true,
+            fresh_steps: 2,
+            settle_steps: 3,
+            restitution: 0.15,
+        }
     }
 }
 
@@ -117,7 +122,11 @@ pub struct DcrAdapter {
 }
 
 fn body_kin(rb: &RigidBody) -> Kin {
-    Kin { linvel: rb.linvel(), angvel: rb.angvel(), com: rb.center_of_mass() }
+    Kin {
+        linvel: rb.linvel(),
+        angvel: rb.angvel(),
+        com: rb.center_of_mass(),
+    }
 }
 
 fn vel_at(k: &Kin, p: Vector) -> Vector {
@@ -150,8 +159,12 @@ impl DcrAdapter {
         let mut slots = Vec::new();
         for (i, response) in responses.into_iter().enumerate() {
             let body = world.elastic_body[i];
-            let mut colliders: Vec<ColliderHandle> =
-                world.collider_body.iter().filter(|(_, &b)| b == body).map(|(&c, _)| c).collect();
+            let mut colliders: Vec<ColliderHandle> = world
+                .collider_body
+                .iter()
+                .filter(|(_, &b)| b == body)
+                .map(|(&c, _)| c)
+                .collect();
             colliders.sort_by_key(|c| c.into_raw_parts());
             slots.push(Slot {
                 body,
@@ -159,7 +172,10 @@ impl DcrAdapter {
                 response,
                 threshold: thresholds[i],
                 gain: gains[i],
-                stats: ModelStats { name: names[i].clone(), ..Default::default() },
+                stats: ModelStats {
+                    name: names[i].clone(),
+                    ..Default::default()
+                },
                 ages: HashMap::new(),
                 impacts: Vec::new(),
                 resting: Vec::new(),
@@ -167,7 +183,12 @@ impl DcrAdapter {
                 chained: Vec::new(),
             });
         }
-        DcrAdapter { params, slots, step: 0, pre: vec![Kin::default(); world.bodies.len()] }
+        DcrAdapter {
+            params,
+            slots,
+            step: 0,
+            pre: vec![Kin::default(); world.bodies.len()],
+        }
     }
 
     /// Records every body's velocity before `step()` (for the dissipated-energy estimate).
@@ -199,15 +220,20 @@ impl DcrAdapter {
             }
             slot.stats.impacts += slot.impacts.len();
             slot.stats.impact_impulse += slot.impacts.iter().map(|i| i.impulse).sum::<f64>();
-            let Some(resp) = slot.response.as_mut() else { continue };
+            let Some(resp) = slot.response.as_mut() else {
+                continue;
+            };
             let tq = Instant::now();
             let responses = resp.step(&slot.impacts, &slot.resting);
             let q_us = tq.elapsed().as_secs_f64() * 1e6;
             slot.stats.query_us.push(q_us);
             slot.stats.query_resting.push(slot.resting.len());
             // Copy out what we need (the response buffer borrows `resp`).
-            let resps: Vec<(u64, [f64; 3], f64)> =
-                responses.iter().filter(|r| r.mapped && r.delta_v > 0.0).map(|r| (r.id, r.normal, r.delta_v)).collect();
+            let resps: Vec<(u64, [f64; 3], f64)> = responses
+                .iter()
+                .filter(|r| r.mapped && r.delta_v > 0.0)
+                .map(|r| (r.id, r.normal, r.delta_v))
+                .collect();
             let elastic_pose = *built.world.bodies[built.bodies[slot.body].handle].position();
             let gain = slot.gain;
             let sources = std::mem::take(&mut slot.sources);
@@ -245,7 +271,9 @@ impl DcrAdapter {
         // Group by body, in response order (deterministic: responses follow the resting order).
         let mut before: HashMap<usize, (Kin, f64)> = HashMap::new();
         for &(id, normal, dv) in resps {
-            let Some(src) = sources.get(&id) else { continue };
+            let Some(src) = sources.get(&id) else {
+                continue;
+            };
             maxdv = maxdv.max(dv);
             applied += 1;
             if !self.params.enabled {
@@ -254,7 +282,9 @@ impl DcrAdapter {
             let handle = built.bodies[src.body].handle;
             let n = elastic_pose.rotation * vecf(normal);
             let rb = &mut built.world.bodies[handle];
-            let entry = before.entry(src.body).or_insert_with(|| (body_kin(rb), ke(rb)));
+            let entry = before
+                .entry(src.body)
+                .or_insert_with(|| (body_kin(rb), ke(rb)));
             let start = entry.0;
             // One Gauss–Seidel pass: only the Δv not yet produced at this point by the
             // impulses already applied to this body this step (see docs/scenes.md).
@@ -267,7 +297,11 @@ impl DcrAdapter {
             let mp = rb.mass_properties();
             let inv_mass = mp.effective_inv_mass.x;
             let ii = mp.effective_world_inv_inertia;
-            let inv_i = [[ii.m11, ii.m12, ii.m13], [ii.m12, ii.m22, ii.m23], [ii.m13, ii.m23, ii.m33]];
+            let inv_i = [
+                [ii.m11, ii.m12, ii.m13],
+                [ii.m12, ii.m22, ii.m23],
+                [ii.m13, ii.m23, ii.m33],
+            ];
             let r = src.world_point - rb.center_of_mass();
             let m_eff = effective_mass(inv_mass, inv_i, arr(r), arr(n));
             let j = vecf(response_impulse(m_eff, need, arr(n)));
@@ -314,22 +348,46 @@ impl DcrAdapter {
         for &ec in &slot.colliders {
             for pair in world.narrow_phase.contact_pairs_with(ec) {
                 let e_is_1 = pair.collider1 == ec;
-                let other = if e_is_1 { pair.collider2 } else { pair.collider1 };
-                let Some(&ob) = built.collider_body.get(&other) else { continue };
+                let other = if e_is_1 {
+                    pair.collider2
+                } else {
+                    pair.collider1
+                };
+                let Some(&ob) = built.collider_body.get(&other) else {
+                    continue;
+                };
                 if ob == slot.body {
                     continue;
                 }
                 let other_dynamic = built.bodies[ob].dynamic;
-                let Some(oc) = world.colliders.get(other) else { continue };
+                let Some(oc) = world.colliders.get(other) else {
+                    continue;
+                };
                 let oc_pose = *oc.position();
+                let Some(ecol) = world.colliders.get(ec) else {
+                    continue;
+                };
+                // The elastic collider's pose in the object (body) frame: fixed, so the
+                // elastic-side contact point maps into the base's frame without any lag.
+                let ec_in_obj = e_pose.inv_mul(ecol.position());
                 for (mi, m) in pair.solver_manifolds().iter().enumerate() {
-                    let sub_other = if e_is_1 { m.subshape_pos2() } else { m.subshape_pos1() };
+                    let (sub_other, sub_e) = if e_is_1 {
+                        (m.subshape_pos2(), m.subshape_pos1())
+                    } else {
+                        (m.subshape_pos1(), m.subshape_pos2())
+                    };
                     // Outward normal of the elastic object, world frame.
-                    let n_out = if e_is_1 { m.data.normal } else { -m.data.normal };
+                    let n_out = if e_is_1 {
+                        m.data.normal
+                    } else {
+                        -m.data.normal
+                    };
                     for sc in m.data.solver_contacts.iter() {
                         let raw = sc.contact_id[0];
                         let idx = (raw & !NEW_CONTACT_BIT) as usize;
-                        let Some(pt) = m.points.get(idx) else { continue };
+                        let Some(pt) = m.points.get(idx) else {
+                            continue;
+                        };
                         let lam = pt.data.impulse;
                         // The point on the other body's surface, riding with that body.
                         let local = if e_is_1 { pt.local_p2 } else { pt.local_p1 };
@@ -338,30 +396,65 @@ impl DcrAdapter {
                             None => local,
                         };
                         let world_point = oc_pose.transform_point(local);
-                        let key = contact_key(pair.collider1, pair.collider2, (m.subshape1, m.subshape2), idx as u32 | (mi as u32) << 16);
-                        let age = slot.ages.entry(key).or_insert(ContactAge { first_step: step, last_step: step, fired: false });
+                        // The point on the elastic object's surface, in its frame: where the
+                        // impulse acted on the base (pre-integration geometry, body-fixed).
+                        let local_e = if e_is_1 { pt.local_p1 } else { pt.local_p2 };
+                        let local_e = match sub_e {
+                            Some(sp) => sp.transform_point(local_e),
+                            None => local_e,
+                        };
+                        let p_obj = ec_in_obj.transform_point(local_e);
+                        let key = contact_key(
+                            pair.collider1,
+                            pair.collider2,
+                            (m.subshape1, m.subshape2),
+                            idx as u32 | (mi as u32) << 16,
+                        );
+                        let age = slot.ages.entry(key).or_insert(ContactAge {
+                            first_step: step,
+                            last_step: step,
+                            fired: false,
+                        });
                         if age.last_step + 1 < step {
                             // Lost for a while and back: a new contact.
-                            *age = ContactAge { first_step: step, last_step: step, fired: false };
+                            *age = ContactAge {
+                                first_step: step,
+                                last_step: step,
+                                fired: false,
+                            };
                         }
                         age.last_step = step;
                         let fresh = step >= params.settle_steps
                             && age.first_step >= params.settle_steps
                             && step - age.first_step <= params.fresh_steps
                             && !age.fired;
-                        let p_obj = e_pose.inverse_transform_point(world_point);
                         if fresh && lam >= slot.threshold {
                             age.fired = true;
                             let dir = e_pose.rotation.inverse() * (-n_out);
-                            slot.impacts.push(Impact { point: arr(p_obj), direction: arr(dir), impulse: lam });
+                            slot.impacts.push(Impact {
+                                point: arr(p_obj),
+                                direction: arr(dir),
+                                impulse: lam,
+                            });
                             // Dissipated energy estimate: ½ λ v⁻ (1 − e) with the pre-step
                             // approach speed at the point.
-                            let vrel = vel_at(&self.pre[ob], world_point) - vel_at(&e_pre, world_point);
+                            let vrel =
+                                vel_at(&self.pre[ob], world_point) - vel_at(&e_pre, world_point);
                             let approach = (-vrel.dot(n_out)).max(0.0);
-                            slot.stats.dissipated += 0.5 * lam * approach * (1.0 - params.restitution);
+                            slot.stats.dissipated +=
+                                0.5 * lam * approach * (1.0 - params.restitution);
                         } else if other_dynamic && lam > 0.0 {
-                            slot.resting.push(RestingContact { id: key, point: arr(p_obj) });
-                            slot.sources.insert(key, RestingSource { body: ob, world_point });
+                            slot.resting.push(RestingContact {
+                                id: key,
+                                point: arr(p_obj),
+                            });
+                            slot.sources.insert(
+                                key,
+                                RestingSource {
+                                    body: ob,
+                                    world_point,
+                                },
+                            );
                         }
                     }
                 }

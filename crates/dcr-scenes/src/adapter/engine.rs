@@ -2,6 +2,7 @@
 //! in one place so the rest of the crate names one module.
 
 pub use dcr_runtime::{
-    effective_mass, response_impulse, AmplitudeKind, AttenuationLaw, AttenuationParams, ContactResponse,
-    DistanceKind, DistantResponse, Impact, Method, ModalModel, ResponseParams, RestingContact,
+    effective_mass, response_impulse, AmplitudeKind, AttenuationLaw, AttenuationParams,
+    ContactResponse, DistanceKind, DistantResponse, Impact, Method, ModalModel, ResponseParams,
+    RestingContact,
 };

@@ -11,7 +11,11 @@ use crate::scene::ElasticDesc;
 /// The bake parameters of an elastic object (material, modes, fixed groups, Rayleigh).
 pub fn bake_params(e: &ElasticDesc) -> BakeParams {
     BakeParams {
-        material: MaterialSi { youngs: e.material.youngs, poisson: e.material.poisson, density: e.material.density },
+        material: MaterialSi {
+            youngs: e.material.youngs,
+            poisson: e.material.poisson,
+            density: e.material.density,
+        },
         modes: ModeRequest::Count(e.modes),
         fixed: e.fixed.clone(),
         rayleigh: e.rayleigh,
@@ -30,7 +34,8 @@ pub fn base_path(bases_dir: &Path, e: &ElasticDesc) -> PathBuf {
 /// # Errors
 /// Mesh or bake failures, with the mesh path.
 pub fn ensure_base(root: &Path, bases_dir: &Path, e: &ElasticDesc) -> Result<(PathBuf, bool)> {
-    std::fs::create_dir_all(bases_dir).with_context(|| format!("creating {}", bases_dir.display()))?;
+    std::fs::create_dir_all(bases_dir)
+        .with_context(|| format!("creating {}", bases_dir.display()))?;
     let mesh = root.join(&e.mesh);
     let params = bake_params(e);
     let out = base_path(bases_dir, e);
@@ -39,7 +44,13 @@ pub fn ensure_base(root: &Path, bases_dir: &Path, e: &ElasticDesc) -> Result<(Pa
     if fresh {
         return Ok((out, false));
     }
-    eprintln!("[dcr-scenes] baking {} ({} modes, fixed {:?}) -> {}", e.name, e.modes, e.fixed, out.display());
+    eprintln!(
+        "[dcr-scenes] baking {} ({} modes, fixed {:?}) -> {}",
+        e.name,
+        e.modes,
+        e.fixed,
+        out.display()
+    );
     let t = std::time::Instant::now();
     let report = modal_bake::bake::bake_file(&mesh, &params, &out, &mut |_| {})
         .with_context(|| format!("baking {}", mesh.display()))?;

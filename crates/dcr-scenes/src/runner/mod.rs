@@ -7,7 +7,7 @@ mod run;
 mod table1;
 mod trajectory;
 
-pub use bases::{base_path, bake_params, ensure_base};
+pub use bases::{bake_params, base_path, ensure_base};
 pub use outcomes::{measure_outcome, unit_of};
 pub use run::{run_scene, MethodChoice, ModelReport, RunParams, RunReport};
 pub use table1::{paper_rows, table1, PaperRow, Table1Params};

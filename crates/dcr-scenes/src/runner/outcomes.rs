@@ -35,11 +35,15 @@ pub fn unit_of(kind: &str) -> &'static str {
 
 /// Measures `o` on `traj`. `None` if no body matches or the kind is unknown.
 pub fn measure_outcome(o: &OutcomeDesc, traj: &Trajectory) -> Option<f64> {
-    let bodies: Vec<usize> = (0..traj.names.len()).filter(|&b| name_matches(&o.bodies, &traj.names[b])).collect();
+    let bodies: Vec<usize> = (0..traj.names.len())
+        .filter(|&b| name_matches(&o.bodies, &traj.names[b]))
+        .collect();
     if bodies.is_empty() || traj.rows() == 0 {
         return None;
     }
-    let rows: Vec<usize> = (0..traj.rows()).filter(|&k| traj.time[k] >= o.after).collect();
+    let rows: Vec<usize> = (0..traj.rows())
+        .filter(|&k| traj.time[k] >= o.after)
+        .collect();
     let last = traj.rows() - 1;
     let mut best: f64 = 0.0;
     match o.kind.as_str() {
@@ -67,7 +71,10 @@ pub fn measure_outcome(o: &OutcomeDesc, traj: &Trajectory) -> Option<f64> {
             }
         }
         "max_sway" => {
-            let rel = o.relative_to.as_ref().and_then(|r| traj.names.iter().position(|n| n == r));
+            let rel = o
+                .relative_to
+                .as_ref()
+                .and_then(|r| traj.names.iter().position(|n| n == r));
             for &b in &bodies {
                 let q0 = match rel {
                     Some(r) => qmul(qconj(traj.rot(0, r)), traj.rot(0, b)),
@@ -85,7 +92,10 @@ pub fn measure_outcome(o: &OutcomeDesc, traj: &Trajectory) -> Option<f64> {
         "sway_range" => {
             // Range (max − min) over time of the signed hinge-free rotation angle of each body
             // relative to `relative_to`, measured from its start; constant sag drops out.
-            let rel = o.relative_to.as_ref().and_then(|r| traj.names.iter().position(|n| n == r));
+            let rel = o
+                .relative_to
+                .as_ref()
+                .and_then(|r| traj.names.iter().position(|n| n == r));
             for &b in &bodies {
                 let relq = |k: usize| match rel {
                     Some(r) => qmul(qconj(traj.rot(k, r)), traj.rot(k, b)),
@@ -107,7 +117,10 @@ pub fn measure_outcome(o: &OutcomeDesc, traj: &Trajectory) -> Option<f64> {
             }
         }
         "count_fallen" => {
-            let n = bodies.iter().filter(|&&b| traj.pos(0, b)[1] - traj.pos(last, b)[1] > o.threshold).count();
+            let n = bodies
+                .iter()
+                .filter(|&&b| traj.pos(0, b)[1] - traj.pos(last, b)[1] > o.threshold)
+                .count();
             best = n as f64;
         }
         "count_moved" => {
@@ -115,7 +128,9 @@ pub fn measure_outcome(o: &OutcomeDesc, traj: &Trajectory) -> Option<f64> {
                 .iter()
                 .filter(|&&b| {
                     let (p0, p) = (traj.pos(0, b), traj.pos(last, b));
-                    ((p[0] - p0[0]).powi(2) + (p[1] - p0[1]).powi(2) + (p[2] - p0[2]).powi(2)).sqrt() > o.threshold
+                    ((p[0] - p0[0]).powi(2) + (p[1] - p0[1]).powi(2) + (p[2] - p0[2]).powi(2))
+                        .sqrt()
+                        > o.threshold
                 })
                 .count();
             best = n as f64;

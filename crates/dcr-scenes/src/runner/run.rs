@@ -4,12 +4,12 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+use crate::adapter::engine::{
+    AmplitudeKind, AttenuationLaw, AttenuationParams, DistanceKind, DistantResponse, Method,
+    ModalModel, ResponseParams,
+};
 use anyhow::{bail, Context, Result};
 use dcr_runtime::format::ModesFile;
-use crate::adapter::engine::{
-    AmplitudeKind, AttenuationLaw, AttenuationParams, DistanceKind, DistantResponse, Method, ModalModel,
-    ResponseParams,
-};
 use ndarray::{Array1, Array2};
 use ndarray_npy::NpzWriter;
 use rapier3d_f64::math::Vector;
@@ -131,14 +131,21 @@ fn percentile(v: &[f64], p: f64) -> Option<f64> {
 
 fn attenuation_of(e: &ElasticDesc, choice: &MethodChoice) -> Option<(f64, f64, String, String)> {
     let from = |m: &MethodDesc| match m {
-        MethodDesc::Attenuation { c, beta, distance, amplitude } => Some((*c, *beta, distance.clone(), amplitude.clone())),
+        MethodDesc::Attenuation {
+            c,
+            beta,
+            distance,
+            amplitude,
+        } => Some((*c, *beta, distance.clone(), amplitude.clone())),
         MethodDesc::Modal => None,
     };
     let own = from(&e.method).or_else(|| e.attenuation.as_ref().and_then(from));
     match choice {
         MethodChoice::Scene => from(&e.method),
         MethodChoice::Modal => None,
-        MethodChoice::Attenuation => Some(own.unwrap_or((1.0, 1.0, "heat".into(), "per_vertex".into()))),
+        MethodChoice::Attenuation => {
+            Some(own.unwrap_or((1.0, 1.0, "heat".into(), "per_vertex".into())))
+        }
         MethodChoice::AttenuationBeta(b) => {
             let (c, _, d, a) = own.unwrap_or((1.0, 1.0, "heat".into(), "per_vertex".into()));
             Some((c, *b, d, a))
@@ -147,13 +154,20 @@ fn attenuation_of(e: &ElasticDesc, choice: &MethodChoice) -> Option<(f64, f64, S
 }
 
 /// Surface-vertex indices of the base whose volume node is in mesh group `group`.
-fn group_surface_vertices(root: &Path, e: &ElasticDesc, base: &ModesFile, group: &str) -> Result<Vec<u32>> {
+fn group_surface_vertices(
+    root: &Path,
+    e: &ElasticDesc,
+    base: &ModesFile,
+    group: &str,
+) -> Result<Vec<u32>> {
     let mesh = modal_bake::mesh::read_mesh(&root.join(&e.mesh))?;
     let Some(nodes) = mesh.groups.get(group) else {
         bail!("elastic object {}: mesh has no group {group:?}", e.name);
     };
     let set: std::collections::BTreeSet<u32> = nodes.iter().map(|&n| n as u32).collect();
-    Ok((0..base.surface_to_volume.len() as u32).filter(|&i| set.contains(&base.surface_to_volume[i as usize])).collect())
+    Ok((0..base.surface_to_volume.len() as u32)
+        .filter(|&i| set.contains(&base.surface_to_volume[i as usize]))
+        .collect())
 }
 
 /// Runs `desc` headless and, if `params.out_dir` is set, writes `trajectory.npz`,
@@ -171,7 +185,8 @@ pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
     let mut infos = Vec::new();
     for e in &desc.elastic {
         let (path, _) = ensure_base(&params.root, &params.bases_dir, e)?;
-        let base = ModesFile::read(&path).with_context(|| format!("reading base {}", path.display()))?;
+        let base =
+            ModesFile::read(&path).with_context(|| format!("reading base {}", path.display()))?;
         let att = attenuation_of(e, &params.method);
         let method = match &att {
             None => Method::Modal,
@@ -183,7 +198,12 @@ pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
                 let amplitude = match amplitude.as_str() {
                     "per_vertex" => AmplitudeKind::PerVertex,
                     "mean" => AmplitudeKind::Mean,
-                    group => AmplitudeKind::MeanOver(group_surface_vertices(&params.root, e, &base, group)?),
+                    group => AmplitudeKind::MeanOver(group_surface_vertices(
+                        &params.root,
+                        e,
+                        &base,
+                        group,
+                    )?),
                 };
                 Method::Attenuation(AttenuationParams {
                     law: AttenuationLaw::Simplified { c: *c, beta: *beta },
@@ -198,7 +218,8 @@ pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
             Some((c, b, d, a)) => format!("attenuation C={c} beta={b} {d} {a}"),
         };
         let response = if params.dcr {
-            let model = ModalModel::load(&path).map_err(|err| anyhow::anyhow!("loading {}: {err}", path.display()))?;
+            let model = ModalModel::load(&path)
+                .map_err(|err| anyhow::anyhow!("loading {}: {err}", path.display()))?;
             let rp = ResponseParams {
                 h: desc.h,
                 impact_threshold: e.impact_threshold,
@@ -206,7 +227,10 @@ pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
                 method,
                 ..ResponseParams::default()
             };
-            Some(DistantResponse::new(model, rp).map_err(|err| anyhow::anyhow!("response of {}: {err}", e.name))?)
+            Some(
+                DistantResponse::new(model, rp)
+                    .map_err(|err| anyhow::anyhow!("response of {}: {err}", e.name))?,
+            )
         } else {
             None
         };
@@ -214,7 +238,14 @@ pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
             Some(r) => (Some(r.substep()), Some(r.samples_per_step())),
             None => (None, None),
         };
-        infos.push((base.num_surface_vertices(), base.surface_triangles.len(), base.num_modes(), method_name, t, sps));
+        infos.push((
+            base.num_surface_vertices(),
+            base.surface_triangles.len(),
+            base.num_modes(),
+            method_name,
+            t,
+            sps,
+        ));
         responses.push(response);
     }
     let thresholds: Vec<f64> = desc.elastic.iter().map(|e| e.impact_threshold).collect();
@@ -226,25 +257,38 @@ pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
         &thresholds,
         &gains,
         &names,
-        AdapterParams { enabled: params.dcr, restitution: desc.restitution, ..AdapterParams::default() },
+        AdapterParams {
+            enabled: params.dcr,
+            restitution: desc.restitution,
+            ..AdapterParams::default()
+        },
     );
 
     // Drivers.
     let mut drivers = Vec::new();
     for d in &desc.drivers {
-        let b = built.body_index(&d.body).with_context(|| format!("driver: no body {}", d.body))?;
+        let b = built
+            .body_index(&d.body)
+            .with_context(|| format!("driver: no body {}", d.body))?;
         drivers.push((b, d.clone()));
     }
 
     // Recording.
-    let rec: Vec<usize> = (0..built.bodies.len()).filter(|&i| built.bodies[i].dynamic).collect();
-    let mut traj = Trajectory { names: rec.iter().map(|&i| built.bodies[i].name.clone()).collect(), ..Default::default() };
+    let rec: Vec<usize> = (0..built.bodies.len())
+        .filter(|&i| built.bodies[i].dynamic)
+        .collect();
+    let mut traj = Trajectory {
+        names: rec.iter().map(|&i| built.bodies[i].name.clone()).collect(),
+        ..Default::default()
+    };
     let record = |built: &crate::scene::BuiltWorld, traj: &mut Trajectory, t: f64| {
         traj.time.push(t);
         for &i in &rec {
             let p = built.world.bodies[built.bodies[i].handle].position();
-            traj.positions.extend([p.translation.x, p.translation.y, p.translation.z]);
-            traj.rotations.extend([p.rotation.x, p.rotation.y, p.rotation.z, p.rotation.w]);
+            traj.positions
+                .extend([p.translation.x, p.translation.y, p.translation.z]);
+            traj.rotations
+                .extend([p.rotation.x, p.rotation.y, p.rotation.z, p.rotation.w]);
         }
     };
     record(&built, &mut traj, 0.0);
@@ -266,7 +310,10 @@ pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
             let mut j = Vector::new(d.impulse[0], d.impulse[1], d.impulse[2]);
             if let Some(ax) = d.rotate_axis {
                 let axis = Vector::new(ax[0], ax[1], ax[2]).normalize();
-                let q = rapier3d_f64::math::Rotation::from_axis_angle(axis, std::f64::consts::TAU * d.hz * (t - d.start));
+                let q = rapier3d_f64::math::Rotation::from_axis_angle(
+                    axis,
+                    std::f64::consts::TAU * d.hz * (t - d.start),
+                );
                 j = q * j;
             }
             let rb = &mut built.world.bodies[built.bodies[*b].handle];
@@ -339,7 +386,11 @@ pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
         models,
         rapier_ms,
         adapter_ms,
-        dcr_share_of_step: if rapier_ms > 0.0 { adapter_ms / rapier_ms } else { 0.0 },
+        dcr_share_of_step: if rapier_ms > 0.0 {
+            adapter_ms / rapier_ms
+        } else {
+            0.0
+        },
         trajectory: traj,
     };
 
@@ -352,7 +403,13 @@ pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
         npz.add_array("adapter_us", &Array1::from(adapter_us.clone()))?;
         for m in &report.models {
             let q = &m.stats.query_us;
-            let arr = Array2::from_shape_vec((q.len(), 2), q.iter().zip(&m.stats.query_resting).flat_map(|(a, b)| [*a, *b as f64]).collect())?;
+            let arr = Array2::from_shape_vec(
+                (q.len(), 2),
+                q.iter()
+                    .zip(&m.stats.query_resting)
+                    .flat_map(|(a, b)| [*a, *b as f64])
+                    .collect(),
+            )?;
             npz.add_array(format!("query_us_resting_{}", m.model), &arr)?;
         }
         npz.finish()?;

@@ -85,14 +85,38 @@ pub fn table1(p: &Table1Params) -> Result<(String, Value)> {
     let mut text = String::new();
     text.push_str(&format!(
         "{:9} {:8} {:>12} {:>13} {:>9} {:>6} {:>15} {:>10} {:>22} {:>8}\n",
-        "scene", "model", "vertices", "triangles", "modes", "h", "T (s)", "contacts", "query ms med/p99", "share"
+        "scene",
+        "model",
+        "vertices",
+        "triangles",
+        "modes",
+        "h",
+        "T (s)",
+        "contacts",
+        "query ms med/p99",
+        "share"
     ));
-    text.push_str(&format!("{:9} {:8} {:>12} {:>13} {:>9} {:>6} {:>15} {:>10} {:>22} {:>8}\n", "", "", "ours/paper", "ours/paper", "", "", "ours/paper", "ours/paper", "ours (paper mean)", "of step"));
+    text.push_str(&format!(
+        "{:9} {:8} {:>12} {:>13} {:>9} {:>6} {:>15} {:>10} {:>22} {:>8}\n",
+        "",
+        "",
+        "ours/paper",
+        "ours/paper",
+        "",
+        "",
+        "ours/paper",
+        "ours/paper",
+        "ours (paper mean)",
+        "of step"
+    ));
     let mut outcome_lines = String::new();
     for name in &p.scenes {
         let desc = SceneDesc::read(&p.root.join("scenes").join(format!("{name}.json")))?;
         let run = |dcr: bool, method: MethodChoice| -> Result<RunReport> {
-            eprintln!("[dcr-scenes] table1: {name} dcr {}", if dcr { "on" } else { "off" });
+            eprintln!(
+                "[dcr-scenes] table1: {name} dcr {}",
+                if dcr { "on" } else { "off" }
+            );
             run_scene(
                 &desc,
                 &RunParams {
@@ -133,16 +157,25 @@ pub fn table1(p: &Table1Params) -> Result<(String, Value)> {
         if name == "scaffold" {
             for &beta in &p.scaffold_betas {
                 let r = run(true, MethodChoice::AttenuationBeta(beta))?;
-                let outs: BTreeMap<_, _> = r.outcomes.iter().map(|(k, (v, u))| (k.clone(), json!({"value": v, "unit": u}))).collect();
+                let outs: BTreeMap<_, _> = r
+                    .outcomes
+                    .iter()
+                    .map(|(k, (v, u))| (k.clone(), json!({"value": v, "unit": u})))
+                    .collect();
                 for (k, (v, u)) in &r.outcomes {
-                    outcome_lines.push_str(&format!("  {:9} {:28} attenuation beta {beta}: {v:.3} {u}\n", name, k));
+                    outcome_lines.push_str(&format!(
+                        "  {:9} {:28} attenuation beta {beta}: {v:.3} {u}\n",
+                        name, k
+                    ));
                 }
                 let m = &r.models[0];
                 extra.push(json!({"beta": beta, "outcomes": outs, "query_us_median": m.query_us_median, "query_us_p99": m.query_us_p99}));
             }
         }
         for m in &on.models {
-            let pr = paper.iter().find(|r| r.scene == name.as_str() && r.model == m.model);
+            let pr = paper
+                .iter()
+                .find(|r| r.scene == name.as_str() && r.model == m.model);
             text.push_str(&format!(
                 "{:9} {:8} {:>12} {:>13} {:>9} {:>6} {:>15} {:>10} {:>22} {:>7.1}%\n",
                 name,
@@ -151,7 +184,11 @@ pub fn table1(p: &Table1Params) -> Result<(String, Value)> {
                 format!("{}/{}", m.surface_triangles, pr.map_or(0, |r| r.triangles)),
                 format!("{}/{}", m.modes, pr.map_or(0, |r| r.modes)),
                 on.h,
-                format!("{}/{:.1e}", fmt_opt(m.iir_t, 1.0, 6), pr.map_or(0.0, |r| r.t)),
+                format!(
+                    "{}/{:.1e}",
+                    fmt_opt(m.iir_t, 1.0, 6),
+                    pr.map_or(0.0, |r| r.t)
+                ),
                 format!("{}/{}", m.distant_contacts, pr.map_or(0, |r| r.contacts)),
                 format!(
                     "{}/{} ({})",

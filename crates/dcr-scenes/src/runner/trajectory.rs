@@ -29,13 +29,22 @@ impl Trajectory {
     /// Position of body `b` at row `k`.
     pub fn pos(&self, k: usize, b: usize) -> [f64; 3] {
         let i = (k * self.names.len() + b) * 3;
-        [self.positions[i], self.positions[i + 1], self.positions[i + 2]]
+        [
+            self.positions[i],
+            self.positions[i + 1],
+            self.positions[i + 2],
+        ]
     }
 
     /// Rotation (x, y, z, w) of body `b` at row `k`.
     pub fn rot(&self, k: usize, b: usize) -> [f64; 4] {
         let i = (k * self.names.len() + b) * 4;
-        [self.rotations[i], self.rotations[i + 1], self.rotations[i + 2], self.rotations[i + 3]]
+        [
+            self.rotations[i],
+            self.rotations[i + 1],
+            self.rotations[i + 2],
+            self.rotations[i + 3],
+        ]
     }
 
     /// `sha256:` of every recorded position and rotation bit pattern (determinism check).
@@ -55,11 +64,18 @@ impl Trajectory {
     pub fn write_npz(&self, path: &Path) -> Result<()> {
         let n = self.rows();
         let b = self.names.len();
-        let file = std::fs::File::create(path).with_context(|| format!("creating {}", path.display()))?;
+        let file =
+            std::fs::File::create(path).with_context(|| format!("creating {}", path.display()))?;
         let mut npz = NpzWriter::new(file);
         npz.add_array("time", &Array1::from(self.time.clone()))?;
-        npz.add_array("positions", &Array3::from_shape_vec((n, b, 3), self.positions.clone())?)?;
-        npz.add_array("rotations", &Array3::from_shape_vec((n, b, 4), self.rotations.clone())?)?;
+        npz.add_array(
+            "positions",
+            &Array3::from_shape_vec((n, b, 3), self.positions.clone())?,
+        )?;
+        npz.add_array(
+            "rotations",
+            &Array3::from_shape_vec((n, b, 4), self.rotations.clone())?,
+        )?;
         npz.finish()?;
         Ok(())
     }

@@ -4,7 +4,7 @@ mod scene_desc;
 mod world_builder;
 
 pub use scene_desc::{
-    name_matches, BodyKind, ColliderDesc, DriverDesc, ElasticDesc, JointDesc, MaterialDesc, MethodDesc,
-    OutcomeDesc, PoseDesc, PropDesc, SceneDesc, ShapeDesc,
+    name_matches, BodyKind, ColliderDesc, DriverDesc, ElasticDesc, JointDesc, MaterialDesc,
+    MethodDesc, OutcomeDesc, PoseDesc, PropDesc, SceneDesc, ShapeDesc,
 };
 pub use world_builder::{build_world, pose_from_desc, BodyInfo, BuiltWorld};

@@ -61,9 +61,6 @@ fn default_seconds() -> f64 {
 fn default_friction() -> f64 {
     0.6
 }
-fn default_one() -> usize {
-    1
-}
 
 /// A pose: translation (m) and rotation as a scaled axis in degrees.
 #[derive(Clone, Copy, Debug, Default, Serialize, Deserialize)]
@@ -368,9 +365,6 @@ pub struct OutcomeDesc {
     /// Only count what happens from this time on (s). Default 0.
     #[serde(default)]
     pub after: f64,
-    /// How many matches to require (tests): unused by the runner.
-    #[serde(default = "default_one")]
-    pub min_count: usize,
 }
 
 fn default_outcome_threshold() -> f64 {
@@ -384,14 +378,21 @@ impl SceneDesc {
     /// I/O or JSON errors, with the path.
     pub fn read(path: &std::path::Path) -> anyhow::Result<SceneDesc> {
         use anyhow::Context;
-        let text = std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
-        let desc: SceneDesc =
-            serde_json::from_str(&text).with_context(|| format!("parsing scene {}", path.display()))?;
+        let text =
+            std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+        let desc: SceneDesc = serde_json::from_str(&text)
+            .with_context(|| format!("parsing scene {}", path.display()))?;
         Ok(desc)
     }
 }
 
 /// Does `name` match `pattern` (exact, or prefix glob ending in `*`)?
+///
+/// ```
+/// use dcr_scenes::scene::name_matches;
+/// assert!(name_matches("plate*", "plate_3"));
+/// assert!(name_matches("pot", "pot") && !name_matches("pot", "pot_0"));
+/// ```
 pub fn name_matches(pattern: &str, name: &str) -> bool {
     match pattern.strip_suffix('*') {
         Some(prefix) => name.starts_with(prefix),

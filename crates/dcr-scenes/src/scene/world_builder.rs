@@ -5,8 +5,8 @@ use std::collections::HashMap;
 use std::path::Path;
 
 use anyhow::{bail, Context, Result};
-use rapier3d_f64::prelude::*;
 use rapier3d_f64::math::{Pose, Rotation, Vector};
+use rapier3d_f64::prelude::*;
 
 use super::scene_desc::{name_matches, BodyKind, ColliderDesc, PoseDesc, SceneDesc, ShapeDesc};
 
@@ -46,7 +46,10 @@ impl BuiltWorld {
 pub fn pose_from_desc(p: &PoseDesc) -> Pose {
     let r = p.rotation_deg;
     let axis = Vector::new(r[0].to_radians(), r[1].to_radians(), r[2].to_radians());
-    Pose::from_parts(Vector::new(p.translation[0], p.translation[1], p.translation[2]), Rotation::from_scaled_axis(axis))
+    Pose::from_parts(
+        Vector::new(p.translation[0], p.translation[1], p.translation[2]),
+        Rotation::from_scaled_axis(axis),
+    )
 }
 
 fn v3(a: [f64; 3]) -> Vector {
@@ -57,9 +60,18 @@ fn shape_builder(shape: &ShapeDesc) -> Result<ColliderBuilder> {
     Ok(match shape {
         ShapeDesc::Cuboid { half_extents: h } => ColliderBuilder::cuboid(h[0], h[1], h[2]),
         ShapeDesc::Ball { radius } => ColliderBuilder::ball(*radius),
-        ShapeDesc::Cylinder { half_height, radius } => ColliderBuilder::cylinder(*half_height, *radius),
-        ShapeDesc::Cone { half_height, radius } => ColliderBuilder::cone(*half_height, *radius),
-        ShapeDesc::Capsule { half_height, radius } => ColliderBuilder::capsule_y(*half_height, *radius),
+        ShapeDesc::Cylinder {
+            half_height,
+            radius,
+        } => ColliderBuilder::cylinder(*half_height, *radius),
+        ShapeDesc::Cone {
+            half_height,
+            radius,
+        } => ColliderBuilder::cone(*half_height, *radius),
+        ShapeDesc::Capsule {
+            half_height,
+            radius,
+        } => ColliderBuilder::capsule_y(*half_height, *radius),
         ShapeDesc::ConvexHull { points } => {
             let pts: Vec<Vector> = points.iter().map(|p| v3(*p)).collect();
             match ColliderBuilder::convex_hull(&pts) {
@@ -91,7 +103,10 @@ pub fn build_world(desc: &SceneDesc, root: &Path) -> Result<BuiltWorld> {
         let pose = pose_from_desc(&e.pose);
         let (rb, dynamic) = match &e.body {
             BodyKind::Static => (RigidBodyBuilder::fixed().pose(pose), false),
-            BodyKind::Dynamic { .. } => (RigidBodyBuilder::dynamic().pose(pose).can_sleep(false), true),
+            BodyKind::Dynamic { .. } => (
+                RigidBodyBuilder::dynamic().pose(pose).can_sleep(false),
+                true,
+            ),
         };
         let handle = world.insert_body(rb);
         let idx = bodies.len();
@@ -99,17 +114,27 @@ pub fn build_world(desc: &SceneDesc, root: &Path) -> Result<BuiltWorld> {
         match &e.colliders {
             None => {
                 if dynamic {
-                    bail!("elastic object {}: a dynamic body needs primitive `colliders`", e.name);
+                    bail!(
+                        "elastic object {}: a dynamic body needs primitive `colliders`",
+                        e.name
+                    );
                 }
                 let mesh_path = root.join(&e.mesh);
                 let mesh = modal_bake::mesh::read_mesh(&mesh_path)
                     .with_context(|| format!("reading mesh {}", mesh_path.display()))?;
                 let (_, tris) = modal_bake::bake::extract_surface(&mesh);
                 let verts: Vec<Vector> = mesh.nodes.iter().map(|p| v3(*p)).collect();
-                let idx_tris: Vec<[u32; 3]> = tris.iter().map(|t| [t[0] as u32, t[1] as u32, t[2] as u32]).collect();
-                let b = ColliderBuilder::trimesh_with_flags(verts.clone(), idx_tris.clone(), TriMeshFlags::FIX_INTERNAL_EDGES)
-                    .or_else(|_| ColliderBuilder::trimesh(verts, idx_tris))
-                    .map_err(|err| anyhow::anyhow!("trimesh of {}: {err:?}", e.name))?;
+                let idx_tris: Vec<[u32; 3]> = tris
+                    .iter()
+                    .map(|t| [t[0] as u32, t[1] as u32, t[2] as u32])
+                    .collect();
+                let b = ColliderBuilder::trimesh_with_flags(
+                    verts.clone(),
+                    idx_tris.clone(),
+                    TriMeshFlags::FIX_INTERNAL_EDGES,
+                )
+                .or_else(|_| ColliderBuilder::trimesh(verts, idx_tris))
+                .map_err(|err| anyhow::anyhow!("trimesh of {}: {err:?}", e.name))?;
                 builders.push(b);
             }
             Some(cs) => {
@@ -119,20 +144,36 @@ pub fn build_world(desc: &SceneDesc, root: &Path) -> Result<BuiltWorld> {
                     BodyKind::Static => 1.0,
                 };
                 for c in cs {
-                    builders.push(shape_builder(&c.shape)?.position(pose_from_desc(&c.offset)).density(density));
+                    builders.push(
+                        shape_builder(&c.shape)?
+                            .position(pose_from_desc(&c.offset))
+                            .density(density),
+                    );
                 }
             }
         }
         for b in builders {
-            let ch = world.insert_collider(b.friction(e.friction).restitution(desc.restitution), Some(handle));
+            let ch = world.insert_collider(
+                b.friction(e.friction).restitution(desc.restitution),
+                Some(handle),
+            );
             collider_body.insert(ch, idx);
         }
-        bodies.push(BodyInfo { name: e.name.clone(), handle, elastic: Some(ei), dynamic });
+        bodies.push(BodyInfo {
+            name: e.name.clone(),
+            handle,
+            elastic: Some(ei),
+            dynamic,
+        });
         elastic_body.push(idx);
     }
 
     for p in &desc.props {
-        let vol: f64 = p.colliders.iter().map(collider_volume).sum::<Result<f64>>()?;
+        let vol: f64 = p
+            .colliders
+            .iter()
+            .map(collider_volume)
+            .sum::<Result<f64>>()?;
         if !(vol > 0.0 && p.mass > 0.0) {
             bail!("prop {}: mass and collider volume must be positive", p.name);
         }
@@ -141,7 +182,12 @@ pub fn build_world(desc: &SceneDesc, root: &Path) -> Result<BuiltWorld> {
             None => Pose::IDENTITY,
             Some(name) => {
                 let e = desc.elastic.iter().find(|e| &e.name == name);
-                let Some(e) = e else { bail!("prop {}: relative_to names no elastic object {name}", p.name) };
+                let Some(e) = e else {
+                    bail!(
+                        "prop {}: relative_to names no elastic object {name}",
+                        p.name
+                    )
+                };
                 pose_from_desc(&e.pose)
             }
         };
@@ -149,13 +195,21 @@ pub fn build_world(desc: &SceneDesc, root: &Path) -> Result<BuiltWorld> {
         let copies: Vec<([f64; 3], String)> = if p.copies.is_empty() {
             vec![([0.0; 3], p.name.clone())]
         } else {
-            p.copies.iter().enumerate().map(|(i, t)| (*t, format!("{}_{i}", p.name))).collect()
+            p.copies
+                .iter()
+                .enumerate()
+                .map(|(i, t)| (*t, format!("{}_{i}", p.name)))
+                .collect()
         };
         for (t, name) in copies {
             let mut pose = base;
             pose.translation += v3(t);
             let pose = frame * pose;
-            let rb = if p.fixed { RigidBodyBuilder::fixed() } else { RigidBodyBuilder::dynamic() };
+            let rb = if p.fixed {
+                RigidBodyBuilder::fixed()
+            } else {
+                RigidBodyBuilder::dynamic()
+            };
             let rb = rb
                 .pose(pose)
                 .linvel(v3(p.linvel))
@@ -174,14 +228,23 @@ pub fn build_world(desc: &SceneDesc, root: &Path) -> Result<BuiltWorld> {
                 let ch = world.insert_collider(b, Some(handle));
                 collider_body.insert(ch, idx);
             }
-            bodies.push(BodyInfo { name, handle, elastic: None, dynamic: !p.fixed });
+            bodies.push(BodyInfo {
+                name,
+                handle,
+                elastic: None,
+                dynamic: !p.fixed,
+            });
         }
     }
 
     for j in &desc.joints {
-        let i1 = bodies.iter().position(|b| b.name == j.body1).with_context(|| format!("joint: no body {}", j.body1))?;
-        let children: Vec<usize> =
-            (0..bodies.len()).filter(|&i| name_matches(&j.body2, &bodies[i].name)).collect();
+        let i1 = bodies
+            .iter()
+            .position(|b| b.name == j.body1)
+            .with_context(|| format!("joint: no body {}", j.body1))?;
+        let children: Vec<usize> = (0..bodies.len())
+            .filter(|&i| name_matches(&j.body2, &bodies[i].name))
+            .collect();
         if children.is_empty() {
             bail!("joint: no body matches {}", j.body2);
         }
@@ -206,5 +269,10 @@ pub fn build_world(desc: &SceneDesc, root: &Path) -> Result<BuiltWorld> {
         }
     }
 
-    Ok(BuiltWorld { world, bodies, collider_body, elastic_body })
+    Ok(BuiltWorld {
+        world,
+        bodies,
+        collider_body,
+        elastic_body,
+    })
 }

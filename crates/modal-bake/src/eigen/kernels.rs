@@ -13,42 +13,35 @@ use rayon::prelude::*;
 const SPMM_ROWS_PER_TASK: usize = 2048;
 
 /// `y = A x` for a symmetric `A` stored with both triangles (column `i` of the CSC arrays is
-/// read as row `i`). Each output entry is one sequential dot product: deterministic, and
-/// parallel over rows.
+/// read as row `i`). Each output entry is one sequential dot product over the sorted row
+/// indices: deterministic, parallel over fixed-size row chunks, no allocation.
 pub(crate) fn sym_spmm(a: &SparseColMat<usize, f64>, x: MatRef<'_, f64>, mut y: MatMut<'_, f64>) {
     let n = a.nrows();
-    let b = x.ncols();
-    assert!(x.nrows() == n && y.nrows() == n && y.ncols() == b);
+    assert!(x.nrows() == n && y.nrows() == n && y.ncols() == x.ncols());
     let (ptr, rows, vals) = (a.symbolic().col_ptr(), a.symbolic().row_idx(), a.val());
-    // Row-major copy of x so one row's b entries are contiguous.
-    let mut xr = vec![0.0f64; n * b];
-    xr.par_chunks_mut(SPMM_ROWS_PER_TASK * b).enumerate().for_each(|(t, chunk)| {
-        let r0 = t * SPMM_ROWS_PER_TASK;
-        for (ri, row) in chunk.chunks_mut(b).enumerate() {
-            for (c, v) in row.iter_mut().enumerate() {
-                *v = x[(r0 + ri, c)];
+    for c in 0..x.ncols() {
+        let xc = x.col(c);
+        let xs: Vec<f64>;
+        let xs = match xc.try_as_col_major() {
+            Some(v) => v.as_slice(),
+            None => {
+                xs = xc.iter().copied().collect();
+                &xs
             }
-        }
-    });
-    let mut yr = vec![0.0f64; n * b];
-    yr.par_chunks_mut(SPMM_ROWS_PER_TASK * b).enumerate().for_each(|(t, chunk)| {
-        let r0 = t * SPMM_ROWS_PER_TASK;
-        for (ri, out) in chunk.chunks_mut(b).enumerate() {
-            let i = r0 + ri;
-            for p in ptr[i]..ptr[i + 1] {
-                let v = vals[p];
-                let xrow = &xr[rows[p] * b..rows[p] * b + b];
-                for (o, &xv) in out.iter_mut().zip(xrow) {
-                    *o += v * xv;
+        };
+        let mut yc = y.rb_mut().col_mut(c);
+        let ys = yc.rb_mut().try_as_col_major_mut().expect("contiguous output column").as_slice_mut();
+        ys.par_chunks_mut(SPMM_ROWS_PER_TASK).enumerate().for_each(|(t, chunk)| {
+            let r0 = t * SPMM_ROWS_PER_TASK;
+            for (ri, out) in chunk.iter_mut().enumerate() {
+                let i = r0 + ri;
+                let mut acc = 0.0;
+                for p in ptr[i]..ptr[i + 1] {
+                    acc += vals[p] * xs[rows[p]];
                 }
+                *out = acc;
             }
-        }
-    });
-    for c in 0..b {
-        let col = y.rb_mut().col_mut(c);
-        for (i, v) in col.iter_mut().enumerate() {
-            *v = yr[i * b + c];
-        }
+        });
     }
 }
 

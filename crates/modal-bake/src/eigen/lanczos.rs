@@ -5,6 +5,7 @@ use std::f64::consts::PI;
 use std::time::Instant;
 
 use faer::sparse::SparseColMat;
+use faer::linalg::triangular_solve::solve_lower_triangular_in_place;
 use faer::{Accum, Mat, MatMut, MatRef, Par};
 
 use super::kernels::{gemm, lower_inverse, small_cholesky, sym_eig, sym_spmm, SplitMix64};
@@ -32,8 +33,7 @@ pub(crate) fn solve(
     check_input(k, m, params)?;
     let sigma = params.shift;
     let lam_lim = params.max_freq_hz.map(|f| (2.0 * PI * f).powi(2));
-    let threads = if params.threads == 0 { 2 } else { params.threads };
-    let par = Par::rayon(threads);
+    let par = Par::rayon(params.threads);
     let mut info = EigenInfo { shift: sigma, ..Default::default() };
     if params.nev == 0 && lam_lim.is_none() {
         return Ok(EigenResult {
@@ -69,8 +69,9 @@ pub(crate) fn solve(
     let mut rng = SplitMix64(params.seed);
     let mut solve_buf = fac.solve_buffer(b);
 
+    let mut z = Mat::<f64>::zeros(n, b);
+    let mut mz = Mat::<f64>::zeros(n, b);
     {
-        let mut z = Mat::<f64>::zeros(n, b);
         for j in 0..b {
             for i in 0..n {
                 z[(i, j)] = rng.next_sym();
@@ -79,7 +80,6 @@ pub(crate) fn solve(
         // Start in the range of T (z ← A⁻¹Mz): a random block is white noise whose
         // high-frequency content would otherwise survive in the Ritz vectors (Ericsson & Ruhe
         // 1980) and, amplified by K, dominate their residuals.
-        let mut mz = Mat::<f64>::zeros(n, b);
         sym_spmm(m, z.as_ref(), mz.as_mut());
         z.copy_from(&mz);
         fac.solve_in_place(z.as_mut(), &mut solve_buf);
@@ -97,10 +97,9 @@ pub(crate) fn solve(
     loop {
         // --- expand: Z = T W = A⁻¹ M W, M-orthogonalise against the basis ------------------
         let nb = kk + b;
-        let mut z = mv.as_ref().subcols(kk, b).to_owned();
+        z.copy_from(mv.as_ref().subcols(kk, b));
         fac.solve_in_place(z.as_mut(), &mut solve_buf);
         info.block_solves += 1;
-        let tp0 = Instant::now();
         let mut c = Mat::<f64>::zeros(nb, b);
         for _pass in 0..2 {
             let mut cp = Mat::<f64>::zeros(nb, b);
@@ -109,7 +108,6 @@ pub(crate) fn solve(
             c += &cp;
         }
         h.as_mut().submatrix_mut(0, kk, nb, b).copy_from(&c);
-        let mut mz = Mat::<f64>::zeros(n, b);
         sym_spmm(m, z.as_ref(), mz.as_mut());
         let pre: Vec<f64> = (0..b)
             .map(|j| {
@@ -132,7 +130,6 @@ pub(crate) fn solve(
         h.as_mut().submatrix_mut(nb, kk, b, b).copy_from(&r);
         kk = nb;
         info.iterations += 1;
-        let tp1 = Instant::now();
         info.krylov_dim = info.krylov_dim.max(kk);
 
         // --- Rayleigh–Ritz on H = VᵀMTV ----------------------------------------------------
@@ -171,10 +168,8 @@ pub(crate) fn solve(
             }
         };
         let conv = est.iter().take(wanted.min(kk)).filter(|&&e| e <= params.tol).count();
-        if std::env::var("DCR_DBG").is_ok() { eprintln!("it {} kk {} est {:?}", info.iterations, kk, est.iter().take(wanted.min(kk)).map(|e| format!("{e:.0e}")).collect::<Vec<_>>()); }
         progress(EigenProgress { converged: conv, requested: wanted, iteration: info.iterations });
 
-        if std::env::var("DCR_DBG").is_ok() { eprintln!("orth {:.3}s rr {:.3}s", (tp1 - tp0).as_secs_f64(), tp1.elapsed().as_secs_f64()); }
         let ready = wanted <= kk
             && est.iter().take(wanted).all(|&e| e <= trigger)
             && (lam_lim.is_none() || capped || below < kk);
@@ -183,7 +178,6 @@ pub(crate) fn solve(
             let sel = select_cols(s_asc.as_ref(), &order[..wanted.min(kk)]);
             let (vals, u, res) = finalize(k, m, &fac, v.as_ref().subcols(0, kk), mv.as_ref().subcols(0, kk), sel.as_ref(), sigma, par)?;
             let worst = res.iter().map(|r| r.rel).fold(0.0, f64::max);
-            if std::env::var("DCR_DBG").is_ok() { eprintln!("it {} check: vals {:?}\n res {:?}\n ratio {:?}\n est {:?}", info.iterations, &vals, res.iter().map(|r| format!("{:.1e}", r.rel)).collect::<Vec<_>>(), res.iter().map(|r| format!("{:.1}", r.rel / r.floor)).collect::<Vec<_>>(), &est[..wanted.min(kk)]); }
             let good = res.iter().filter(|r| r.converged(params.tol)).count();
             if good == res.len() && wanted <= kk {
                 info.solve_seconds = t1.elapsed().as_secs_f64();
@@ -278,10 +272,10 @@ fn check_input(
     Ok(())
 }
 
-/// Krylov basis size for `wanted` pairs: the parameter, or max(2·wanted, wanted + 3b), at
-/// least wanted + 2b, rounded up to a multiple of b.
+/// Krylov basis size for `wanted` pairs: the parameter, or wanted + max(wanted, 4b), at least
+/// wanted + 2b, rounded up to a multiple of b.
 fn krylov_dim(params: &EigenParams, wanted: usize, b: usize) -> usize {
-    let base = params.krylov_dim.unwrap_or_else(|| (2 * wanted).max(wanted + 3 * b));
+    let base = params.krylov_dim.unwrap_or_else(|| wanted + wanted.max(4 * b));
     let d = base.max(wanted + 2 * b);
     d.div_ceil(b) * b
 }
@@ -335,13 +329,9 @@ fn orthonormalize(
                 break;
             }
             let l = Mat::from_fn(b, b, |i, j| if i >= j { g[(i, j)] } else { 0.0 });
-            let li = lower_inverse(l.as_ref());
-            let mut tmp = Mat::<f64>::zeros(z.nrows(), b);
-            gemm(tmp.as_mut(), Accum::Replace, z.as_ref(), li.as_ref().transpose(), 1.0, par);
-            *z = tmp;
-            let mut tmp = Mat::<f64>::zeros(z.nrows(), b);
-            gemm(tmp.as_mut(), Accum::Replace, mz.as_ref(), li.as_ref().transpose(), 1.0, par);
-            *mz = tmp;
+            // z ← z L⁻ᵀ, i.e. zᵀ ← L⁻¹ zᵀ, in place.
+            solve_lower_triangular_in_place(l.as_ref(), z.as_mut().transpose_mut(), par);
+            solve_lower_triangular_in_place(l.as_ref(), mz.as_mut().transpose_mut(), par);
             r_total = l.transpose() * &r_total;
         }
         if ok {

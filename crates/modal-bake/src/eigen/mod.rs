@@ -23,12 +23,13 @@
 //! - The start block comes from a fixed-seed splitmix64 generator; each eigenvector is signed so
 //!   its entry of largest magnitude (first on ties) is positive.
 //!
-//! Determinism (measured on faer 0.24.4, see `tests/fem_eigen.rs`): the results are
-//! bit-identical across runs and across rayon pools of 1 and 2 threads. Our own kernels
-//! (sparse products, orthogonalisation bookkeeping) split work by a fixed chunk size, never by
-//! the thread count; the faer factorization, solves and dense products run with
-//! `Par::rayon(EigenParams::threads)` where the thread count is a parameter, not read from
-//! the pool (see [`EigenParams::threads`]).
+//! Determinism: the results are bit-identical across runs and across thread counts. Our own
+//! kernels (sparse products, Gram–Schmidt bookkeeping) split work by fixed chunk sizes, never by
+//! the thread count, and sum in a fixed order. faer 0.24.4's supernodal factorization, solves
+//! and dense products were measured to give bit-identical results with `Par::rayon(1)`, `(2)`
+//! and `(3)` and on rayon pools of 1 and 2 threads (`tests/fem_eigen.rs` guards the latter);
+//! the small dense eigensolves run with `Par::Seq`. Bits may differ between machines with
+//! different SIMD support (faer dispatches on CPU features at run time).
 
 mod kernels;
 mod lanczos;
@@ -52,10 +53,10 @@ pub struct EigenParams {
     /// positive definite. 0 suits clamped objects; free-free objects need σ < 0
     /// ([`default_shift`]).
     pub shift: f64,
-    /// Block size b: right-hand sides per factor solve (default 12).
+    /// Block size b: right-hand sides per factor solve (default 8).
     pub block: usize,
-    /// Maximum Krylov basis size before a thick restart; `None`: max(2·nev, nev + 3b) rounded
-    /// up to a multiple of b.
+    /// Maximum Krylov basis size before a thick restart; `None`: nev + max(nev, 4b), rounded
+    /// up to a multiple of b (grown automatically in max-frequency mode).
     pub krylov_dim: Option<usize>,
     /// Tolerance on the relative residual (see the module docs), default 1e-10.
     pub tol: f64,
@@ -64,8 +65,8 @@ pub struct EigenParams {
     /// Cap on the number of modes returned in max-frequency mode (default 2000).
     pub max_modes: usize,
     /// Threads given to faer's factorization, solves and dense products as `Par::rayon(n)`;
-    /// 0 (default) means 2. The split of work depends on this number only, so results are
-    /// bit-identical on pools of any size for a fixed value.
+    /// 0 (default): the current rayon pool's size. Results do not depend on it (measured:
+    /// bit-identical for 1, 2 and 3 threads on faer 0.24.4; `tests/fem_eigen.rs` guards it).
     pub threads: usize,
     /// Seed of the start block.
     pub seed: u64,
@@ -77,7 +78,7 @@ impl Default for EigenParams {
             nev: 20,
             max_freq_hz: None,
             shift: 0.0,
-            block: 12,
+            block: 8,
             krylov_dim: None,
             tol: 1e-10,
             max_iters: 300,

@@ -97,17 +97,12 @@ impl ShiftInvert {
 
     /// Overwrites every column of `rhs` with A⁻¹ rhs.
     pub fn solve_in_place(&self, rhs: MatMut<'_, f64>, mem: &mut MemBuffer) {
-        let t = std::time::Instant::now();
-        let nc = rhs.ncols();
         LltRef::new(&self.symbolic, &self.values).solve_in_place_with_conj(
             Conj::No,
             rhs,
             self.par,
             MemStack::new(mem),
         );
-        if std::env::var("DCR_DBG").is_ok() {
-            eprintln!("solve {nc} cols {:.3}s", t.elapsed().as_secs_f64());
-        }
     }
 
     /// Scratch buffer for solves of up to `ncols` right-hand sides.

@@ -1,0 +1,91 @@
+//! Timing of the bake's numerical core on clamped structured beams: assembly of K and M, the
+//! factorization of K − σM and the shift-invert block Lanczos eigensolve.
+//!
+//! `cargo run --release -p modal-bake --example eigen_timing -- [sizes...] [--nev N] [--reps R]`
+//! with sizes among `3k 15k 100k` (default: all three). Prints one CSV row per run and a
+//! median summary per size. Speed is measured here, never asserted in tests.
+
+use std::time::Instant;
+
+use modal_bake::eigen::{solve_lowest, EigenParams};
+use modal_bake::fem::{assemble_mass, assemble_stiffness, reduce_fixed, Material};
+use modal_bake::mesh::TetMesh;
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(|a, b| a.total_cmp(b));
+    v[v.len() / 2]
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let mut sizes = Vec::new();
+    let mut nev = 20usize;
+    let mut reps = 0usize;
+    let mut block = EigenParams::default().block;
+    let mut i = 0;
+    while i < args.len() {
+        match args[i].as_str() {
+            "--nev" => {
+                nev = args[i + 1].parse().expect("--nev N");
+                i += 1;
+            }
+            "--reps" => {
+                reps = args[i + 1].parse().expect("--reps R");
+                i += 1;
+            }
+            "--block" => {
+                block = args[i + 1].parse().expect("--block B");
+                i += 1;
+            }
+            s => sizes.push(s.to_string()),
+        }
+        i += 1;
+    }
+    if sizes.is_empty() {
+        sizes = vec!["3k".into(), "15k".into(), "100k".into()];
+    }
+    let mat = Material::new(2.0e9, 0.3, 1200.0).unwrap();
+    println!("size,free_dofs,assembly_s,factor_s,eigensolve_s,total_s,block_solves,factor_nnz,f1_hz");
+    for size in &sizes {
+        // L = 1 m beams with a 0.1 m square section, clamped at x = 0.
+        let cells = match size.as_str() {
+            "3k" => [40, 4, 4],
+            "15k" => [60, 8, 8],
+            "100k" => [120, 16, 16],
+            other => panic!("unknown size {other} (3k, 15k, 100k)"),
+        };
+        let reps = if reps > 0 { reps } else if size == "100k" { 3 } else { 5 };
+        let mesh = TetMesh::structured_box(cells, [1.0, 0.1, 0.1]);
+        let (mut ta, mut tf, mut te, mut tt) = (vec![], vec![], vec![], vec![]);
+        for _ in 0..reps {
+            let t0 = Instant::now();
+            let k = assemble_stiffness(&mesh, &mat);
+            let m = assemble_mass(&mesh, &mat, false);
+            let (_, k, m) = reduce_fixed(&k, &m, &mesh.groups["xmin"]).unwrap();
+            let assembly = t0.elapsed().as_secs_f64();
+            let p = EigenParams { nev, block, ..Default::default() };
+            let res = solve_lowest(&k, &m, &p, &mut |_| {}).expect("eigensolve");
+            let total = t0.elapsed().as_secs_f64();
+            println!(
+                "{size},{},{assembly:.4},{:.4},{:.4},{total:.4},{},{},{:.4}",
+                k.nrows(),
+                res.info.factor_seconds,
+                res.info.solve_seconds,
+                res.info.block_solves,
+                res.info.factor_nnz,
+                res.frequencies_hz()[0]
+            );
+            ta.push(assembly);
+            tf.push(res.info.factor_seconds);
+            te.push(res.info.solve_seconds);
+            tt.push(total);
+        }
+        println!(
+            "# {size} median of {reps}: assembly {:.3} s, factor {:.3} s, eigensolve {:.3} s, total {:.3} s",
+            median(ta),
+            median(tf),
+            median(te),
+            median(tt)
+        );
+    }
+}

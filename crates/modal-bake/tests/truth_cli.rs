@@ -1,0 +1,74 @@
+//! End-to-end tests of `modal-bake truth` (needs the `Truth` subcommand wired in
+//! `src/cli/mod.rs`): probe's JSON shape, the two methods agree, clear errors on bad input.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn data(rel: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data").join(rel)
+}
+
+fn truth(extra: &[&str]) -> Output {
+    let beam = data("meshes/beam.msh");
+    let mut a = vec![
+        "truth",
+        beam.to_str().unwrap(),
+        "--fixed",
+        "clamp",
+        "--impact",
+        "1.0,0.05,0.1",
+        "--impulse",
+        "1",
+        "--contact",
+        "0.5,0.05,0.1",
+        "--contact",
+        "0.8,0.0,0.05",
+        "--h",
+        "0.002",
+        "--dt",
+        "2e-6",
+    ];
+    a.extend_from_slice(extra);
+    Command::new(env!("CARGO_BIN_EXE_modal-bake")).args(&a).output().expect("modal-bake runs")
+}
+
+fn peaks(out: &Output) -> Vec<f64> {
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON on stdout");
+    let cs = v["contacts"].as_array().expect("contacts");
+    assert_eq!(cs.len(), 2);
+    for c in cs {
+        for k in ["point", "triangle", "bary", "distance_m", "peak_displacement_m", "delta_v_mps"] {
+            assert!(!c[k].is_null(), "missing {k} in {c}");
+        }
+        let p = c["peak_displacement_m"].as_f64().unwrap();
+        let dv = c["delta_v_mps"].as_f64().unwrap();
+        assert!((dv - p / 0.002).abs() <= 1e-12 * dv.abs());
+    }
+    cs.iter().map(|c| c["peak_displacement_m"].as_f64().unwrap()).collect()
+}
+
+#[test]
+fn truth_json_methods_agree() {
+    let a = peaks(&truth(&["--json"]));
+    let b = peaks(&truth(&["--json", "--method", "modal-all"]));
+    for (x, y) in a.iter().zip(&b) {
+        assert!(*y > 0.0 && ((x - y) / y).abs() < 0.01, "newmark {x} vs modal-all {y}");
+    }
+}
+
+#[test]
+fn truth_rejects_bad_input_with_a_clear_message() {
+    for (extra, needle) in [
+        (&["--fixed", "nope"][..], "no node group named"),
+        (&["--dt", "0"][..], "--dt"),
+        (&["--modes", "5"][..], "--method modal-all"),
+        (&["--impulse", "nan"][..], "impulse"),
+    ] {
+        let out = truth(extra);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{extra:?} succeeded");
+        assert!(err.contains(needle), "{extra:?}: {err}");
+        assert!(!err.contains("panicked"), "{extra:?}: {err}");
+    }
+}
