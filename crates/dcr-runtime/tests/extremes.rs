@@ -9,8 +9,8 @@
 use std::sync::Arc;
 
 use dcr_runtime::{
-    damping_ratio, samples_per_step, testing, DistantResponse, Impact, ModalModel, ModeFilter, ParamsError,
-    ResponseParams, RestingContact, Sampling,
+    damping_ratio, samples_per_step, testing, DistantResponse, Impact, ModalModel, ModeFilter,
+    ParamsError, ResponseParams, RestingContact, Sampling,
 };
 
 const HIT: [f64; 3] = [0.5, 0.3, 0.0];
@@ -31,10 +31,16 @@ fn reference_peak(model: &ModalModel, rayleigh: [f64; 2], h: f64, t_req: f64, im
     let (mut r, mut w) = (vec![0.0; m], vec![0.0; m]);
     model.add_reduced_impulse(&sp, DOWN, impulse, &mut r);
     model.contact_row(&cp, &mut w);
-    let f: Vec<ModeFilter> = model.omega().iter().map(|&om| ModeFilter::new(om, damping_ratio(om, rayleigh), t)).collect();
+    let f: Vec<ModeFilter> = model
+        .omega()
+        .iter()
+        .map(|&om| ModeFilter::new(om, damping_ratio(om, rayleigh), t))
+        .collect();
     let mut peak = 0.0f64;
     for k in 1..=s {
-        let y: f64 = (0..m).map(|j| w[j] * r[j] * f[j].impulse_response(k as f64 * t)).sum();
+        let y: f64 = (0..m)
+            .map(|j| w[j] * r[j] * f[j].impulse_response(k as f64 * t))
+            .sum();
         peak = peak.max(y.abs());
     }
     peak
@@ -43,11 +49,22 @@ fn reference_peak(model: &ModalModel, rayleigh: [f64; 2], h: f64, t_req: f64, im
 fn run(params: ResponseParams, impulse: f64) -> f64 {
     let mut resp = DistantResponse::new(model(), params).unwrap();
     let out = resp.step(
-        &[Impact { point: HIT, direction: DOWN, impulse }],
-        &[RestingContact { id: 1, point: CONTACT }],
+        &[Impact {
+            point: HIT,
+            direction: DOWN,
+            impulse,
+        }],
+        &[RestingContact {
+            id: 1,
+            point: CONTACT,
+        }],
     );
     assert!(out[0].mapped);
-    assert!(out[0].peak_displacement.is_finite() && out[0].delta_v.is_finite(), "{:?}", out[0]);
+    assert!(
+        out[0].peak_displacement.is_finite() && out[0].delta_v.is_finite(),
+        "{:?}",
+        out[0]
+    );
     out[0].peak_displacement
 }
 
@@ -63,13 +80,21 @@ fn samples_per_step_up_to_1e5() {
     let h = 0.01;
     for ratio in [1.0, 3.0, 20.0, 1e3, 1e4, 1e5] {
         let t = h / ratio;
-        let p = ResponseParams { h, sampling: Sampling::Substep(t), ..Default::default() };
+        let p = ResponseParams {
+            h,
+            sampling: Sampling::Substep(t),
+            ..Default::default()
+        };
         let got = run(p, 2.0);
         let want = reference_peak(&model(), rayleigh, h, t, 2.0);
         assert!(want > 0.0);
         assert!(rel(got, want) <= 1e-9, "h/T = {ratio}: {got} vs {want}");
     }
-    let p = ResponseParams { h, sampling: Sampling::Substep(h / 2e6), ..Default::default() };
+    let p = ResponseParams {
+        h,
+        sampling: Sampling::Substep(h / 2e6),
+        ..Default::default()
+    };
     match DistantResponse::new(model(), p) {
         Err(ParamsError::TooManySamples { .. }) => {}
         other => panic!("expected TooManySamples, got {other:?}"),
@@ -85,21 +110,41 @@ fn damping_ratio_up_to_100() {
     let omega = m.omega().to_vec();
     let (wmin, wmax) = (omega[0], *omega.last().unwrap());
     let h = 0.01;
-    let undamped = run(ResponseParams { h, rayleigh: Some([0.0, 0.0]), ..Default::default() }, 2.0);
+    let undamped = run(
+        ResponseParams {
+            h,
+            rayleigh: Some([0.0, 0.0]),
+            ..Default::default()
+        },
+        2.0,
+    );
     let cases: Vec<[f64; 2]> = vec![
         [0.0, 0.0],
-        [0.0, 2.0 / omega[3]],         // mode 3 exactly critical (ξ = ½·α1·ω = 1)
-        [2.0 * wmin, 0.0],             // mode 0 critical via α0
-        [0.0, 200.0 / wmax],           // ξ = 100 at ω_max, ≥ 6 everywhere
-        [200.0 * wmin, 200.0 / wmax],  // ξ ≥ 100 for every mode
+        [0.0, 2.0 / omega[3]], // mode 3 exactly critical (ξ = ½·α1·ω = 1)
+        [2.0 * wmin, 0.0],     // mode 0 critical via α0
+        [0.0, 200.0 / wmax],   // ξ = 100 at ω_max, ≥ 6 everywhere
+        [200.0 * wmin, 200.0 / wmax], // ξ ≥ 100 for every mode
     ];
     for rayleigh in cases {
         let xis: Vec<f64> = omega.iter().map(|&w| damping_ratio(w, rayleigh)).collect();
-        let got = run(ResponseParams { h, rayleigh: Some(rayleigh), ..Default::default() }, 2.0);
+        let got = run(
+            ResponseParams {
+                h,
+                rayleigh: Some(rayleigh),
+                ..Default::default()
+            },
+            2.0,
+        );
         let t = Sampling::PaperT.period(wmax);
         let want = reference_peak(&m, rayleigh, h, t, 2.0);
-        assert!(rel(got, want) <= 1e-9, "rayleigh {rayleigh:?} (ξ {xis:?}): {got} vs {want}");
-        assert!(got <= undamped * (1.0 + 1e-12), "rayleigh {rayleigh:?}: {got} > undamped {undamped}");
+        assert!(
+            rel(got, want) <= 1e-9,
+            "rayleigh {rayleigh:?} (ξ {xis:?}): {got} vs {want}"
+        );
+        assert!(
+            got <= undamped * (1.0 + 1e-12),
+            "rayleigh {rayleigh:?}: {got} > undamped {undamped}"
+        );
         assert!(got > 0.0, "rayleigh {rayleigh:?}: zero response");
     }
 }
@@ -109,17 +154,32 @@ fn damping_ratio_up_to_100() {
 #[test]
 fn impulse_range_is_linear() {
     let h = 0.01;
-    let p = || ResponseParams { h, impact_threshold: 0.0, ..Default::default() };
+    let p = || ResponseParams {
+        h,
+        impact_threshold: 0.0,
+        ..Default::default()
+    };
     let unit = run(p(), 1.0);
     for lambda in [1e-12, 1e-9, 1e-6, 1e-3, 1e3, 1e6, 1e9] {
         let got = run(p(), lambda);
-        assert!(rel(got / lambda, unit) <= 1e-12, "λ = {lambda:e}: {got} vs {}", unit * lambda);
+        assert!(
+            rel(got / lambda, unit) <= 1e-12,
+            "λ = {lambda:e}: {got} vs {}",
+            unit * lambda
+        );
     }
     let mut resp = DistantResponse::new(model(), p()).unwrap();
     for bad in [f64::NAN, f64::INFINITY, -1.0] {
         let out = resp.step(
-            &[Impact { point: HIT, direction: DOWN, impulse: bad }],
-            &[RestingContact { id: 1, point: CONTACT }],
+            &[Impact {
+                point: HIT,
+                direction: DOWN,
+                impulse: bad,
+            }],
+            &[RestingContact {
+                id: 1,
+                point: CONTACT,
+            }],
         );
         assert_eq!(out[0].peak_displacement, 0.0, "impulse {bad}");
         assert_eq!(resp.last_step_info().impacts_below_threshold, 1);

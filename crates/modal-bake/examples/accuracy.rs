@@ -11,7 +11,7 @@ use std::time::Instant;
 
 use dcr_runtime::samples_per_step;
 use modal_bake::mesh::read_mesh;
-use modal_bake::truth::{newmark_peaks, ModalAll, TruthParams, TruthSystem};
+use modal_bake::truth::{newmark_peaks, ModalAll, ModalInput, TruthParams, TruthSystem};
 
 struct Args {
     mesh: String,
@@ -25,7 +25,10 @@ struct Args {
 }
 
 fn vec3(s: &str) -> [f64; 3] {
-    let v: Vec<f64> = s.split(',').map(|t| t.trim().parse().expect("number")).collect();
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|t| t.trim().parse().expect("number"))
+        .collect();
     [v[0], v[1], v[2]]
 }
 
@@ -96,8 +99,10 @@ fn main() {
     println!("- mesh `{}`: {} nodes, {} tets, {} free dofs ({} fixed nodes), {} elastic modes ({:.1} Hz … {:.0} Hz), dense eigensolve {:.1} s",
         a.mesh, sys.mesh.nodes.len(), sys.mesh.tets.len(), sys.n(), sys.fixed_nodes, n_modes,
         ma.eigenvalues[0].sqrt() / std::f64::consts::TAU, ma.eigenvalues[n_modes - 1].sqrt() / std::f64::consts::TAU, eig_s);
-    println!("- material E = {:.3e} Pa, ν = {}, ρ = {} kg/m³; Rayleigh α0 = {} 1/s, α1 = {} s",
-        mat.youngs, mat.poisson, mat.density, params.rayleigh[0], params.rayleigh[1]);
+    println!(
+        "- material E = {:.3e} Pa, ν = {}, ρ = {} kg/m³; Rayleigh α0 = {:e} 1/s, α1 = {:e} s",
+        mat.youngs, mat.poisson, mat.density, params.rayleigh[0], params.rayleigh[1]
+    );
     println!("- impulse {} N·s at t = 0 into the surface; peak |normal displacement| over h = {} s; truth sampled every Δt = {:.1e} s ({} samples)",
         a.impulse, a.h, dt, steps);
     println!("- cells: error = (peak_m − peak_truth) / peak_truth in %, as `Δt / paper T`: the m-mode sum sampled at the truth's Δt (truncation only) / at the runtime's T = π/(2ω_m) (truncation + sampling, what `DistantResponse` computes). Negative: the base under-predicts. Distances are Euclidean from the impact.\n");
@@ -105,16 +110,27 @@ fn main() {
     for imp in &a.impacts {
         let isp = sys.surface.project(*imp).expect("impact");
         let f = sys.load_vector(&isp, isp.normal.map(|x| -x), a.impulse);
-        let csp: Vec<_> = a.contacts.iter().map(|c| sys.surface.project(*c).expect("contact")).collect();
+        let csp: Vec<_> = a
+            .contacts
+            .iter()
+            .map(|c| sys.surface.project(*c).expect("contact"))
+            .collect();
         let rows: Vec<Vec<f64>> = csp.iter().map(|c| sys.contact_row(c)).collect();
         let r = ma.project(&f);
         let w: Vec<Vec<f64>> = rows.iter().map(|x| ma.project(x)).collect();
         let truth = ma.peaks_projected(&r, &w, params.rayleigh, dt, steps, None);
-        println!("## Impact at ({:.3}, {:.3}, {:.3})\n", isp.point[0], isp.point[1], isp.point[2]);
+        println!(
+            "## Impact at ({:.3}, {:.3}, {:.3})\n",
+            isp.point[0], isp.point[1], isp.point[2]
+        );
         if a.newmark {
             let t = Instant::now();
             let (nm, _) = newmark_peaks(&sys, &f, &rows, dt, steps).expect("newmark");
-            let worst = nm.iter().zip(&truth).map(|(x, y)| ((x - y) / y).abs()).fold(0.0, f64::max);
+            let worst = nm
+                .iter()
+                .zip(&truth)
+                .map(|(x, y)| ((x - y) / y).abs())
+                .fold(0.0, f64::max);
             println!("Cross-check: full-order Newmark (β = ¼, γ = ½, Δt = {dt:.1e} s, {:.1} s) vs all-mode sum: worst |difference| {:.3} %.\n",
                 t.elapsed().as_secs_f64(), 100.0 * worst);
         }
@@ -133,7 +149,10 @@ fn main() {
                 + (sp.point[1] - isp.point[1]).powi(2)
                 + (sp.point[2] - isp.point[2]).powi(2))
             .sqrt();
-            print!(" ({:.2}, {:.2}, {:.2}) at {:.2} m |", sp.point[0], sp.point[1], sp.point[2], d);
+            print!(
+                " ({:.2}, {:.2}, {:.2}) at {:.2} m |",
+                sp.point[0], sp.point[1], sp.point[2], d
+            );
         }
         println!();
         println!("|---|{}", "---|".repeat(csp.len()));
@@ -148,6 +167,58 @@ fn main() {
                 let e1 = 100.0 * (fine[k][c] - truth[c]) / truth[c];
                 let e2 = 100.0 * (paper[k][c] - truth[c]) / truth[c];
                 print!(" {e1:+.1} / {e2:+.1} |");
+            }
+            println!();
+        }
+        println!();
+        // Idea (static correction), evaluated on the force path: a force switched on at t = 0
+        // and held (ZOH forces of the runtime, e.g. a machine standing on the table).
+        let fsteps = steps;
+        let truth_f = ma.response_peaks(
+            &r,
+            &w,
+            params.rayleigh,
+            dt,
+            fsteps,
+            None,
+            ModalInput::Step,
+            false,
+        );
+        println!("Force switched on at t = 0 and held (same point and direction, peak over h; errors in %, `uncorrected / with static correction`):\n");
+        print!("| modes |");
+        for c in 0..csp.len() {
+            print!(" contact {c} |");
+        }
+        println!();
+        println!("|---|{}", "---|".repeat(csp.len()));
+        for &m in &counts {
+            let a = ma.response_peaks(
+                &r,
+                &w,
+                params.rayleigh,
+                dt,
+                fsteps,
+                Some(m),
+                ModalInput::Step,
+                false,
+            );
+            let b = ma.response_peaks(
+                &r,
+                &w,
+                params.rayleigh,
+                dt,
+                fsteps,
+                Some(m),
+                ModalInput::Step,
+                true,
+            );
+            print!("| {m} |");
+            for c in 0..csp.len() {
+                print!(
+                    " {:+.1} / {:+.1} |",
+                    100.0 * (a[c] - truth_f[c]) / truth_f[c],
+                    100.0 * (b[c] - truth_f[c]) / truth_f[c]
+                );
             }
             println!();
         }

@@ -45,7 +45,9 @@ fn main() {
         sizes = vec!["3k".into(), "15k".into(), "100k".into()];
     }
     let mat = Material::new(2.0e9, 0.3, 1200.0).unwrap();
-    println!("size,free_dofs,assembly_s,factor_s,eigensolve_s,total_s,block_solves,factor_nnz,f1_hz");
+    println!(
+        "size,free_dofs,assembly_s,factor_s,eigensolve_s,total_s,block_solves,factor_nnz,f1_hz"
+    );
     for size in &sizes {
         // L = 1 m beams with a 0.1 m square section, clamped at x = 0.
         let cells = match size.as_str() {
@@ -54,7 +56,13 @@ fn main() {
             "100k" => [120, 16, 16],
             other => panic!("unknown size {other} (3k, 15k, 100k)"),
         };
-        let reps = if reps > 0 { reps } else if size == "100k" { 3 } else { 5 };
+        let reps = if reps > 0 {
+            reps
+        } else if size == "100k" {
+            3
+        } else {
+            5
+        };
         let mesh = TetMesh::structured_box(cells, [1.0, 0.1, 0.1]);
         let (mut ta, mut tf, mut te, mut tt) = (vec![], vec![], vec![], vec![]);
         for _ in 0..reps {
@@ -63,7 +71,11 @@ fn main() {
             let m = assemble_mass(&mesh, &mat, false);
             let (_, k, m) = reduce_fixed(&k, &m, &mesh.groups["xmin"]).unwrap();
             let assembly = t0.elapsed().as_secs_f64();
-            let p = EigenParams { nev, block, ..Default::default() };
+            let p = EigenParams {
+                nev,
+                block,
+                ..Default::default()
+            };
             let res = solve_lowest(&k, &m, &p, &mut |_| {}).expect("eigensolve");
             let total = t0.elapsed().as_secs_f64();
             println!(

@@ -43,7 +43,12 @@ fn distorted_box(n: [usize; 3], l: [f64; 3], amp: f64, seed: u64) -> TetMesh {
         }
     }
     for t in &mesh.tets {
-        let v = signed_volume(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]], mesh.nodes[t[3]]);
+        let v = signed_volume(
+            mesh.nodes[t[0]],
+            mesh.nodes[t[1]],
+            mesh.nodes[t[2]],
+            mesh.nodes[t[3]],
+        );
         assert!(v > 0.0, "distortion inverted a tetrahedron");
     }
     mesh
@@ -51,10 +56,22 @@ fn distorted_box(n: [usize; 3], l: [f64; 3], amp: f64, seed: u64) -> TetMesh {
 
 fn corpus() -> Vec<(&'static str, TetMesh)> {
     vec![
-        ("cube 1x1x1", TetMesh::structured_box([1, 1, 1], [1.0, 1.0, 1.0])),
-        ("box 3x2x4", TetMesh::structured_box([3, 2, 4], [0.3, 0.2, 0.5])),
-        ("beam 8x2x2", TetMesh::structured_box([8, 2, 2], [1.0, 0.1, 0.1])),
-        ("distorted 4x3x3", distorted_box([4, 3, 3], [0.4, 0.3, 0.3], 0.2, 7)),
+        (
+            "cube 1x1x1",
+            TetMesh::structured_box([1, 1, 1], [1.0, 1.0, 1.0]),
+        ),
+        (
+            "box 3x2x4",
+            TetMesh::structured_box([3, 2, 4], [0.3, 0.2, 0.5]),
+        ),
+        (
+            "beam 8x2x2",
+            TetMesh::structured_box([8, 2, 2], [1.0, 0.1, 0.1]),
+        ),
+        (
+            "distorted 4x3x3",
+            distorted_box([4, 3, 3], [0.4, 0.3, 0.3], 0.2, 7),
+        ),
     ]
 }
 
@@ -67,7 +84,10 @@ fn frob(a: MatRef<'_, f64>) -> f64 {
 }
 
 /// Eigenvalues of K u = λ M u by the dense route: M = LLᵀ, eig(L⁻¹ K L⁻ᵀ).
-fn dense_generalized_eigenvalues(k: &SparseColMat<usize, f64>, m: &SparseColMat<usize, f64>) -> Vec<f64> {
+fn dense_generalized_eigenvalues(
+    k: &SparseColMat<usize, f64>,
+    m: &SparseColMat<usize, f64>,
+) -> Vec<f64> {
     let kd = dense(k);
     let md = dense(m);
     let llt = md.llt(Side::Lower).expect("M positive definite");
@@ -92,13 +112,20 @@ fn m_orthonormality_error(m: &SparseColMat<usize, f64>, u: MatRef<'_, f64>) -> f
     worst
 }
 
-fn clamped(mesh: &TetMesh, mat: &Material) -> (DofMap, SparseColMat<usize, f64>, SparseColMat<usize, f64>) {
+fn clamped(
+    mesh: &TetMesh,
+    mat: &Material,
+) -> (DofMap, SparseColMat<usize, f64>, SparseColMat<usize, f64>) {
     let k = assemble_stiffness(mesh, mat);
     let m = assemble_mass(mesh, mat, false);
     reduce_fixed(&k, &m, &mesh.groups["xmin"]).unwrap()
 }
 
-fn solve(k: &SparseColMat<usize, f64>, m: &SparseColMat<usize, f64>, p: &EigenParams) -> EigenResult {
+fn solve(
+    k: &SparseColMat<usize, f64>,
+    m: &SparseColMat<usize, f64>,
+    p: &EigenParams,
+) -> EigenResult {
     solve_lowest(k, m, p, &mut |_| {}).unwrap()
 }
 
@@ -122,7 +149,10 @@ fn mass_sums_to_rho_v_per_axis() {
                     }
                     assert!(i % 3 == j % 3 || v == 0.0, "mass couples axes");
                 }
-                assert!((s - rv).abs() <= 1e-12 * rv, "{name} lumped={lumped} axis {axis}: {s} vs {rv}");
+                assert!(
+                    (s - rv).abs() <= 1e-12 * rv,
+                    "{name} lumped={lumped} axis {axis}: {s} vs {rv}"
+                );
             }
         }
     }
@@ -133,12 +163,19 @@ fn mass_sums_to_rho_v_per_axis() {
 fn matrices_are_symmetric() {
     let mat = steelish();
     for (name, mesh) in corpus() {
-        for a in [assemble_stiffness(&mesh, &mat), assemble_mass(&mesh, &mat, false)] {
+        for a in [
+            assemble_stiffness(&mesh, &mat),
+            assemble_mass(&mesh, &mat, false),
+        ] {
             let d = dense(&a);
             for i in 0..d.nrows() {
                 assert!(d[(i, i)] > 0.0, "{name}: diagonal {i}");
                 for j in 0..i {
-                    assert_eq!(d[(i, j)].to_bits(), d[(j, i)].to_bits(), "{name}: ({i},{j})");
+                    assert_eq!(
+                        d[(i, j)].to_bits(),
+                        d[(j, i)].to_bits(),
+                        "{name}: ({i},{j})"
+                    );
                 }
             }
         }
@@ -174,13 +211,23 @@ fn assembly_is_deterministic_across_thread_counts() {
     let mat = steelish();
     let mesh = distorted_box([12, 6, 5], [1.2, 0.6, 0.5], 0.15, 3);
     let run = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
         pool.install(|| {
             let k = assemble_stiffness(&mesh, &mat);
             let m = assemble_mass(&mesh, &mat, false);
             let ml = assemble_mass(&mesh, &mat, true);
-            let bits = |a: &SparseColMat<usize, f64>| a.val().iter().map(|v| v.to_bits()).collect::<Vec<_>>();
-            (bits(&k), bits(&m), bits(&ml), k.symbolic().row_idx().to_vec())
+            let bits = |a: &SparseColMat<usize, f64>| {
+                a.val().iter().map(|v| v.to_bits()).collect::<Vec<_>>()
+            };
+            (
+                bits(&k),
+                bits(&m),
+                bits(&ml),
+                k.symbolic().row_idx().to_vec(),
+            )
         })
     };
     assert_eq!(run(1), run(2));
@@ -188,19 +235,40 @@ fn assembly_is_deterministic_across_thread_counts() {
 
 #[test]
 fn material_and_dof_map_validation() {
-    assert!(matches!(Material::new(-1.0, 0.3, 1.0), Err(MaterialError::Youngs(_))));
-    assert!(matches!(Material::new(1.0, 0.5, 1.0), Err(MaterialError::Poisson(_))));
-    assert!(matches!(Material::new(1.0, -1.0, 1.0), Err(MaterialError::Poisson(_))));
-    assert!(matches!(Material::new(1.0, 0.3, f64::NAN), Err(MaterialError::Density(_))));
-    assert!(matches!(DofMap::new(4, &[1, 1]), Err(DofMapError::NotSorted { position: 1 })));
-    assert!(matches!(DofMap::new(4, &[4]), Err(DofMapError::NodeOutOfRange { node: 4, .. })));
+    assert!(matches!(
+        Material::new(-1.0, 0.3, 1.0),
+        Err(MaterialError::Youngs(_))
+    ));
+    assert!(matches!(
+        Material::new(1.0, 0.5, 1.0),
+        Err(MaterialError::Poisson(_))
+    ));
+    assert!(matches!(
+        Material::new(1.0, -1.0, 1.0),
+        Err(MaterialError::Poisson(_))
+    ));
+    assert!(matches!(
+        Material::new(1.0, 0.3, f64::NAN),
+        Err(MaterialError::Density(_))
+    ));
+    assert!(matches!(
+        DofMap::new(4, &[1, 1]),
+        Err(DofMapError::NotSorted { position: 1 })
+    ));
+    assert!(matches!(
+        DofMap::new(4, &[4]),
+        Err(DofMapError::NodeOutOfRange { node: 4, .. })
+    ));
     let map = DofMap::new(3, &[1]).unwrap();
     assert_eq!(map.free_dofs(), &[0, 1, 2, 6, 7, 8]);
     assert_eq!(map.free_index(7), Some(4));
     assert_eq!(map.free_index(4), None);
     let u = Mat::from_fn(6, 1, |i, _| i as f64 + 1.0);
     let full = map.expand(u.as_ref());
-    assert_eq!(full.col(0).iter().copied().collect::<Vec<_>>(), vec![1.0, 2.0, 3.0, 0.0, 0.0, 0.0, 4.0, 5.0, 6.0]);
+    assert_eq!(
+        full.col(0).iter().copied().collect::<Vec<_>>(),
+        vec![1.0, 2.0, 3.0, 0.0, 0.0, 0.0, 4.0, 5.0, 6.0]
+    );
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -212,10 +280,26 @@ fn material_and_dof_map_validation() {
 fn lanczos_matches_dense_generalized_solve() {
     let mat = steelish();
     for (name, mesh, free) in [
-        ("beam 8x2x2 clamped", TetMesh::structured_box([8, 2, 2], [1.0, 0.1, 0.1]), false),
-        ("distorted 4x3x3 clamped", distorted_box([4, 3, 3], [0.4, 0.3, 0.3], 0.2, 7), false),
-        ("box 3x3x3 free", TetMesh::structured_box([3, 3, 3], [0.3, 0.3, 0.3]), true),
-        ("distorted 4x3x3 free", distorted_box([4, 3, 3], [0.4, 0.3, 0.3], 0.2, 11), true),
+        (
+            "beam 8x2x2 clamped",
+            TetMesh::structured_box([8, 2, 2], [1.0, 0.1, 0.1]),
+            false,
+        ),
+        (
+            "distorted 4x3x3 clamped",
+            distorted_box([4, 3, 3], [0.4, 0.3, 0.3], 0.2, 7),
+            false,
+        ),
+        (
+            "box 3x3x3 free",
+            TetMesh::structured_box([3, 3, 3], [0.3, 0.3, 0.3]),
+            true,
+        ),
+        (
+            "distorted 4x3x3 free",
+            distorted_box([4, 3, 3], [0.4, 0.3, 0.3], 0.2, 11),
+            true,
+        ),
     ] {
         let (k, m, shift, nev) = if free {
             let k = assemble_stiffness(&mesh, &mat);
@@ -226,19 +310,37 @@ fn lanczos_matches_dense_generalized_solve() {
             (k, m, 0.0, 8)
         };
         assert!(k.nrows() <= 300);
-        let p = EigenParams { nev, shift, block: 4, ..Default::default() };
+        let p = EigenParams {
+            nev,
+            shift,
+            block: 4,
+            ..Default::default()
+        };
         let res = solve(&k, &m, &p);
         assert!(!res.info.dense, "{name}: expected the Lanczos path");
         let reference = dense_generalized_eigenvalues(&k, &m);
         let scale = reference[nev - 1];
+        #[allow(clippy::needless_range_loop)]
         for i in 0..nev {
             let err = (res.eigenvalues[i] - reference[i]).abs();
             // Rigid modes (λ ≈ 0) are compared on the scale of the spectrum.
             let denom = if free && i < 6 { scale } else { reference[i] };
-            assert!(err <= 1e-9 * denom, "{name} mode {i}: {} vs {}", res.eigenvalues[i], reference[i]);
+            assert!(
+                err <= 1e-9 * denom,
+                "{name} mode {i}: {} vs {}",
+                res.eigenvalues[i],
+                reference[i]
+            );
         }
-        assert!(m_orthonormality_error(&m, res.vectors.as_ref()) <= 1e-10, "{name}");
-        assert!(res.residuals.iter().all(|&r| r <= 1e-8), "{name}: {:?}", res.residuals);
+        assert!(
+            m_orthonormality_error(&m, res.vectors.as_ref()) <= 1e-10,
+            "{name}"
+        );
+        assert!(
+            res.residuals.iter().all(|&r| r <= 1e-8),
+            "{name}: {:?}",
+            res.residuals
+        );
     }
 }
 
@@ -251,11 +353,19 @@ fn free_free_cube_has_six_rigid_modes() {
     let mesh = TetMesh::structured_box([6, 6, 6], [0.5, 0.5, 0.5]);
     let k = assemble_stiffness(&mesh, &mat);
     let m = assemble_mass(&mesh, &mat, false);
-    let p = EigenParams { nev: 26, shift: default_shift(&mesh, &mat), ..Default::default() };
+    let p = EigenParams {
+        nev: 26,
+        shift: default_shift(&mesh, &mat),
+        ..Default::default()
+    };
     let res = solve(&k, &m, &p);
     let l7 = res.eigenvalues[6];
     for i in 0..6 {
-        assert!(res.eigenvalues[i].abs() < 1e-9 * l7, "rigid {i}: {} vs λ7 {l7}", res.eigenvalues[i]);
+        assert!(
+            res.eigenvalues[i].abs() < 1e-9 * l7,
+            "rigid {i}: {} vs λ7 {l7}",
+            res.eigenvalues[i]
+        );
     }
     assert!(l7 > 0.0);
     for w in res.eigenvalues.windows(2) {
@@ -268,14 +378,23 @@ fn free_free_cube_has_six_rigid_modes() {
     let rel = frob((&proj - &r).as_ref()) / frob(r.as_ref());
     assert!(rel < 1e-8, "rigid span error {rel:e}");
     assert!(m_orthonormality_error(&m, res.vectors.as_ref()) <= 1e-10);
-    assert!(res.residuals.iter().all(|&x| x <= 1e-8), "{:?}", res.residuals);
-    assert!(res.residuals[6..].iter().all(|&x| x <= p.tol.max(8.0 * 1e-16 * 1e6)));
+    assert!(
+        res.residuals.iter().all(|&x| x <= 1e-8),
+        "{:?}",
+        res.residuals
+    );
+    assert!(res.residuals[6..]
+        .iter()
+        .all(|&x| x <= p.tol.max(8.0 * 1e-16 * 1e6)));
     // UᵀKU is diagonal with the eigenvalues.
     let kq = res.vectors.transpose() * (&k * &res.vectors);
     for i in 0..26 {
         for j in 0..26 {
             let expect = if i == j { res.eigenvalues[i] } else { 0.0 };
-            assert!((kq[(i, j)] - expect).abs() <= 1e-8 * res.eigenvalues[25], "Kq[{i},{j}]");
+            assert!(
+                (kq[(i, j)] - expect).abs() <= 1e-8 * res.eigenvalues[25],
+                "Kq[{i},{j}]"
+            );
         }
     }
     // Sign convention: the largest-magnitude entry of each mode is positive.
@@ -304,14 +423,27 @@ fn cantilever_first_bending_converges_from_above() {
     let mat = Material::new(1.0e9, 0.3, 1000.0).unwrap();
     let (l, a) = (1.0, 0.1);
     // Euler–Bernoulli: f = (β₁L)²/(2π L²) √(EI/ρA), β₁L = 1.875104, I = a⁴/12.
-    let f_eb = 1.875104068711961f64.powi(2) / (2.0 * PI * l * l) * (mat.youngs * a * a / 12.0 / mat.density).sqrt();
+    let f_eb = 1.875104068711961f64.powi(2) / (2.0 * PI * l * l)
+        * (mat.youngs * a * a / 12.0 / mat.density).sqrt();
     let mut f = Vec::new();
     for r in [1usize, 2, 4, 8] {
         let mesh = TetMesh::structured_box([10 * r, r, r], [l, a, a]);
         let (_, k, m) = clamped(&mesh, &mat);
-        let res = solve(&k, &m, &EigenParams { nev: 2, ..Default::default() });
+        let res = solve(
+            &k,
+            &m,
+            &EigenParams {
+                nev: 2,
+                ..Default::default()
+            },
+        );
         let f1 = res.frequencies_hz()[0];
-        println!("cantilever {}x{r}x{r}: {} dofs, f1 = {f1:.4} Hz (EB {f_eb:.4} Hz, +{:.2}%)", 10 * r, k.nrows(), 100.0 * (f1 / f_eb - 1.0));
+        println!(
+            "cantilever {}x{r}x{r}: {} dofs, f1 = {f1:.4} Hz (EB {f_eb:.4} Hz, +{:.2}%)",
+            10 * r,
+            k.nrows(),
+            100.0 * (f1 / f_eb - 1.0)
+        );
         f.push(f1);
     }
     for w in f.windows(2) {
@@ -326,7 +458,10 @@ fn cantilever_first_bending_converges_from_above() {
     // Richardson extrapolation lands within 2% of Euler–Bernoulli.
     let ratio = 2f64.powf(order);
     let f_inf = f[n - 1] + (f[n - 1] - f[n - 2]) / (ratio - 1.0);
-    println!("extrapolated f1 = {f_inf:.4} Hz ({:+.2}% vs EB)", 100.0 * (f_inf / f_eb - 1.0));
+    println!(
+        "extrapolated f1 = {f_inf:.4} Hz ({:+.2}% vs EB)",
+        100.0 * (f_inf / f_eb - 1.0)
+    );
     assert!((f_inf / f_eb - 1.0).abs() < 0.02);
 }
 
@@ -339,7 +474,11 @@ fn clamped_free_rod_first_axial_mode() {
     let f_axial = (mat.youngs / mat.density).sqrt() / (4.0 * l);
     let mesh = TetMesh::structured_box([40, 3, 3], [l, 0.1, 0.1]);
     let (map, k, m) = clamped(&mesh, &mat);
-    let p = EigenParams { nev: 0, max_freq_hz: Some(300.0), ..Default::default() };
+    let p = EigenParams {
+        nev: 0,
+        max_freq_hz: Some(300.0),
+        ..Default::default()
+    };
     let res = solve(&k, &m, &p);
     let f = res.frequencies_hz();
     assert!(f.iter().all(|&x| x < 300.0));
@@ -359,11 +498,24 @@ fn clamped_free_rod_first_axial_mode() {
             best = (ex / e, j);
         }
     }
-    println!("modes below 300 Hz: {:?}; axial = mode {} ({:.1}% x-motion), {:.3} Hz vs {f_axial:.3} Hz", f, best.1, 100.0 * best.0, f[best.1]);
+    println!(
+        "modes below 300 Hz: {:?}; axial = mode {} ({:.1}% x-motion), {:.3} Hz vs {f_axial:.3} Hz",
+        f,
+        best.1,
+        100.0 * best.0,
+        f[best.1]
+    );
     assert!(best.0 > 0.9);
     assert!((f[best.1] / f_axial - 1.0).abs() < 0.02);
     // Max-frequency mode really found everything below the limit: compare with nev mode.
-    let all = solve(&k, &m, &EigenParams { nev: f.len() + 1, ..Default::default() });
+    let all = solve(
+        &k,
+        &m,
+        &EigenParams {
+            nev: f.len() + 1,
+            ..Default::default()
+        },
+    );
     assert!(all.frequencies_hz()[f.len()] >= 300.0);
     for (a, b) in all.eigenvalues.iter().zip(&res.eigenvalues) {
         assert!((a - b).abs() <= 1e-9 * a);
@@ -378,32 +530,65 @@ fn shift_above_lowest_eigenvalue_is_a_factorization_error() {
     let mat = steelish();
     let mesh = TetMesh::structured_box([10, 2, 2], [1.0, 0.1, 0.1]);
     let (_, k, m) = clamped(&mesh, &mat);
-    let lam1 = solve(&k, &m, &EigenParams { nev: 1, ..Default::default() }).eigenvalues[0];
-    let p = EigenParams { nev: 4, shift: 2.0 * lam1, ..Default::default() };
-    assert!(matches!(solve_lowest(&k, &m, &p, &mut |_| {}), Err(EigenError::Factorization(_))));
-    let p = EigenParams { nev: 20, max_iters: 2, ..Default::default() };
+    let lam1 = solve(
+        &k,
+        &m,
+        &EigenParams {
+            nev: 1,
+            ..Default::default()
+        },
+    )
+    .eigenvalues[0];
+    let p = EigenParams {
+        nev: 4,
+        shift: 2.0 * lam1,
+        ..Default::default()
+    };
+    assert!(matches!(
+        solve_lowest(&k, &m, &p, &mut |_| {}),
+        Err(EigenError::Factorization(_))
+    ));
+    let p = EigenParams {
+        nev: 20,
+        max_iters: 2,
+        ..Default::default()
+    };
     match solve_lowest(&k, &m, &p, &mut |_| {}) {
-        Err(EigenError::NotConverged { requested, worst_residual, .. }) => {
+        Err(EigenError::NotConverged {
+            requested,
+            worst_residual,
+            ..
+        }) => {
             assert_eq!(requested, 20);
             assert!(worst_residual > p.tol);
         }
         other => panic!("expected NotConverged, got {other:?}"),
     }
-    let p = EigenParams { nev: k.nrows() + 1, ..Default::default() };
-    assert!(matches!(solve_lowest(&k, &m, &p, &mut |_| {}), Err(EigenError::InvalidInput(_))));
+    let p = EigenParams {
+        nev: k.nrows() + 1,
+        ..Default::default()
+    };
+    assert!(matches!(
+        solve_lowest(&k, &m, &p, &mut |_| {}),
+        Err(EigenError::InvalidInput(_))
+    ));
 }
 
 // ---------------------------------------------------------------------------------------------
 // Determinism
 
-/// Same input → bit-identical eigenvalues and vectors, run twice and on rayon pools of 1 and 2
-/// threads (the faer factorization/solves included).
+/// Same input → bit-identical eigenvalues and vectors: run twice, on rayon pools of 1 and 2
+/// threads, and with faer sequential (`threads: 0` → `Par::Seq` at this size) or parallel
+/// (`threads: 1, 2` → `Par::rayon(n)`) factorization, solves and products.
 #[test]
 fn eigensolve_is_bit_deterministic_across_runs_and_pools() {
     let mat = steelish();
     let mesh = TetMesh::structured_box([40, 6, 6], [1.0, 0.15, 0.15]);
     let (_, k, m) = clamped(&mesh, &mat);
-    let p = EigenParams { nev: 20, ..Default::default() };
+    let p = EigenParams {
+        nev: 20,
+        ..Default::default()
+    };
     let bits = |r: &EigenResult| {
         let mut v: Vec<u64> = r.eigenvalues.iter().map(|x| x.to_bits()).collect();
         for j in 0..r.vectors.ncols() {
@@ -416,9 +601,22 @@ fn eigensolve_is_bit_deterministic_across_runs_and_pools() {
     assert!(calls > 0);
     let reference = bits(&first);
     assert_eq!(reference, bits(&solve(&k, &m, &p)));
-    for threads in [1, 2] {
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-        let r = pool.install(|| solve(&k, &m, &p));
-        assert_eq!(reference, bits(&r), "pool of {threads} thread(s)");
+    for pool_threads in [1, 2] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(pool_threads)
+            .build()
+            .unwrap();
+        for threads in [0, 1, 2] {
+            let p = EigenParams {
+                threads,
+                ..p.clone()
+            };
+            let r = pool.install(|| solve(&k, &m, &p));
+            assert_eq!(
+                reference,
+                bits(&r),
+                "pool of {pool_threads}, faer threads {threads}"
+            );
+        }
     }
 }

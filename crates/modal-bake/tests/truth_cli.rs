@@ -5,7 +5,9 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 fn data(rel: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data").join(rel)
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../data")
+        .join(rel)
 }
 
 fn truth(extra: &[&str]) -> Output {
@@ -29,23 +31,39 @@ fn truth(extra: &[&str]) -> Output {
         "2e-6",
     ];
     a.extend_from_slice(extra);
-    Command::new(env!("CARGO_BIN_EXE_modal-bake")).args(&a).output().expect("modal-bake runs")
+    Command::new(env!("CARGO_BIN_EXE_modal-bake"))
+        .args(&a)
+        .output()
+        .expect("modal-bake runs")
 }
 
 fn peaks(out: &Output) -> Vec<f64> {
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON on stdout");
     let cs = v["contacts"].as_array().expect("contacts");
     assert_eq!(cs.len(), 2);
     for c in cs {
-        for k in ["point", "triangle", "bary", "distance_m", "peak_displacement_m", "delta_v_mps"] {
+        for k in [
+            "point",
+            "triangle",
+            "bary",
+            "distance_m",
+            "peak_displacement_m",
+            "delta_v_mps",
+        ] {
             assert!(!c[k].is_null(), "missing {k} in {c}");
         }
         let p = c["peak_displacement_m"].as_f64().unwrap();
         let dv = c["delta_v_mps"].as_f64().unwrap();
         assert!((dv - p / 0.002).abs() <= 1e-12 * dv.abs());
     }
-    cs.iter().map(|c| c["peak_displacement_m"].as_f64().unwrap()).collect()
+    cs.iter()
+        .map(|c| c["peak_displacement_m"].as_f64().unwrap())
+        .collect()
 }
 
 #[test]
@@ -53,7 +71,10 @@ fn truth_json_methods_agree() {
     let a = peaks(&truth(&["--json"]));
     let b = peaks(&truth(&["--json", "--method", "modal-all"]));
     for (x, y) in a.iter().zip(&b) {
-        assert!(*y > 0.0 && ((x - y) / y).abs() < 0.01, "newmark {x} vs modal-all {y}");
+        assert!(
+            *y > 0.0 && ((x - y) / y).abs() < 0.01,
+            "newmark {x} vs modal-all {y}"
+        );
     }
 }
 
@@ -64,6 +85,8 @@ fn truth_rejects_bad_input_with_a_clear_message() {
         (&["--dt", "0"][..], "--dt"),
         (&["--modes", "5"][..], "--method modal-all"),
         (&["--impulse", "nan"][..], "impulse"),
+        (&["--impulse", "-1"][..], "impulse"),
+        (&["--contact", "3,0,0"][..], "farther than"),
     ] {
         let out = truth(extra);
         let err = String::from_utf8_lossy(&out.stderr);
@@ -71,4 +94,25 @@ fn truth_rejects_bad_input_with_a_clear_message() {
         assert!(err.contains(needle), "{extra:?}: {err}");
         assert!(!err.contains("panicked"), "{extra:?}: {err}");
     }
+}
+
+/// Coordinates starting with a minus sign are values, not flags.
+#[test]
+fn truth_accepts_negative_coordinates() {
+    let out = truth(&[
+        "--json",
+        "--direction",
+        "-1,-0.5,0",
+        "--contact",
+        "-0.03,0.05,0.05",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["contacts"].as_array().unwrap().len(), 3);
+    let d = v["info"]["impact_direction"].as_array().unwrap();
+    assert!(d[0].as_f64().unwrap() < 0.0);
 }

@@ -11,7 +11,7 @@
 
 use std::sync::Arc;
 
-use super::peak_kernel::{peak_abs_projection, BLOCK};
+use super::peak_kernel::{panel_index, peak_abs_projection, BLOCK};
 use super::{ContactResponse, ForceInput, Impact, Method, ParamsError, ResponseParams, RestingContact, StepInfo, Variant};
 use crate::attenuation::{AmplitudeKind, AttenuationParams, DistanceCache, DistanceKind, HeatWorkspace};
 use crate::filter::{damping_ratio, samples_per_step, ModalBank};
@@ -94,6 +94,8 @@ pub struct DistantResponse {
     w_step: Vec<f64>,
     /// (cache generation, slots) the current `w_step` was built for.
     w_key: (u64, Vec<u32>),
+    w_scaled: Vec<f64>,
+    q_stale: bool,
     peaks: Vec<f64>,
     out: Vec<ContactResponse>,
     step_index: u64,
@@ -191,6 +193,8 @@ impl DistantResponse {
             chan: Vec::new(),
             w_step: Vec::new(),
             w_key: (u64::MAX, Vec::new()),
+            w_scaled: Vec::new(),
+            q_stale: false,
             peaks: Vec::new(),
             out: Vec::new(),
             step_index: 0,
@@ -323,10 +327,23 @@ impl DistantResponse {
         self.bank.q()
     }
 
-    /// The last step's modal displacement samples q(k), k = 1..S (row-major S × m), valid when
-    /// the bank was active (modal method).
-    pub fn modal_samples(&self) -> &[f64] {
+    /// The last step's modal displacement samples q(k) (kg^1/2·m), k = 1..S (row-major S × m;
+    /// zeros when the bank was idle or for the attenuation method).
+    pub fn modal_samples(&mut self) -> &[f64] {
+        if self.q_stale {
+            self.fill_q_from_table();
+        }
         &self.q_table
+    }
+
+    fn fill_q_from_table(&mut self) {
+        let m = self.m;
+        for (qk, gk) in self.q_table.chunks_exact_mut(m).zip(self.g_table.chunks_exact(m)) {
+            for ((q, g), r) in qk.iter_mut().zip(gk).zip(&self.r) {
+                *q = g * r;
+            }
+        }
+        self.q_stale = false;
     }
 
     /// Returns the filters to rest (and wakes nothing); cached contacts and distance fields are
@@ -336,6 +353,7 @@ impl DistantResponse {
         self.asleep = true;
         self.energy_ref = 0.0;
         self.q_table.iter_mut().for_each(|x| *x = 0.0);
+        self.q_stale = false;
     }
 
     /// One rigid-body step with the step's new `impacts` and the current `resting` contacts;
@@ -467,12 +485,12 @@ impl DistantResponse {
                     for (corner, v) in model.triangle(sp.triangle).into_iter().enumerate() {
                         let col = c as usize * 3 + corner;
                         for (j, x) in rows[v * m..(v + 1) * m].iter().enumerate() {
-                            w[j * nch + col] = *x;
+                            w[panel_index(col, j, m)] = *x;
                         }
                     }
                 } else {
                     for (j, x) in self.cache.row(s).iter().enumerate() {
-                        w[j * nch + c as usize] = *x;
+                        w[panel_index(c as usize, j, m)] = *x;
                     }
                 }
             }
@@ -484,13 +502,33 @@ impl DistantResponse {
             self.asleep = false;
         }
         let active = have_impulse || have_force || (carry && !self.asleep);
-        let peaks = &mut self.peaks[..nch];
+        let mut peaks_buf = std::mem::take(&mut self.peaks);
+        let peaks = &mut peaks_buf[..nch];
         if active {
             let s = self.samples;
             if !carry && !have_force {
-                for (qk, gk) in self.q_table.chunks_exact_mut(m).zip(self.g_table.chunks_exact(m)) {
-                    for ((q, g), r) in qk.iter_mut().zip(gk).zip(&self.r) {
-                        *q = g * r;
+                // Reset path: q(k) = g(kT) ∘ r. Fold r into whichever operand is smaller:
+                // the S × m table or the m × nch channel matrix.
+                if nch > 0 && s > nch {
+                    if self.w_scaled.len() < nch * m {
+                        self.w_scaled.resize(nch * m, 0.0);
+                    }
+                    let ws = &mut self.w_scaled[..nch * m];
+                    // Panel layout: rows of 8 channels, mode j = row index mod m.
+                    for (row, (dst, src)) in
+                        ws.chunks_exact_mut(BLOCK).zip(self.w_step.chunks_exact(BLOCK)).enumerate()
+                    {
+                        let r = self.r[row % m];
+                        for (d, x) in dst.iter_mut().zip(src) {
+                            *d = x * r;
+                        }
+                    }
+                    peak_abs_projection(&self.g_table, s, m, ws, nch, peaks);
+                    self.q_stale = true;
+                } else {
+                    self.fill_q_from_table();
+                    if nch > 0 {
+                        peak_abs_projection(&self.q_table, s, m, &self.w_step[..nch * m], nch, peaks);
                     }
                 }
                 for j in 0..m {
@@ -504,9 +542,10 @@ impl DistantResponse {
                 }
                 let force = if have_force { Some(&self.f[..]) } else { None };
                 self.bank.run(s, force, &mut self.q_table);
-            }
-            if nch > 0 {
-                peak_abs_projection(&self.q_table, s, m, &self.w_step[..nch * m], nch, peaks);
+                self.q_stale = false;
+                if nch > 0 {
+                    peak_abs_projection(&self.q_table, s, m, &self.w_step[..nch * m], nch, peaks);
+                }
             }
             if carry {
                 self.asleep = false;
@@ -524,8 +563,10 @@ impl DistantResponse {
         } else {
             peaks.iter_mut().for_each(|x| *x = 0.0);
             self.q_table.iter_mut().for_each(|x| *x = 0.0);
+            self.q_stale = false;
             self.info.asleep = carry;
         }
+        self.peaks = peaks_buf;
 
         let h = self.params.h;
         self.out.clear();

@@ -407,10 +407,17 @@ fn peak_kernel_matches_naive() {
     let w: Vec<f64> = (0..m * nch).map(|_| rng.range(-1.0, 1.0)).collect();
     let mut peaks = vec![0.0; nch];
     peak_abs_projection(&q, s, m, &w, nch, &mut peaks);
+    // Panel layout: W(j, c) = w[((c/8)·m + j)·8 + c%8].
+    let wjc = |j: usize, c: usize| w[((c / 8) * m + j) * 8 + c % 8];
     for c in 0..nch {
         let naive = (0..s)
-            .map(|k| (0..m).map(|j| q[k * m + j] * w[j * nch + c]).sum::<f64>().abs())
+            .map(|k| (0..m).map(|j| q[k * m + j] * wjc(j, c)).sum::<f64>().abs())
             .fold(0.0, f64::max);
         assert!((naive - peaks[c]).abs() < 1e-14);
+    }
+    let mut base = vec![0.0; nch];
+    super::peak_kernel::peak_abs_projection_baseline(&q, s, m, &w, nch, &mut base);
+    for c in 0..nch {
+        assert!((base[c] - peaks[c]).abs() < 1e-14);
     }
 }

@@ -2,8 +2,11 @@
 
 mod bake;
 mod check;
+mod geodesic;
 mod info;
 mod parse;
+mod probe;
+mod truth;
 
 use std::process::ExitCode;
 
@@ -30,6 +33,14 @@ enum Command {
     /// 2 on an error (unreadable mesh, bad options).
     #[command(allow_negative_numbers = true)]
     Check(check::CheckArgs),
+    /// Distant response of one impulse at the contacts of a base (runtime conventions).
+    #[command(allow_negative_numbers = true)]
+    Probe(probe::ProbeArgs),
+    /// Heat-method geodesic distances (m) from one surface vertex of a base.
+    Geodesic(geodesic::GeodesicArgs),
+    /// Full-order reference response of a mesh to an impulse (Newmark or all modes).
+    #[command(allow_negative_numbers = true)]
+    Truth(truth::TruthArgs),
 }
 
 /// Writes `s` to stdout; a closed pipe (`modal-bake info x | head`) is not an error.
@@ -43,6 +54,9 @@ pub fn main() -> ExitCode {
     let result = match cli.command {
         Command::Bake(a) => bake::run(&a).map(|()| ExitCode::SUCCESS),
         Command::Info(a) => info::run(&a).map(|()| ExitCode::SUCCESS),
+        Command::Probe(a) => probe::run(&a).map(|()| ExitCode::SUCCESS),
+        Command::Geodesic(a) => geodesic::run(&a).map(|()| ExitCode::SUCCESS),
+        Command::Truth(a) => truth::run(&a).map(|()| ExitCode::SUCCESS),
         Command::Check(a) => return check::run(&a),
     };
     match result {

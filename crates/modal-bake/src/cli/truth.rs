@@ -41,17 +41,24 @@ pub struct TruthArgs {
     /// Lumped (diagonal) mass instead of the consistent mass.
     #[arg(long)]
     pub lumped: bool,
-    /// Impact point (m, object frame), mapped to the closest surface point.
-    #[arg(long, value_name = "X,Y,Z", value_parser = parse::vec3)]
+    /// Impact point (m, object frame), mapped to the closest surface point (refused farther than
+    /// 5% of the surface's bounding-box diagonal, as `probe`).
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse::vec3, allow_hyphen_values = true)]
     pub impact: [f64; 3],
-    /// Impulse magnitude (N·s), applied at t = 0.
-    #[arg(long, value_name = "NS")]
+    /// Impulse magnitude (N·s, > 0), applied at t = 0.
+    #[arg(long, value_name = "NS", allow_hyphen_values = true)]
     pub impulse: f64,
     /// Impulse direction (normalised); default: into the surface (−normal at the impact).
-    #[arg(long, value_name = "X,Y,Z", value_parser = parse::vec3)]
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse::vec3, allow_hyphen_values = true)]
     pub direction: Option<[f64; 3]>,
     /// A distant contact point (m, object frame; repeatable).
-    #[arg(long = "contact", value_name = "X,Y,Z", value_parser = parse::vec3, required = true)]
+    #[arg(
+        long = "contact",
+        value_name = "X,Y,Z",
+        value_parser = parse::vec3,
+        required = true,
+        allow_hyphen_values = true
+    )]
     pub contacts: Vec<[f64; 3]>,
     /// Window h (s) over which the peak displacement is taken.
     #[arg(long, value_name = "S", default_value_t = 0.01)]

@@ -3,9 +3,9 @@
 
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::evd::{self_adjoint_evd, self_adjoint_evd_scratch, ComputeEigenvectors};
+use faer::reborrow::ReborrowMut;
 use faer::sparse::SparseColMat;
 use faer::{Accum, Mat, MatMut, MatRef, Par, Spec};
-use faer::reborrow::ReborrowMut;
 use rayon::prelude::*;
 
 /// Rows per parallel task in [`sym_spmm`]; a fixed constant so the work split (and so the
@@ -14,34 +14,86 @@ const SPMM_ROWS_PER_TASK: usize = 2048;
 
 /// `y = A x` for a symmetric `A` stored with both triangles (column `i` of the CSC arrays is
 /// read as row `i`). Each output entry is one sequential dot product over the sorted row
-/// indices: deterministic, parallel over fixed-size row chunks, no allocation.
-pub(crate) fn sym_spmm(a: &SparseColMat<usize, f64>, x: MatRef<'_, f64>, mut y: MatMut<'_, f64>) {
+/// indices: deterministic, parallel over fixed-size row chunks.
+pub(crate) fn sym_spmm(a: &SparseColMat<usize, f64>, x: MatRef<'_, f64>, y: MatMut<'_, f64>) {
+    spmm_impl(a, x, y, None);
+}
+
+/// `y = A x` and `y_abs = |A| |x|` in one pass (the second is the rounding-error scale of the
+/// first).
+pub(crate) fn sym_spmm_with_abs(
+    a: &SparseColMat<usize, f64>,
+    x: MatRef<'_, f64>,
+    y: MatMut<'_, f64>,
+    y_abs: MatMut<'_, f64>,
+) {
+    spmm_impl(a, x, y, Some(y_abs));
+}
+
+/// Columns handled per pass over the matrix (index loads shared between them).
+const SPMM_COLS: usize = 4;
+
+fn spmm_impl(
+    a: &SparseColMat<usize, f64>,
+    x: MatRef<'_, f64>,
+    mut y: MatMut<'_, f64>,
+    mut y_abs: Option<MatMut<'_, f64>>,
+) {
     let n = a.nrows();
-    assert!(x.nrows() == n && y.nrows() == n && y.ncols() == x.ncols());
+    let w = x.ncols();
+    assert!(x.nrows() == n && y.nrows() == n && y.ncols() == w);
     let (ptr, rows, vals) = (a.symbolic().col_ptr(), a.symbolic().row_idx(), a.val());
-    for c in 0..x.ncols() {
-        let xc = x.col(c);
-        let xs: Vec<f64>;
-        let xs = match xc.try_as_col_major() {
-            Some(v) => v.as_slice(),
-            None => {
-                xs = xc.iter().copied().collect();
-                &xs
-            }
-        };
-        let mut yc = y.rb_mut().col_mut(c);
-        let ys = yc.rb_mut().try_as_col_major_mut().expect("contiguous output column").as_slice_mut();
-        ys.par_chunks_mut(SPMM_ROWS_PER_TASK).enumerate().for_each(|(t, chunk)| {
-            let r0 = t * SPMM_ROWS_PER_TASK;
-            for (ri, out) in chunk.iter_mut().enumerate() {
-                let i = r0 + ri;
-                let mut acc = 0.0;
-                for p in ptr[i]..ptr[i + 1] {
-                    acc += vals[p] * xs[rows[p]];
+    let xc = x.to_owned(); // contiguous columns
+    let mut c0 = 0;
+    while c0 < w {
+        let nc = SPMM_COLS.min(w - c0);
+        let xs: Vec<&[f64]> = (c0..c0 + nc)
+            .map(|c| {
+                xc.col(c)
+                    .try_as_col_major()
+                    .expect("owned column")
+                    .as_slice()
+            })
+            .collect();
+        let with_abs = y_abs.is_some();
+        // Row-major output chunk: [y_c0..y_c(nc-1), |y|_c0..] per row.
+        let stride = if with_abs { 2 * nc } else { nc };
+        let mut out = vec![0.0f64; n * stride];
+        out.par_chunks_mut(SPMM_ROWS_PER_TASK * stride)
+            .enumerate()
+            .for_each(|(t, chunk)| {
+                let r0 = t * SPMM_ROWS_PER_TASK;
+                for (ri, o) in chunk.chunks_mut(stride).enumerate() {
+                    let i = r0 + ri;
+                    let mut acc = [0.0f64; SPMM_COLS];
+                    let mut acc_abs = [0.0f64; SPMM_COLS];
+                    for p in ptr[i]..ptr[i + 1] {
+                        let (v, r) = (vals[p], rows[p]);
+                        for c in 0..nc {
+                            let xv = xs[c][r];
+                            acc[c] += v * xv;
+                            if with_abs {
+                                acc_abs[c] += (v * xv).abs();
+                            }
+                        }
+                    }
+                    o[..nc].copy_from_slice(&acc[..nc]);
+                    if with_abs {
+                        o[nc..].copy_from_slice(&acc_abs[..nc]);
+                    }
                 }
-                *out = acc;
+            });
+        for c in 0..nc {
+            for (i, v) in y.rb_mut().col_mut(c0 + c).iter_mut().enumerate() {
+                *v = out[i * stride + c];
             }
-        });
+            if let Some(ya) = y_abs.as_mut() {
+                for (i, v) in ya.rb_mut().col_mut(c0 + c).iter_mut().enumerate() {
+                    *v = out[i * stride + nc + c];
+                }
+            }
+        }
+        c0 += nc;
     }
 }
 
@@ -92,7 +144,8 @@ pub(crate) fn small_cholesky(mut a: MatMut<'_, f64>, rel_tol: f64) -> Result<(),
         for k in 0..j {
             d -= a[(j, k)] * a[(j, k)];
         }
-        if !(d > rel_tol * orig.abs()) || !d.is_finite() || d <= 0.0 {
+        let acceptable = d > rel_tol * orig.abs() && d.is_finite() && d > 0.0;
+        if !acceptable {
             return Err(j);
         }
         let l = d.sqrt();

@@ -4,16 +4,25 @@
 use std::f64::consts::PI;
 use std::time::Instant;
 
-use faer::sparse::SparseColMat;
 use faer::linalg::triangular_solve::solve_lower_triangular_in_place;
+use faer::sparse::SparseColMat;
 use faer::{Accum, Mat, MatMut, MatRef, Par};
 
-use super::kernels::{gemm, lower_inverse, small_cholesky, sym_eig, sym_spmm, SplitMix64};
+use super::kernels::{
+    gemm, lower_inverse, small_cholesky, sym_eig, sym_spmm, sym_spmm_with_abs, SplitMix64,
+};
 use super::shift_invert::{shifted, ShiftInvert};
 use super::{EigenError, EigenInfo, EigenParams, EigenProgress, EigenResult};
 
+/// Ascending eigenvalues (rad²/s²), their vectors (columns) and residuals.
+type RitzPairs = (Vec<f64>, Mat<f64>, Vec<Residual>);
+
 /// Problems with at most this many dofs beyond the Krylov basis size are solved densely.
 const DENSE_MARGIN: usize = 16;
+
+/// With `threads == 0`, problems below this many dofs run sequentially: thread
+/// synchronisation costs more than it saves there (measured on 2 cores).
+const AUTO_SEQ_BELOW: usize = 20_000;
 
 /// Breakdown threshold: a new direction whose M-norm after orthogonalisation is below this
 /// fraction of its norm before is treated as lying in the current basis.
@@ -33,8 +42,14 @@ pub(crate) fn solve(
     check_input(k, m, params)?;
     let sigma = params.shift;
     let lam_lim = params.max_freq_hz.map(|f| (2.0 * PI * f).powi(2));
-    let par = Par::rayon(params.threads);
-    let mut info = EigenInfo { shift: sigma, ..Default::default() };
+    let par = match params.threads {
+        0 if n < AUTO_SEQ_BELOW => Par::Seq,
+        t => Par::rayon(t),
+    };
+    let mut info = EigenInfo {
+        shift: sigma,
+        ..Default::default()
+    };
     if params.nev == 0 && lam_lim.is_none() {
         return Ok(EigenResult {
             eigenvalues: vec![],
@@ -86,13 +101,21 @@ pub(crate) fn solve(
         info.block_solves += 1;
         sym_spmm(m, z.as_ref(), mz.as_mut());
         let pre: Vec<f64> = (0..b).map(|j| m_norm(z.as_ref(), mz.as_ref(), j)).collect();
-        orthonormalize(&mut z, &mut mz, v.as_ref().subcols(0, 0), mv.as_ref().subcols(0, 0), &pre, m, &mut rng, par)?;
+        orthonormalize(
+            &mut z,
+            &mut mz,
+            v.as_ref().subcols(0, 0),
+            mv.as_ref().subcols(0, 0),
+            &pre,
+            m,
+            &mut rng,
+            par,
+        )?;
         v.as_mut().subcols_mut(0, b).copy_from(&z);
         mv.as_mut().subcols_mut(0, b).copy_from(&mz);
     }
     let mut kk = 0usize; // Rayleigh–Ritz size; the newest block sits at kk..kk+b
     let mut trigger = params.tol;
-    let mut last_explicit: Option<(usize, f64)> = None;
 
     loop {
         // --- expand: Z = T W = A⁻¹ M W, M-orthogonalise against the basis ------------------
@@ -103,8 +126,22 @@ pub(crate) fn solve(
         let mut c = Mat::<f64>::zeros(nb, b);
         for _pass in 0..2 {
             let mut cp = Mat::<f64>::zeros(nb, b);
-            gemm(cp.as_mut(), Accum::Replace, mv.as_ref().subcols(0, nb).transpose(), z.as_ref(), 1.0, par);
-            gemm(z.as_mut(), Accum::Add, v.as_ref().subcols(0, nb), cp.as_ref(), -1.0, par);
+            gemm(
+                cp.as_mut(),
+                Accum::Replace,
+                mv.as_ref().subcols(0, nb).transpose(),
+                z.as_ref(),
+                1.0,
+                par,
+            );
+            gemm(
+                z.as_mut(),
+                Accum::Add,
+                v.as_ref().subcols(0, nb),
+                cp.as_ref(),
+                -1.0,
+                par,
+            );
             c += &cp;
         }
         h.as_mut().submatrix_mut(0, kk, nb, b).copy_from(&c);
@@ -138,8 +175,16 @@ pub(crate) fn solve(
         // Descending θ = ascending λ.
         let order: Vec<usize> = (0..kk).rev().collect();
         let theta: Vec<f64> = order.iter().map(|&i| theta_asc[i]).collect();
-        let lam: Vec<f64> =
-            theta.iter().map(|&t| if t > 0.0 { sigma + 1.0 / t } else { f64::INFINITY }).collect();
+        let lam: Vec<f64> = theta
+            .iter()
+            .map(|&t| {
+                if t > 0.0 {
+                    sigma + 1.0 / t
+                } else {
+                    f64::INFINITY
+                }
+            })
+            .collect();
         let r_last = h.as_ref().submatrix(kk, kk - b, b, b).to_owned();
         let est: Vec<f64> = order
             .iter()
@@ -163,20 +208,42 @@ pub(crate) fn solve(
             Some(lim) => {
                 let below = lam.iter().take_while(|&&l| l < lim).count();
                 let capped = below >= params.max_modes;
-                let w = if capped { params.max_modes } else { (below + 1).max(params.nev) };
+                let w = if capped {
+                    params.max_modes
+                } else {
+                    (below + 1).max(params.nev)
+                };
                 (w.min(n), below, capped)
             }
         };
-        let conv = est.iter().take(wanted.min(kk)).filter(|&&e| e <= params.tol).count();
-        progress(EigenProgress { converged: conv, requested: wanted, iteration: info.iterations });
+        let conv = est
+            .iter()
+            .take(wanted.min(kk))
+            .filter(|&&e| e <= params.tol)
+            .count();
+        progress(EigenProgress {
+            converged: conv,
+            requested: wanted,
+            iteration: info.iterations,
+        });
 
         let ready = wanted <= kk
             && est.iter().take(wanted).all(|&e| e <= trigger)
             && (lam_lim.is_none() || capped || below < kk);
         let out_of_steps = info.block_solves >= params.max_iters;
         if ready || out_of_steps {
+            info.residual_checks += 1;
             let sel = select_cols(s_asc.as_ref(), &order[..wanted.min(kk)]);
-            let (vals, u, res) = finalize(k, m, &fac, v.as_ref().subcols(0, kk), mv.as_ref().subcols(0, kk), sel.as_ref(), sigma, par)?;
+            let (vals, u, res) = finalize(
+                k,
+                m,
+                &fac,
+                v.as_ref().subcols(0, kk),
+                mv.as_ref().subcols(0, kk),
+                sel.as_ref(),
+                sigma,
+                par,
+            )?;
             let worst = res.iter().map(|r| r.rel).fold(0.0, f64::max);
             let good = res.iter().filter(|r| r.converged(params.tol)).count();
             if good == res.len() && wanted <= kk {
@@ -184,7 +251,6 @@ pub(crate) fn solve(
                 info.capped = capped;
                 return Ok(trim_and_sign(vals, u, res, lam_lim, params, info));
             }
-            last_explicit = Some((good, worst));
             if out_of_steps {
                 return Err(EigenError::NotConverged {
                     converged: good,
@@ -195,7 +261,6 @@ pub(crate) fn solve(
             // The estimate was optimistic: demand a smaller one before the next check.
             trigger *= 1e-2;
         }
-        let _ = last_explicit;
 
         // --- make room: grow (max-frequency mode) or thick-restart --------------------------
         let need = krylov_dim(params, wanted, b);
@@ -211,12 +276,28 @@ pub(crate) fn solve(
         }
         if kk + 2 * b > cap {
             // Keep the best p Ritz vectors plus the newest block.
-            let p = (wanted + (kk - wanted) / 2).min(ncv - b).max(wanted.min(ncv - b));
+            let p = (wanted + (kk - wanted) / 2)
+                .min(ncv - b)
+                .max(wanted.min(ncv - b));
             let sp = select_cols(s_asc.as_ref(), &order[..p]);
             let mut nv = Mat::<f64>::zeros(n, p);
             let mut nmv = Mat::<f64>::zeros(n, p);
-            gemm(nv.as_mut(), Accum::Replace, v.as_ref().subcols(0, kk), sp.as_ref(), 1.0, par);
-            gemm(nmv.as_mut(), Accum::Replace, mv.as_ref().subcols(0, kk), sp.as_ref(), 1.0, par);
+            gemm(
+                nv.as_mut(),
+                Accum::Replace,
+                v.as_ref().subcols(0, kk),
+                sp.as_ref(),
+                1.0,
+                par,
+            );
+            gemm(
+                nmv.as_mut(),
+                Accum::Replace,
+                mv.as_ref().subcols(0, kk),
+                sp.as_ref(),
+                1.0,
+                par,
+            );
             let w = v.as_ref().subcols(kk, b).to_owned();
             let mw = mv.as_ref().subcols(kk, b).to_owned();
             v.as_mut().subcols_mut(0, p).copy_from(&nv);
@@ -224,7 +305,14 @@ pub(crate) fn solve(
             v.as_mut().subcols_mut(p, b).copy_from(&w);
             mv.as_mut().subcols_mut(p, b).copy_from(&mw);
             let mut coupling = Mat::<f64>::zeros(b, p);
-            gemm(coupling.as_mut(), Accum::Replace, r_last.as_ref(), sp.as_ref().subrows(kk - b, b), 1.0, Par::Seq);
+            gemm(
+                coupling.as_mut(),
+                Accum::Replace,
+                r_last.as_ref(),
+                sp.as_ref().subrows(kk - b, b),
+                1.0,
+                Par::Seq,
+            );
             h.fill(0.0);
             for i in 0..p {
                 h[(i, i)] = theta[i];
@@ -275,13 +363,20 @@ fn check_input(
 /// Krylov basis size for `wanted` pairs: the parameter, or wanted + max(wanted, 4b), at least
 /// wanted + 2b, rounded up to a multiple of b.
 fn krylov_dim(params: &EigenParams, wanted: usize, b: usize) -> usize {
-    let base = params.krylov_dim.unwrap_or_else(|| wanted + wanted.max(4 * b));
+    let base = params
+        .krylov_dim
+        .unwrap_or_else(|| wanted + wanted.max(4 * b));
     let d = base.max(wanted + 2 * b);
     d.div_ceil(b) * b
 }
 
 fn m_norm(z: MatRef<'_, f64>, mz: MatRef<'_, f64>, j: usize) -> f64 {
-    let s: f64 = z.col(j).iter().zip(mz.col(j).iter()).map(|(a, b)| a * b).sum();
+    let s: f64 = z
+        .col(j)
+        .iter()
+        .zip(mz.col(j).iter())
+        .map(|(a, b)| a * b)
+        .sum();
     s.max(0.0).sqrt()
 }
 
@@ -316,13 +411,21 @@ fn orthonormalize(
     par: Par,
 ) -> Result<Mat<f64>, EigenError> {
     let b = z.ncols();
-    let healthy = (0..b).all(|j| m_norm(z.as_ref(), mz.as_ref(), j) > BREAKDOWN * pre[j] && pre[j] > 0.0);
+    let healthy =
+        (0..b).all(|j| m_norm(z.as_ref(), mz.as_ref(), j) > BREAKDOWN * pre[j] && pre[j] > 0.0);
     if healthy {
         let mut r_total = Mat::<f64>::identity(b, b);
         let mut ok = true;
         for _pass in 0..2 {
             let mut g = Mat::<f64>::zeros(b, b);
-            gemm(g.as_mut(), Accum::Replace, z.as_ref().transpose(), mz.as_ref(), 1.0, Par::Seq);
+            gemm(
+                g.as_mut(),
+                Accum::Replace,
+                z.as_ref().transpose(),
+                mz.as_ref(),
+                1.0,
+                Par::Seq,
+            );
             let mut g = symmetrized(g.as_ref());
             if small_cholesky(g.as_mut(), 1e-14).is_err() {
                 ok = false;
@@ -344,16 +447,46 @@ fn orthonormalize(
     for j in 0..b {
         let mut replaced = false;
         for attempt in 0..3 {
-            let reference = if replaced { m_norm(z.as_ref(), mz.as_ref(), j) } else { pre[j] };
+            let reference = if replaced {
+                m_norm(z.as_ref(), mz.as_ref(), j)
+            } else {
+                pre[j]
+            };
             for _pass in 0..2 {
                 if v.ncols() > 0 {
                     let mut c = Mat::<f64>::zeros(v.ncols(), 1);
-                    gemm(c.as_mut(), Accum::Replace, mv.transpose(), z.as_ref().subcols(j, 1), 1.0, par);
-                    gemm(z.as_mut().subcols_mut(j, 1), Accum::Add, v, c.as_ref(), -1.0, par);
-                    gemm(mz.as_mut().subcols_mut(j, 1), Accum::Add, mv, c.as_ref(), -1.0, par);
+                    gemm(
+                        c.as_mut(),
+                        Accum::Replace,
+                        mv.transpose(),
+                        z.as_ref().subcols(j, 1),
+                        1.0,
+                        par,
+                    );
+                    gemm(
+                        z.as_mut().subcols_mut(j, 1),
+                        Accum::Add,
+                        v,
+                        c.as_ref(),
+                        -1.0,
+                        par,
+                    );
+                    gemm(
+                        mz.as_mut().subcols_mut(j, 1),
+                        Accum::Add,
+                        mv,
+                        c.as_ref(),
+                        -1.0,
+                        par,
+                    );
                 }
                 for i in 0..j {
-                    let c: f64 = mz.col(i).iter().zip(z.col(j).iter()).map(|(a, b)| a * b).sum();
+                    let c: f64 = mz
+                        .col(i)
+                        .iter()
+                        .zip(z.col(j).iter())
+                        .map(|(a, b)| a * b)
+                        .sum();
                     let (zi, mzi) = (z.col(i).to_owned(), mz.col(i).to_owned());
                     for (t, s) in z.as_mut().col_mut(j).iter_mut().zip(zi.iter()) {
                         *t -= c * s;
@@ -381,7 +514,8 @@ fn orthonormalize(
             }
             if attempt == 2 {
                 return Err(EigenError::InvalidInput(
-                    "Krylov space exhausted: the problem is too small for the requested basis".into(),
+                    "Krylov space exhausted: the problem is too small for the requested basis"
+                        .into(),
                 ));
             }
             // Replace by a fresh random direction; the Lanczos relation gets a zero column.
@@ -414,7 +548,7 @@ fn finalize(
     s: MatRef<'_, f64>,
     sigma: f64,
     par: Par,
-) -> Result<(Vec<f64>, Mat<f64>, Vec<Residual>), EigenError> {
+) -> Result<RitzPairs, EigenError> {
     let n = v.nrows();
     let w = s.ncols();
     let mut u = Mat::<f64>::zeros(n, w);
@@ -446,12 +580,26 @@ fn rayleigh_ritz(
     ku: Mat<f64>,
     sigma: f64,
     par: Par,
-) -> Result<(Vec<f64>, Mat<f64>, Vec<Residual>), EigenError> {
+) -> Result<RitzPairs, EigenError> {
     let w = u.ncols();
     let mut g = Mat::<f64>::zeros(w, w);
     let mut a = Mat::<f64>::zeros(w, w);
-    gemm(g.as_mut(), Accum::Replace, u.as_ref().transpose(), mu.as_ref(), 1.0, par);
-    gemm(a.as_mut(), Accum::Replace, u.as_ref().transpose(), ku.as_ref(), 1.0, par);
+    gemm(
+        g.as_mut(),
+        Accum::Replace,
+        u.as_ref().transpose(),
+        mu.as_ref(),
+        1.0,
+        par,
+    );
+    gemm(
+        a.as_mut(),
+        Accum::Replace,
+        u.as_ref().transpose(),
+        ku.as_ref(),
+        1.0,
+        par,
+    );
     let mut g = symmetrized(g.as_ref());
     let a = symmetrized(a.as_ref());
     small_cholesky(g.as_mut(), 0.0)
@@ -498,16 +646,10 @@ fn residuals(
     let (n, w) = (u.nrows(), u.ncols());
     let mut ku = Mat::<f64>::zeros(n, w);
     let mut mu = Mat::<f64>::zeros(n, w);
-    sym_spmm(k, u, ku.as_mut());
-    sym_spmm(m, u, mu.as_mut());
-    let abs = |a: &SparseColMat<usize, f64>| {
-        SparseColMat::new(a.symbolic().to_owned().unwrap(), a.val().iter().map(|x| x.abs()).collect())
-    };
-    let ua = Mat::from_fn(n, w, |i, j| u[(i, j)].abs());
     let mut aku = Mat::<f64>::zeros(n, w);
     let mut amu = Mat::<f64>::zeros(n, w);
-    sym_spmm(&abs(k), ua.as_ref(), aku.as_mut());
-    sym_spmm(&abs(m), ua.as_ref(), amu.as_mut());
+    sym_spmm_with_abs(k, u, ku.as_mut(), aku.as_mut());
+    sym_spmm_with_abs(m, u, mu.as_mut(), amu.as_mut());
     (0..w)
         .map(|j| {
             let l = lam[j];
@@ -616,7 +758,11 @@ fn solve_dense(
     info.krylov_dim = n;
     info.solve_seconds = t1.elapsed().as_secs_f64();
     let good = res.iter().filter(|r| r.converged(params.tol)).count();
-    progress(EigenProgress { converged: good, requested: wanted, iteration: 1 });
+    progress(EigenProgress {
+        converged: good,
+        requested: wanted,
+        iteration: 1,
+    });
     if good < res.len() {
         return Err(EigenError::NotConverged {
             converged: good,

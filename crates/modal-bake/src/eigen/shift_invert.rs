@@ -2,6 +2,8 @@
 
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::LltRegularization;
+use faer::perm::PermRef;
+use faer::sparse::linalg::amd;
 use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky, CholeskySymbolicParams, LltRef, SymbolicCholesky,
     SymmetricOrdering,
@@ -47,10 +49,69 @@ pub(crate) fn shifted(
         }
         col_ptr.push(rows.len());
     }
-    SparseColMat::new(SymbolicSparseColMat::new_checked(n, n, col_ptr, None, rows), vals)
+    SparseColMat::new(
+        SymbolicSparseColMat::new_checked(n, n, col_ptr, None, rows),
+        vals,
+    )
 }
 
-/// Sparse LLᵀ factor of A = K − σM (AMD ordering, faer's supernodal/simplicial choice).
+/// AMD on the node graph when the pattern is made of full 3×3 node blocks (node-major dofs, as
+/// assembled by [`crate::fem`]), expanded to the dofs of each node in order. Same fill as AMD
+/// on the dof graph (AMD merges the indistinguishable dofs of a node anyway), ~2× faster to
+/// compute. `None` when the pattern is not blocked.
+fn node_amd(a: &SparseColMat<usize, f64>) -> Option<(Vec<usize>, Vec<usize>)> {
+    let n = a.nrows();
+    if !n.is_multiple_of(3) || n == 0 {
+        return None;
+    }
+    let (cp, ri) = (a.symbolic().col_ptr(), a.symbolic().row_idx());
+    let nn = n / 3;
+    let mut ncp = Vec::with_capacity(nn + 1);
+    let mut nri = Vec::with_capacity(ri.len() / 9 + nn);
+    ncp.push(0);
+    for node in 0..nn {
+        let first = &ri[cp[3 * node]..cp[3 * node + 1]];
+        // Each of the node's three columns must hold the same full row blocks.
+        if first.len() % 3 != 0 {
+            return None;
+        }
+        for c in 3 * node..3 * node + 3 {
+            if ri[cp[c]..cp[c + 1]] != *first {
+                return None;
+            }
+        }
+        for blk in first.chunks_exact(3) {
+            if blk[0] % 3 != 0 || blk[1] != blk[0] + 1 || blk[2] != blk[0] + 2 {
+                return None;
+            }
+            nri.push(blk[0] / 3);
+        }
+        ncp.push(nri.len());
+    }
+    let g = SymbolicSparseColMat::new_checked(nn, nn, ncp, None, nri);
+    let mut fwd = vec![0usize; nn];
+    let mut inv = vec![0usize; nn];
+    let mut mem = MemBuffer::try_new(amd::order_scratch::<usize>(nn, g.row_idx().len())).ok()?;
+    amd::order(
+        &mut fwd,
+        &mut inv,
+        g.as_ref(),
+        amd::Control::default(),
+        MemStack::new(&mut mem),
+    )
+    .ok()?;
+    let fwd3: Vec<usize> = fwd
+        .iter()
+        .flat_map(|&v| [3 * v, 3 * v + 1, 3 * v + 2])
+        .collect();
+    let mut inv3 = vec![0usize; n];
+    for (i, &p) in fwd3.iter().enumerate() {
+        inv3[p] = i;
+    }
+    Some((fwd3, inv3))
+}
+
+/// Sparse LLᵀ factor of A = K − σM (AMD ordering on nodes, faer's supernodal/simplicial choice).
 pub(crate) struct ShiftInvert {
     symbolic: SymbolicCholesky<usize>,
     values: Vec<f64>,
@@ -60,10 +121,17 @@ pub(crate) struct ShiftInvert {
 impl ShiftInvert {
     /// Factors `a` (symmetric positive definite, full storage; the lower triangle is read).
     pub fn new(a: &SparseColMat<usize, f64>, par: Par) -> Result<ShiftInvert, EigenError> {
+        let node_perm = node_amd(a);
+        let ordering = match &node_perm {
+            Some((fwd, inv)) => {
+                SymmetricOrdering::Custom(PermRef::new_checked(fwd, inv, a.nrows()))
+            }
+            None => SymmetricOrdering::Amd,
+        };
         let symbolic = factorize_symbolic_cholesky(
             a.symbolic(),
             Side::Lower,
-            SymmetricOrdering::Amd,
+            ordering,
             CholeskySymbolicParams::default(),
         )
         .map_err(|e| EigenError::Factorization(format!("symbolic analysis failed: {e:?}")))?;
@@ -87,7 +155,11 @@ impl ShiftInvert {
                      lowest eigenvalue"
                 ))
             })?;
-        Ok(ShiftInvert { symbolic, values, par })
+        Ok(ShiftInvert {
+            symbolic,
+            values,
+            par,
+        })
     }
 
     /// Number of stored factor entries.

@@ -63,7 +63,12 @@ impl NodeGraph {
             adj.extend_from_slice(l);
             adj_ptr.push(adj.len());
         }
-        NodeGraph { adj_ptr, adj, inc_ptr, inc }
+        NodeGraph {
+            adj_ptr,
+            adj,
+            inc_ptr,
+            inc,
+        }
     }
 
     fn neighbours(&self, a: usize) -> &[usize] {
@@ -95,7 +100,11 @@ impl NodeGraph {
 
     /// Splits `values` into the per-node column-block slices (`len_per_neighbour` values per
     /// neighbour).
-    fn node_slices<'a>(&self, values: &'a mut [f64], len_per_neighbour: usize) -> Vec<&'a mut [f64]> {
+    fn node_slices<'a>(
+        &self,
+        values: &'a mut [f64],
+        len_per_neighbour: usize,
+    ) -> Vec<&'a mut [f64]> {
         let n = self.adj_ptr.len() - 1;
         let mut out = Vec::with_capacity(n);
         let mut rest = values;
@@ -118,7 +127,11 @@ fn element_geometry(mesh: &TetMesh, t: &[usize; 4]) -> ([[f64; 3]; 4], f64) {
     };
     let (e1, e2, e3) = (e(1), e(2), e(3));
     let cross = |a: [f64; 3], b: [f64; 3]| {
-        [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+        [
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ]
     };
     let c23 = cross(e2, e3);
     let det = e1[0] * c23[0] + e1[1] * c23[1] + e1[2] * c23[2];
@@ -167,8 +180,11 @@ pub(crate) fn assemble_stiffness_with_graph(
     graph: &NodeGraph,
 ) -> SparseColMat<usize, f64> {
     let (lam, mu) = mat.lame();
-    let geo: Vec<([[f64; 3]; 4], f64)> =
-        mesh.tets.par_iter().map(|t| element_geometry(mesh, t)).collect();
+    let geo: Vec<([[f64; 3]; 4], f64)> = mesh
+        .tets
+        .par_iter()
+        .map(|t| element_geometry(mesh, t))
+        .collect();
     let pattern = graph.dof_pattern(true);
     let mut values = vec![0.0f64; pattern.row_idx().len()];
     let slices = graph.node_slices(&mut values, 9);
@@ -222,7 +238,11 @@ pub fn assemble_mass(mesh: &TetMesh, mat: &Material, lumped: bool) -> SparseColM
     let n = mesh.nodes.len();
     if lumped {
         let graph = NodeGraph::new(mesh);
-        let vols: Vec<f64> = mesh.tets.par_iter().map(|t| element_geometry(mesh, t).1).collect();
+        let vols: Vec<f64> = mesh
+            .tets
+            .par_iter()
+            .map(|t| element_geometry(mesh, t).1)
+            .collect();
         let mut values = vec![0.0f64; 3 * n];
         values.par_chunks_mut(3).enumerate().for_each(|(a, out)| {
             let mut m = 0.0;
@@ -250,7 +270,11 @@ pub(crate) fn assemble_consistent_mass_with_graph(
     graph: &NodeGraph,
 ) -> SparseColMat<usize, f64> {
     let rho = mat.density;
-    let vols: Vec<f64> = mesh.tets.par_iter().map(|t| element_geometry(mesh, t).1).collect();
+    let vols: Vec<f64> = mesh
+        .tets
+        .par_iter()
+        .map(|t| element_geometry(mesh, t).1)
+        .collect();
     let pattern = graph.dof_pattern(false);
     let mut values = vec![0.0f64; pattern.row_idx().len()];
     let slices = graph.node_slices(&mut values, 3);
@@ -287,8 +311,8 @@ pub fn rigid_body_modes(mesh: &TetMesh) -> faer::Mat<f64> {
     for t in &mesh.tets {
         let v = element_geometry(mesh, t).1;
         vol += v;
-        for k in 0..3 {
-            c[k] += v * 0.25 * t.iter().map(|&a| mesh.nodes[a][k]).sum::<f64>();
+        for (k, ck) in c.iter_mut().enumerate() {
+            *ck += v * 0.25 * t.iter().map(|&a| mesh.nodes[a][k]).sum::<f64>();
         }
     }
     if vol > 0.0 {

@@ -62,7 +62,11 @@ impl DofMap {
                 free.push(3 * a + k);
             }
         }
-        Ok(DofMap { n_full, free, full_to_free })
+        Ok(DofMap {
+            n_full,
+            free,
+            full_to_free,
+        })
     }
 
     /// Number of dofs of the full problem (3 per node).
@@ -82,7 +86,10 @@ impl DofMap {
 
     /// Free index of full dof `dof`, or `None` when it is fixed.
     pub fn free_index(&self, dof: usize) -> Option<usize> {
-        self.full_to_free.get(dof).copied().filter(|&i| i != usize::MAX)
+        self.full_to_free
+            .get(dof)
+            .copied()
+            .filter(|&i| i != usize::MAX)
     }
 
     /// The submatrix of a full `3n × 3n` matrix on the free rows and columns (same units).
@@ -109,7 +116,10 @@ impl DofMap {
             col_ptr.push(rows.len());
         }
         let n = self.free.len();
-        SparseColMat::new(SymbolicSparseColMat::new_checked(n, n, col_ptr, None, rows), vals)
+        SparseColMat::new(
+            SymbolicSparseColMat::new_checked(n, n, col_ptr, None, rows),
+            vals,
+        )
     }
 
     /// Expands free-dof vectors (`n_free × m`, e.g. mode shapes) to full length with zeros at the

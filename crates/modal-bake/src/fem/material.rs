@@ -40,7 +40,11 @@ impl Material {
     /// # let _ = steel;
     /// ```
     pub fn new(youngs: f64, poisson: f64, density: f64) -> Result<Self, MaterialError> {
-        let m = Material { youngs, poisson, density };
+        let m = Material {
+            youngs,
+            poisson,
+            density,
+        };
         m.validate()?;
         Ok(m)
     }
@@ -65,7 +69,10 @@ impl Material {
     /// Lamé parameters `(λ, μ)` in Pa: λ = Eν/((1+ν)(1−2ν)), μ = E/(2(1+ν)).
     pub fn lame(&self) -> (f64, f64) {
         let (e, nu) = (self.youngs, self.poisson);
-        (e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)), e / (2.0 * (1.0 + nu)))
+        (
+            e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)),
+            e / (2.0 * (1.0 + nu)),
+        )
     }
 
     /// Squared bar wave speed E/ρ (m²/s²): sets the frequency scale of the material.

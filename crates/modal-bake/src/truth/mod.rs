@@ -12,7 +12,8 @@
 //!
 //! Conventions (identical to `modal-bake probe` and `dcr_runtime::ModalModel`):
 //! - points are mapped to the closest triangle of the extracted boundary surface (brute force,
-//!   [`SurfaceMap`]); weights in triangle order; normals are area-weighted vertex normals
+//!   [`SurfaceMap`]) and refused farther than [`MAP_DISTANCE_REL`] × the bounding-box diagonal;
+//!   weights in triangle order; normals are area-weighted vertex normals
 //!   interpolated with the weights and normalised;
 //! - the impulse acts at t = 0 along `direction`, by default *into* the surface (−normal at
 //!   the impact), spread to the impact triangle's three nodes by barycentric weights;
@@ -36,7 +37,7 @@ use std::path::Path;
 use std::time::Instant;
 
 pub use dcr_runtime::format::MaterialSi;
-pub use modal_all::ModalAll;
+pub use modal_all::{ModalAll, ModalInput};
 pub use newmark::{newmark_peaks, newmark_run, NewmarkInfo};
 pub use surface_map::SurfaceMap;
 pub use truth_system::TruthSystem;
@@ -98,6 +99,10 @@ impl Default for TruthParams {
         }
     }
 }
+
+/// Points farther than this fraction of the surface's bounding-box diagonal are refused (as
+/// `modal-bake probe` and `DistantResponse` do by default).
+pub const MAP_DISTANCE_REL: f64 = 0.05;
 
 /// Largest number of steps accepted (h/dt).
 pub const MAX_STEPS: usize = 100_000_000;
@@ -232,15 +237,24 @@ fn map_points(
     impact: &TruthImpact,
     contacts: &[[f64; 3]],
 ) -> Result<(SurfacePoint, [f64; 3], Vec<SurfacePoint>), TruthError> {
-    if !(impact.impulse.is_finite()) {
+    if !(impact.impulse.is_finite() && impact.impulse > 0.0) {
         return Err(TruthError::Params(format!(
-            "--impulse must be finite, got {}",
+            "--impulse must be a finite number > 0 (N·s), got {}",
             impact.impulse
         )));
     }
-    let isp = sys.surface.project(impact.point).ok_or_else(|| {
-        TruthError::Params(format!("impact point {:?} cannot be mapped", impact.point))
-    })?;
+    let max_map = MAP_DISTANCE_REL * sys.surface.bounding_box_diagonal();
+    let map = |p: [f64; 3], what: &str| {
+        sys.surface
+            .project(p)
+            .filter(|sp| sp.distance <= max_map)
+            .ok_or_else(|| {
+                TruthError::Params(format!(
+                    "{what} at {p:?} is farther than {max_map:.4} m from the surface"
+                ))
+            })
+    };
+    let isp = map(impact.point, "impact point")?;
     let dir = match impact.direction {
         Some(d) => {
             let n = surface_map::normalize(d);
@@ -255,11 +269,8 @@ fn map_points(
     };
     let csp = contacts
         .iter()
-        .map(|&p| {
-            sys.surface
-                .project(p)
-                .ok_or_else(|| TruthError::Params(format!("contact {p:?} cannot be mapped")))
-        })
+        .enumerate()
+        .map(|(i, &p)| map(p, &format!("contact {}", i + 1)))
         .collect::<Result<Vec<_>, _>>()?;
     Ok((isp, dir, csp))
 }
@@ -274,7 +285,10 @@ fn distances(sys: &TruthSystem, isp: &SurfacePoint, csp: &[SurfacePoint]) -> (Ve
                 .iter()
                 .map(|c| {
                     let t = sys.surface.triangles[c.triangle as usize];
-                    (0..3).map(|i| c.bary[i] * d[t[i] as usize]).sum::<f64>().max(0.0)
+                    (0..3)
+                        .map(|i| c.bary[i] * d[t[i] as usize])
+                        .sum::<f64>()
+                        .max(0.0)
                 })
                 .collect();
             return (out, "geodesic".into());
@@ -348,10 +362,7 @@ pub fn run_truth(
             let ma = ModalAll::new(&sys, params.max_dense_dofs)?;
             info.solve_s = ma.solve_s;
             info.rigid_modes_dropped = ma.rigid_dropped;
-            info.modes_used = params
-                .modes
-                .unwrap_or(usize::MAX)
-                .min(ma.eigenvalues.len());
+            info.modes_used = params.modes.unwrap_or(usize::MAX).min(ma.eigenvalues.len());
             let t = Instant::now();
             let p = ma.peaks(&f, &rows, params.rayleigh, dt, steps, params.modes);
             info.step_s = t.elapsed().as_secs_f64();

@@ -45,7 +45,10 @@ impl ModalAll {
     pub fn new(sys: &TruthSystem, max_dofs: usize) -> Result<ModalAll, TruthError> {
         let n = sys.n();
         if n > max_dofs {
-            return Err(TruthError::TooLarge { dofs: n, max: max_dofs });
+            return Err(TruthError::TooLarge {
+                dofs: n,
+                max: max_dofs,
+            });
         }
         let t = Instant::now();
         let md = sys.m.to_dense();
@@ -69,7 +72,10 @@ impl ModalAll {
         let rigid = if sys.free_free() { 6 } else { 0 };
         if rigid > 0 {
             let lam7 = vals.get(rigid).copied().unwrap_or(f64::INFINITY).abs();
-            let near = vals.iter().filter(|l| l.abs() <= RIGID_REL_TOL * lam7).count();
+            let near = vals
+                .iter()
+                .filter(|l| l.abs() <= RIGID_REL_TOL * lam7)
+                .count();
             if near != rigid {
                 return Err(TruthError::Eigen(format!(
                     "expected 6 rigid-body modes for a free-free object, found {near}"
@@ -124,9 +130,32 @@ impl ModalAll {
         steps: usize,
         modes: Option<usize>,
     ) -> Vec<f64> {
+        self.response_peaks(r, w, rayleigh, dt, steps, modes, ModalInput::Impulse, false)
+    }
+
+    /// Peak |Σ_j w_cj r_j x_j(kΔt)| per row c over k = 1 … `steps`, summing the lowest `modes`
+    /// elastic modes (`None`: all); x_j is the impulse response g_j (r in N·s units, paper Eq. 10)
+    /// or the step response (1 − φ_j)/ω_j² (r in N: a force switched on at t = 0 and held).
+    ///
+    /// `static_correction` (step input only; ignored for impulses, whose truncated part has
+    /// no static component): adds the residual flexibility of the dropped modes,
+    /// Σ_{j > m} w_cj r_j / ω_j² = wᵀ(K⁻¹ − U_m Λ_m⁻¹ U_mᵀ) f, to every sample — the
+    /// quasi-static response of modes far above the excitation (mode-acceleration method).
+    #[allow(clippy::too_many_arguments)]
+    pub fn response_peaks(
+        &self,
+        r: &[f64],
+        w: &[Vec<f64>],
+        rayleigh: [f64; 2],
+        dt: f64,
+        steps: usize,
+        modes: Option<usize>,
+        input: ModalInput,
+        static_correction: bool,
+    ) -> Vec<f64> {
         let m = modes.unwrap_or(usize::MAX).min(self.eigenvalues.len());
         let nc = w.len();
-        // y[c][k] = Σ_j w_cj r_j g_j(kΔt), accumulated per chunk of modes in parallel.
+        // y[c][k] = Σ_j w_cj r_j x_j(kΔt), accumulated per chunk of modes in parallel.
         let y = (0..m)
             .into_par_iter()
             .with_min_len(32)
@@ -134,16 +163,20 @@ impl ModalAll {
                 || vec![0.0f64; nc * steps],
                 |mut acc, j| {
                     let lam = self.eigenvalues[j];
-                    if !(lam > 0.0) || r[j] == 0.0 {
+                    if lam.is_nan() || lam <= 0.0 || r[j] == 0.0 {
                         return acc;
                     }
                     let omega = lam.sqrt();
                     let filt = ModeFilter::new(omega, damping_ratio(omega, rayleigh), dt);
                     let coef: Vec<f64> = w.iter().map(|wc| wc[j] * r[j]).collect();
                     for k in 0..steps {
-                        let g = filt.impulse_response((k + 1) as f64 * dt);
+                        let t = (k + 1) as f64 * dt;
+                        let x = match input {
+                            ModalInput::Impulse => filt.impulse_response(t),
+                            ModalInput::Step => filt.step_response(t),
+                        };
                         for (c, a) in coef.iter().enumerate() {
-                            acc[c * steps + k] += a * g;
+                            acc[c * steps + k] += a * x;
                         }
                     }
                     acc
@@ -156,8 +189,33 @@ impl ModalAll {
                     a
                 },
             );
+        let offset: Vec<f64> = if static_correction && input == ModalInput::Step {
+            w.iter()
+                .map(|wc| {
+                    (m..self.eigenvalues.len())
+                        .filter(|&j| self.eigenvalues[j] > 0.0)
+                        .map(|j| wc[j] * r[j] / self.eigenvalues[j])
+                        .sum()
+                })
+                .collect()
+        } else {
+            vec![0.0; nc]
+        };
         (0..nc)
-            .map(|c| y[c * steps..(c + 1) * steps].iter().fold(0.0f64, |p, v| p.max(v.abs())))
+            .map(|c| {
+                y[c * steps..(c + 1) * steps]
+                    .iter()
+                    .fold(0.0f64, |p, v| p.max((v + offset[c]).abs()))
+            })
             .collect()
     }
+}
+
+/// The time profile of the load in [`ModalAll::response_peaks`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ModalInput {
+    /// An impulse at t = 0 (load in N·s).
+    Impulse,
+    /// A force switched on at t = 0 and held (load in N).
+    Step,
 }

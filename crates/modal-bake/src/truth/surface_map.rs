@@ -91,6 +91,18 @@ impl SurfaceMap {
         }
     }
 
+    /// Diagonal of the surface's axis-aligned bounding box (m).
+    pub fn bounding_box_diagonal(&self) -> f64 {
+        let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+        for p in &self.vertices {
+            for k in 0..3 {
+                lo[k] = lo[k].min(p[k]);
+                hi[k] = hi[k].max(p[k]);
+            }
+        }
+        norm2(sub(hi, lo)).sqrt()
+    }
+
     /// Volume nodes of triangle `tri` (triangle order).
     pub fn triangle_nodes(&self, tri: u32) -> [usize; 3] {
         self.triangles[tri as usize].map(|i| self.surface_to_volume[i as usize])
@@ -144,7 +156,13 @@ pub(crate) fn closest_point_triangle(
             }
         }
     };
-    let mut bary = bary.map(|x: f64| if x.is_finite() { x.clamp(0.0, 1.0) } else { 0.0 });
+    let mut bary = bary.map(|x: f64| {
+        if x.is_finite() {
+            x.clamp(0.0, 1.0)
+        } else {
+            0.0
+        }
+    });
     let s = bary[0] + bary[1] + bary[2];
     bary = if s > 0.0 {
         bary.map(|x| x / s)

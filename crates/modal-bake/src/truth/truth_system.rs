@@ -58,7 +58,9 @@ impl TruthSystem {
             TruthError::Mesh(e)
         };
         if mesh.tets.is_empty() {
-            return Err(TruthError::Params(format!("{file}: the mesh has no tetrahedra")));
+            return Err(TruthError::Params(format!(
+                "{file}: the mesh has no tetrahedra"
+            )));
         }
         mesh.orient_tets(DEFAULT_DEGENERATE_REL_TOL)
             .map_err(name_file)?;
@@ -132,7 +134,12 @@ impl TruthSystem {
     }
 
     fn scatter(&self, sp: &SurfacePoint, d: [f64; 3], s: f64, out: &mut [f64]) {
-        for (i, v) in self.surface.triangle_nodes(sp.triangle).into_iter().enumerate() {
+        for (i, v) in self
+            .surface
+            .triangle_nodes(sp.triangle)
+            .into_iter()
+            .enumerate()
+        {
             for (axis, da) in d.iter().enumerate() {
                 if let Some(j) = self.map.free_index(3 * v + axis) {
                     out[j] += sp.bary[i] * da * s;
