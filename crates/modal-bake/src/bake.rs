@@ -291,6 +291,14 @@ fn prepare(mut mesh: TetMesh, params: &BakeParams, file: &str) -> Result<Prepare
     }
     fixed.sort_unstable();
     fixed.dedup();
+    if !fixed.is_empty() && !spans_a_plane(&mesh, &fixed) {
+        return Err(BakeError::Params(format!(
+            "{file}: the fixed nodes ({} of them, groups {:?}) are collinear, so rotations about their line stay free \
+             (a mechanism, K is singular); fix a patch of at least three non-collinear nodes",
+            fixed.len(),
+            params.fixed
+        )));
+    }
     if !fixed.is_empty() && fixed.len() == mesh.nodes.len() {
         return Err(BakeError::Params(format!(
             "{file}: --fixed fixes every node; nothing can vibrate"
@@ -302,6 +310,29 @@ fn prepare(mut mesh: TetMesh, params: &BakeParams, file: &str) -> Result<Prepare
         fixed,
         reoriented,
         hash,
+    })
+}
+
+/// Whether the nodes `set` contain three non-collinear points (relative tolerance 1e-9 of the
+/// set's extent): only then do they suppress every rigid-body motion.
+fn spans_a_plane(mesh: &TetMesh, set: &[usize]) -> bool {
+    let p0 = mesh.nodes[set[0]];
+    let dist2 = |a: [f64; 3], b: [f64; 3]| (0..3).map(|i| (a[i] - b[i]).powi(2)).sum::<f64>();
+    let Some(&far) = set.iter().max_by(|&&a, &&b| dist2(p0, mesh.nodes[a]).total_cmp(&dist2(p0, mesh.nodes[b]))) else {
+        return false;
+    };
+    let p1 = mesh.nodes[far];
+    let l2 = dist2(p0, p1);
+    if !(l2 > 0.0) {
+        return false;
+    }
+    // Area of (p0, p1, p) relative to |p0 p1|²: twice the triangle area = |(p1−p0)×(p−p0)|.
+    let e = [p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]];
+    set.iter().any(|&v| {
+        let p = mesh.nodes[v];
+        let d = [p[0] - p0[0], p[1] - p0[1], p[2] - p0[2]];
+        let c = [e[1] * d[2] - e[2] * d[1], e[2] * d[0] - e[0] * d[2], e[0] * d[1] - e[1] * d[0]];
+        (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt() > 1e-9 * l2
     })
 }
 
