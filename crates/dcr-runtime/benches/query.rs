@@ -12,8 +12,8 @@ use std::sync::Arc;
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
 use dcr_runtime::testing::{box_surface, geometric_omegas, synthetic_base, SplitMix64};
 use dcr_runtime::{
-    AmplitudeKind, AttenuationLaw, AttenuationParams, DistanceKind, DistantResponse, HeatGeodesic, Impact, Method,
-    ModalModel, ResponseParams, RestingContact, Sampling,
+    AmplitudeKind, AttenuationLaw, AttenuationParams, DistanceKind, DistantResponse, HeatGeodesic,
+    Impact, Method, ModalModel, ResponseParams, RestingContact, Sampling,
 };
 
 /// (name, samples per step, distant contacts, surface vertices, paper ms).
@@ -38,14 +38,23 @@ struct Workload {
 fn workload(verts: usize, contacts: usize, seed: u64) -> Workload {
     let n = (((verts as f64 - 2.0) / 6.0).sqrt().round() as usize).max(2);
     let surface = box_surface(n, [1.2, 0.8, 0.6]);
-    let base = synthetic_base(surface, &geometric_omegas(20, 60.0, 3000.0), [1.0, 1e-6], seed);
+    let base = synthetic_base(
+        surface,
+        &geometric_omegas(20, 60.0, 3000.0),
+        [1.0, 1e-6],
+        seed,
+    );
     let model = Arc::new(ModalModel::from_base(base).unwrap());
     let mut rng = SplitMix64(seed);
     let mut point = |rng: &mut SplitMix64| {
         let b = model.base();
         let t = b.surface_triangles[(rng.next_u64() % b.surface_triangles.len() as u64) as usize];
         let (u, v) = (rng.next_f64(), rng.next_f64());
-        let (u, v) = if u + v > 1.0 { (1.0 - u, 1.0 - v) } else { (u, v) };
+        let (u, v) = if u + v > 1.0 {
+            (1.0 - u, 1.0 - v)
+        } else {
+            (u, v)
+        };
         let w = [1.0 - u - v, u, v];
         let mut p = [0.0; 3];
         for i in 0..3 {
@@ -55,18 +64,36 @@ fn workload(verts: usize, contacts: usize, seed: u64) -> Workload {
         }
         p
     };
-    let resting = (0..contacts).map(|i| RestingContact { id: i as u64, point: point(&mut rng) }).collect();
+    let resting = (0..contacts)
+        .map(|i| RestingContact {
+            id: i as u64,
+            point: point(&mut rng),
+        })
+        .collect();
     let impacts = (0..64)
         .map(|_| {
             let p = point(&mut rng);
             let sp = model.project(p, 1.0).unwrap();
-            Impact { point: p, direction: sp.normal.map(|x| -x), impulse: 1.0 }
+            Impact {
+                point: p,
+                direction: sp.normal.map(|x| -x),
+                impulse: 1.0,
+            }
         })
         .collect();
-    Workload { model, resting, impacts }
+    Workload {
+        model,
+        resting,
+        impacts,
+    }
 }
 
-fn bench_rows(c: &mut Criterion, label: &str, method: impl Fn() -> Method, rows: &[(&str, usize, usize, usize, f64)]) {
+fn bench_rows(
+    c: &mut Criterion,
+    label: &str,
+    method: impl Fn() -> Method,
+    rows: &[(&str, usize, usize, usize, f64)],
+) {
     for &(name, s, nc, verts, _) in rows {
         let w = workload(verts, nc, 17);
         let params = ResponseParams {
@@ -128,9 +155,17 @@ fn attenuation(c: &mut Criterion) {
 
 fn geodesic(c: &mut Criterion) {
     let (v, t) = box_surface(29, [1.2, 0.8, 0.6]); // 5048 vertices
-    c.bench_function(&format!("heat/setup/{}v", v.len()), |b| b.iter(|| black_box(HeatGeodesic::new(&v, &t).unwrap())));
+    c.bench_function(&format!("heat/setup/{}v", v.len()), |b| {
+        b.iter(|| black_box(HeatGeodesic::new(&v, &t).unwrap()))
+    });
     let heat = HeatGeodesic::new(&v, &t).unwrap();
-    let model = ModalModel::from_base(synthetic_base((v.clone(), t.clone()), &[100.0], [0.0, 0.0], 1)).unwrap();
+    let model = ModalModel::from_base(synthetic_base(
+        (v.clone(), t.clone()),
+        &[100.0],
+        [0.0, 0.0],
+        1,
+    ))
+    .unwrap();
     let sp = model.project([0.3, 0.2, 0.6], 1.0).unwrap();
     let mut ws = heat.workspace();
     let mut out = vec![0.0; v.len()];

@@ -22,10 +22,13 @@ pub mod model;
 pub mod response;
 pub mod testing;
 
-pub use attenuation::{AmplitudeKind, AttenuationLaw, AttenuationParams, DistanceKind, GeodesicError, HeatGeodesic};
+pub use attenuation::{
+    AmplitudeKind, AttenuationLaw, AttenuationParams, DistanceKind, GeodesicError, HeatGeodesic,
+    HeatWorkspace,
+};
 pub use filter::{damping_ratio, samples_per_step, ModalBank, ModeFilter, Sampling};
 pub use model::{LoadError, ModalModel, SurfacePoint};
 pub use response::{
-    effective_mass, response_impulse, ContactResponse, DistantResponse, ForceInput, Impact, Method, ParamsError,
-    ResponseParams, RestingContact, StepInfo, Variant,
+    effective_mass, peak_abs_projection, response_impulse, ContactResponse, DistantResponse,
+    ForceInput, Impact, Method, ParamsError, ResponseParams, RestingContact, StepInfo, Variant,
 };

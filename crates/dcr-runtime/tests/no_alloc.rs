@@ -13,8 +13,8 @@ use std::sync::Arc;
 
 use dcr_runtime::testing::{box_surface, geometric_omegas, synthetic_base, SplitMix64};
 use dcr_runtime::{
-    AmplitudeKind, AttenuationLaw, AttenuationParams, DistanceKind, DistantResponse, ForceInput, Impact, Method,
-    ModalModel, ResponseParams, RestingContact, Variant,
+    AmplitudeKind, AttenuationLaw, AttenuationParams, DistanceKind, DistantResponse, ForceInput,
+    Impact, Method, ModalModel, ResponseParams, RestingContact, Variant,
 };
 
 struct Counting;
@@ -44,19 +44,39 @@ static GLOBAL: Counting = Counting;
 
 fn surface_point(rng: &mut SplitMix64) -> [f64; 3] {
     // A point on (or just off) the box [0,1]×[0,0.6]×[0,0.4] surface: the top face.
-    [rng.range(0.0, 1.0), rng.range(0.0, 0.6), 0.4 + rng.range(-0.001, 0.001)]
+    [
+        rng.range(0.0, 1.0),
+        rng.range(0.0, 0.6),
+        0.4 + rng.range(-0.001, 0.001),
+    ]
 }
 
 #[test]
 fn steps_do_not_allocate_after_warm_up() {
     let om = geometric_omegas(20, 100.0, 3000.0);
-    let model = Arc::new(ModalModel::from_base(synthetic_base(box_surface(8, [1.0, 0.6, 0.4]), &om, [1.0, 1e-6], 3)).unwrap());
+    let model = Arc::new(
+        ModalModel::from_base(synthetic_base(
+            box_surface(8, [1.0, 0.6, 0.4]),
+            &om,
+            [1.0, 1e-6],
+            3,
+        ))
+        .unwrap(),
+    );
     let mut rng = SplitMix64(99);
-    let resting: Vec<RestingContact> =
-        (0..30).map(|i| RestingContact { id: 1000 + i, point: surface_point(&mut rng) }).collect();
+    let resting: Vec<RestingContact> = (0..30)
+        .map(|i| RestingContact {
+            id: 1000 + i,
+            point: surface_point(&mut rng),
+        })
+        .collect();
     let heat = |capacity| {
         Method::Attenuation(AttenuationParams {
-            law: AttenuationLaw::Full { alpha: 0.1, beta: 0.5, r0: 0.05 },
+            law: AttenuationLaw::Full {
+                alpha: 0.1,
+                beta: 0.5,
+                r0: 0.05,
+            },
             distance: DistanceKind::Heat,
             amplitude: AmplitudeKind::PerVertex,
             cache_capacity: capacity,
@@ -71,15 +91,26 @@ fn steps_do_not_allocate_after_warm_up() {
     for variant in [Variant::PerContact, Variant::PerNode] {
         for carry_over in [false, true] {
             for method in [Method::Modal, heat(64), heat(0), euclid.clone()] {
-                configs.push(ResponseParams { variant, carry_over, method, ..Default::default() });
+                configs.push(ResponseParams {
+                    variant,
+                    carry_over,
+                    method,
+                    ..Default::default()
+                });
             }
         }
     }
     for params in configs {
-        let label = format!("{:?} carry={} {:?}", params.variant, params.carry_over, params.method);
+        let label = format!(
+            "{:?} carry={} {:?}",
+            params.variant, params.carry_over, params.method
+        );
         let mut resp = DistantResponse::new(Arc::clone(&model), params).unwrap();
         let mut impacts = Vec::with_capacity(4);
-        let forces = [ForceInput { point: [0.5, 0.3, 0.4], force: [0.0, 0.0, -3.0] }];
+        let forces = [ForceInput {
+            point: [0.5, 0.3, 0.4],
+            force: [0.0, 0.0, -3.0],
+        }];
         let mut run = |resp: &mut DistantResponse, rng: &mut SplitMix64, n: usize| {
             let mut sum = 0.0;
             for step in 0..n {
@@ -98,7 +129,11 @@ fn steps_do_not_allocate_after_warm_up() {
                 let f: &[ForceInput] = if step % 5 == 0 { &forces } else { &[] };
                 // Resting contacts in a rotating order and a varying subset.
                 let k = step % resting.len();
-                let sub = if step % 3 == 0 { &resting[..] } else { &resting[k / 2..] };
+                let sub = if step % 3 == 0 {
+                    &resting[..]
+                } else {
+                    &resting[k / 2..]
+                };
                 let out = resp.step_with_forces(&impacts, f, sub);
                 sum += out.iter().map(|c| c.delta_v).sum::<f64>();
             }
@@ -109,6 +144,9 @@ fn steps_do_not_allocate_after_warm_up() {
         let sum = run(&mut resp, &mut rng, 600);
         let allocs = ALLOCS.load(Ordering::SeqCst) - before;
         assert!(sum > 0.0, "{label}: no response at all");
-        assert_eq!(allocs, 0, "{label}: {allocs} allocations in 600 steps after warm-up");
+        assert_eq!(
+            allocs, 0,
+            "{label}: {allocs} allocations in 600 steps after warm-up"
+        );
     }
 }

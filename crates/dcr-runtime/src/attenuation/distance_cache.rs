@@ -25,7 +25,11 @@ impl DistanceCache {
             owner: Vec::new(),
             last_used: Vec::new(),
             slot_field: Vec::new(),
-            scratch: if capacity == 0 { vec![0.0; ns] } else { Vec::new() },
+            scratch: if capacity == 0 {
+                vec![0.0; ns]
+            } else {
+                Vec::new()
+            },
             computed: 0,
         }
     }
@@ -65,7 +69,9 @@ impl DistanceCache {
             self.last_used.push(0);
             self.owner.len() - 1
         } else {
-            let lru = (0..self.owner.len()).min_by_key(|&i| self.last_used[i]).unwrap_or(0);
+            let lru = (0..self.owner.len())
+                .min_by_key(|&i| self.last_used[i])
+                .unwrap_or(0);
             let prev = self.owner[lru];
             self.slot_field[prev as usize] = NONE;
             lru

@@ -61,6 +61,14 @@ pub struct HeatWorkspace {
     stack: MemBuffer,
 }
 
+impl std::fmt::Debug for HeatWorkspace {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("HeatWorkspace")
+            .field("vertices", &self.u.len())
+            .finish()
+    }
+}
+
 /// Heat-method geodesic distances (m) on a fixed triangle surface: factor once, many sources.
 pub struct HeatGeodesic {
     n: usize,
@@ -155,7 +163,11 @@ impl HeatGeodesic {
         let diag: Vec<usize> = {
             let (col_ptr, row_idx) = (lap.symbolic().col_ptr(), lap.symbolic().row_idx());
             (0..n)
-                .map(|j| (col_ptr[j]..col_ptr[j + 1]).find(|&k| row_idx[k] == j).expect("diagonal present"))
+                .map(|j| {
+                    (col_ptr[j]..col_ptr[j + 1])
+                        .find(|&k| row_idx[k] == j)
+                        .expect("diagonal present")
+                })
                 .collect()
         };
         let with_diag = |a: f64, b: f64| {
@@ -180,8 +192,9 @@ impl HeatGeodesic {
         )
         .map_err(|e| GeodesicError::Factorization(format!("{e:?}")))?;
         let par = Par::Seq;
-        let mut fact_buf = MemBuffer::new(symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default()));
-        let mut numeric = |a: &SparseColMat<usize, f64>| -> Result<Factor, GeodesicError> {
+        // The two numeric factorisations are independent: run them on two threads.
+        let numeric = |a: &SparseColMat<usize, f64>| -> Result<Factor, GeodesicError> {
+            let mut buf = MemBuffer::new(symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default()));
             let mut values = vec![0.0; symbolic.len_val()];
             symbolic
                 .factorize_numeric_llt::<f64>(
@@ -190,14 +203,18 @@ impl HeatGeodesic {
                     Side::Lower,
                     Default::default(),
                     par,
-                    MemStack::new(&mut fact_buf),
+                    MemStack::new(&mut buf),
                     Default::default(),
                 )
                 .map_err(|e| GeodesicError::Factorization(format!("{e:?}")))?;
             Ok(Factor { values })
         };
-        let heat = numeric(&heat_mat)?;
-        let poisson = numeric(&poisson_mat)?;
+        let (heat, poisson) = std::thread::scope(|scope| {
+            let h = scope.spawn(|| numeric(&heat_mat));
+            let p = numeric(&poisson_mat);
+            (h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)), p)
+        });
+        let (heat, poisson) = (heat?, poisson?);
         let solve_req = symbolic.solve_in_place_scratch::<f64>(1, par);
         Ok(HeatGeodesic {
             n,
@@ -255,7 +272,12 @@ impl HeatGeodesic {
     }
 
     /// As [`HeatGeodesic::distances_from_point`] with caller-owned scratch: does not allocate.
-    pub fn distances_from_point_with(&self, sp: &SurfacePoint, out: &mut [f64], ws: &mut HeatWorkspace) {
+    pub fn distances_from_point_with(
+        &self,
+        sp: &SurfacePoint,
+        out: &mut [f64],
+        ws: &mut HeatWorkspace,
+    ) {
         let tri = self.triangles[sp.triangle as usize];
         let src = [0, 1, 2].map(|i| (tri[i] as usize, sp.bary[i]));
         self.distances_with(&src, out, ws);

@@ -17,7 +17,10 @@ fn plate_geodesic_is_euclidean_within_an_edge() {
         for (i, d) in out.iter().enumerate() {
             worst = worst.max((d - norm(sub(v[i], v[src]))).abs());
         }
-        assert!(worst <= edge, "source {src}: worst error {worst} > edge {edge}");
+        assert!(
+            worst <= edge,
+            "source {src}: worst error {worst} > edge {edge}"
+        );
         assert_eq!(out[src], 0.0);
     }
 }
@@ -50,7 +53,10 @@ fn sphere_geodesic_matches_great_circle_and_is_symmetric() {
     for a in 0..sources.len() {
         for b in 0..sources.len() {
             let (dab, dba) = (fields[a][sources[b]], fields[b][sources[a]]);
-            assert!((dab - dba).abs() <= 0.01 * half, "d({a},{b}) {dab} vs {dba}");
+            assert!(
+                (dab - dba).abs() <= 0.01 * half,
+                "d({a},{b}) {dab} vs {dba}"
+            );
         }
     }
 }
@@ -83,10 +89,19 @@ fn point_source_is_consistent() {
 
 #[test]
 fn degenerate_and_empty_surfaces_are_errors() {
-    assert!(matches!(HeatGeodesic::new(&[], &[]), Err(GeodesicError::Empty)));
+    assert!(matches!(
+        HeatGeodesic::new(&[], &[]),
+        Err(GeodesicError::Empty)
+    ));
     let v = [[0.0; 3], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]];
-    assert!(matches!(HeatGeodesic::new(&v, &[[0, 1, 2]]), Err(GeodesicError::Degenerate { .. })));
-    assert!(matches!(HeatGeodesic::new(&v, &[[0, 1, 5]]), Err(GeodesicError::BadIndex { .. })));
+    assert!(matches!(
+        HeatGeodesic::new(&v, &[[0, 1, 2]]),
+        Err(GeodesicError::Degenerate { .. })
+    ));
+    assert!(matches!(
+        HeatGeodesic::new(&v, &[[0, 1, 5]]),
+        Err(GeodesicError::BadIndex { .. })
+    ));
 }
 
 /// s(r) follows Eq. 14 / the §4.5 form beyond r0 and is clamped inside r0.
@@ -149,12 +164,23 @@ fn heat_timing() {
         let setup = t0.elapsed().as_secs_f64() / 5.0;
         let mut out = vec![0.0; v.len()];
         let mut ws = heat.workspace();
-        let sp = crate::SurfacePoint { triangle: 7, bary: [0.2, 0.3, 0.5], point: [0.0; 3], normal: [0.0; 3], distance: 0.0 };
+        let sp = crate::SurfacePoint {
+            triangle: 7,
+            bary: [0.2, 0.3, 0.5],
+            point: [0.0; 3],
+            normal: [0.0; 3],
+            distance: 0.0,
+        };
         let t0 = std::time::Instant::now();
         for _ in 0..50 {
             heat.distances_from_point_with(&sp, &mut out, &mut ws);
         }
         let q = t0.elapsed().as_secs_f64() / 50.0;
-        println!("{name}: nnz(L) {} setup {:.2} ms, source {:.3} ms", heat.factor_len(), setup * 1e3, q * 1e3);
+        println!(
+            "{name}: nnz(L) {} setup {:.2} ms, source {:.3} ms",
+            heat.factor_len(),
+            setup * 1e3,
+            q * 1e3
+        );
     }
 }

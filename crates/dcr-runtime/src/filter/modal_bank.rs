@@ -28,8 +28,11 @@ impl ModalBank {
     /// If `omega` and `xi` differ in length.
     pub fn new(omega: &[f64], xi: &[f64], period: f64) -> ModalBank {
         assert_eq!(omega.len(), xi.len());
-        let filters: Vec<ModeFilter> =
-            omega.iter().zip(xi).map(|(&w, &x)| ModeFilter::new(w, x, period)).collect();
+        let filters: Vec<ModeFilter> = omega
+            .iter()
+            .zip(xi)
+            .map(|(&w, &x)| ModeFilter::new(w, x, period))
+            .collect();
         let m = filters.len();
         ModalBank {
             phi: filters.iter().map(|f| f.phi).collect(),
@@ -92,7 +95,8 @@ impl ModalBank {
                     for j in 0..m {
                         let (q, v) = (self.q[j], self.qd[j]);
                         self.q[j] = self.phi[j] * q + self.g[j] * v + self.step[j] * f[j];
-                        self.qd[j] = self.g_dot[j] * v - self.omega2[j] * self.g[j] * q + self.g[j] * f[j];
+                        self.qd[j] =
+                            self.g_dot[j] * v - self.omega2[j] * self.g[j] * q + self.g[j] * f[j];
                     }
                 }
             }

@@ -14,10 +14,16 @@ const CRITICAL_BAND: f64 = 1e-12;
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Regime {
     /// ω_d = ω√(1 − ξ²).
-    Under { wd: f64 },
+    Under {
+        wd: f64,
+    },
     Critical,
     /// Real poles λ1 = −ω/(ξ + s) (slow), λ2 = −ω(ξ + s) (fast), Δ = λ1 − λ2 = 2ωs, s = √(ξ² − 1).
-    Over { l1: f64, l2: f64, d: f64 },
+    Over {
+        l1: f64,
+        l2: f64,
+        d: f64,
+    },
 }
 
 /// One mode's exact sampled response over a period T (s): impulse response g, free response φ,
@@ -128,7 +134,11 @@ impl ModeFilter {
         match self.regime {
             Regime::Under { wd } => {
                 let e = (-xi * w * t).exp();
-                let sinc = if wd * t == 0.0 { t } else { (wd * t).sin() / wd };
+                let sinc = if wd * t == 0.0 {
+                    t
+                } else {
+                    (wd * t).sin() / wd
+                };
                 e * ((wd * t).cos() + xi * w * sinc)
             }
             Regime::Critical => (-w * t).exp() * (1.0 + w * t),
@@ -146,7 +156,11 @@ impl ModeFilter {
         match self.regime {
             Regime::Under { wd } => {
                 let e = (-xi * w * t).exp();
-                let sinc = if wd * t == 0.0 { t } else { (wd * t).sin() / wd };
+                let sinc = if wd * t == 0.0 {
+                    t
+                } else {
+                    (wd * t).sin() / wd
+                };
                 -(-xi * w * t).exp_m1() + 2.0 * e * (0.5 * wd * t).sin().powi(2) - e * xi * w * sinc
             }
             Regime::Critical => -(-w * t).exp_m1() - w * t * (-w * t).exp(),

@@ -4,20 +4,15 @@ use std::f64::consts::FRAC_PI_2;
 
 /// How the filter period T is chosen (paper §4.2: T = π/(2 ω_max), four samples per period of the
 /// highest kept mode).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub enum Sampling {
-    /// The paper's T = π/(2 ω_max) (ω_max in rad/s).
+    /// The paper's T = π/(2 ω_max) (ω_max in rad/s) (default).
+    #[default]
     PaperT,
     /// T = π/(2 ω_max)/K with K ≥ 1 (finer peak search).
     Oversample(f64),
     /// T given in seconds.
     Substep(f64),
-}
-
-impl Default for Sampling {
-    fn default() -> Self {
-        Sampling::PaperT
-    }
 }
 
 impl Sampling {

@@ -20,7 +20,9 @@ fn impulse_response_is_exact_in_every_regime() {
             let mut out = vec![0.0; n];
             bank.run(n, None, &mut out);
             let f = bank.filters()[0];
-            let exact: Vec<f64> = (1..=n).map(|k| r * f.impulse_response(k as f64 * t)).collect();
+            let exact: Vec<f64> = (1..=n)
+                .map(|k| r * f.impulse_response(k as f64 * t))
+                .collect();
             let peak = exact.iter().fold(0.0f64, |a, x| a.max(x.abs()));
             assert!(peak > 0.0);
             for (k, (a, b)) in out.iter().zip(&exact).enumerate() {
@@ -55,9 +57,17 @@ fn closed_forms_match_rk4() {
                     y[i] += dt / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
                 }
             }
-            let exact = if which == 0 { f.impulse_response(1.0) } else { f.free_response(1.0) };
+            let exact = if which == 0 {
+                f.impulse_response(1.0)
+            } else {
+                f.free_response(1.0)
+            };
             let scale = if which == 0 { 1.0 / omega } else { 1.0 };
-            assert!((y[0] - exact).abs() <= 1e-9 * scale, "ξ={xi} which={which}: rk4 {} vs {exact}", y[0]);
+            assert!(
+                (y[0] - exact).abs() <= 1e-9 * scale,
+                "ξ={xi} which={which}: rk4 {} vs {exact}",
+                y[0]
+            );
         }
     }
 }
@@ -75,7 +85,10 @@ fn zero_order_hold_settles_at_static_deflection() {
             // here, so the check loses ε/(ωT)²).
             let gain = (f.b1 + f.b2) / (1.0 - f.a1 + f.a2);
             let tol = 1e-9f64.max(1e-14 / (wt * wt));
-            assert!((gain * omega * omega - 1.0).abs() < tol, "ξ={xi} ωT={wt}: gain {gain}");
+            assert!(
+                (gain * omega * omega - 1.0).abs() < tol,
+                "ξ={xi} ωT={wt}: gain {gain}"
+            );
             let n = 2000;
             let mut bank = ModalBank::new(&[omega], &[xi], t);
             let mut out = vec![0.0; n];
@@ -83,10 +96,17 @@ fn zero_order_hold_settles_at_static_deflection() {
             let stat = force / (omega * omega);
             for (k, q) in out.iter().enumerate() {
                 let exact = force * f.step_response((k + 1) as f64 * t);
-                assert!((q - exact).abs() <= 1e-10 * stat, "ξ={xi} ωT={wt} k={k}: {q} vs {exact}");
+                assert!(
+                    (q - exact).abs() <= 1e-10 * stat,
+                    "ξ={xi} ωT={wt} k={k}: {q} vs {exact}"
+                );
             }
             // Long enough to settle: decay e^{-ξ' ω t} with the slow rate.
-            let slow = if xi < 1.0 { xi * omega } else { omega / (xi + (xi * xi - 1.0).sqrt()) };
+            let slow = if xi < 1.0 {
+                xi * omega
+            } else {
+                omega / (xi + (xi * xi - 1.0).sqrt())
+            };
             let horizon = 60.0 / slow;
             let extra = ((horizon / t) as usize).min(20_000_000);
             let mut one = [0.0];
@@ -94,7 +114,11 @@ fn zero_order_hold_settles_at_static_deflection() {
                 bank.run(1, Some(&[force]), &mut one);
             }
             if slow * (extra as f64 + n as f64) * t > 40.0 {
-                assert!((one[0] - stat).abs() <= 1e-9 * stat, "ξ={xi} ωT={wt}: settled {} vs {stat}", one[0]);
+                assert!(
+                    (one[0] - stat).abs() <= 1e-9 * stat,
+                    "ξ={xi} ωT={wt}: settled {} vs {stat}",
+                    one[0]
+                );
             }
         }
     }
@@ -116,8 +140,14 @@ fn two_sample_recursion_agrees() {
                 let s = f.a1 * s1 - f.a2 * s2 + f.b1 + if k == 1 { 0.0 } else { f.b2 };
                 let t = k as f64 * f.period;
                 peak = peak.max(q.abs());
-                assert!((q - f.impulse_response(t)).abs() <= 1e-9 * peak.max(f.g.abs()), "ξ={xi} ωT={wt} k={k}");
-                assert!((s - f.step_response(t)).abs() <= 1e-9 / (omega * omega), "ξ={xi} ωT={wt} k={k}");
+                assert!(
+                    (q - f.impulse_response(t)).abs() <= 1e-9 * peak.max(f.g.abs()),
+                    "ξ={xi} ωT={wt} k={k}"
+                );
+                assert!(
+                    (s - f.step_response(t)).abs() <= 1e-9 / (omega * omega),
+                    "ξ={xi} ωT={wt} k={k}"
+                );
                 (q2, q1, s2, s1) = (q1, q, s1, s);
             }
         }
@@ -139,11 +169,17 @@ fn free_energy_never_grows() {
         for _ in 0..20_000 {
             bank.run(1, None, &mut row);
             let e = bank.energy();
-            assert!(e <= prev * (1.0 + 1e-12), "ξ={xi}: energy grew {prev} → {e}");
+            assert!(
+                e <= prev * (1.0 + 1e-12),
+                "ξ={xi}: energy grew {prev} → {e}"
+            );
             prev = e;
         }
         if xi == 0.0 {
-            assert!((prev - e0).abs() <= 1e-9 * e0, "undamped energy drifted {e0} → {prev}");
+            assert!(
+                (prev - e0).abs() <= 1e-9 * e0,
+                "undamped energy drifted {e0} → {prev}"
+            );
         } else {
             assert!(prev < e0);
         }

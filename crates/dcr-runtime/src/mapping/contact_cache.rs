@@ -108,7 +108,8 @@ impl ContactCache {
                 });
                 self.rows.resize(self.rows.len() + self.m, 0.0);
                 // Keep the free list able to hold every slot, so eviction never allocates.
-                self.free.reserve(self.slots.len().saturating_sub(self.free.len()));
+                self.free
+                    .reserve(self.slots.len().saturating_sub(self.free.len()));
                 (self.slots.len() - 1) as u32
             }
         };

@@ -161,8 +161,9 @@ impl ModalModel {
             return None;
         }
         let q = Vector::new(p[0], p[1], p[2]);
-        let (_, (tri, loc)) =
-            self.trimesh.project_local_point_and_get_location_with_max_dist(q, false, max_distance)?;
+        let (_, (tri, loc)) = self
+            .trimesh
+            .project_local_point_and_get_location_with_max_dist(q, false, max_distance)?;
         let mut bary = loc.barycentric_coordinates()?;
         for b in &mut bary {
             *b = b.clamp(0.0, 1.0);
@@ -202,7 +203,13 @@ impl ModalModel {
 
     /// Reduced impulse `r += Uᵀ H (d·λ)` (paper Eq. 9) of an impulse `lambda` (N·s) along unit
     /// `direction` (object frame) applied at `sp`; `r` has length m.
-    pub fn add_reduced_impulse(&self, sp: &SurfacePoint, direction: [f64; 3], lambda: f64, r: &mut [f64]) {
+    pub fn add_reduced_impulse(
+        &self,
+        sp: &SurfacePoint,
+        direction: [f64; 3],
+        lambda: f64,
+        r: &mut [f64],
+    ) {
         let m = self.num_modes();
         for (i, v) in self.triangle(sp.triangle).into_iter().enumerate() {
             for axis in 0..3 {
@@ -231,7 +238,9 @@ impl ModalModel {
     /// The [`GeodesicError`] from building it (e.g. degenerate triangles, unused vertices).
     pub fn heat_geodesic(&self) -> Result<&HeatGeodesic, &GeodesicError> {
         self.heat
-            .get_or_init(|| HeatGeodesic::new(&self.base.surface_vertices, &self.base.surface_triangles))
+            .get_or_init(|| {
+                HeatGeodesic::new(&self.base.surface_vertices, &self.base.surface_triangles)
+            })
             .as_ref()
     }
 }

@@ -4,7 +4,9 @@ use std::path::Path;
 
 use super::*;
 use crate::math::{add, dot, norm, scale, sub};
-use crate::testing::{box_surface, geometric_omegas, icosphere, plate_base, synthetic_base, SplitMix64};
+use crate::testing::{
+    box_surface, geometric_omegas, icosphere, plate_base, synthetic_base, SplitMix64,
+};
 
 /// Closest point on triangle (a, b, c) to p (Ericson, Real-Time Collision Detection §5.1.5).
 fn closest_on_triangle(p: [f64; 3], a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> [f64; 3] {
@@ -46,7 +48,13 @@ fn models() -> Vec<ModalModel> {
     vec![
         ModalModel::from_base(plate_base()).unwrap(),
         ModalModel::from_base(synthetic_base(icosphere(2, 0.7), &om, [1.0, 1e-5], 3)).unwrap(),
-        ModalModel::from_base(synthetic_base(box_surface(5, [1.0, 0.5, 0.3]), &om, [1.0, 1e-5], 4)).unwrap(),
+        ModalModel::from_base(synthetic_base(
+            box_surface(5, [1.0, 0.5, 0.3]),
+            &om,
+            [1.0, 1e-5],
+            4,
+        ))
+        .unwrap(),
     ]
 }
 
@@ -59,7 +67,8 @@ fn projection_matches_brute_force_and_bary_reconstructs() {
         let base = model.base();
         let diag = model.bounding_box_diagonal();
         for _ in 0..400 {
-            let v = base.surface_vertices[(rng.next_u64() % base.surface_vertices.len() as u64) as usize];
+            let v = base.surface_vertices
+                [(rng.next_u64() % base.surface_vertices.len() as u64) as usize];
             let p = [0, 1, 2].map(|k| v[k] + rng.range(-0.2, 0.2) * diag);
             let sp = model.project(p, f64::MAX).expect("mapped");
             let brute = base
@@ -70,11 +79,21 @@ fn projection_matches_brute_force_and_bary_reconstructs() {
                     norm(sub(p, closest_on_triangle(p, a, b, c)))
                 })
                 .fold(f64::INFINITY, f64::min);
-            assert!((sp.distance - brute).abs() <= 1e-9 * diag, "{} vs {brute}", sp.distance);
+            assert!(
+                (sp.distance - brute).abs() <= 1e-9 * diag,
+                "{} vs {brute}",
+                sp.distance
+            );
             let s: f64 = sp.bary.iter().sum();
-            assert!((s - 1.0).abs() < 1e-12 && sp.bary.iter().all(|&b| b >= 0.0), "{:?}", sp.bary);
+            assert!(
+                (s - 1.0).abs() < 1e-12 && sp.bary.iter().all(|&b| b >= 0.0),
+                "{:?}",
+                sp.bary
+            );
             let vs = model.triangle(sp.triangle);
-            let rec = (0..3).fold([0.0; 3], |acc, i| add(acc, scale(base.surface_vertices[vs[i]], sp.bary[i])));
+            let rec = (0..3).fold([0.0; 3], |acc, i| {
+                add(acc, scale(base.surface_vertices[vs[i]], sp.bary[i]))
+            });
             assert!(norm(sub(rec, sp.point)) <= 1e-12 * diag);
             assert!((norm(sp.normal) - 1.0).abs() < 1e-12);
         }
@@ -95,17 +114,30 @@ fn max_distance_is_respected() {
 #[test]
 fn vertex_normals_are_unit_and_outward() {
     let om = [100.0];
-    let sphere = ModalModel::from_base(synthetic_base(icosphere(3, 2.0), &om, [0.0, 0.0], 1)).unwrap();
-    for (n, x) in sphere.vertex_normals().iter().zip(&sphere.base().surface_vertices) {
+    let sphere =
+        ModalModel::from_base(synthetic_base(icosphere(3, 2.0), &om, [0.0, 0.0], 1)).unwrap();
+    for (n, x) in sphere
+        .vertex_normals()
+        .iter()
+        .zip(&sphere.base().surface_vertices)
+    {
         assert!((norm(*n) - 1.0).abs() < 1e-12);
         assert!(dot(*n, *x) / norm(*x) > 0.99);
     }
-    let cube = ModalModel::from_base(synthetic_base(box_surface(4, [1.0; 3]), &om, [0.0, 0.0], 1)).unwrap();
-    for (n, x) in cube.vertex_normals().iter().zip(&cube.base().surface_vertices) {
+    let cube = ModalModel::from_base(synthetic_base(box_surface(4, [1.0; 3]), &om, [0.0, 0.0], 1))
+        .unwrap();
+    for (n, x) in cube
+        .vertex_normals()
+        .iter()
+        .zip(&cube.base().surface_vertices)
+    {
         assert!(dot(*n, sub(*x, [0.5; 3])) > 0.0);
     }
     let plate = ModalModel::from_base(plate_base()).unwrap();
-    assert!(plate.vertex_normals().iter().all(|n| (n[2] - 1.0).abs() < 1e-12));
+    assert!(plate
+        .vertex_normals()
+        .iter()
+        .all(|n| (n[2] - 1.0).abs() < 1e-12));
 }
 
 /// Truncated, mismatched and NaN files give a LoadError naming the file.
@@ -128,7 +160,10 @@ fn bad_files_are_load_errors_naming_the_file() {
     let p = dir.path().join("nan.modes");
     std::fs::write(&p, nan.to_bytes().unwrap()).unwrap();
     let err = ModalModel::load(&p).unwrap_err().to_string();
-    assert!(err.contains("nan.modes") && err.contains("non-finite"), "{err}");
+    assert!(
+        err.contains("nan.modes") && err.contains("non-finite"),
+        "{err}"
+    );
 
     let mut mis = plate_base();
     mis.surface_to_volume.pop();
@@ -137,12 +172,17 @@ fn bad_files_are_load_errors_naming_the_file() {
     let err = ModalModel::load(&p).unwrap_err().to_string();
     assert!(err.contains("mis.modes"), "{err}");
 
-    let err = ModalModel::load(Path::new("/nonexistent/x.modes")).unwrap_err().to_string();
+    let err = ModalModel::load(Path::new("/nonexistent/x.modes"))
+        .unwrap_err()
+        .to_string();
     assert!(err.contains("x.modes"), "{err}");
 
     let mut bad = plate_base();
     bad.eigenvalues[0] = -1.0;
-    assert!(ModalModel::from_base(bad).unwrap_err().to_string().contains("<memory>"));
+    assert!(ModalModel::from_base(bad)
+        .unwrap_err()
+        .to_string()
+        .contains("<memory>"));
 }
 
 /// The contact row equals nᵀ Σ b_i U_i assembled by hand.
@@ -163,4 +203,13 @@ fn contact_row_is_interpolated_normal_projection() {
         }
         assert!((w[j] - e).abs() < 1e-15);
     }
+}
+
+/// The model is shared between threads (Arc) and instances can move to worker threads.
+#[test]
+fn model_is_send_sync_and_response_is_send() {
+    fn send_sync<T: Send + Sync>() {}
+    fn send<T: Send>() {}
+    send_sync::<ModalModel>();
+    send::<crate::DistantResponse>();
 }

@@ -12,8 +12,13 @@
 use std::sync::Arc;
 
 use super::peak_kernel::{panel_index, peak_abs_projection, BLOCK};
-use super::{ContactResponse, ForceInput, Impact, Method, ParamsError, ResponseParams, RestingContact, StepInfo, Variant};
-use crate::attenuation::{AmplitudeKind, AttenuationParams, DistanceCache, DistanceKind, HeatWorkspace};
+use super::{
+    ContactResponse, ForceInput, Impact, Method, ParamsError, ResponseParams, RestingContact,
+    StepInfo, Variant,
+};
+use crate::attenuation::{
+    AmplitudeKind, AttenuationParams, DistanceCache, DistanceKind, HeatWorkspace,
+};
 use crate::filter::{damping_ratio, samples_per_step, ModalBank};
 use crate::mapping::ContactCache;
 use crate::math::{dot, norm, normalize, sub};
@@ -36,12 +41,6 @@ struct AttenuationState {
     ws: Option<HeatWorkspace>,
     /// This step's applied impacts: surface point and local displacement Δx_c (m).
     hits: Vec<(SurfacePoint, f64)>,
-}
-
-impl std::fmt::Debug for HeatWorkspace {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str("HeatWorkspace")
-    }
 }
 
 /// The distant collision response of one object instance (paper §4.2–4.5).
@@ -126,10 +125,16 @@ impl DistantResponse {
         }
         let rayleigh = p.rayleigh.unwrap_or(model.base().rayleigh);
         if !rayleigh.iter().all(|x| x.is_finite() && *x >= 0.0) {
-            return Err(invalid("rayleigh", format!("{rayleigh:?} (must be finite and ≥ 0)")));
+            return Err(invalid(
+                "rayleigh",
+                format!("{rayleigh:?} (must be finite and ≥ 0)"),
+            ));
         }
         if !(p.impact_threshold >= 0.0 && p.impact_threshold.is_finite()) {
-            return Err(invalid("impact_threshold", format!("{} N·s", p.impact_threshold)));
+            return Err(invalid(
+                "impact_threshold",
+                format!("{} N·s", p.impact_threshold),
+            ));
         }
         let max_map = if p.max_map_distance.is_nan() {
             0.05 * model.bounding_box_diagonal()
@@ -140,17 +145,25 @@ impl DistantResponse {
             return Err(invalid("max_map_distance", format!("{max_map} m")));
         }
         if !(p.sleep_energy_rel >= 0.0 && p.sleep_energy_rel.is_finite()) {
-            return Err(invalid("sleep_energy_rel", format!("{}", p.sleep_energy_rel)));
+            return Err(invalid(
+                "sleep_energy_rel",
+                format!("{}", p.sleep_energy_rel),
+            ));
         }
         let omega = model.omega();
         let m = omega.len();
         let omega_max = omega[m - 1];
         let t_req = p.sampling.period(omega_max);
         if !(t_req.is_finite() && t_req > 0.0) {
-            return Err(invalid("sampling", format!("{:?} gives T = {t_req} s", p.sampling)));
+            return Err(invalid(
+                "sampling",
+                format!("{:?} gives T = {t_req} s", p.sampling),
+            ));
         }
         if p.h / t_req > MAX_SAMPLES {
-            return Err(ParamsError::TooManySamples { samples: (p.h / t_req).ceil() });
+            return Err(ParamsError::TooManySamples {
+                samples: (p.h / t_req).ceil(),
+            });
         }
         let samples = samples_per_step(p.h, t_req);
         let period = p.h / samples as f64;
@@ -239,7 +252,11 @@ impl DistantResponse {
             }
             let mut peak = 0.0f64;
             for k in 0..samples {
-                let y: f64 = g_table[k * m..(k + 1) * m].iter().zip(&sq).map(|(g, s)| g * s).sum();
+                let y: f64 = g_table[k * m..(k + 1) * m]
+                    .iter()
+                    .zip(&sq)
+                    .map(|(g, s)| g * s)
+                    .sum();
                 peak = peak.max(y.abs());
             }
             *amp = peak;
@@ -252,19 +269,28 @@ impl DistantResponse {
                     return Err(invalid("amplitude", "MeanOver subset is empty"));
                 }
                 if let Some(bad) = subset.iter().find(|&&v| v as usize >= ns) {
-                    return Err(invalid("amplitude", format!("MeanOver names vertex {bad} ≥ {ns}")));
+                    return Err(invalid(
+                        "amplitude",
+                        format!("MeanOver names vertex {bad} ≥ {ns}"),
+                    ));
                 }
                 subset.iter().map(|&v| amplitude[v as usize]).sum::<f64>() / subset.len() as f64
             }
         };
         let ws = match a.distance {
             DistanceKind::Heat => {
-                let heat = model.heat_geodesic().map_err(|e| ParamsError::Geodesic(e.to_string()))?;
+                let heat = model
+                    .heat_geodesic()
+                    .map_err(|e| ParamsError::Geodesic(e.to_string()))?;
                 Some(heat.workspace())
             }
             DistanceKind::Euclidean => None,
         };
-        let capacity = if a.distance == DistanceKind::Heat { a.cache_capacity } else { 1 };
+        let capacity = if a.distance == DistanceKind::Heat {
+            a.cache_capacity
+        } else {
+            1
+        };
         Ok(AttenuationState {
             params: a.clone(),
             amplitude,
@@ -338,7 +364,11 @@ impl DistantResponse {
 
     fn fill_q_from_table(&mut self) {
         let m = self.m;
-        for (qk, gk) in self.q_table.chunks_exact_mut(m).zip(self.g_table.chunks_exact(m)) {
+        for (qk, gk) in self
+            .q_table
+            .chunks_exact_mut(m)
+            .zip(self.g_table.chunks_exact(m))
+        {
             for ((q, g), r) in qk.iter_mut().zip(gk).zip(&self.r) {
                 *q = g * r;
             }
@@ -377,15 +407,18 @@ impl DistantResponse {
         let step = self.step_index;
         {
             let att = &mut self.att;
-            self.cache.evict_unseen(step, self.params.evict_after_steps, |s| {
-                if let Some(a) = att.as_mut() {
-                    a.fields.invalidate(s);
-                }
-            });
+            self.cache
+                .evict_unseen(step, self.params.evict_after_steps, |s| {
+                    if let Some(a) = att.as_mut() {
+                        a.fields.invalidate(s);
+                    }
+                });
         }
         self.slots.clear();
         for rc in resting {
-            let (s, mapped_now) = self.cache.lookup(&self.model, rc.id, rc.point, step, self.max_map);
+            let (s, mapped_now) =
+                self.cache
+                    .lookup(&self.model, rc.id, rc.point, step, self.max_map);
             if mapped_now {
                 self.info.contacts_mapped_now += 1;
                 if let Some(a) = self.att.as_mut() {
@@ -413,7 +446,12 @@ impl DistantResponse {
         ok
     }
 
-    fn step_modal(&mut self, impacts: &[Impact], forces: &[ForceInput], resting: &[RestingContact]) {
+    fn step_modal(
+        &mut self,
+        impacts: &[Impact],
+        forces: &[ForceInput],
+        resting: &[RestingContact],
+    ) {
         let m = self.m;
         let model = Arc::clone(&self.model);
         self.r.iter_mut().for_each(|x| *x = 0.0);
@@ -424,7 +462,12 @@ impl DistantResponse {
             }
             match model.project(imp.point, self.max_map) {
                 Some(sp) => {
-                    model.add_reduced_impulse(&sp, normalize(imp.direction), imp.impulse, &mut self.r);
+                    model.add_reduced_impulse(
+                        &sp,
+                        normalize(imp.direction),
+                        imp.impulse,
+                        &mut self.r,
+                    );
                     have_impulse = true;
                     self.info.impacts_applied += 1;
                 }
@@ -515,8 +558,10 @@ impl DistantResponse {
                     }
                     let ws = &mut self.w_scaled[..nch * m];
                     // Panel layout: rows of 8 channels, mode j = row index mod m.
-                    for (row, (dst, src)) in
-                        ws.chunks_exact_mut(BLOCK).zip(self.w_step.chunks_exact(BLOCK)).enumerate()
+                    for (row, (dst, src)) in ws
+                        .chunks_exact_mut(BLOCK)
+                        .zip(self.w_step.chunks_exact(BLOCK))
+                        .enumerate()
                     {
                         let r = self.r[row % m];
                         for (d, x) in dst.iter_mut().zip(src) {
@@ -528,7 +573,14 @@ impl DistantResponse {
                 } else {
                     self.fill_q_from_table();
                     if nch > 0 {
-                        peak_abs_projection(&self.q_table, s, m, &self.w_step[..nch * m], nch, peaks);
+                        peak_abs_projection(
+                            &self.q_table,
+                            s,
+                            m,
+                            &self.w_step[..nch * m],
+                            nch,
+                            peaks,
+                        );
                     }
                 }
                 for j in 0..m {
@@ -575,7 +627,9 @@ impl DistantResponse {
             let resp = match cached.surface {
                 Some(sp) if c != UNMAPPED => {
                     let d = if per_node {
-                        (0..3).map(|i| sp.bary[i] * self.peaks[c as usize * 3 + i]).sum()
+                        (0..3)
+                            .map(|i| sp.bary[i] * self.peaks[c as usize * 3 + i])
+                            .sum()
                     } else {
                         self.peaks[c as usize]
                     };
@@ -594,7 +648,12 @@ impl DistantResponse {
         }
     }
 
-    fn step_attenuation(&mut self, impacts: &[Impact], forces: &[ForceInput], resting: &[RestingContact]) {
+    fn step_attenuation(
+        &mut self,
+        impacts: &[Impact],
+        forces: &[ForceInput],
+        resting: &[RestingContact],
+    ) {
         let model = Arc::clone(&self.model);
         let step = self.step_index;
         let h = self.params.h;
@@ -643,7 +702,9 @@ impl DistantResponse {
                         let heat = model.heat_geodesic().expect("checked at set-up");
                         let ws = att.ws.as_mut().expect("heat workspace");
                         let before = att.fields.computed;
-                        let field = att.fields.get(s, step, |out| heat.distances_from_point_with(&sp, out, ws));
+                        let field = att
+                            .fields
+                            .get(s, step, |out| heat.distances_from_point_with(&sp, out, ws));
                         for (hp, dx) in &hits {
                             let vs = model.triangle(hp.triangle);
                             let r: f64 = (0..3).map(|i| hp.bary[i] * field[vs[i]]).sum();

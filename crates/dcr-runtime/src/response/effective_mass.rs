@@ -8,7 +8,12 @@ use crate::math::cross;
 /// `inv_mass` in 1/kg, `inv_inertia_world` the world-frame inverse inertia tensor (1/(kg·m²)),
 /// `r` = contact point − centre of mass (m, world), `n` unit (world). Returns 0 for an
 /// immovable body (zero inverse mass and inertia): there is nothing to push.
-pub fn effective_mass(inv_mass: f64, inv_inertia_world: [[f64; 3]; 3], r: [f64; 3], n: [f64; 3]) -> f64 {
+pub fn effective_mass(
+    inv_mass: f64,
+    inv_inertia_world: [[f64; 3]; 3],
+    r: [f64; 3],
+    n: [f64; 3],
+) -> f64 {
     let rn = cross(r, n);
     let mut quad = 0.0;
     for i in 0..3 {

@@ -23,8 +23,18 @@ pub(crate) fn panel_index(c: usize, j: usize, m: usize) -> usize {
 ///
 /// # Panics
 /// If `nch` is not a multiple of 8 or a slice is too short.
-pub fn peak_abs_projection(q: &[f64], samples: usize, m: usize, w: &[f64], nch: usize, peaks: &mut [f64]) {
-    assert!(nch % BLOCK == 0, "channel count must be padded to a multiple of {BLOCK}");
+pub fn peak_abs_projection(
+    q: &[f64],
+    samples: usize,
+    m: usize,
+    w: &[f64],
+    nch: usize,
+    peaks: &mut [f64],
+) {
+    assert!(
+        nch % BLOCK == 0,
+        "channel count must be padded to a multiple of {BLOCK}"
+    );
     assert!(q.len() >= samples * m && w.len() >= m * nch && peaks.len() >= nch);
     if m == 0 {
         peaks[..nch].iter_mut().for_each(|p| *p = 0.0);
@@ -62,7 +72,13 @@ fn kernel<const FMA: bool>(q: &[f64], m: usize, w: &[f64], peaks: &mut [f64]) {
             let (r1, rest) = rest.split_at(m);
             let (r2, r3) = rest.split_at(m);
             let mut acc = [[0.0f64; BLOCK]; 4];
-            for ((((&a0, &a1), &a2), &a3), wj) in r0.iter().zip(r1).zip(r2).zip(r3).zip(panel.chunks_exact(BLOCK)) {
+            for ((((&a0, &a1), &a2), &a3), wj) in r0
+                .iter()
+                .zip(r1)
+                .zip(r2)
+                .zip(r3)
+                .zip(panel.chunks_exact(BLOCK))
+            {
                 for i in 0..BLOCK {
                     acc[0][i] = fmadd::<FMA>(a0, wj[i], acc[0][i]);
                     acc[1][i] = fmadd::<FMA>(a1, wj[i], acc[1][i]);
@@ -93,6 +109,13 @@ fn kernel<const FMA: bool>(q: &[f64], m: usize, w: &[f64], peaks: &mut [f64]) {
 
 /// The baseline (non-dispatched) kernel, for tests on machines that dispatch to AVX2.
 #[cfg(test)]
-pub(crate) fn peak_abs_projection_baseline(q: &[f64], samples: usize, m: usize, w: &[f64], nch: usize, peaks: &mut [f64]) {
+pub(crate) fn peak_abs_projection_baseline(
+    q: &[f64],
+    samples: usize,
+    m: usize,
+    w: &[f64],
+    nch: usize,
+    peaks: &mut [f64],
+) {
     kernel::<false>(&q[..samples * m], m, &w[..m * nch], &mut peaks[..nch]);
 }

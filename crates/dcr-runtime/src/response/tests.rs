@@ -17,7 +17,15 @@ fn plate() -> Arc<ModalModel> {
 
 fn boxy() -> Arc<ModalModel> {
     let om = geometric_omegas(12, 80.0, 2000.0);
-    Arc::new(ModalModel::from_base(synthetic_base(box_surface(6, [1.0, 0.6, 0.4]), &om, [1.0, 2e-6], 11)).unwrap())
+    Arc::new(
+        ModalModel::from_base(synthetic_base(
+            box_surface(6, [1.0, 0.6, 0.4]),
+            &om,
+            [1.0, 2e-6],
+            11,
+        ))
+        .unwrap(),
+    )
 }
 
 fn hit(p: [f64; 3], lambda: f64) -> Impact {
@@ -29,14 +37,20 @@ fn hit(p: [f64; 3], lambda: f64) -> Impact {
 }
 
 fn contacts() -> Vec<RestingContact> {
-    [[0.1, 0.1], [0.9, 0.5], [0.5, 0.55], [0.25, 0.4], [0.75, 0.05]]
-        .iter()
-        .enumerate()
-        .map(|(i, xy)| RestingContact {
-            id: 100 + i as u64,
-            point: [xy[0], xy[1], 0.002],
-        })
-        .collect()
+    [
+        [0.1, 0.1],
+        [0.9, 0.5],
+        [0.5, 0.55],
+        [0.25, 0.4],
+        [0.75, 0.05],
+    ]
+    .iter()
+    .enumerate()
+    .map(|(i, xy)| RestingContact {
+        id: 100 + i as u64,
+        point: [xy[0], xy[1], 0.002],
+    })
+    .collect()
 }
 
 fn rel(a: f64, b: f64) -> f64 {
@@ -90,21 +104,35 @@ fn simultaneous_impacts_superpose() {
 #[test]
 fn response_is_reciprocal() {
     let model = boxy();
-    let pts = [[0.3, 0.2, 0.4], [0.8, 0.5, 0.4], [1.0, 0.3, 0.1], [0.0, 0.1, 0.35], [0.5, 0.0, 0.2]];
+    let pts = [
+        [0.3, 0.2, 0.4],
+        [0.8, 0.5, 0.4],
+        [1.0, 0.3, 0.1],
+        [0.0, 0.1, 0.35],
+        [0.5, 0.0, 0.2],
+    ];
     for a in 0..pts.len() {
         for b in 0..pts.len() {
             if a == b {
                 continue;
             }
             let peak = |from: usize, to: usize| {
-                let mut r = DistantResponse::new(Arc::clone(&model), ResponseParams::default()).unwrap();
+                let mut r =
+                    DistantResponse::new(Arc::clone(&model), ResponseParams::default()).unwrap();
                 let sp = model.project(pts[from], 1.0).unwrap();
                 let imp = Impact {
                     point: pts[from],
                     direction: scale(sp.normal, -1.0),
                     impulse: 1.0,
                 };
-                r.step(&[imp], &[RestingContact { id: 1, point: pts[to] }])[0].peak_displacement
+                r.step(
+                    &[imp],
+                    &[RestingContact {
+                        id: 1,
+                        point: pts[to],
+                    }],
+                )[0]
+                .peak_displacement
             };
             let (ab, ba) = (peak(a, b), peak(b, a));
             assert!(ab > 0.0 && rel(ab, ba) < 1e-12, "{a}->{b}: {ab} vs {ba}");
@@ -118,7 +146,9 @@ fn response_is_reciprocal() {
 fn zero_threshold_and_unmapped() {
     let mut r = DistantResponse::new(plate(), ResponseParams::default()).unwrap();
     let out = r.step(&[], &contacts());
-    assert!(out.iter().all(|c| c.mapped && c.peak_displacement == 0.0 && c.delta_v == 0.0));
+    assert!(out
+        .iter()
+        .all(|c| c.mapped && c.peak_displacement == 0.0 && c.delta_v == 0.0));
     let out = r.step(&[hit([0.5, 0.3, 0.0], 0.0)], &contacts());
     assert!(out.iter().all(|c| c.delta_v == 0.0));
     let out = r.step(&[hit([0.5, 0.3, 0.0], 0.999e-3)], &contacts());
@@ -220,7 +250,10 @@ fn carried_energy_decays_then_sleeps() {
         }
     }
     assert!(slept, "bank never slept");
-    assert!(r.step(&[hit([0.5, 0.3, 0.0], 1.0)], &cs).iter().all(|c| c.delta_v > 0.0));
+    assert!(r
+        .step(&[hit([0.5, 0.3, 0.0], 1.0)], &cs)
+        .iter()
+        .all(|c| c.delta_v > 0.0));
 }
 
 /// A force held over many steps (carry-over) settles each mode at the static deflection f/ω².
@@ -244,7 +277,10 @@ fn held_force_settles_at_static_deflection() {
     model.add_reduced_impulse(&sp, force[0].force, 1.0, &mut fr);
     for (j, q) in r.modal_state().iter().enumerate() {
         let stat = fr[j] / model.omega()[j].powi(2);
-        assert!((q - stat).abs() <= 1e-9 * stat.abs().max(1e-12), "mode {j}: {q} vs {stat}");
+        assert!(
+            (q - stat).abs() <= 1e-9 * stat.abs().max(1e-12),
+            "mode {j}: {q} vs {stat}"
+        );
     }
 }
 
@@ -323,7 +359,11 @@ fn attenuation_follows_eq15_16() {
         beta: 1.0,
         r0: 0.05,
     };
-    for amplitude in [AmplitudeKind::PerVertex, AmplitudeKind::Mean, AmplitudeKind::MeanOver(vec![0, 5, 9])] {
+    for amplitude in [
+        AmplitudeKind::PerVertex,
+        AmplitudeKind::Mean,
+        AmplitudeKind::MeanOver(vec![0, 5, 9]),
+    ] {
         let params = ResponseParams {
             method: Method::Attenuation(AttenuationParams {
                 law,
@@ -348,7 +388,9 @@ fn attenuation_follows_eq15_16() {
         let qhat = match &amplitude {
             AmplitudeKind::PerVertex => (0..3).map(|i| sp.bary[i] * q[vs[i]]).sum::<f64>(),
             AmplitudeKind::Mean => q.iter().sum::<f64>() / q.len() as f64,
-            AmplitudeKind::MeanOver(s) => s.iter().map(|&v| q[v as usize]).sum::<f64>() / s.len() as f64,
+            AmplitudeKind::MeanOver(s) => {
+                s.iter().map(|&v| q[v as usize]).sum::<f64>() / s.len() as f64
+            }
         };
         let dx = qhat * 2.0 * 0.8;
         for (c, o) in cs.iter().zip(&out) {
@@ -390,12 +432,23 @@ fn attenuation_heat_fields_are_cached() {
 /// Eq. 17: point mass → m; lever arm adds (r×n)ᵀI⁻¹(r×n); Eq. 18 impulse along n.
 #[test]
 fn effective_mass_and_impulse() {
-    assert_eq!(effective_mass(0.5, [[0.0; 3]; 3], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]), 2.0);
+    assert_eq!(
+        effective_mass(0.5, [[0.0; 3]; 3], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]),
+        2.0
+    );
     let inv_i = [[2.0, 0.0, 0.0], [0.0, 3.0, 0.0], [0.0, 0.0, 4.0]];
     // r × n = (1,0,0) × (0,0,1) = (0,−1,0): quad = 3.
-    assert!((effective_mass(0.5, inv_i, [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]) - 1.0 / 3.5).abs() < 1e-15);
-    assert_eq!(effective_mass(0.0, [[0.0; 3]; 3], [1.0; 3], [0.0, 0.0, 1.0]), 0.0);
-    assert_eq!(response_impulse(2.0, 0.25, [0.0, 0.6, 0.8]), [0.0, 0.3, 0.4]);
+    assert!(
+        (effective_mass(0.5, inv_i, [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]) - 1.0 / 3.5).abs() < 1e-15
+    );
+    assert_eq!(
+        effective_mass(0.0, [[0.0; 3]; 3], [1.0; 3], [0.0, 0.0, 1.0]),
+        0.0
+    );
+    assert_eq!(
+        response_impulse(2.0, 0.25, [0.0, 0.6, 0.8]),
+        [0.0, 0.3, 0.4]
+    );
 }
 
 /// The blocked kernel equals a naive triple loop.

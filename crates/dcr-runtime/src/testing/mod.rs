@@ -199,9 +199,17 @@ pub fn synthetic_base(surface: Surface, omega: &[f64], rayleigh: [f64; 2], seed:
         for axis in 0..3 {
             let mut terms = Vec::new();
             for _ in 0..3 {
-                let dir = [rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), rng.range(-1.0, 1.0)];
+                let dir = [
+                    rng.range(-1.0, 1.0),
+                    rng.range(-1.0, 1.0),
+                    rng.range(-1.0, 1.0),
+                ];
                 let k = std::f64::consts::PI * waves / size;
-                terms.push((dir.map(|d| d * k), rng.range(0.0, 6.28), rng.range(0.01, 0.05)));
+                terms.push((
+                    dir.map(|d| d * k),
+                    rng.range(0.0, std::f64::consts::TAU),
+                    rng.range(0.01, 0.05),
+                ));
             }
             for (v, p) in vertices.iter().enumerate() {
                 let val: f64 = terms
@@ -258,5 +266,10 @@ pub fn geometric_omegas(m: usize, omega_min: f64, omega_max: f64) -> Vec<f64> {
 /// A small ready-made base: a 1 m × 0.6 m plate (12 × 8 cells, 117 vertices), 8 modes from
 /// 60 to 900 rad/s, Rayleigh [2, 1e-5].
 pub fn plate_base() -> ModesFile {
-    synthetic_base(plate_grid(12, 8, 1.0, 0.6), &geometric_omegas(8, 60.0, 900.0), [2.0, 1e-5], 7)
+    synthetic_base(
+        plate_grid(12, 8, 1.0, 0.6),
+        &geometric_omegas(8, 60.0, 900.0),
+        [2.0, 1e-5],
+        7,
+    )
 }

@@ -52,10 +52,14 @@ pub fn run(args: &GeodesicArgs) -> anyhow::Result<()> {
     let mut d = vec![0.0; ns];
     heat.distances_from_vertex(args.from_vertex, &mut d);
     if let Some(path) = &args.npy {
-        write_npy(path, &ndarray::Array1::from(d.clone())).with_context(|| format!("writing {}", path.display()))?;
+        write_npy(path, &ndarray::Array1::from(d.clone()))
+            .with_context(|| format!("writing {}", path.display()))?;
     }
     if args.json {
-        println!("{}", serde_json::json!({ "from_vertex": args.from_vertex, "distances_m": d }));
+        println!(
+            "{}",
+            serde_json::json!({ "from_vertex": args.from_vertex, "distances_m": d })
+        );
     } else if args.npy.is_none() {
         for x in &d {
             println!("{x}");

@@ -11,8 +11,8 @@ use std::sync::Arc;
 
 use anyhow::{bail, Context};
 use dcr_runtime::{
-    AttenuationParams, DistantResponse, Impact, Method, ModalModel, ResponseParams, RestingContact, Sampling,
-    SurfacePoint, Variant,
+    AttenuationParams, DistantResponse, Impact, Method, ModalModel, ResponseParams, RestingContact,
+    Sampling, SurfacePoint, Variant,
 };
 
 /// Distant-response model selectable from the command line.
@@ -117,7 +117,10 @@ pub fn parse_vec2(s: &str) -> Result<[f64; 2], String> {
 /// surface (one-line messages).
 pub fn run(args: &ProbeArgs) -> anyhow::Result<()> {
     if !(args.impulse.is_finite() && args.impulse > 0.0) {
-        bail!("--impulse must be a finite number > 0 (N·s), got {}", args.impulse);
+        bail!(
+            "--impulse must be a finite number > 0 (N·s), got {}",
+            args.impulse
+        );
     }
     // LoadError messages already name the file and the cause: one line, no repeated chain.
     let model = ModalModel::load(&args.file).map_err(|e| anyhow::anyhow!("{e}"))?;
@@ -151,7 +154,10 @@ pub fn run(args: &ProbeArgs) -> anyhow::Result<()> {
         .with_context(|| format!("{}: invalid parameters", args.file.display()))?;
     let max_map = resp.max_map_distance();
     let impact_sp = model.project(args.impact, max_map).with_context(|| {
-        format!("impact point {:?} is farther than {max_map:.4} m from the surface", args.impact)
+        format!(
+            "impact point {:?} is farther than {max_map:.4} m from the surface",
+            args.impact
+        )
     })?;
     let direction = match args.direction {
         Some(d) => {
@@ -166,7 +172,10 @@ pub fn run(args: &ProbeArgs) -> anyhow::Result<()> {
     let mut mapped: Vec<SurfacePoint> = Vec::with_capacity(args.contacts.len());
     for (i, c) in args.contacts.iter().enumerate() {
         let sp = model.project(*c, max_map).with_context(|| {
-            format!("contact {} at {c:?} is farther than {max_map:.4} m from the surface", i + 1)
+            format!(
+                "contact {} at {c:?} is farther than {max_map:.4} m from the surface",
+                i + 1
+            )
         })?;
         mapped.push(sp);
     }
@@ -175,8 +184,15 @@ pub fn run(args: &ProbeArgs) -> anyhow::Result<()> {
         .map_err(|e| anyhow::anyhow!("{}: heat geodesics: {e}", args.file.display()))?;
     let mut field = vec![0.0; model.num_vertices()];
     heat.distances_from_point(&impact_sp, &mut field);
-    let resting: Vec<RestingContact> =
-        args.contacts.iter().enumerate().map(|(i, &p)| RestingContact { id: i as u64, point: p }).collect();
+    let resting: Vec<RestingContact> = args
+        .contacts
+        .iter()
+        .enumerate()
+        .map(|(i, &p)| RestingContact {
+            id: i as u64,
+            point: p,
+        })
+        .collect();
     let impact = Impact {
         point: args.impact,
         direction,

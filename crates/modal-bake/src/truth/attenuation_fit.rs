@@ -713,12 +713,10 @@ pub struct AttenuationFitInfo {
     pub pairs_used: usize,
     /// Seed.
     pub seed: u64,
-    /// Seconds: eigensolve (dense or sparse), response sampling, geodesics.
+    /// Seconds in assembly and the eigensolve (dense or sparse).
     pub eigensolve_s: f64,
-    /// Response seconds.
+    /// Seconds sampling the pairs (geodesics and responses).
     pub response_s: f64,
-    /// Geodesic seconds.
-    pub geodesic_s: f64,
 }
 
 /// Samples, fits and run information.
@@ -929,7 +927,6 @@ pub fn fit_attenuation_mesh(
         seed: params.seed,
         eigensolve_s,
         response_s,
-        geodesic_s: 0.0,
     };
     Ok(AttenuationFitReport {
         fit,
