@@ -1,10 +1,13 @@
 #!/bin/sh
-# Regenerate docs/accuracy.md: peak distant displacement of truncated modal bases (5 … 640 modes)
-# vs the full-order truth (all-mode sum, cross-checked with full-order Newmark) on the table.
-# Needs data/scenes/table.msh (scripts/gen_scene_meshes.sh). ~1 min on 2 cores.
+# Regenerate docs/accuracy.md and docs/accuracy/*.svg: peak distant displacement of truncated
+# modal bases (5 … 640 modes, four samplings, per-node vs per-contact), read and stepped through
+# the runtime, vs the full-order truth on the table, the ground slab and the scaffold; a mesh
+# resolution sweep on a structured plate; bake time, base size, query time; and the Eq. 14
+# attenuation fit of each object (modal-bake fit-attenuation).
+# Needs data/scenes/*.msh (scripts/gen_scene_meshes.sh). About 5–10 min on 2 cores.
 set -e
 cd "$(dirname "$0")/.."
 cargo build --release -p modal-bake --example accuracy
-target/release/examples/accuracy data/scenes/table.msh --fixed feet "$@" > docs/accuracy.md.tmp
+target/release/examples/accuracy --out docs "$@" > docs/accuracy.md.tmp
 mv docs/accuracy.md.tmp docs/accuracy.md
-echo "wrote docs/accuracy.md"
+echo "wrote docs/accuracy.md and docs/accuracy/*.svg"

@@ -22,6 +22,7 @@ fn main() {
     let mut nev = 20usize;
     let mut reps = 0usize;
     let mut block = EigenParams::default().block;
+    let mut ncv: Option<usize> = None;
     let mut i = 0;
     while i < args.len() {
         match args[i].as_str() {
@@ -31,6 +32,10 @@ fn main() {
             }
             "--reps" => {
                 reps = args[i + 1].parse().expect("--reps R");
+                i += 1;
+            }
+            "--ncv" => {
+                ncv = Some(args[i + 1].parse().expect("--ncv D"));
                 i += 1;
             }
             "--block" => {
@@ -74,6 +79,7 @@ fn main() {
             let p = EigenParams {
                 nev,
                 block,
+                krylov_dim: ncv,
                 ..Default::default()
             };
             let res = solve_lowest(&k, &m, &p, &mut |_| {}).expect("eigensolve");

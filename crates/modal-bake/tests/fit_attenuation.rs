@@ -82,10 +82,16 @@ fn recovers_known_parameters_from_noisy_samples() {
 fn fixed_r0_and_simplified_fits_recover_their_parameters() {
     let (r, s) = synthetic(0.3, 0.7, 0.1, 0.0, 100);
     let f = fit_eq14_fixed_r0(&r, &s, 0.1).unwrap();
-    assert!((f.alpha - 0.3).abs() < 1e-9 && (f.beta - 0.7).abs() < 1e-9, "{f:?}");
+    assert!(
+        (f.alpha - 0.3).abs() < 1e-9 && (f.beta - 0.7).abs() < 1e-9,
+        "{f:?}"
+    );
     let s2: Vec<f64> = r.iter().map(|r| 0.6 * r.powf(-1.2)).collect();
     let g = fit_simplified(&r, &s2).unwrap();
-    assert!((g.c - 0.6).abs() < 1e-9 && (g.beta - 1.2).abs() < 1e-9, "{g:?}");
+    assert!(
+        (g.c - 0.6).abs() < 1e-9 && (g.beta - 1.2).abs() < 1e-9,
+        "{g:?}"
+    );
 }
 
 #[test]
@@ -126,8 +132,7 @@ fn measured_samples_match_run_truth_at_the_same_points() {
     let sys = TruthSystem::new(slab(), &tp, "slab").unwrap();
     let ma = ModalAll::new(&sys, 6000).unwrap();
     let resp = SurfaceResponse::from_modal_all(&sys, &ma, None);
-    let (samples, kind, dt, _) =
-        sample_attenuation(&resp, tp.rayleigh, tp.h, None, 4, 3).unwrap();
+    let (samples, kind, dt, _) = sample_attenuation(&resp, tp.rayleigh, tp.h, None, 4, 3).unwrap();
     assert_eq!(kind, "geodesic");
     for smp in &samples {
         let p = TruthParams { dt, ..tp.clone() };
@@ -148,8 +153,14 @@ fn measured_samples_match_run_truth_at_the_same_points() {
             t.contacts[0].peak_displacement_m,
             t.contacts[1].peak_displacement_m,
         );
-        assert!((smp.local_peak_m / local - 1.0).abs() < 1e-6, "{smp:?} vs {local}");
-        assert!((smp.contact_peak_m / far - 1.0).abs() < 1e-6, "{smp:?} vs {far}");
+        assert!(
+            (smp.local_peak_m / local - 1.0).abs() < 1e-6,
+            "{smp:?} vs {local}"
+        );
+        assert!(
+            (smp.contact_peak_m / far - 1.0).abs() < 1e-6,
+            "{smp:?} vs {far}"
+        );
         assert!((smp.distance_m - t.contacts[1].distance_m).abs() < 1e-9);
     }
 }
@@ -170,7 +181,10 @@ fn small_mesh_fit_is_finite_and_decays_with_distance() {
     };
     let rep = fit_attenuation_mesh(slab(), &p, "slab").unwrap();
     let f = rep.fit;
-    assert!(f.alpha.is_finite() && f.beta.is_finite() && f.r0.is_finite(), "{f:?}");
+    assert!(
+        f.alpha.is_finite() && f.beta.is_finite() && f.r0.is_finite(),
+        "{f:?}"
+    );
     assert!(f.beta > 0.0, "amplitude must decay with distance: {f:?}");
     assert!(f.r0 > 0.0 && f.r2_log.is_finite() && f.rms_log.is_finite());
     assert_eq!(rep.samples.len(), 60);
@@ -193,7 +207,11 @@ fn sparse_truth_runs_and_decays_with_distance() {
     let rep = fit_attenuation_mesh(slab(), &p, "slab").unwrap();
     assert_eq!(rep.info.method, "modes");
     assert_eq!(rep.info.modes, 60);
-    assert!(rep.fit.beta > 0.0 && rep.fit.alpha.is_finite(), "{:?}", rep.fit);
+    assert!(
+        rep.fit.beta > 0.0 && rep.fit.alpha.is_finite(),
+        "{:?}",
+        rep.fit
+    );
 }
 
 #[derive(Parser)]
@@ -228,13 +246,8 @@ fn cli_runs_on_a_small_mesh() {
         fit_attenuation_cli::run(&cmd.args).unwrap();
     }
     // A user error is a clean error, not a panic.
-    let bad = Cmd::try_parse_from([
-        "fit-attenuation",
-        beam.to_str().unwrap(),
-        "--fixed",
-        "nope",
-    ])
-    .unwrap();
+    let bad = Cmd::try_parse_from(["fit-attenuation", beam.to_str().unwrap(), "--fixed", "nope"])
+        .unwrap();
     let e = fit_attenuation_cli::run(&bad.args).unwrap_err();
     assert!(format!("{e:#}").contains("nope"), "{e:#}");
 }

@@ -194,7 +194,9 @@ impl HeatGeodesic {
         let par = Par::Seq;
         // The two numeric factorisations are independent: run them on two threads.
         let numeric = |a: &SparseColMat<usize, f64>| -> Result<Factor, GeodesicError> {
-            let mut buf = MemBuffer::new(symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default()));
+            let mut buf = MemBuffer::new(
+                symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default()),
+            );
             let mut values = vec![0.0; symbolic.len_val()];
             symbolic
                 .factorize_numeric_llt::<f64>(

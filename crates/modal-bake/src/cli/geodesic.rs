@@ -10,8 +10,7 @@ use ndarray_npy::write_npy;
 /// Arguments of `modal-bake geodesic`.
 #[derive(clap::Args, Debug, Clone)]
 #[command(
-    about = "Heat-method geodesic distances (m) from one surface vertex to every surface vertex",
-    long_about = "Heat-method geodesic distances (m) from one surface vertex to every surface vertex, \
+    after_help = "Heat-method geodesic distances (m) from one surface vertex to every surface vertex, \
         in the base's surface-vertex order (Crane, Weischedel & Wardetzky 2013: t = mean edge \
         length², cotan Laplacian, lumped mass, no boundary averaging). Without --npy or --json the \
         distances are printed one per line."

@@ -36,8 +36,7 @@ pub enum VariantArg {
 /// Arguments of `modal-bake probe`.
 #[derive(clap::Args, Debug, Clone)]
 #[command(
-    about = "Distant response at contact points to one impact on a .modes base",
-    long_about = "Distant response at contact points to one impact on a .modes base.\n\n\
+    after_help = "Distant response at contact points to one impact on a .modes base.\n\n\
         Conventions: the impulse (N·s) acts at t = 0 at --impact, along --direction or by default \
         into the surface (−normal at the impact); any impulse > 0 is applied (no threshold). Points \
         are in the base's object frame (m) and must lie within 5% of the bounding-box diagonal of \

@@ -30,8 +30,8 @@ pub(crate) fn sym_spmm_with_abs(
     spmm_impl(a, x, y, Some(y_abs));
 }
 
-/// Columns handled per pass over the matrix (index loads shared between them).
-const SPMM_COLS: usize = 4;
+/// Columns handled per pass over the matrix (index and value loads shared between them).
+const SPMM_COLS: usize = 8;
 
 fn spmm_impl(
     a: &SparseColMat<usize, f64>,
@@ -42,59 +42,77 @@ fn spmm_impl(
     let n = a.nrows();
     let w = x.ncols();
     assert!(x.nrows() == n && y.nrows() == n && y.ncols() == w);
-    let (ptr, rows, vals) = (a.symbolic().col_ptr(), a.symbolic().row_idx(), a.val());
-    let xc = x.to_owned(); // contiguous columns
+    let with_abs = y_abs.is_some();
+    // Row-major panels: input [x_c0 .. x_c7] per row, output [y.., |y|..] per row.
+    let mut xr = vec![0.0f64; n * SPMM_COLS];
+    let stride = if with_abs { 2 * SPMM_COLS } else { SPMM_COLS };
+    let mut out = vec![0.0f64; n * stride];
     let mut c0 = 0;
     while c0 < w {
         let nc = SPMM_COLS.min(w - c0);
-        let xs: Vec<&[f64]> = (c0..c0 + nc)
-            .map(|c| {
-                xc.col(c)
-                    .try_as_col_major()
-                    .expect("owned column")
-                    .as_slice()
-            })
-            .collect();
-        let with_abs = y_abs.is_some();
-        // Row-major output chunk: [y_c0..y_c(nc-1), |y|_c0..] per row.
-        let stride = if with_abs { 2 * nc } else { nc };
-        let mut out = vec![0.0f64; n * stride];
-        out.par_chunks_mut(SPMM_ROWS_PER_TASK * stride)
-            .enumerate()
-            .for_each(|(t, chunk)| {
-                let r0 = t * SPMM_ROWS_PER_TASK;
-                for (ri, o) in chunk.chunks_mut(stride).enumerate() {
-                    let i = r0 + ri;
-                    let mut acc = [0.0f64; SPMM_COLS];
-                    let mut acc_abs = [0.0f64; SPMM_COLS];
-                    for p in ptr[i]..ptr[i + 1] {
-                        let (v, r) = (vals[p], rows[p]);
-                        for c in 0..nc {
-                            let xv = xs[c][r];
-                            acc[c] += v * xv;
-                            if with_abs {
-                                acc_abs[c] += (v * xv).abs();
-                            }
-                        }
-                    }
-                    o[..nc].copy_from_slice(&acc[..nc]);
-                    if with_abs {
-                        o[nc..].copy_from_slice(&acc_abs[..nc]);
-                    }
+        for c in 0..SPMM_COLS {
+            if c < nc {
+                for (i, &v) in x.col(c0 + c).iter().enumerate() {
+                    xr[i * SPMM_COLS + c] = v;
                 }
-            });
+            } else {
+                for i in 0..n {
+                    xr[i * SPMM_COLS + c] = 0.0;
+                }
+            }
+        }
+        spmm_panel(a, &xr, &mut out, with_abs);
         for c in 0..nc {
             for (i, v) in y.rb_mut().col_mut(c0 + c).iter_mut().enumerate() {
                 *v = out[i * stride + c];
             }
             if let Some(ya) = y_abs.as_mut() {
                 for (i, v) in ya.rb_mut().col_mut(c0 + c).iter_mut().enumerate() {
-                    *v = out[i * stride + nc + c];
+                    *v = out[i * stride + SPMM_COLS + c];
                 }
             }
         }
         c0 += nc;
     }
+}
+
+/// One panel of [`spmm_impl`]: `out[i] = Σ_p a_ip · xr[row_p]` (and the absolute sums), each
+/// output row a sequential sum in index order.
+fn spmm_panel(a: &SparseColMat<usize, f64>, xr: &[f64], out: &mut [f64], with_abs: bool) {
+    const W: usize = SPMM_COLS;
+    let (ptr, rows, vals) = (a.symbolic().col_ptr(), a.symbolic().row_idx(), a.val());
+    let (xrows, _) = xr.as_chunks::<W>();
+    let stride = if with_abs { 2 * W } else { W };
+    out.par_chunks_mut(SPMM_ROWS_PER_TASK * stride)
+        .enumerate()
+        .for_each(|(t, chunk)| {
+            let r0 = t * SPMM_ROWS_PER_TASK;
+            for (ri, o) in chunk.chunks_exact_mut(stride).enumerate() {
+                let i = r0 + ri;
+                let (p0, p1) = (ptr[i], ptr[i + 1]);
+                let mut acc = [0.0f64; W];
+                if with_abs {
+                    let mut acc_abs = [0.0f64; W];
+                    for (&r, &v) in rows[p0..p1].iter().zip(&vals[p0..p1]) {
+                        let xv = &xrows[r];
+                        for c in 0..W {
+                            let t = v * xv[c];
+                            acc[c] += t;
+                            acc_abs[c] += t.abs();
+                        }
+                    }
+                    o[W..].copy_from_slice(&acc_abs);
+                } else {
+                    for (&r, &v) in rows[p0..p1].iter().zip(&vals[p0..p1]) {
+                        let xv = &xrows[r];
+                        for c in 0..W {
+                            acc[c] += v * xv[c];
+                        }
+                    }
+                }
+                o[..W].copy_from_slice(&acc);
+            }
+        });
 }
 
 /// `dst (+)= alpha · lhs · rhs` with faer's dense kernel at parallelism `par`.

@@ -120,9 +120,12 @@ pub(crate) fn solve(
     loop {
         // --- expand: Z = T W = A⁻¹ M W, M-orthogonalise against the basis ------------------
         let nb = kk + b;
+        let tp = Instant::now();
         z.copy_from(mv.as_ref().subcols(kk, b));
         fac.solve_in_place(z.as_mut(), &mut solve_buf);
         info.block_solves += 1;
+        prof(0, tp);
+        let tp = Instant::now();
         let mut c = Mat::<f64>::zeros(nb, b);
         for _pass in 0..2 {
             let mut cp = Mat::<f64>::zeros(nb, b);
@@ -145,7 +148,11 @@ pub(crate) fn solve(
             c += &cp;
         }
         h.as_mut().submatrix_mut(0, kk, nb, b).copy_from(&c);
+        prof(1, tp);
+        let tp = Instant::now();
         sym_spmm(m, z.as_ref(), mz.as_mut());
+        prof(2, tp);
+        let tp = Instant::now();
         let pre: Vec<f64> = (0..b)
             .map(|j| {
                 let cn: f64 = (0..nb).map(|i| c[(i, j)] * c[(i, j)]).sum();
@@ -165,6 +172,8 @@ pub(crate) fn solve(
         v.as_mut().subcols_mut(nb, b).copy_from(&z);
         mv.as_mut().subcols_mut(nb, b).copy_from(&mz);
         h.as_mut().submatrix_mut(nb, kk, b, b).copy_from(&r);
+        prof(3, tp);
+        let tp = Instant::now();
         kk = nb;
         info.iterations += 1;
         info.krylov_dim = info.krylov_dim.max(kk);
@@ -227,11 +236,17 @@ pub(crate) fn solve(
             iteration: info.iterations,
         });
 
+        if std::env::var_os("EIG_EST").is_some() {
+            let w = wanted.min(kk);
+            eprintln!("it {} kk {} est max {:.2e} est[0] {:.2e} est[w-1] {:.2e} est[w] {:.2e}", info.iterations, kk, est[..w].iter().cloned().fold(0.0, f64::max), est[0], est[w-1], est.get(w).cloned().unwrap_or(0.0));
+        }
         let ready = wanted <= kk
             && est.iter().take(wanted).all(|&e| e <= trigger)
             && (lam_lim.is_none() || capped || below < kk);
         let out_of_steps = info.block_solves >= params.max_iters;
+        prof(4, tp);
         if ready || out_of_steps {
+            let tp = Instant::now();
             info.residual_checks += 1;
             let sel = select_cols(s_asc.as_ref(), &order[..wanted.min(kk)]);
             let (vals, u, res) = finalize(
@@ -244,10 +259,15 @@ pub(crate) fn solve(
                 sigma,
                 par,
             )?;
+            prof(5, tp);
             let worst = res.iter().map(|r| r.rel).fold(0.0, f64::max);
+            if std::env::var_os("EIG_EST").is_some() {
+                eprintln!("check: worst {:.2e} rel {:?}", worst, res.iter().map(|r| format!("{:.1e}/{:.1e}", r.rel, r.floor)).collect::<Vec<_>>());
+            }
             let good = res.iter().filter(|r| r.converged(params.tol)).count();
             if good == res.len() && wanted <= kk {
                 info.solve_seconds = t1.elapsed().as_secs_f64();
+                prof_dump(&info);
                 info.capped = capped;
                 return Ok(trim_and_sign(vals, u, res, lam_lim, params, info));
             }
@@ -275,6 +295,7 @@ pub(crate) fn solve(
             cap = new_cap;
         }
         if kk + 2 * b > cap {
+            let tp = Instant::now();
             // Keep the best p Ritz vectors plus the newest block.
             let p = (wanted + (kk - wanted) / 2)
                 .min(ncv - b)
@@ -320,6 +341,7 @@ pub(crate) fn solve(
             h.as_mut().submatrix_mut(p, 0, b, p).copy_from(&coupling);
             kk = p;
             info.restarts += 1;
+            prof(6, tp);
         }
     }
 }
@@ -780,4 +802,13 @@ fn solve_dense(
         residual_floors: res.iter().map(|r| r.floor).collect(),
         info,
     })
+}
+
+thread_local! { static PROF: std::cell::RefCell<[f64; 8]> = const { std::cell::RefCell::new([0.0; 8]) }; }
+fn prof(i: usize, t: Instant) { PROF.with(|p| p.borrow_mut()[i] += t.elapsed().as_secs_f64()); }
+fn prof_dump(info: &EigenInfo) {
+    if std::env::var_os("EIG_PROF").is_some() {
+        PROF.with(|p| { let p = p.borrow(); eprintln!("PROF solve {:.4} gs {:.4} mprod {:.4} orth {:.4} rr {:.4} fin {:.4} restart {:.4} | it {} bs {} rs {} chk {}", p[0],p[1],p[2],p[3],p[4],p[5],p[6], info.iterations, info.block_solves, info.restarts, info.residual_checks); });
+    }
+    PROF.with(|p| *p.borrow_mut() = [0.0; 8]);
 }

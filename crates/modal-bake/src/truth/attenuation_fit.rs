@@ -282,9 +282,8 @@ pub fn fit_eq14(r: &[f64], s: &[f64]) -> Result<AttenuationFit, FitError> {
             ));
         }
     }
-    best.map(|(_, f)| f).ok_or_else(|| {
-        FitError::Degenerate("no α ≥ 0, β ≥ 0, r0 > 0 fits the samples".into())
-    })
+    best.map(|(_, f)| f)
+        .ok_or_else(|| FitError::Degenerate("no α ≥ 0, β ≥ 0, r0 > 0 fits the samples".into()))
 }
 
 /// As [`fit_eq14`] with r0 (m) given: ln s = −α(r − r0) − β ln(r/r0), linear in (α, β).
@@ -461,10 +460,7 @@ impl SurfaceResponse {
                 }
             });
         for (v, f) in fixed.iter_mut().enumerate() {
-            *f = sys
-                .map
-                .free_index(3 * s.surface_to_volume[v])
-                .is_none();
+            *f = sys.map.free_index(3 * s.surface_to_volume[v]).is_none();
         }
         Self::finish(
             ma.eigenvalues[..m].to_vec(),
@@ -916,8 +912,7 @@ pub fn fit_attenuation_mesh(
         method: method.into(),
         free_dofs,
         modes: resp.num_modes(),
-        max_freq_hz: resp.eigenvalues.last().copied().unwrap_or(0.0).sqrt()
-            / std::f64::consts::TAU,
+        max_freq_hz: resp.eigenvalues.last().copied().unwrap_or(0.0).sqrt() / std::f64::consts::TAU,
         dt,
         samples: steps,
         h: params.h,
