@@ -91,12 +91,20 @@ fn main() {
     std::fs::create_dir_all(&target).unwrap();
     let machine = std::fs::read_to_string("/proc/cpuinfo")
         .ok()
-        .and_then(|s| s.lines().find(|l| l.starts_with("model name")).map(|l| l.split(':').nth(1).unwrap_or("").trim().to_string()))
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("model name"))
+                .map(|l| l.split(':').nth(1).unwrap_or("").trim().to_string())
+        })
         .unwrap_or_default();
     let report = serde_json::json!({
         "machine": {"cpu": machine, "threads": std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1)},
         "rows": rows,
     });
-    std::fs::write(target.join("bake.json"), serde_json::to_vec_pretty(&report).unwrap()).unwrap();
+    std::fs::write(
+        target.join("bake.json"),
+        serde_json::to_vec_pretty(&report).unwrap(),
+    )
+    .unwrap();
     eprintln!("wrote target/bench/bake.json");
 }

@@ -23,6 +23,7 @@ fn main() {
     let mut reps = 0usize;
     let mut block = EigenParams::default().block;
     let mut ncv: Option<usize> = None;
+    let mut threads = 0usize;
     let mut i = 0;
     while i < args.len() {
         match args[i].as_str() {
@@ -32,6 +33,10 @@ fn main() {
             }
             "--reps" => {
                 reps = args[i + 1].parse().expect("--reps R");
+                i += 1;
+            }
+            "--threads" => {
+                threads = args[i + 1].parse().expect("--threads T");
                 i += 1;
             }
             "--ncv" => {
@@ -80,6 +85,7 @@ fn main() {
                 nev,
                 block,
                 krylov_dim: ncv,
+                threads,
                 ..Default::default()
             };
             let res = solve_lowest(&k, &m, &p, &mut |_| {}).expect("eigensolve");

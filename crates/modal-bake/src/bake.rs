@@ -318,7 +318,10 @@ fn prepare(mut mesh: TetMesh, params: &BakeParams, file: &str) -> Result<Prepare
 fn spans_a_plane(mesh: &TetMesh, set: &[usize]) -> bool {
     let p0 = mesh.nodes[set[0]];
     let dist2 = |a: [f64; 3], b: [f64; 3]| (0..3).map(|i| (a[i] - b[i]).powi(2)).sum::<f64>();
-    let Some(&far) = set.iter().max_by(|&&a, &&b| dist2(p0, mesh.nodes[a]).total_cmp(&dist2(p0, mesh.nodes[b]))) else {
+    let Some(&far) = set
+        .iter()
+        .max_by(|&&a, &&b| dist2(p0, mesh.nodes[a]).total_cmp(&dist2(p0, mesh.nodes[b])))
+    else {
         return false;
     };
     let p1 = mesh.nodes[far];
@@ -331,7 +334,11 @@ fn spans_a_plane(mesh: &TetMesh, set: &[usize]) -> bool {
     set.iter().any(|&v| {
         let p = mesh.nodes[v];
         let d = [p[0] - p0[0], p[1] - p0[1], p[2] - p0[2]];
-        let c = [e[1] * d[2] - e[2] * d[1], e[2] * d[0] - e[0] * d[2], e[0] * d[1] - e[1] * d[0]];
+        let c = [
+            e[1] * d[2] - e[2] * d[1],
+            e[2] * d[0] - e[0] * d[2],
+            e[0] * d[1] - e[1] * d[0],
+        ];
         (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt() > 1e-9 * l2
     })
 }

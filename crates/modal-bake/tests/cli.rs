@@ -10,7 +10,9 @@ fn bin() -> Command {
 }
 
 fn data(rel: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data").join(rel)
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../data")
+        .join(rel)
 }
 
 fn run(args: &[&str]) -> Output {
@@ -38,7 +40,11 @@ fn every_input_form_gives_a_byte_identical_base_and_rebaking_is_identical() {
     for (i, f) in forms.iter().enumerate() {
         let out = dir.path().join(format!("{i}.modes"));
         let o = bake(&data(f), &out, &["--fixed", "bottom", "--modes", "8"]);
-        assert!(o.status.success(), "{f}: {}", String::from_utf8_lossy(&o.stderr));
+        assert!(
+            o.status.success(),
+            "{f}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
         let bytes = std::fs::read(&out).unwrap();
         match &first {
             None => first = Some(bytes),
@@ -47,7 +53,13 @@ fn every_input_form_gives_a_byte_identical_base_and_rebaking_is_identical() {
     }
     // Twice, same file: bit-identical.
     let again = dir.path().join("again.modes");
-    assert!(bake(&data(forms[2]), &again, &["--fixed", "bottom", "--modes", "8"]).status.success());
+    assert!(bake(
+        &data(forms[2]),
+        &again,
+        &["--fixed", "bottom", "--modes", "8"]
+    )
+    .status
+    .success());
     assert!(first.unwrap() == std::fs::read(&again).unwrap());
 }
 
@@ -58,25 +70,57 @@ fn check_exit_codes_follow_staleness() {
     let out = dir.path().join("c.modes");
     let m = mesh.to_str().unwrap();
     let o = out.to_str().unwrap();
-    assert_eq!(run(&["check", m, o, "--modes", "6"]).status.code(), Some(1), "missing → 1");
+    assert_eq!(
+        run(&["check", m, o, "--modes", "6"]).status.code(),
+        Some(1),
+        "missing → 1"
+    );
     assert!(bake(&mesh, &out, &["--modes", "6"]).status.success());
-    assert_eq!(run(&["check", m, o, "--modes", "6"]).status.code(), Some(0), "fresh → 0");
-    assert_eq!(run(&["check", m, o, "--modes", "7"]).status.code(), Some(1), "other params → 1");
-    assert_eq!(run(&["check", m, o, "--modes", "6", "--youngs", "2e9"]).status.code(), Some(1));
+    assert_eq!(
+        run(&["check", m, o, "--modes", "6"]).status.code(),
+        Some(0),
+        "fresh → 0"
+    );
+    assert_eq!(
+        run(&["check", m, o, "--modes", "7"]).status.code(),
+        Some(1),
+        "other params → 1"
+    );
+    assert_eq!(
+        run(&["check", m, o, "--modes", "6", "--youngs", "2e9"])
+            .status
+            .code(),
+        Some(1)
+    );
     // Same geometry in another form is still up to date (hash of parsed geometry, not bytes).
     let json = data("meshes/cube_cell_sets.json");
-    assert_eq!(run(&["check", json.to_str().unwrap(), o, "--modes", "6"]).status.code(), Some(0));
+    assert_eq!(
+        run(&["check", json.to_str().unwrap(), o, "--modes", "6"])
+            .status
+            .code(),
+        Some(0)
+    );
     let bad = data("bad/truncated.msh");
-    assert_eq!(run(&["check", bad.to_str().unwrap(), o]).status.code(), Some(2), "unreadable mesh → 2");
+    assert_eq!(
+        run(&["check", bad.to_str().unwrap(), o]).status.code(),
+        Some(2),
+        "unreadable mesh → 2"
+    );
     std::fs::write(&out, b"garbage").unwrap();
-    assert_eq!(run(&["check", m, o, "--modes", "6"]).status.code(), Some(1), "corrupt base → stale");
+    assert_eq!(
+        run(&["check", m, o, "--modes", "6"]).status.code(),
+        Some(1),
+        "corrupt base → stale"
+    );
 }
 
 #[test]
 fn info_json_has_the_documented_keys() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("c.modes");
-    assert!(bake(&data("meshes/cube_v41.msh"), &out, &["--modes", "5"]).status.success());
+    assert!(bake(&data("meshes/cube_v41.msh"), &out, &["--modes", "5"])
+        .status
+        .success());
     let o = run(&["info", out.to_str().unwrap(), "--json"]);
     assert!(o.status.success());
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
@@ -84,12 +128,20 @@ fn info_json_has_the_documented_keys() {
     assert_eq!(v["frequencies_hz"].as_array().unwrap().len(), 5);
     assert_eq!(v["eigenvalues"].as_array().unwrap().len(), 5);
     assert_eq!(v["format_version"], 1);
-    assert_eq!(v["rigid_modes_excluded"], 6, "free-free cube: six rigid modes excluded");
+    assert_eq!(
+        v["rigid_modes_excluded"], 6,
+        "free-free cube: six rigid modes excluded"
+    );
     assert!(v["surface_vertices"].as_u64().unwrap() > 0);
     assert!(v["surface_triangles"].as_u64().unwrap() > 0);
     assert!(v["source_hash"].as_str().unwrap().starts_with("sha256:"));
     // f = √λ / 2π for every mode.
-    for (f, l) in v["frequencies_hz"].as_array().unwrap().iter().zip(v["eigenvalues"].as_array().unwrap()) {
+    for (f, l) in v["frequencies_hz"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .zip(v["eigenvalues"].as_array().unwrap())
+    {
         let (f, l) = (f.as_f64().unwrap(), l.as_f64().unwrap());
         assert!((f - l.sqrt() / (2.0 * std::f64::consts::PI)).abs() <= 1e-12 * f);
     }
@@ -112,7 +164,11 @@ fn bad_inputs_fail_cleanly_with_located_errors() {
         ("bad/bad_shape.json", &[], "bad_shape.json"),
         ("bad/negative_index.json", &[], "negative_index.json"),
         ("bad/not_a_mesh.msh", &[], "not_a_mesh.msh"),
-        ("meshes/cube_v41.msh", &["--fixed", "no_such_group"], "no_such_group"),
+        (
+            "meshes/cube_v41.msh",
+            &["--fixed", "no_such_group"],
+            "no_such_group",
+        ),
         ("meshes/cube_v41.msh", &["--youngs", "-5"], "material"),
         ("meshes/cube_v41.msh", &["--modes", "0"], "--modes"),
         ("meshes/cube_v41.msh", &["--modes", "100000"], "modes"),
@@ -125,7 +181,10 @@ fn bad_inputs_fail_cleanly_with_located_errors() {
         assert!(!o.status.success(), "{file} {extra:?} must fail");
         assert_ne!(o.status.code(), Some(101), "{file}: panicked: {err}");
         assert!(!err.contains("panicked"), "{file}: {err}");
-        assert!(err.contains(needle), "{file} {extra:?}: message `{err}` should mention `{needle}`");
+        assert!(
+            err.contains(needle),
+            "{file} {extra:?}: message `{err}` should mention `{needle}`"
+        );
         assert!(!out.exists(), "{file}: output left behind");
     }
     // Nothing half-written: no temporary files either.
@@ -136,7 +195,11 @@ fn bad_inputs_fail_cleanly_with_located_errors() {
 fn an_inverted_tet_is_reoriented_and_counted() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("inv.modes");
-    let o = bake(&data("bad/inverted_tet.msh"), &out, &["--modes", "2", "--json"]);
+    let o = bake(
+        &data("bad/inverted_tet.msh"),
+        &out,
+        &["--modes", "2", "--json"],
+    );
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(v["reoriented_tets"], 1);

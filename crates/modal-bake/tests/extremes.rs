@@ -263,8 +263,13 @@ fn collinear_fixed_nodes_are_refused_as_a_mechanism() {
     for set in [vec![0usize], vec![0, 1]] {
         let mut mesh = plate();
         mesh.groups.insert("corner".into(), set.clone());
-        let e = bake_mesh(mesh, &params(1e9, 1000.0, &["corner"], 10), "plate", &mut |_| {})
-            .expect_err("a collinear fixed set must be refused");
+        let e = bake_mesh(
+            mesh,
+            &params(1e9, 1000.0, &["corner"], 10),
+            "plate",
+            &mut |_| {},
+        )
+        .expect_err("a collinear fixed set must be refused");
         let msg = e.to_string();
         assert!(matches!(e, BakeError::Params(_)), "{e:?}");
         assert!(msg.contains("collinear") && msg.contains("plate"), "{msg}");

@@ -28,7 +28,7 @@ fn truth(extra: &[&str]) -> Output {
         "--h",
         "0.002",
         "--dt",
-        "2e-6",
+        "5e-7",
     ];
     a.extend_from_slice(extra);
     Command::new(env!("CARGO_BIN_EXE_modal-bake"))

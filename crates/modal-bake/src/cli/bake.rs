@@ -133,7 +133,7 @@ pub fn run(args: &BakeArgs) -> anyhow::Result<()> {
     let report = report
         .with_context(|| format!("baking {} failed; nothing was written", args.mesh.display()))?;
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
+        outln!("{}", serde_json::to_string_pretty(&report)?);
     } else {
         print_report(&args.out, &report);
     }
@@ -152,19 +152,22 @@ pub fn run(args: &BakeArgs) -> anyhow::Result<()> {
 }
 
 fn print_report(out: &std::path::Path, r: &BakeReport) {
-    println!("wrote {}", out.display());
-    println!(
+    outln!("wrote {}", out.display());
+    outln!(
         "  mesh: {} nodes, {} tets, {} free dofs, mass {:.6} kg",
-        r.nodes, r.tets, r.free_dofs, r.mass_kg
+        r.nodes,
+        r.tets,
+        r.free_dofs,
+        r.mass_kg
     );
     for n in &r.notes {
-        println!("  note: {n}");
+        outln!("  note: {n}");
     }
     if r.reoriented_tets > 0 {
-        println!("  reoriented {} inverted tetrahedra", r.reoriented_tets);
+        outln!("  reoriented {} inverted tetrahedra", r.reoriented_tets);
     }
     if r.rigid_modes_excluded > 0 {
-        println!(
+        outln!(
             "  free-free: {} rigid-body modes detected (|λ| ≤ {:.2e} rad²/s²) and excluded",
             r.rigid_modes_excluded,
             r.rigid_eigenvalues
@@ -172,14 +175,15 @@ fn print_report(out: &std::path::Path, r: &BakeReport) {
                 .fold(0.0f64, |a, l| a.max(l.abs()))
         );
     } else {
-        println!("  fixed nodes: {}", r.fixed_nodes);
+        outln!("  fixed nodes: {}", r.fixed_nodes);
     }
-    println!(
+    outln!(
         "  surface: {} vertices, {} triangles",
-        r.surface_vertices, r.surface_triangles
+        r.surface_vertices,
+        r.surface_triangles
     );
     let worst = r.residuals.iter().fold(0.0f64, |a, &b| a.max(b));
-    println!(
+    outln!(
         "  {} modes, {:.3} Hz … {:.3} Hz, worst relative residual {:.1e}",
         r.modes,
         r.frequencies_hz.first().copied().unwrap_or(0.0),

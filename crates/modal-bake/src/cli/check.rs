@@ -21,11 +21,11 @@ pub struct CheckArgs {
 pub fn run(args: &CheckArgs) -> ExitCode {
     match bake::is_up_to_date(&args.mesh, &args.options.params(), &args.out) {
         Ok(true) => {
-            println!("{}: up to date", args.out.display());
+            outln!("{}: up to date", args.out.display());
             ExitCode::SUCCESS
         }
         Ok(false) => {
-            println!("{}: stale or missing", args.out.display());
+            outln!("{}: stale or missing", args.out.display());
             ExitCode::from(1)
         }
         Err(e) => {

@@ -55,13 +55,13 @@ pub fn run(args: &GeodesicArgs) -> anyhow::Result<()> {
             .with_context(|| format!("writing {}", path.display()))?;
     }
     if args.json {
-        println!(
+        outln!(
             "{}",
             serde_json::json!({ "from_vertex": args.from_vertex, "distances_m": d })
         );
     } else if args.npy.is_none() {
         for x in &d {
-            println!("{x}");
+            outln!("{x}");
         }
     }
     Ok(())

@@ -1,5 +1,13 @@
 //! Command-line front end: one file per subcommand.
 
+/// `println!` that ignores a closed stdout (`modal-bake info x.modes | head` must not panic).
+macro_rules! outln {
+    ($($t:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stdout().lock(), $($t)*);
+    }};
+}
+
 mod bake;
 mod check;
 mod geodesic;

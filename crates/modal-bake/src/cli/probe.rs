@@ -215,9 +215,9 @@ pub fn run(args: &ProbeArgs) -> anyhow::Result<()> {
         })
         .collect();
     if args.json {
-        println!("{}", serde_json::json!({ "contacts": rows }));
+        outln!("{}", serde_json::json!({ "contacts": rows }));
     } else {
-        println!(
+        outln!(
             "{}: {} modes, S = {} samples per step, T = {:.4e} s, impulse {} N·s along {:?}",
             args.file.display(),
             model.num_modes(),
@@ -226,13 +226,18 @@ pub fn run(args: &ProbeArgs) -> anyhow::Result<()> {
             args.impulse,
             direction
         );
-        println!(
+        outln!(
             "{:>3} {:>8} {:>26} {:>12} {:>14} {:>12}",
-            "#", "triangle", "bary", "distance_m", "peak_disp_m", "delta_v_mps"
+            "#",
+            "triangle",
+            "bary",
+            "distance_m",
+            "peak_disp_m",
+            "delta_v_mps"
         );
         for (i, r) in rows.iter().enumerate() {
             let b = &r["bary"];
-            println!(
+            outln!(
                 "{:>3} {:>8} {:>8.5},{:>8.5},{:>8.5} {:>12.5e} {:>14.5e} {:>12.5e}",
                 i + 1,
                 r["triangle"],

@@ -238,7 +238,15 @@ pub(crate) fn solve(
 
         if std::env::var_os("EIG_EST").is_some() {
             let w = wanted.min(kk);
-            eprintln!("it {} kk {} est max {:.2e} est[0] {:.2e} est[w-1] {:.2e} est[w] {:.2e}", info.iterations, kk, est[..w].iter().cloned().fold(0.0, f64::max), est[0], est[w-1], est.get(w).cloned().unwrap_or(0.0));
+            eprintln!(
+                "it {} kk {} est max {:.2e} est[0] {:.2e} est[w-1] {:.2e} est[w] {:.2e}",
+                info.iterations,
+                kk,
+                est[..w].iter().cloned().fold(0.0, f64::max),
+                est[0],
+                est[w - 1],
+                est.get(w).cloned().unwrap_or(0.0)
+            );
         }
         let ready = wanted <= kk
             && est.iter().take(wanted).all(|&e| e <= trigger)
@@ -262,7 +270,13 @@ pub(crate) fn solve(
             prof(5, tp);
             let worst = res.iter().map(|r| r.rel).fold(0.0, f64::max);
             if std::env::var_os("EIG_EST").is_some() {
-                eprintln!("check: worst {:.2e} rel {:?}", worst, res.iter().map(|r| format!("{:.1e}/{:.1e}", r.rel, r.floor)).collect::<Vec<_>>());
+                eprintln!(
+                    "check: worst {:.2e} rel {:?}",
+                    worst,
+                    res.iter()
+                        .map(|r| format!("{:.1e}/{:.1e}", r.rel, r.floor))
+                        .collect::<Vec<_>>()
+                );
             }
             let good = res.iter().filter(|r| r.converged(params.tol)).count();
             if good == res.len() && wanted <= kk {
@@ -805,7 +819,9 @@ fn solve_dense(
 }
 
 thread_local! { static PROF: std::cell::RefCell<[f64; 8]> = const { std::cell::RefCell::new([0.0; 8]) }; }
-fn prof(i: usize, t: Instant) { PROF.with(|p| p.borrow_mut()[i] += t.elapsed().as_secs_f64()); }
+fn prof(i: usize, t: Instant) {
+    PROF.with(|p| p.borrow_mut()[i] += t.elapsed().as_secs_f64());
+}
 fn prof_dump(info: &EigenInfo) {
     if std::env::var_os("EIG_PROF").is_some() {
         PROF.with(|p| { let p = p.borrow(); eprintln!("PROF solve {:.4} gs {:.4} mprod {:.4} orth {:.4} rr {:.4} fin {:.4} restart {:.4} | it {} bs {} rs {} chk {}", p[0],p[1],p[2],p[3],p[4],p[5],p[6], info.iterations, info.block_solves, info.restarts, info.residual_checks); });

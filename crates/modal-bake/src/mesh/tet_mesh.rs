@@ -61,7 +61,10 @@ impl TetMesh {
     /// If any of `nx, ny, nz` is zero.
     pub fn structured_box(n: [usize; 3], l: [f64; 3]) -> TetMesh {
         let [nx, ny, nz] = n;
-        assert!(nx > 0 && ny > 0 && nz > 0, "structured_box needs at least one cell per axis");
+        assert!(
+            nx > 0 && ny > 0 && nz > 0,
+            "structured_box needs at least one cell per axis"
+        );
         let id = |i: usize, j: usize, k: usize| i + (nx + 1) * (j + (ny + 1) * k);
         let mut nodes = Vec::with_capacity((nx + 1) * (ny + 1) * (nz + 1));
         for k in 0..=nz {
@@ -106,11 +109,17 @@ impl TetMesh {
             }
         }
         let mut groups = BTreeMap::new();
-        for (axis, lo, hi) in [(0, "xmin", "xmax"), (1, "ymin", "ymax"), (2, "zmin", "zmax")] {
-            let lo_set: Vec<usize> =
-                (0..nodes.len()).filter(|&v| nodes[v][axis] == 0.0).collect();
-            let hi_set: Vec<usize> =
-                (0..nodes.len()).filter(|&v| nodes[v][axis] == l[axis]).collect();
+        for (axis, lo, hi) in [
+            (0, "xmin", "xmax"),
+            (1, "ymin", "ymax"),
+            (2, "zmin", "zmax"),
+        ] {
+            let lo_set: Vec<usize> = (0..nodes.len())
+                .filter(|&v| nodes[v][axis] == 0.0)
+                .collect();
+            let hi_set: Vec<usize> = (0..nodes.len())
+                .filter(|&v| nodes[v][axis] == l[axis])
+                .collect();
             groups.insert(lo.to_string(), lo_set);
             groups.insert(hi.to_string(), hi_set);
         }
@@ -130,8 +139,13 @@ impl TetMesh {
         self.tets
             .iter()
             .map(|t| {
-                signed_volume(self.nodes[t[0]], self.nodes[t[1]], self.nodes[t[2]], self.nodes[t[3]])
-                    .abs()
+                signed_volume(
+                    self.nodes[t[0]],
+                    self.nodes[t[1]],
+                    self.nodes[t[2]],
+                    self.nodes[t[3]],
+                )
+                .abs()
             })
             .sum()
     }

@@ -37,13 +37,13 @@ mod truth_system;
 use std::path::Path;
 use std::time::Instant;
 
-pub use dcr_runtime::format::MaterialSi;
 pub use attenuation_fit::{
     fit_attenuation_mesh, fit_eq14, fit_eq14_fixed_r0, fit_simplified, sample_attenuation,
     AttenuationFit, AttenuationFitInfo, AttenuationFitParams, AttenuationFitReport,
     AttenuationSample, FitError, FitTruth, SimplifiedFit, SplitMix64, SurfaceResponse,
     DEFAULT_SPARSE_MODES, MIN_FIT_SAMPLES,
 };
+pub use dcr_runtime::format::MaterialSi;
 pub use modal_all::{ModalAll, ModalInput};
 pub use newmark::{newmark_peaks, newmark_run, NewmarkInfo};
 pub use surface_map::SurfaceMap;
