@@ -46,7 +46,7 @@ fn workload(verts: usize, contacts: usize, seed: u64) -> Workload {
     );
     let model = Arc::new(ModalModel::from_base(base).unwrap());
     let mut rng = SplitMix64(seed);
-    let mut point = |rng: &mut SplitMix64| {
+    let point = |rng: &mut SplitMix64| {
         let b = model.base();
         let t = b.surface_triangles[(rng.next_u64() % b.surface_triangles.len() as u64) as usize];
         let (u, v) = (rng.next_f64(), rng.next_f64());
@@ -177,5 +177,100 @@ fn geodesic(c: &mut Criterion) {
     });
 }
 
-criterion_group!(benches, modal, attenuation, geodesic);
+/// The pre-2026-11 peak kernel (8 channels × 4 samples blocking), kept for same-run A/B.
+mod old_kernel {
+    pub fn peak_abs_projection(q: &[f64], m: usize, w: &[f64], peaks: &mut [f64]) {
+        #[cfg(target_arch = "x86_64")]
+        if let Some(simd) = pulp::x86::V3::try_new() {
+            simd.vectorize(
+                #[inline(always)]
+                || kernel::<true>(q, m, w, peaks),
+            );
+            return;
+        }
+        kernel::<false>(q, m, w, peaks);
+    }
+    const BLOCK: usize = 8;
+    #[inline(always)]
+    fn fmadd<const FMA: bool>(a: f64, b: f64, c: f64) -> f64 {
+        if FMA {
+            a.mul_add(b, c)
+        } else {
+            c + a * b
+        }
+    }
+
+    #[inline(always)]
+    fn kernel<const FMA: bool>(q: &[f64], m: usize, w: &[f64], peaks: &mut [f64]) {
+        for (panel, pk_out) in w.chunks_exact(m * BLOCK).zip(peaks.chunks_exact_mut(BLOCK)) {
+            let mut pk = [0.0f64; BLOCK];
+            // Four samples at a time (8 independent 4-wide chains with AVX2).
+            let mut quads = q.chunks_exact(4 * m);
+            for qq in &mut quads {
+                let (r0, rest) = qq.split_at(m);
+                let (r1, rest) = rest.split_at(m);
+                let (r2, r3) = rest.split_at(m);
+                let mut acc = [[0.0f64; BLOCK]; 4];
+                for ((((&a0, &a1), &a2), &a3), wj) in r0
+                    .iter()
+                    .zip(r1)
+                    .zip(r2)
+                    .zip(r3)
+                    .zip(panel.chunks_exact(BLOCK))
+                {
+                    for i in 0..BLOCK {
+                        acc[0][i] = fmadd::<FMA>(a0, wj[i], acc[0][i]);
+                        acc[1][i] = fmadd::<FMA>(a1, wj[i], acc[1][i]);
+                        acc[2][i] = fmadd::<FMA>(a2, wj[i], acc[2][i]);
+                        acc[3][i] = fmadd::<FMA>(a3, wj[i], acc[3][i]);
+                    }
+                }
+                for a in &acc {
+                    for i in 0..BLOCK {
+                        pk[i] = pk[i].max(a[i].abs());
+                    }
+                }
+            }
+            for qk in quads.remainder().chunks_exact(m) {
+                let mut acc = [0.0f64; BLOCK];
+                for (&a, wj) in qk.iter().zip(panel.chunks_exact(BLOCK)) {
+                    for i in 0..BLOCK {
+                        acc[i] = fmadd::<FMA>(a, wj[i], acc[i]);
+                    }
+                }
+                for i in 0..BLOCK {
+                    pk[i] = pk[i].max(acc[i].abs());
+                }
+            }
+            pk_out.copy_from_slice(&pk);
+        }
+    }
+}
+
+/// The Eq. 11 peak kernel alone on the dinner shape (21 samples × 20 modes × 48 channels),
+/// current vs previous blocking, same data.
+fn kernel(c: &mut Criterion) {
+    let (s, m, nch) = (21, 20, 48);
+    let mut rng = SplitMix64(5);
+    let q: Vec<f64> = (0..s * m).map(|_| rng.next_f64() - 0.5).collect();
+    let w: Vec<f64> = (0..m * nch).map(|_| rng.next_f64() - 0.5).collect();
+    let (mut a, mut b) = (vec![0.0; nch], vec![0.0; nch]);
+    dcr_runtime::peak_abs_projection(&q, s, m, &w, nch, &mut a);
+    old_kernel::peak_abs_projection(&q, m, &w, &mut b);
+    assert_eq!(a, b, "new kernel must match the old one bit for bit");
+    c.bench_function("kernel/dinner/new", |bch| {
+        bch.iter(|| {
+            dcr_runtime::peak_abs_projection(black_box(&q), s, m, black_box(&w), nch, &mut a);
+            black_box(a[3])
+        })
+    });
+    c.bench_function("kernel/dinner/old", |bch| {
+        bch.iter(|| {
+            old_kernel::peak_abs_projection(black_box(&q), m, black_box(&w), &mut b);
+            black_box(b[3])
+        })
+    });
+}
+
+criterion_group!(benches, kernel, modal, attenuation, geodesic);
 criterion_main!(benches);

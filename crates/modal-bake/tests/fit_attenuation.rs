@@ -5,18 +5,6 @@
 //!
 //! Run with `cargo test --release -p modal-bake --test fit_attenuation`.
 
-#[path = "../src/cli/fit_attenuation.rs"]
-mod fit_attenuation_cli;
-#[allow(dead_code)]
-#[path = "../src/cli/parse.rs"]
-mod parse;
-
-/// Stand-in for `cli::emit` so the CLI file compiles inside this test crate.
-pub fn emit(s: &str) {
-    print!("{s}");
-}
-
-use clap::Parser;
 use modal_bake::mesh::TetMesh;
 use modal_bake::truth::{
     fit_attenuation_mesh, fit_eq14, fit_eq14_fixed_r0, fit_simplified, run_truth,
@@ -214,40 +202,48 @@ fn sparse_truth_runs_and_decays_with_distance() {
     );
 }
 
-#[derive(Parser)]
-struct Cmd {
-    #[command(flatten)]
-    args: fit_attenuation_cli::FitAttenuationArgs,
-}
-
+/// `modal-bake fit-attenuation` through the binary: text and JSON output, and a clean error.
 #[test]
 fn cli_runs_on_a_small_mesh() {
     let beam = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/meshes/beam.msh");
-    for json in [false, true] {
-        let mut argv = vec![
-            "fit-attenuation".to_string(),
-            beam.display().to_string(),
-            "--fixed".into(),
-            "clamp".into(),
-            "--pairs".into(),
-            "30".into(),
-            "--h".into(),
-            "2e-3".into(),
-            "--seed".into(),
-            "5".into(),
-            "--rayleigh".into(),
-            "10,1e-7".into(),
-        ];
-        if json {
-            argv.push("--json".into());
-        }
-        let cmd = Cmd::try_parse_from(&argv).unwrap();
-        assert_eq!(cmd.args.params().pairs, 30);
-        fit_attenuation_cli::run(&cmd.args).unwrap();
-    }
+    let run = |extra: &[&str]| {
+        let mut argv = vec!["fit-attenuation", beam.to_str().unwrap()];
+        argv.extend_from_slice(extra);
+        std::process::Command::new(env!("CARGO_BIN_EXE_modal-bake"))
+            .args(&argv)
+            .output()
+            .unwrap()
+    };
+    let base = [
+        "--fixed",
+        "clamp",
+        "--pairs",
+        "30",
+        "--h",
+        "2e-3",
+        "--seed",
+        "5",
+        "--rayleigh",
+        "10,1e-7",
+    ];
+    let text = run(&base);
+    assert!(
+        text.status.success(),
+        "{}",
+        String::from_utf8_lossy(&text.stderr)
+    );
+    let mut with_json = base.to_vec();
+    with_json.push("--json");
+    let o = run(&with_json);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("one JSON object");
+    let text = v.to_string();
+    assert!(text.contains("beta"), "{text}");
     // A user error is a clean error, not a panic.
-    let bad = Cmd::try_parse_from(["fit-attenuation", beam.to_str().unwrap(), "--fixed", "nope"])
-        .unwrap();
-    let e = fit_attenuation_cli::run(&bad.args).unwrap_err();
-    assert!(format!("{e:#}").contains("nope"), "{e:#}");
+    let bad = run(&["--fixed", "nope"]);
+    let err = String::from_utf8_lossy(&bad.stderr);
+    assert!(
+        !bad.status.success() && err.contains("nope") && !err.contains("panicked"),
+        "{err}"
+    );
 }

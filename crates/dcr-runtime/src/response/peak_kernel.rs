@@ -1,7 +1,8 @@
 //! The hot loop of Eq. 11: peak |wᵀ q(k)| over the step's samples for every channel.
 //!
-//! A dense multiply-max blocked over 8 channels × several samples held in registers
-//! (independent accumulator chains, so the loop is throughput- rather than latency-bound). The
+//! A dense multiply-max register-blocked over 16 channels × 3 samples (8 channels × 6 samples
+//! for a last odd panel): 12 independent 4-wide accumulator chains per pass over the modes, so
+//! the loop is FMA-throughput- rather than latency- or load-bound. The
 //! channel matrix is stored as panels of 8 channels (`(block·m + j)·8 + i`) so every inner
 //! load is one contiguous 8-wide row. On x86-64 CPUs with AVX2 + FMA the same safe loop is
 //! compiled for those features and picked at run time (`pulp` dispatch); elsewhere the
@@ -61,49 +62,78 @@ fn fmadd<const FMA: bool>(a: f64, b: f64, c: f64) -> f64 {
     }
 }
 
+/// One register block: `NP` panels (8·NP channels) × `NS` samples of accumulators
+/// (NP·NS·2 four-wide chains with AVX2; 2 × 3 → 12 of the 16 ymm registers), folded into
+/// the running channel peaks `pk`. Each accumulator is the same sequential FMA chain over j as
+/// the unblocked loop, so results are bit-identical whatever the blocking.
+#[inline(always)]
+fn block<const FMA: bool, const NP: usize, const NS: usize>(
+    q: &[f64],
+    m: usize,
+    panels: &[f64],
+    pk: &mut [[f64; BLOCK]; NP],
+) {
+    let rows: [&[f64]; NS] = std::array::from_fn(|s| &q[s * m..(s + 1) * m]);
+    let pan: [&[f64]; NP] = std::array::from_fn(|p| &panels[p * m * BLOCK..(p + 1) * m * BLOCK]);
+    let mut acc = [[[0.0f64; BLOCK]; NP]; NS];
+    for j in 0..m {
+        let a: [f64; NS] = std::array::from_fn(|s| rows[s][j]);
+        let w: [&[f64]; NP] = std::array::from_fn(|p| &pan[p][j * BLOCK..(j + 1) * BLOCK]);
+        for p in 0..NP {
+            for i in 0..BLOCK {
+                let wv = w[p][i];
+                for s in 0..NS {
+                    acc[s][p][i] = fmadd::<FMA>(a[s], wv, acc[s][p][i]);
+                }
+            }
+        }
+    }
+    for acc_s in &acc {
+        for p in 0..NP {
+            for i in 0..BLOCK {
+                pk[p][i] = pk[p][i].max(acc_s[p][i].abs());
+            }
+        }
+    }
+}
+
+/// All samples for `NP` panels: blocks of `NS` samples, then single samples.
+#[inline(always)]
+fn panels_pass<const FMA: bool, const NP: usize, const NS: usize>(
+    q: &[f64],
+    m: usize,
+    panels: &[f64],
+    out: &mut [f64],
+) {
+    let mut pk = [[0.0f64; BLOCK]; NP];
+    let mut groups = q.chunks_exact(NS * m);
+    for qq in &mut groups {
+        block::<FMA, NP, NS>(qq, m, panels, &mut pk);
+    }
+    let mut rest = groups.remainder();
+    if NS == 6 && rest.len() >= 3 * m {
+        block::<FMA, NP, 3>(&rest[..3 * m], m, panels, &mut pk);
+        rest = &rest[3 * m..];
+    }
+    for qk in rest.chunks_exact(m) {
+        block::<FMA, NP, 1>(qk, m, panels, &mut pk);
+    }
+    for (o, p) in out.chunks_exact_mut(BLOCK).zip(&pk) {
+        o.copy_from_slice(p);
+    }
+}
+
 #[inline(always)]
 fn kernel<const FMA: bool>(q: &[f64], m: usize, w: &[f64], peaks: &mut [f64]) {
-    for (panel, pk_out) in w.chunks_exact(m * BLOCK).zip(peaks.chunks_exact_mut(BLOCK)) {
-        let mut pk = [0.0f64; BLOCK];
-        // Four samples at a time (8 independent 4-wide chains with AVX2).
-        let mut quads = q.chunks_exact(4 * m);
-        for qq in &mut quads {
-            let (r0, rest) = qq.split_at(m);
-            let (r1, rest) = rest.split_at(m);
-            let (r2, r3) = rest.split_at(m);
-            let mut acc = [[0.0f64; BLOCK]; 4];
-            for ((((&a0, &a1), &a2), &a3), wj) in r0
-                .iter()
-                .zip(r1)
-                .zip(r2)
-                .zip(r3)
-                .zip(panel.chunks_exact(BLOCK))
-            {
-                for i in 0..BLOCK {
-                    acc[0][i] = fmadd::<FMA>(a0, wj[i], acc[0][i]);
-                    acc[1][i] = fmadd::<FMA>(a1, wj[i], acc[1][i]);
-                    acc[2][i] = fmadd::<FMA>(a2, wj[i], acc[2][i]);
-                    acc[3][i] = fmadd::<FMA>(a3, wj[i], acc[3][i]);
-                }
-            }
-            for a in &acc {
-                for i in 0..BLOCK {
-                    pk[i] = pk[i].max(a[i].abs());
-                }
-            }
-        }
-        for qk in quads.remainder().chunks_exact(m) {
-            let mut acc = [0.0f64; BLOCK];
-            for (&a, wj) in qk.iter().zip(panel.chunks_exact(BLOCK)) {
-                for i in 0..BLOCK {
-                    acc[i] = fmadd::<FMA>(a, wj[i], acc[i]);
-                }
-            }
-            for i in 0..BLOCK {
-                pk[i] = pk[i].max(acc[i].abs());
-            }
-        }
-        pk_out.copy_from_slice(&pk);
+    // Pairs of panels (16 channels) × 3 samples, then a last single panel × 6 samples.
+    let mut pairs = w.chunks_exact(2 * m * BLOCK);
+    let mut outs = peaks.chunks_exact_mut(2 * BLOCK);
+    for (panels, out) in (&mut pairs).zip(&mut outs) {
+        panels_pass::<FMA, 2, 3>(q, m, panels, out);
+    }
+    let rest = pairs.remainder();
+    if !rest.is_empty() {
+        panels_pass::<FMA, 1, 6>(q, m, rest, outs.into_remainder());
     }
 }
 

@@ -142,6 +142,14 @@ pub fn run(args: &FitAttenuationArgs) -> anyhow::Result<()> {
         f.rms_log,
         f.rms_log.exp()
     );
+    if args.r0.is_none() && !(f.r0 >= 0.01 * rmin && f.r0 <= rmax) {
+        out += &format!(
+            "  note: r0 is outside [{:.2e}, {:.4}] m (β ≈ 0 makes r0 ill-conditioned); \
+             the law is still the least-squares optimum; consider --r0 or the §4.5 fit\n",
+            0.01 * rmin,
+            rmax
+        );
+    }
     out += &format!(
         "  §4.5 s = C r^-beta: C = {:.6}, beta = {:.6}; R² (ln s) = {:.4}, RMS ln error = {:.4}\n",
         s.c, s.beta, s.r2_log, s.rms_log

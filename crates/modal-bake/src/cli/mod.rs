@@ -10,6 +10,7 @@ macro_rules! outln {
 
 mod bake;
 mod check;
+mod fit_attenuation;
 mod geodesic;
 mod info;
 mod parse;
@@ -49,6 +50,9 @@ enum Command {
     /// Full-order reference response of a mesh to an impulse (Newmark or all modes).
     #[command(allow_negative_numbers = true)]
     Truth(truth::TruthArgs),
+    /// Fit the spatial attenuation law (Eq. 14) to the full-order response at random surface pairs.
+    #[command(allow_negative_numbers = true)]
+    FitAttenuation(fit_attenuation::FitAttenuationArgs),
 }
 
 /// Writes `s` to stdout; a closed pipe (`modal-bake info x | head`) is not an error.
@@ -65,6 +69,7 @@ pub fn main() -> ExitCode {
         Command::Probe(a) => probe::run(&a).map(|()| ExitCode::SUCCESS),
         Command::Geodesic(a) => geodesic::run(&a).map(|()| ExitCode::SUCCESS),
         Command::Truth(a) => truth::run(&a).map(|()| ExitCode::SUCCESS),
+        Command::FitAttenuation(a) => fit_attenuation::run(&a).map(|()| ExitCode::SUCCESS),
         Command::Check(a) => return check::run(&a),
     };
     match result {

@@ -81,6 +81,9 @@ pub(crate) fn solve(
     let mut v = Mat::<f64>::zeros(n, cap);
     let mut mv = Mat::<f64>::zeros(n, cap);
     let mut h = Mat::<f64>::zeros(cap, cap);
+    // Spare basis workspaces for the thick restart (allocated at the first restart).
+    let mut v2 = Mat::<f64>::zeros(0, 0);
+    let mut mv2 = Mat::<f64>::zeros(0, 0);
     let mut rng = SplitMix64(params.seed);
     let mut solve_buf = fac.solve_buffer(b);
 
@@ -120,12 +123,9 @@ pub(crate) fn solve(
     loop {
         // --- expand: Z = T W = A⁻¹ M W, M-orthogonalise against the basis ------------------
         let nb = kk + b;
-        let tp = Instant::now();
         z.copy_from(mv.as_ref().subcols(kk, b));
         fac.solve_in_place(z.as_mut(), &mut solve_buf);
         info.block_solves += 1;
-        prof(0, tp);
-        let tp = Instant::now();
         let mut c = Mat::<f64>::zeros(nb, b);
         for _pass in 0..2 {
             let mut cp = Mat::<f64>::zeros(nb, b);
@@ -148,11 +148,7 @@ pub(crate) fn solve(
             c += &cp;
         }
         h.as_mut().submatrix_mut(0, kk, nb, b).copy_from(&c);
-        prof(1, tp);
-        let tp = Instant::now();
         sym_spmm(m, z.as_ref(), mz.as_mut());
-        prof(2, tp);
-        let tp = Instant::now();
         let pre: Vec<f64> = (0..b)
             .map(|j| {
                 let cn: f64 = (0..nb).map(|i| c[(i, j)] * c[(i, j)]).sum();
@@ -172,8 +168,6 @@ pub(crate) fn solve(
         v.as_mut().subcols_mut(nb, b).copy_from(&z);
         mv.as_mut().subcols_mut(nb, b).copy_from(&mz);
         h.as_mut().submatrix_mut(nb, kk, b, b).copy_from(&r);
-        prof(3, tp);
-        let tp = Instant::now();
         kk = nb;
         info.iterations += 1;
         info.krylov_dim = info.krylov_dim.max(kk);
@@ -236,25 +230,11 @@ pub(crate) fn solve(
             iteration: info.iterations,
         });
 
-        if std::env::var_os("EIG_EST").is_some() {
-            let w = wanted.min(kk);
-            eprintln!(
-                "it {} kk {} est max {:.2e} est[0] {:.2e} est[w-1] {:.2e} est[w] {:.2e}",
-                info.iterations,
-                kk,
-                est[..w].iter().cloned().fold(0.0, f64::max),
-                est[0],
-                est[w - 1],
-                est.get(w).cloned().unwrap_or(0.0)
-            );
-        }
         let ready = wanted <= kk
             && est.iter().take(wanted).all(|&e| e <= trigger)
             && (lam_lim.is_none() || capped || below < kk);
         let out_of_steps = info.block_solves >= params.max_iters;
-        prof(4, tp);
         if ready || out_of_steps {
-            let tp = Instant::now();
             info.residual_checks += 1;
             let sel = select_cols(s_asc.as_ref(), &order[..wanted.min(kk)]);
             let (vals, u, res) = finalize(
@@ -267,21 +247,10 @@ pub(crate) fn solve(
                 sigma,
                 par,
             )?;
-            prof(5, tp);
             let worst = res.iter().map(|r| r.rel).fold(0.0, f64::max);
-            if std::env::var_os("EIG_EST").is_some() {
-                eprintln!(
-                    "check: worst {:.2e} rel {:?}",
-                    worst,
-                    res.iter()
-                        .map(|r| format!("{:.1e}/{:.1e}", r.rel, r.floor))
-                        .collect::<Vec<_>>()
-                );
-            }
             let good = res.iter().filter(|r| r.converged(params.tol)).count();
             if good == res.len() && wanted <= kk {
                 info.solve_seconds = t1.elapsed().as_secs_f64();
-                prof_dump(&info);
                 info.capped = capped;
                 return Ok(trim_and_sign(vals, u, res, lam_lim, params, info));
             }
@@ -309,16 +278,19 @@ pub(crate) fn solve(
             cap = new_cap;
         }
         if kk + 2 * b > cap {
-            let tp = Instant::now();
             // Keep the best p Ritz vectors plus the newest block.
             let p = (wanted + (kk - wanted) / 2)
                 .min(ncv - b)
                 .max(wanted.min(ncv - b));
             let sp = select_cols(s_asc.as_ref(), &order[..p]);
-            let mut nv = Mat::<f64>::zeros(n, p);
-            let mut nmv = Mat::<f64>::zeros(n, p);
+            // New basis [V S, W] built in the spare workspaces, then swapped in (no
+            // allocation, no copies of the n × p products).
+            if v2.ncols() != cap {
+                v2 = Mat::<f64>::zeros(n, cap);
+                mv2 = Mat::<f64>::zeros(n, cap);
+            }
             gemm(
-                nv.as_mut(),
+                v2.as_mut().subcols_mut(0, p),
                 Accum::Replace,
                 v.as_ref().subcols(0, kk),
                 sp.as_ref(),
@@ -326,19 +298,21 @@ pub(crate) fn solve(
                 par,
             );
             gemm(
-                nmv.as_mut(),
+                mv2.as_mut().subcols_mut(0, p),
                 Accum::Replace,
                 mv.as_ref().subcols(0, kk),
                 sp.as_ref(),
                 1.0,
                 par,
             );
-            let w = v.as_ref().subcols(kk, b).to_owned();
-            let mw = mv.as_ref().subcols(kk, b).to_owned();
-            v.as_mut().subcols_mut(0, p).copy_from(&nv);
-            mv.as_mut().subcols_mut(0, p).copy_from(&nmv);
-            v.as_mut().subcols_mut(p, b).copy_from(&w);
-            mv.as_mut().subcols_mut(p, b).copy_from(&mw);
+            v2.as_mut()
+                .subcols_mut(p, b)
+                .copy_from(v.as_ref().subcols(kk, b));
+            mv2.as_mut()
+                .subcols_mut(p, b)
+                .copy_from(mv.as_ref().subcols(kk, b));
+            std::mem::swap(&mut v, &mut v2);
+            std::mem::swap(&mut mv, &mut mv2);
             let mut coupling = Mat::<f64>::zeros(b, p);
             gemm(
                 coupling.as_mut(),
@@ -355,7 +329,6 @@ pub(crate) fn solve(
             h.as_mut().submatrix_mut(p, 0, b, p).copy_from(&coupling);
             kk = p;
             info.restarts += 1;
-            prof(6, tp);
         }
     }
 }
@@ -816,15 +789,4 @@ fn solve_dense(
         residual_floors: res.iter().map(|r| r.floor).collect(),
         info,
     })
-}
-
-thread_local! { static PROF: std::cell::RefCell<[f64; 8]> = const { std::cell::RefCell::new([0.0; 8]) }; }
-fn prof(i: usize, t: Instant) {
-    PROF.with(|p| p.borrow_mut()[i] += t.elapsed().as_secs_f64());
-}
-fn prof_dump(info: &EigenInfo) {
-    if std::env::var_os("EIG_PROF").is_some() {
-        PROF.with(|p| { let p = p.borrow(); eprintln!("PROF solve {:.4} gs {:.4} mprod {:.4} orth {:.4} rr {:.4} fin {:.4} restart {:.4} | it {} bs {} rs {} chk {}", p[0],p[1],p[2],p[3],p[4],p[5],p[6], info.iterations, info.block_solves, info.restarts, info.residual_checks); });
-    }
-    PROF.with(|p| *p.borrow_mut() = [0.0; 8]);
 }
