@@ -258,6 +258,26 @@ fn kernel(c: &mut Criterion) {
     dcr_runtime::peak_abs_projection(&q, s, m, &w, nch, &mut a);
     old_kernel::peak_abs_projection(&q, m, &w, &mut b);
     assert_eq!(a, b, "new kernel must match the old one bit for bit");
+    // Interleaved A/B robust to a noisy, shared machine: the best (minimum) per-call time of
+    // many alternating batches, so preemption by other jobs hits neither side systematically.
+    let (mut best_new, mut best_old) = (f64::INFINITY, f64::INFINITY);
+    for _ in 0..300 {
+        let t0 = std::time::Instant::now();
+        for _ in 0..200 {
+            dcr_runtime::peak_abs_projection(black_box(&q), s, m, black_box(&w), nch, &mut a);
+        }
+        best_new = best_new.min(t0.elapsed().as_secs_f64() / 200.0);
+        let t0 = std::time::Instant::now();
+        for _ in 0..200 {
+            old_kernel::peak_abs_projection(black_box(&q), m, black_box(&w), &mut b);
+        }
+        best_old = best_old.min(t0.elapsed().as_secs_f64() / 200.0);
+    }
+    println!(
+        "kernel/dinner interleaved best-of-300: new {:.3} µs, old {:.3} µs",
+        best_new * 1e6,
+        best_old * 1e6
+    );
     c.bench_function("kernel/dinner/new", |bch| {
         bch.iter(|| {
             dcr_runtime::peak_abs_projection(black_box(&q), s, m, black_box(&w), nch, &mut a);

@@ -3,8 +3,8 @@
 //!
 //! `cargo run --release -p modal-bake --example eigen_timing -- [sizes...] [--nev N] [--reps R]`
 //! with sizes among `3k 15k 100k beam100k` (default: the first three), optional `--block B`,
-//! `--ncv D` (Krylov dimension) and `--threads T` (`EigenParams::threads`). Prints one CSV row per run and a
-//! median summary per size. Speed is measured here, never asserted in tests.
+//! `--ncv D` (Krylov dimension) and `--threads T` (`EigenParams::threads`). Prints one CSV row
+//! per run and a median summary per size. Speed is measured here, never asserted in tests.
 
 use std::time::Instant;
 

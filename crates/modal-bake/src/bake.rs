@@ -103,12 +103,12 @@ pub enum BakeError {
         tol: f64,
     },
     /// The eigensolver failed or did not converge; nothing is written.
-    #[error("{file}: {source}")]
+    #[error("{file}: {error}")]
     Eigen {
         /// Mesh file.
         file: String,
         /// What the solver reported.
-        source: EigenError,
+        error: EigenError,
     },
     /// Modes whose residual exceeds [`MAX_RESIDUAL`]; nothing is written.
     #[error("{file}: mode {mode} did not converge (relative residual {residual:.3e} > {MAX_RESIDUAL:.0e}); refusing to write the base")]
@@ -440,15 +440,18 @@ pub fn bake_mesh(
         } else {
             0.0
         },
-        tol: 1e-10,
+        // Ten times stricter than the MAX_RESIDUAL a written mode must meet; 1e-10 is below
+        // the rounding floor of the higher modes of fine meshes (measured: table, 80 modes,
+        // worst 7.4e-10).
+        tol: 1e-9,
         ..Default::default()
     };
     let res = eigen::solve_lowest(&kf, &mf, &eparams, &mut |p| {
         progress(BakeStage::Eigensolve(p))
     })
-    .map_err(|source| BakeError::Eigen {
+    .map_err(|error| BakeError::Eigen {
         file: file.to_string(),
-        source,
+        error,
     })?;
     report.factor_s = res.info.factor_seconds;
     report.eigensolve_s = res.info.solve_seconds;

@@ -149,31 +149,38 @@ fn distance_cache_is_bounded_lru() {
 #[test]
 #[ignore]
 fn heat_timing() {
+    use faer::sparse::linalg::SupernodalThreshold;
     let (v, t) = crate::testing::box_surface(29, [1.2, 0.8, 0.6]);
-    let t0 = std::time::Instant::now();
-    let mut heat = HeatGeodesic::new(&v, &t).unwrap();
-    for _ in 0..9 {
-        heat = HeatGeodesic::new(&v, &t).unwrap();
+    for (name, th) in [
+        ("auto", SupernodalThreshold::AUTO),
+        ("simplicial", SupernodalThreshold::FORCE_SIMPLICIAL),
+        ("supernodal", SupernodalThreshold::FORCE_SUPERNODAL),
+    ] {
+        let t0 = std::time::Instant::now();
+        let mut heat = HeatGeodesic::with_threshold(&v, &t, th).unwrap();
+        for _ in 0..4 {
+            heat = HeatGeodesic::with_threshold(&v, &t, th).unwrap();
+        }
+        let setup = t0.elapsed().as_secs_f64() / 5.0;
+        let mut out = vec![0.0; v.len()];
+        let mut ws = heat.workspace();
+        let sp = crate::SurfacePoint {
+            triangle: 7,
+            bary: [0.2, 0.3, 0.5],
+            point: [0.0; 3],
+            normal: [0.0; 3],
+            distance: 0.0,
+        };
+        let t0 = std::time::Instant::now();
+        for _ in 0..50 {
+            heat.distances_from_point_with(&sp, &mut out, &mut ws);
+        }
+        let q = t0.elapsed().as_secs_f64() / 50.0;
+        println!(
+            "{name}: nnz(L) {} setup {:.2} ms, source {:.3} ms",
+            heat.factor_len(),
+            setup * 1e3,
+            q * 1e3
+        );
     }
-    let setup = t0.elapsed().as_secs_f64() / 10.0;
-    let mut out = vec![0.0; v.len()];
-    let mut ws = heat.workspace();
-    let sp = crate::SurfacePoint {
-        triangle: 7,
-        bary: [0.2, 0.3, 0.5],
-        point: [0.0; 3],
-        normal: [0.0; 3],
-        distance: 0.0,
-    };
-    let t0 = std::time::Instant::now();
-    for _ in 0..50 {
-        heat.distances_from_point_with(&sp, &mut out, &mut ws);
-    }
-    let q = t0.elapsed().as_secs_f64() / 50.0;
-    println!(
-        "nnz(L) {} setup {:.2} ms, source {:.3} ms",
-        heat.factor_len(),
-        setup * 1e3,
-        q * 1e3
-    );
 }
