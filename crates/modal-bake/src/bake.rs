@@ -66,7 +66,8 @@ pub const TOOL_VERSION: &str = concat!("modal-bake ", env!("CARGO_PKG_VERSION"))
 /// A near-zero eigenvalue is a rigid-body mode when |λ| ≤ this × the first elastic λ.
 pub const RIGID_REL_TOL: f64 = 1e-6;
 
-/// Largest relative residual ‖Ku − λMu‖/‖Ku‖ accepted for a mode that is written.
+/// Largest relative residual ‖Ku − λMu‖/‖Ku‖ accepted for a mode that is written, unless the
+/// residual is at its double-precision floor (see `bake_mesh`).
 pub const MAX_RESIDUAL: f64 = 1e-8;
 
 /// Why a bake failed. Every variant names what and where.
@@ -158,6 +159,8 @@ pub struct BakeReport {
     pub frequencies_hz: Vec<f64>,
     /// Their relative residuals.
     pub residuals: Vec<f64>,
+    /// Their double-precision residual floors (see [`MAX_RESIDUAL`]).
+    pub residual_floors: Vec<f64>,
     /// Surface vertices and triangles.
     pub surface_vertices: usize,
     /// Surface triangles.
@@ -495,7 +498,12 @@ pub fn bake_mesh(
         )));
     }
     for (i, &j) in elastic.iter().enumerate() {
-        if !(res.residuals[j] <= MAX_RESIDUAL) || !(res.eigenvalues[j] > 0.0) {
+        // A mode passes at MAX_RESIDUAL, or within the eigensolver's factor of its double-
+        // precision floor ε(‖|K||u|‖ + λ‖|M||u|‖)/‖Ku‖ ≈ ε·λ_max/λ, which exceeds 1e-8 for the
+        // low modes of slender, finely meshed objects (measured: 1.5e-7 on a 300×10×10 beam):
+        // no double-precision vector can do better there.
+        let floor_ok = res.residuals[j] <= eigen::FLOOR_FACTOR * res.residual_floors[j];
+        if !(res.residuals[j] <= MAX_RESIDUAL || floor_ok) || !(res.eigenvalues[j] > 0.0) {
             return Err(BakeError::NotConverged {
                 file: file.to_string(),
                 mode: i,
@@ -549,6 +557,7 @@ pub fn bake_mesh(
     report.modes = nm;
     report.frequencies_hz = base.frequencies_hz();
     report.residuals = base.residuals.clone();
+    report.residual_floors = elastic.iter().map(|&j| res.residual_floors[j]).collect();
     report.surface_vertices = base.surface_vertices.len();
     report.surface_triangles = base.surface_triangles.len();
     Ok((base, report))

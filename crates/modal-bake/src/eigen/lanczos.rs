@@ -30,7 +30,7 @@ const BREAKDOWN: f64 = 1e-12;
 
 /// A pair whose relative residual is within this factor of its rounding floor counts as
 /// converged even above `tol` (see [`Residual`]).
-pub(crate) const FLOOR_FACTOR: f64 = 8.0;
+pub const FLOOR_FACTOR: f64 = 8.0;
 
 pub(crate) fn solve(
     k: &SparseColMat<usize, f64>,

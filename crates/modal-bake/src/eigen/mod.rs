@@ -50,6 +50,9 @@ use faer::Mat;
 use crate::fem::Material;
 use crate::mesh::TetMesh;
 
+/// A pair counts as converged within this factor of its double-precision residual floor.
+pub use lanczos::FLOOR_FACTOR;
+
 /// Parameters of [`solve_lowest`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct EigenParams {
