@@ -12,9 +12,10 @@ use modal_bake::bake::{
 
 use super::parse;
 
-/// Options that determine a base (shared by `bake` and `check`).
+/// The object's material, boundary conditions and damping (shared by `bake`, `check`,
+/// `truth` and `fit-attenuation`).
 #[derive(Args, Clone, Debug)]
-pub struct BakeOptions {
+pub struct ModelOptions {
     /// Young's modulus E (Pa).
     #[arg(long, value_name = "PA", default_value_t = 1.1e9)]
     pub youngs: f64,
@@ -24,22 +25,40 @@ pub struct BakeOptions {
     /// Density ρ (kg/m³).
     #[arg(long, value_name = "KG_M3", default_value_t = 770.0)]
     pub density: f64,
+    /// Fix every node of this named physical group (repeatable). Nothing fixed: free-free (the
+    /// six rigid-body modes, or the rigid-body part of a response, are excluded).
+    #[arg(long, value_name = "NAME")]
+    pub fixed: Vec<String>,
+    /// Rayleigh damping: α0 (1/s), α1 (s); `bake` stores it as the base's default.
+    #[arg(long, value_name = "A0,A1", value_parser = parse::pair, default_value = "10,1e-7")]
+    pub rayleigh: [f64; 2],
+    /// Lumped (diagonal) mass instead of the consistent mass.
+    #[arg(long)]
+    pub lumped: bool,
+}
+
+impl ModelOptions {
+    /// The material in SI units.
+    pub fn material(&self) -> MaterialSi {
+        MaterialSi {
+            youngs: self.youngs,
+            poisson: self.poisson,
+            density: self.density,
+        }
+    }
+}
+
+/// Options that determine a base (shared by `bake` and `check`).
+#[derive(Args, Clone, Debug)]
+pub struct BakeOptions {
+    #[command(flatten)]
+    pub model: ModelOptions,
     /// Number of lowest elastic modes to keep [default: 20].
     #[arg(long, value_name = "N", conflicts_with = "max_freq")]
     pub modes: Option<usize>,
     /// Keep every elastic mode below this frequency (Hz) instead of a count.
     #[arg(long, value_name = "HZ")]
     pub max_freq: Option<f64>,
-    /// Fix every node of this named physical group (repeatable). Nothing fixed: free-free,
-    /// the six rigid-body modes are detected and excluded.
-    #[arg(long, value_name = "NAME")]
-    pub fixed: Vec<String>,
-    /// Default Rayleigh damping stored in the base: α0 (1/s), α1 (s).
-    #[arg(long, value_name = "A0,A1", value_parser = parse::pair, default_value = "10,1e-7")]
-    pub rayleigh: [f64; 2],
-    /// Lumped (diagonal) mass instead of the consistent mass.
-    #[arg(long)]
-    pub lumped: bool,
     /// Store the surface mode shapes as 32-bit floats (half the file size).
     #[arg(long)]
     pub f32: bool,
@@ -48,18 +67,14 @@ pub struct BakeOptions {
 impl BakeOptions {
     pub fn params(&self) -> BakeParams {
         BakeParams {
-            material: MaterialSi {
-                youngs: self.youngs,
-                poisson: self.poisson,
-                density: self.density,
-            },
+            material: self.model.material(),
             modes: match self.max_freq {
                 Some(f) => ModeRequest::MaxFreqHz(f),
                 None => ModeRequest::Count(self.modes.unwrap_or(20)),
             },
-            fixed: self.fixed.clone(),
-            rayleigh: self.rayleigh,
-            lumped: self.lumped,
+            fixed: self.model.fixed.clone(),
+            rayleigh: self.model.rayleigh,
+            lumped: self.model.lumped,
             precision: if self.f32 {
                 ModesPrecision::F32
             } else {

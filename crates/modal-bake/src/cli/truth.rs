@@ -5,8 +5,9 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::{Args, ValueEnum};
-use modal_bake::truth::{self, MaterialSi, TruthImpact, TruthMethod, TruthParams};
+use modal_bake::truth::{self, TruthImpact, TruthMethod, TruthParams};
 
+use super::bake::ModelOptions;
 use super::parse;
 
 /// Truth method.
@@ -22,25 +23,8 @@ pub enum MethodArg {
 pub struct TruthArgs {
     /// Tetrahedral mesh: gmsh .msh (2.2 or 4.1, ASCII or binary) or meshio-style .json.
     pub mesh: PathBuf,
-    /// Young's modulus E (Pa).
-    #[arg(long, value_name = "PA", default_value_t = 1.1e9)]
-    pub youngs: f64,
-    /// Poisson ratio ν (−1 < ν < 0.5).
-    #[arg(long, value_name = "NU", default_value_t = 0.3)]
-    pub poisson: f64,
-    /// Density ρ (kg/m³).
-    #[arg(long, value_name = "KG_M3", default_value_t = 770.0)]
-    pub density: f64,
-    /// Fix every node of this named physical group (repeatable). Nothing fixed: free-free, the
-    /// rigid-body part of the motion is projected out and the elastic displacement reported.
-    #[arg(long, value_name = "NAME")]
-    pub fixed: Vec<String>,
-    /// Rayleigh damping: α0 (1/s), α1 (s).
-    #[arg(long, value_name = "A0,A1", value_parser = parse::pair, default_value = "10,1e-7")]
-    pub rayleigh: [f64; 2],
-    /// Lumped (diagonal) mass instead of the consistent mass.
-    #[arg(long)]
-    pub lumped: bool,
+    #[command(flatten)]
+    pub model: ModelOptions,
     /// Impact point (m, object frame), mapped to the closest surface point (refused farther than
     /// 5% of the surface's bounding-box diagonal, as `probe`).
     #[arg(long, value_name = "X,Y,Z", value_parser = parse::vec3, allow_hyphen_values = true)]
@@ -84,14 +68,10 @@ impl TruthArgs {
     /// The library parameters these options describe.
     pub fn params(&self) -> TruthParams {
         TruthParams {
-            material: MaterialSi {
-                youngs: self.youngs,
-                poisson: self.poisson,
-                density: self.density,
-            },
-            fixed: self.fixed.clone(),
-            rayleigh: self.rayleigh,
-            lumped: self.lumped,
+            material: self.model.material(),
+            fixed: self.model.fixed.clone(),
+            rayleigh: self.model.rayleigh,
+            lumped: self.model.lumped,
             h: self.h,
             dt: self.dt,
             method: match self.method {
