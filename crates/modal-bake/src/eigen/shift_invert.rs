@@ -13,38 +13,48 @@ use faer::{Conj, MatMut, Par, Side, Spec};
 
 use super::EigenError;
 
-/// A − σB on the union of the two patterns (both full symmetric storage, rows sorted).
+/// K − σM on the union of the two patterns (both full symmetric storage, rows sorted).
 pub(crate) fn shifted(
     k: &SparseColMat<usize, f64>,
     m: &SparseColMat<usize, f64>,
     sigma: f64,
 ) -> SparseColMat<usize, f64> {
-    let n = k.ncols();
-    let (kp, kr, kv) = (k.symbolic().col_ptr(), k.symbolic().row_idx(), k.val());
-    let (mp, mr, mv) = (m.symbolic().col_ptr(), m.symbolic().row_idx(), m.val());
+    lin_comb(k, 1.0, m, -sigma)
+}
+
+/// α A + β B on the union of both patterns (full symmetric storage, rows sorted).
+pub(crate) fn lin_comb(
+    a: &SparseColMat<usize, f64>,
+    alpha: f64,
+    b: &SparseColMat<usize, f64>,
+    beta: f64,
+) -> SparseColMat<usize, f64> {
+    let n = a.ncols();
+    let (ap, ar, av) = (a.symbolic().col_ptr(), a.symbolic().row_idx(), a.val());
+    let (bp, br, bv) = (b.symbolic().col_ptr(), b.symbolic().row_idx(), b.val());
     let mut col_ptr = Vec::with_capacity(n + 1);
-    let mut rows = Vec::with_capacity(kr.len());
-    let mut vals = Vec::with_capacity(kr.len());
+    let mut rows = Vec::with_capacity(ar.len());
+    let mut vals = Vec::with_capacity(ar.len());
     col_ptr.push(0);
     for j in 0..n {
-        let (mut a, ae) = (kp[j], kp[j + 1]);
-        let (mut b, be) = (mp[j], mp[j + 1]);
-        while a < ae || b < be {
-            let ra = if a < ae { kr[a] } else { usize::MAX };
-            let rb = if b < be { mr[b] } else { usize::MAX };
+        let (mut p, pe) = (ap[j], ap[j + 1]);
+        let (mut q, qe) = (bp[j], bp[j + 1]);
+        while p < pe || q < qe {
+            let ra = if p < pe { ar[p] } else { usize::MAX };
+            let rb = if q < qe { br[q] } else { usize::MAX };
             if ra == rb {
                 rows.push(ra);
-                vals.push(kv[a] - sigma * mv[b]);
-                a += 1;
-                b += 1;
+                vals.push(alpha * av[p] + beta * bv[q]);
+                p += 1;
+                q += 1;
             } else if ra < rb {
                 rows.push(ra);
-                vals.push(kv[a]);
-                a += 1;
+                vals.push(alpha * av[p]);
+                p += 1;
             } else {
                 rows.push(rb);
-                vals.push(-sigma * mv[b]);
-                b += 1;
+                vals.push(beta * bv[q]);
+                q += 1;
             }
         }
         col_ptr.push(rows.len());

@@ -11,6 +11,7 @@
 //! Each step solves K_eff u⁺ = M x + K y with K_eff = K + (γ/(βΔt)) D + (1/(βΔt²)) M,
 //! factored once (faer sparse supernodal LLᵀ, AMD ordering) and back-solved per step.
 
+use crate::eigen::lin_comb;
 use std::time::Instant;
 
 use faer::dyn_stack::{MemBuffer, MemStack};
@@ -19,7 +20,7 @@ use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky, CholeskySymbolicParams, LltRef, SymbolicCholesky,
     SymmetricOrdering,
 };
-use faer::sparse::{SparseColMat, SymbolicSparseColMat};
+use faer::sparse::SparseColMat;
 use faer::{Conj, MatMut, Par, Side, Spec};
 
 use super::truth_system::{spmv, TruthSystem};
@@ -125,49 +126,6 @@ pub fn newmark_run(
         factor_s,
         step_s: t.elapsed().as_secs_f64(),
     })
-}
-
-/// `α A + β B` on the union of both patterns (full symmetric storage, rows sorted).
-fn lin_comb(
-    a: &SparseColMat<usize, f64>,
-    alpha: f64,
-    b: &SparseColMat<usize, f64>,
-    beta: f64,
-) -> SparseColMat<usize, f64> {
-    let n = a.ncols();
-    let (ap, ar, av) = (a.symbolic().col_ptr(), a.symbolic().row_idx(), a.val());
-    let (bp, br, bv) = (b.symbolic().col_ptr(), b.symbolic().row_idx(), b.val());
-    let mut col_ptr = Vec::with_capacity(n + 1);
-    let mut rows = Vec::with_capacity(ar.len());
-    let mut vals = Vec::with_capacity(ar.len());
-    col_ptr.push(0);
-    for j in 0..n {
-        let (mut p, pe) = (ap[j], ap[j + 1]);
-        let (mut q, qe) = (bp[j], bp[j + 1]);
-        while p < pe || q < qe {
-            let ra = if p < pe { ar[p] } else { usize::MAX };
-            let rb = if q < qe { br[q] } else { usize::MAX };
-            if ra == rb {
-                rows.push(ra);
-                vals.push(alpha * av[p] + beta * bv[q]);
-                p += 1;
-                q += 1;
-            } else if ra < rb {
-                rows.push(ra);
-                vals.push(alpha * av[p]);
-                p += 1;
-            } else {
-                rows.push(rb);
-                vals.push(beta * bv[q]);
-                q += 1;
-            }
-        }
-        col_ptr.push(rows.len());
-    }
-    SparseColMat::new(
-        SymbolicSparseColMat::new_checked(n, n, col_ptr, None, rows),
-        vals,
-    )
 }
 
 /// Sparse LLᵀ factor (AMD ordering) with single-vector solves.
