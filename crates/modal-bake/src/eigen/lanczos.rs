@@ -69,7 +69,11 @@ pub(crate) fn solve(
     let t0 = Instant::now();
     let fac = {
         let a = shifted(k, m, sigma);
-        ShiftInvert::new(&a, par)?
+        ShiftInvert::new(&a, par).map_err(|e| {
+            EigenError::Factorization(format!(
+                "K − σM with σ = {sigma:e}: {e}; the shift must lie below the lowest eigenvalue"
+            ))
+        })?
     };
     info.factor_seconds = t0.elapsed().as_secs_f64();
     info.factor_nnz = fac.factor_nnz();

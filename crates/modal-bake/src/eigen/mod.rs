@@ -52,7 +52,7 @@ use crate::mesh::TetMesh;
 
 /// A pair counts as converged within this factor of its double-precision residual floor.
 pub use lanczos::FLOOR_FACTOR;
-pub(crate) use shift_invert::lin_comb;
+pub(crate) use shift_invert::{lin_comb, ShiftInvert};
 
 /// Parameters of [`solve_lowest`].
 #[derive(Clone, Debug, PartialEq)]

@@ -121,7 +121,8 @@ fn node_amd(a: &SparseColMat<usize, f64>) -> Option<(Vec<usize>, Vec<usize>)> {
     Some((fwd3, inv3))
 }
 
-/// Sparse LLᵀ factor of A = K − σM (AMD ordering on nodes, faer's supernodal/simplicial choice).
+/// Sparse LLᵀ factor of an SPD matrix (here A = K − σM, Newmark's K_eff and M), AMD ordering on
+/// nodes, faer's supernodal/simplicial choice.
 pub(crate) struct ShiftInvert {
     symbolic: SymbolicCholesky<usize>,
     values: Vec<f64>,
@@ -160,10 +161,7 @@ impl ShiftInvert {
                 Spec::default(),
             )
             .map_err(|e| {
-                EigenError::Factorization(format!(
-                    "K - sigma*M is not positive definite ({e:?}); the shift must lie below the \
-                     lowest eigenvalue"
-                ))
+                EigenError::Factorization(format!("matrix is not positive definite ({e:?})"))
             })?;
         Ok(ShiftInvert {
             symbolic,

@@ -11,17 +11,11 @@
 //! Each step solves K_eff u⁺ = M x + K y with K_eff = K + (γ/(βΔt)) D + (1/(βΔt²)) M,
 //! factored once (faer sparse supernodal LLᵀ, AMD ordering) and back-solved per step.
 
-use crate::eigen::lin_comb;
+use crate::eigen::{lin_comb, ShiftInvert};
 use std::time::Instant;
 
-use faer::dyn_stack::{MemBuffer, MemStack};
-use faer::linalg::cholesky::llt::factor::LltRegularization;
-use faer::sparse::linalg::cholesky::{
-    factorize_symbolic_cholesky, CholeskySymbolicParams, LltRef, SymbolicCholesky,
-    SymmetricOrdering,
-};
 use faer::sparse::SparseColMat;
-use faer::{Conj, MatMut, Par, Side, Spec};
+use faer::{MatMut, Par};
 
 use super::truth_system::{spmv, TruthSystem};
 use super::TruthError;
@@ -79,20 +73,28 @@ pub fn newmark_run(
     let c1 = gamma / (beta * dt);
     let c2 = 1.0 / (beta * dt);
     let t = Instant::now();
-    let mfac = SparseLlt::new(&sys.m, "M")?;
+    let factor = |a: &SparseColMat<usize, f64>, what: &str| {
+        ShiftInvert::new(a, Par::Seq).map_err(|e| TruthError::Factorization(format!("{what}: {e}")))
+    };
+    let mfac = factor(&sys.m, "M")?;
     // K_eff = (1 + c1 α1) K + (c0 + c1 α0) M.
     let keff = lin_comb(&sys.k, 1.0 + c1 * a1, &sys.m, c0 + c1 * a0);
-    let kfac = SparseLlt::new(&keff, "K_eff")?;
+    let kfac = factor(&keff, "K_eff")?;
+    let mut mem = kfac.solve_buffer(1);
+    let mut solve = |fac: &ShiftInvert, x: &mut [f64]| {
+        let len = x.len();
+        fac.solve_in_place(MatMut::from_column_major_slice_mut(x, len, 1), &mut mem);
+    };
     let factor_s = t.elapsed().as_secs_f64();
     let t = Instant::now();
 
     let mut u = vec![0.0; n];
     let mut v = f.to_vec();
-    mfac.solve(&mut v);
+    solve(&mfac, &mut v);
     // ü(0) = −α0 v − α1 M⁻¹ K v.
     let mut acc = vec![0.0; n];
     spmv(&sys.k, &v, &mut acc);
-    mfac.solve(&mut acc);
+    solve(&mfac, &mut acc);
     for (ai, vi) in acc.iter_mut().zip(&v) {
         *ai = -a0 * vi - a1 * *ai;
     }
@@ -111,7 +113,7 @@ pub fn newmark_run(
         for i in 0..n {
             un[i] = mx[i] + ky[i];
         }
-        kfac.solve(&mut un);
+        solve(&kfac, &mut un);
         for i in 0..n {
             let an = c0 * (un[i] - u[i]) - c2 * v[i] - acc[i];
             v[i] += 0.5 * dt * (acc[i] + an);
@@ -126,62 +128,4 @@ pub fn newmark_run(
         factor_s,
         step_s: t.elapsed().as_secs_f64(),
     })
-}
-
-/// Sparse LLᵀ factor (AMD ordering) with single-vector solves.
-pub(crate) struct SparseLlt {
-    symbolic: SymbolicCholesky<usize>,
-    values: Vec<f64>,
-    mem: std::cell::RefCell<MemBuffer>,
-}
-
-impl SparseLlt {
-    /// Factors the SPD matrix `a` (full storage; the lower triangle is read); `what` names it.
-    pub(crate) fn new(a: &SparseColMat<usize, f64>, what: &str) -> Result<SparseLlt, TruthError> {
-        let par = Par::Seq;
-        let fail = |e: String| TruthError::Factorization(format!("{what}: {e}"));
-        let symbolic = factorize_symbolic_cholesky(
-            a.symbolic(),
-            Side::Lower,
-            SymmetricOrdering::Amd,
-            CholeskySymbolicParams::default(),
-        )
-        .map_err(|e| fail(format!("symbolic analysis failed: {e:?}")))?;
-        let mut values = vec![0.0f64; symbolic.len_val()];
-        let scratch = symbolic.factorize_numeric_llt_scratch::<f64>(par, Spec::default());
-        let mut mem = MemBuffer::try_new(scratch).map_err(|_| fail("out of memory".into()))?;
-        symbolic
-            .factorize_numeric_llt(
-                &mut values,
-                a.as_ref(),
-                Side::Lower,
-                LltRegularization::default(),
-                par,
-                MemStack::new(&mut mem),
-                Spec::default(),
-            )
-            .map_err(|e| fail(format!("not positive definite ({e:?})")))?;
-        if !values.iter().all(|v| v.is_finite()) {
-            return Err(fail("factor has non-finite entries".into()));
-        }
-        let mem = MemBuffer::new(symbolic.solve_in_place_scratch::<f64>(1, par));
-        Ok(SparseLlt {
-            symbolic,
-            values,
-            mem: std::cell::RefCell::new(mem),
-        })
-    }
-
-    /// Overwrites `x` with A⁻¹ x.
-    pub(crate) fn solve(&self, x: &mut [f64]) {
-        let n = x.len();
-        let rhs = MatMut::from_column_major_slice_mut(x, n, 1);
-        let mut mem = self.mem.borrow_mut();
-        LltRef::new(&self.symbolic, &self.values).solve_in_place_with_conj(
-            Conj::No,
-            rhs,
-            Par::Seq,
-            MemStack::new(&mut mem),
-        );
-    }
 }
