@@ -111,7 +111,8 @@ pub(crate) fn solve(
             &mut |p| {
                 progress(EigenProgress {
                     converged: p.converged + found,
-                    requested: p.requested + found,
+                    // Count mode: the whole request, so a progress bar spans all runs.
+                    requested: (p.requested + found).max(if more { 0 } else { params.nev }),
                     iteration: p.iteration,
                 })
             },
