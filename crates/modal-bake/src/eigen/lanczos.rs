@@ -83,8 +83,11 @@ pub(crate) fn solve(
     let mut locked = Mat::<f64>::zeros(n, 0);
     let mut mlocked = Mat::<f64>::zeros(n, 0);
     let mut vals: Vec<f64> = Vec::new();
+    let mut res: Vec<Residual> = Vec::new();
     let mut capped = false;
+    let mut runs = 0;
     loop {
+        runs += 1;
         let found = locked.ncols();
         let mut cp = params.clone();
         let more = match lam_lim {
@@ -98,7 +101,7 @@ pub(crate) fn solve(
                 true
             }
         };
-        let ((cv, cu, _), chunk_capped) = lanczos_chunk(
+        let ((cv, cu, cres), chunk_capped) = lanczos_chunk(
             k,
             m,
             &fac,
@@ -122,6 +125,7 @@ pub(crate) fn solve(
         append_cols(&mut locked, cu.as_ref());
         append_cols(&mut mlocked, mcu.as_ref());
         vals.extend_from_slice(&cv);
+        res.extend(cres);
         let total = locked.ncols();
         let done = if more {
             let global_cap = total >= params.max_modes;
@@ -136,10 +140,9 @@ pub(crate) fn solve(
     }
     // One Cholesky-QR over all chunks (ascending λ, so each vector only mixes in lower ones)
     // restores UᵀMU = I across chunk boundaries; residuals are measured on the result.
-    let (vals, u, res) = if vals.len() > CHUNK.min(params.nev.max(1)) || locked.ncols() > CHUNK {
+    let (vals, u, res) = if runs > 1 {
         orthonormalize_ascending(k, m, locked, mlocked, sigma, par)?
     } else {
-        let res = residuals(k, m, locked.as_ref(), &vals, sigma);
         (vals, locked, res)
     };
     let good = res.iter().filter(|r| r.converged(params.tol)).count();
