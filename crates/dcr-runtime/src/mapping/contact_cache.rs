@@ -87,7 +87,31 @@ impl ContactCache {
         step: u64,
         max_distance: f64,
     ) -> (u32, bool) {
-        if let Some(&s) = self.map.get(&id) {
+        self.lookup_with_hint(model, id, point, step, max_distance, u32::MAX)
+    }
+
+    /// As [`ContactCache::lookup`], trying slot `hint` first (e.g. the slot this contact had at
+    /// the same position of last step's list): a live slot holding `id` is the one the hash
+    /// table would return, so steady-state steps skip the hashing. Same results either way.
+    pub fn lookup_with_hint(
+        &mut self,
+        model: &ModalModel,
+        id: u64,
+        point: [f64; 3],
+        step: u64,
+        max_distance: f64,
+        hint: u32,
+    ) -> (u32, bool) {
+        let hinted = self
+            .slots
+            .get(hint as usize)
+            .is_some_and(|c| c.live && c.id == id);
+        let found = if hinted {
+            Some(hint)
+        } else {
+            self.map.get(&id).copied()
+        };
+        if let Some(s) = found {
             let c = &mut self.slots[s as usize];
             c.last_seen = step;
             if norm(sub(c.query, point)) <= self.remap_tolerance {

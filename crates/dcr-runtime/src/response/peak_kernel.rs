@@ -1,21 +1,212 @@
 //! The hot loop of Eq. 11: peak |wᵀ q(k)| over the step's samples for every channel.
 //!
-//! A dense multiply-max register-blocked over 16 channels × 3 samples (8 channels × 6 samples
-//! for a last odd panel): 12 independent 4-wide accumulator chains per pass over the modes, so
-//! the loop is FMA-throughput- rather than latency- or load-bound. The
-//! channel matrix is stored as panels of 8 channels (`(block·m + j)·8 + i`) so every inner
-//! load is one contiguous 8-wide row. On x86-64 CPUs with AVX2 + FMA the same safe loop is
-//! compiled for those features and picked at run time (`pulp` dispatch); elsewhere the
-//! baseline build is used.
+//! Two layouts of the same dense multiply-max:
+//! - [`peak_abs_rows`] (used by [`DistantResponse`](super::DistantResponse)): samples along the
+//!   SIMD lanes, channels broadcast. Samples and channel weights are both stored mode-major
+//!   (`m × stride` with samples zero-padded to a multiple of 4, and `m × nb`), so a tile reads
+//!   one contiguous run of each per mode. Register tiles of 6 channels × 2 four-sample vectors
+//!   (12 independent FMA chains, no spills), 8 × 1 when a step has at most 4 samples; the last
+//!   tile in each direction overlaps its predecessor instead of being narrower. The running
+//!   max over samples stays in registers and is reduced across lanes once per channel. Nothing
+//!   is padded to a channel block, so few-contact / many-sample rows (fridge: 6 × 117) waste
+//!   nothing (the 8-channel panels computed 8 channels for 6).
+//! - [`peak_abs_projection`]: channels along the lanes in panels of 8 (the earlier layout,
+//!   kept for callers of the public function).
+//!
+//! Every accumulator is the same sequential FMA chain over the modes j = 0..m in both, so the
+//! results are bit-identical whatever the layout or blocking. On x86-64 CPUs with AVX2 + FMA
+//! the kernels are compiled for those features and picked at run time (`pulp` dispatch);
+//! elsewhere the baseline build is used.
 
-/// Channels per panel (channel counts are padded to a multiple of this).
-pub const BLOCK: usize = 8;
+/// Samples per SIMD vector in [`peak_abs_rows`] (its sample stride is a multiple of this).
+pub const LANES: usize = 4;
 
-/// Index of channel `c`, mode `j` in the panel layout for `m` modes.
-#[inline]
-pub(crate) fn panel_index(c: usize, j: usize, m: usize) -> usize {
-    ((c / BLOCK) * m + j) * BLOCK + c % BLOCK
+/// Per-lane arithmetic of the rows kernel on `[f64; 4]` (LLVM keeps each in one register):
+/// fused multiply-add where the dispatch enabled FMA, `c + a·b` in the baseline build.
+#[inline(always)]
+fn fma4<const FMA: bool>(a: f64, b: &[f64; LANES], c: &mut [f64; LANES]) {
+    for i in 0..LANES {
+        c[i] = if FMA {
+            a.mul_add(b[i], c[i])
+        } else {
+            c[i] + a * b[i]
+        };
+    }
 }
+
+/// `pk = max(|acc|, pk)` per lane, keeping `pk` where `acc` is NaN (as `f64::max` does; written
+/// as a compare-select so it compiles to a single `maxpd`).
+#[inline(always)]
+fn abs_max4(acc: &[f64; LANES], pk: &mut [f64; LANES]) {
+    for i in 0..LANES {
+        let a = acc[i].abs();
+        pk[i] = if a > pk[i] { a } else { pk[i] };
+    }
+}
+
+/// `peaks[c] = max_k |Σ_j b[j·nb + c] · v[j·stride + k]|` for `c < nb`: the largest normal
+/// displacement magnitude (m) of channel c over the step's samples. `v` holds the modal samples
+/// mode-major (`m × stride`, `stride` a multiple of [`LANES`], unused samples zero); `b` holds
+/// the channel weights mode-major too (`m × nb`, one column per channel). Does not allocate.
+///
+/// # Panics
+/// If `stride` is not a multiple of [`LANES`] or a slice is too short.
+pub fn peak_abs_rows(v: &[f64], stride: usize, m: usize, b: &[f64], nb: usize, peaks: &mut [f64]) {
+    assert!(
+        stride.is_multiple_of(LANES),
+        "sample stride must be a multiple of {LANES}"
+    );
+    assert!(v.len() >= m * stride && b.len() >= nb * m && peaks.len() >= nb);
+    let peaks = &mut peaks[..nb];
+    if m == 0 || stride == 0 {
+        peaks.iter_mut().for_each(|p| *p = 0.0);
+        return;
+    }
+    let (v, _) = pulp::as_arrays::<LANES, f64>(&v[..m * stride]);
+    let b = &b[..nb * m];
+    let nv = stride / LANES;
+    #[cfg(target_arch = "x86_64")]
+    if let Some(simd) = pulp::x86::V3::try_new() {
+        // Through `WithSimd` rather than a closure: a closure's `FnOnce` shim is only an inline
+        // hint, and LLVM declined it for this kernel, compiling it without AVX2/FMA (10× slower).
+        pulp::Simd::vectorize(
+            simd,
+            RowsKernel {
+                v,
+                nv,
+                b,
+                nb,
+                peaks,
+            },
+        );
+        return;
+    }
+    rows_kernel::<false>(v, nv, b, nb, peaks);
+}
+
+/// [`peak_abs_rows`]' arguments, run under `pulp` dispatch.
+struct RowsKernel<'a> {
+    v: &'a [[f64; LANES]],
+    nv: usize,
+    b: &'a [f64],
+    nb: usize,
+    peaks: &'a mut [f64],
+}
+
+impl pulp::WithSimd for RowsKernel<'_> {
+    type Output = ();
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, _simd: S) {
+        rows_kernel::<true>(self.v, self.nv, self.b, self.nb, self.peaks);
+    }
+}
+
+#[inline(always)]
+fn rows_kernel<const FMA: bool>(
+    v: &[[f64; LANES]],
+    nv: usize,
+    b: &[f64],
+    nb: usize,
+    peaks: &mut [f64],
+) {
+    if nv == 1 {
+        channel_blocks::<FMA, 8, 1>(v, nv, b, nb, peaks);
+    } else {
+        channel_blocks::<FMA, 6, 2>(v, nv, b, nb, peaks);
+    }
+}
+
+/// All channels in blocks of `NC`; the last block overlaps its predecessor instead of being
+/// narrower (a channel's peak does not depend on its block, and narrow tiles compile badly).
+#[inline(always)]
+fn channel_blocks<const FMA: bool, const NC: usize, const NV: usize>(
+    v: &[[f64; LANES]],
+    nv: usize,
+    b: &[f64],
+    nb: usize,
+    peaks: &mut [f64],
+) {
+    if nb >= NC {
+        let mut c0 = 0;
+        while c0 < nb {
+            let c = c0.min(nb - NC);
+            sample_pass::<FMA, NC, NV>(v, nv, b, nb, c, &mut peaks[c..c + NC]);
+            c0 += NC;
+        }
+        return;
+    }
+    let c0 = 0;
+    let out = &mut peaks[..];
+    macro_rules! rest {
+        ($($n:literal)*) => {
+            match out.len() {
+                $($n => sample_pass::<FMA, $n, NV>(v, nv, b, nb, c0, out),)*
+                _ => {}
+            }
+        };
+    }
+    rest!(1 2 3 4 5 6 7);
+}
+
+/// Channels `c0..c0 + NC` over all samples in tiles of `NV` vectors, the last one overlapping
+/// its predecessor (the max over samples is unaffected by seeing some twice).
+#[inline(always)]
+fn sample_pass<const FMA: bool, const NC: usize, const NV: usize>(
+    v: &[[f64; LANES]],
+    nv: usize,
+    b: &[f64],
+    nb: usize,
+    c0: usize,
+    out: &mut [f64],
+) {
+    let mut pk = [[0.0f64; LANES]; NC];
+    if nv >= NV {
+        let mut v0 = 0;
+        while v0 < nv {
+            tile::<FMA, NC, NV>(v, nv, v0.min(nv - NV), b, nb, c0, &mut pk);
+            v0 += NV;
+        }
+    } else {
+        for v0 in 0..nv {
+            tile::<FMA, NC, 1>(v, nv, v0, b, nb, c0, &mut pk);
+        }
+    }
+    for (p, x) in out.iter_mut().zip(pk) {
+        *p = x.into_iter().fold(0.0, f64::max);
+    }
+}
+
+/// One register tile: channels `c0..c0 + NC` × `NV` vectors of samples from vector `v0`, FMA
+/// chains over all modes, folded into the running per-channel lane maxima `pk`.
+#[inline(always)]
+fn tile<const FMA: bool, const NC: usize, const NV: usize>(
+    v: &[[f64; LANES]],
+    nv: usize,
+    v0: usize,
+    b: &[f64],
+    nb: usize,
+    c0: usize,
+    pk: &mut [[f64; LANES]; NC],
+) {
+    let mut acc = [[[0.0f64; LANES]; NV]; NC];
+    for (vj, bj) in v.chunks_exact(nv).zip(b.chunks_exact(nb)) {
+        let x: &[[f64; LANES]; NV] = vj[v0..v0 + NV].try_into().expect("tile in range");
+        let w: &[f64; NC] = bj[c0..c0 + NC].try_into().expect("tile in range");
+        for c in 0..NC {
+            for t in 0..NV {
+                fma4::<FMA>(w[c], &x[t], &mut acc[c][t]);
+            }
+        }
+    }
+    for (acc_c, pk_c) in acc.iter().zip(pk.iter_mut()) {
+        for a in acc_c {
+            abs_max4(a, pk_c);
+        }
+    }
+}
+
+/// Channels per panel of [`peak_abs_projection`] (channel counts are padded to a multiple).
+pub const BLOCK: usize = 8;
 
 /// `peaks[c] = max_k |Σ_j q[k·m + j] · W(j, c)|` for `c < nch`: the largest normal displacement
 /// magnitude (m) of channel c over `samples` rows of modal displacements `q` (row-major
@@ -148,4 +339,56 @@ pub(crate) fn peak_abs_projection_baseline(
     peaks: &mut [f64],
 ) {
     kernel::<false>(&q[..samples * m], m, &w[..m * nch], &mut peaks[..nch]);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The rows kernel equals a naive loop with the same FMA order, bit for bit, for every
+    /// tile remainder (channels 1..=20, 1..=13 samples), on the dispatched and baseline paths.
+    #[test]
+    fn rows_kernel_matches_naive_bitwise() {
+        let mut rng = crate::testing::SplitMix64(11);
+        let m = 7;
+        for s in 1..=13usize {
+            let stride = s.div_ceil(LANES) * LANES;
+            for nb in 1..=20 {
+                let mut v = vec![0.0; m * stride];
+                for j in 0..m {
+                    for k in 0..s {
+                        v[j * stride + k] = rng.range(-1.0, 1.0);
+                    }
+                }
+                let b: Vec<f64> = (0..nb * m).map(|_| rng.range(-1.0, 1.0)).collect();
+                let mut peaks = vec![f64::NAN; nb];
+                peak_abs_rows(&v, stride, m, &b, nb, &mut peaks);
+                let mut base = vec![f64::NAN; nb];
+                rows_kernel::<false>(pulp::as_arrays(&v).0, stride / LANES, &b, nb, &mut base);
+                let fused = peaks != base;
+                for c in 0..nb {
+                    let naive = |fma: bool| {
+                        (0..s)
+                            .map(|k| {
+                                (0..m)
+                                    .fold(0.0f64, |acc, j| {
+                                        let (x, y) = (b[j * nb + c], v[j * stride + k]);
+                                        if fma {
+                                            x.mul_add(y, acc)
+                                        } else {
+                                            acc + x * y
+                                        }
+                                    })
+                                    .abs()
+                            })
+                            .fold(0.0, f64::max)
+                    };
+                    assert_eq!(base[c], naive(false), "baseline s={s} nb={nb} c={c}");
+                    if fused {
+                        assert_eq!(peaks[c], naive(true), "fma s={s} nb={nb} c={c}");
+                    }
+                }
+            }
+        }
+    }
 }
