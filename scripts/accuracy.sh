@@ -2,9 +2,11 @@
 # Regenerate docs/accuracy.md and docs/accuracy/*.svg: peak distant displacement of truncated
 # modal bases (5 … 640 modes, four samplings, per-node vs per-contact), read and stepped through
 # the runtime, vs the full-order truth on the table, the ground slab and the scaffold; a mesh
-# resolution sweep on a structured plate; bake time, base size, query time; and the Eq. 14
-# attenuation fit of each object (modal-bake fit-attenuation).
-# Needs data/scenes/*.msh (scripts/gen_scene_meshes.sh). About 5–10 min on 2 cores.
+# resolution sweep on a structured plate; bake time, base size, query time; the bake-time
+# peak-transfer table (Method::Transfer, issue #5 item 3) vs the 20-mode base; and the Eq. 14
+# attenuation fit of each object (modal-bake fit-attenuation). For just the transfer study run
+# the example directly: target/release/examples/accuracy --out /tmp/x --transfer-only.
+# Needs data/scenes/*.msh (scripts/gen_scene_meshes.sh). About 10–15 min on 2 cores.
 set -e
 cd "$(dirname "$0")/.."
 cargo build --release -p modal-bake --example accuracy

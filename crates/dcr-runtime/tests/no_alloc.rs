@@ -2,8 +2,9 @@
 //!
 //! Expectation: once every buffer has seen the largest contact / impact counts, many steps with
 //! impacts (some below threshold, some unmapped), forces, and cached resting contacts allocate
-//! nothing — for both variants, both methods (heat and Euclidean distances), with and without
-//! carry-over. Counted with a global allocator wrapper; this file is its own test binary and
+//! nothing — for both variants, all methods (heat and Euclidean distances; the transfer table,
+//! with its modal fallback for contacts and impacts outside its region and for forces), with
+//! and without carry-over. Counted with a global allocator wrapper; this file is its own test binary and
 //! holds a single test so no other test thread allocates concurrently.
 #![allow(unsafe_code)]
 
@@ -54,15 +55,28 @@ fn surface_point(rng: &mut SplitMix64) -> [f64; 3] {
 #[test]
 fn steps_do_not_allocate_after_warm_up() {
     let om = geometric_omegas(20, 100.0, 3000.0);
-    let model = Arc::new(
-        ModalModel::from_base(synthetic_base(
-            box_surface(8, [1.0, 0.6, 0.4]),
-            &om,
-            [1.0, 1e-6],
-            3,
-        ))
-        .unwrap(),
-    );
+    let mut base = synthetic_base(box_surface(8, [1.0, 0.6, 0.4]), &om, [1.0, 1e-6], 3);
+    // A synthetic transfer table over the top face's half x ≤ 0.5 m: some impacts and contacts
+    // fall outside it (modal fallback).
+    let vertices: Vec<u32> = (0..base.surface_vertices.len())
+        .filter(|&v| {
+            let p = base.surface_vertices[v];
+            p[2] >= 0.4 - 1e-9 && p[0] <= 0.5 + 1e-9
+        })
+        .map(|v| v as u32)
+        .collect();
+    let nr = vertices.len();
+    base.transfer = Some(dcr_runtime::format::TransferTable {
+        h: 0.01,
+        rayleigh: base.rayleigh,
+        modes: 40,
+        samples: 100,
+        vertices,
+        peaks: (0..nr * (nr + 1) / 2)
+            .map(|k| 1e-5 * (1 + k % 5) as f32)
+            .collect(),
+    });
+    let model = Arc::new(ModalModel::from_base(base).unwrap());
     let mut rng = SplitMix64(99);
     let resting: Vec<RestingContact> = (0..30)
         .map(|i| RestingContact {
@@ -98,6 +112,17 @@ fn steps_do_not_allocate_after_warm_up() {
                     ..Default::default()
                 });
             }
+        }
+    }
+    // The transfer table (appended last: the other configurations see the same random input).
+    for variant in [Variant::PerContact, Variant::PerNode] {
+        for carry_over in [false, true] {
+            configs.push(ResponseParams {
+                variant,
+                carry_over,
+                method: Method::Transfer,
+                ..Default::default()
+            });
         }
     }
     for params in configs {

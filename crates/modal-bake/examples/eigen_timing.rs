@@ -2,8 +2,8 @@
 //! factorization of K − σM and the shift-invert block Lanczos eigensolve.
 //!
 //! `cargo run --release -p modal-bake --example eigen_timing -- [sizes...] [--nev N] [--reps R]`
-//! with sizes among `3k 15k 100k beam100k` (default: the first three), optional `--block B`,
-//! `--ncv D` (Krylov dimension) and `--threads T` (`EigenParams::threads`). Prints one CSV row
+//! with sizes among `3k 15k 100k beam100k bench3k bench15k` (default: the first three), optional `--block B`,
+//! `--ncv D` (Krylov dimension), `--tol T` (default: the bake's 1e-8) and `--threads T` (`EigenParams::threads`). Prints one CSV row
 //! per run and a median summary per size. Speed is measured here, never asserted in tests.
 
 use std::time::Instant;
@@ -25,6 +25,8 @@ fn main() {
     let mut block = EigenParams::default().block;
     let mut ncv: Option<usize> = None;
     let mut threads = 0usize;
+    // The bake's tolerance (modal_bake::bake::MAX_RESIDUAL).
+    let mut tol = modal_bake::bake::MAX_RESIDUAL;
     let mut i = 0;
     while i < args.len() {
         match args[i].as_str() {
@@ -44,6 +46,10 @@ fn main() {
                 ncv = Some(args[i + 1].parse().expect("--ncv D"));
                 i += 1;
             }
+            "--tol" => {
+                tol = args[i + 1].parse().expect("--tol T");
+                i += 1;
+            }
             "--block" => {
                 block = args[i + 1].parse().expect("--block B");
                 i += 1;
@@ -57,7 +63,7 @@ fn main() {
     }
     let mat = Material::new(2.0e9, 0.3, 1200.0).unwrap();
     println!(
-        "size,free_dofs,assembly_s,factor_s,eigensolve_s,total_s,block_solves,factor_nnz,f1_hz"
+        "size,free_dofs,assembly_s,factor_s,eigensolve_s,total_s,block_solves,restarts,checks,factor_nnz,f1_hz"
     );
     for size in &sizes {
         // Beams with a 0.1 m square section, clamped at x = 0: L = 1 m, or 3 m for the
@@ -67,7 +73,10 @@ fn main() {
             "15k" => ([60, 8, 8], 1.0),
             "100k" => ([120, 16, 16], 1.0),
             "beam100k" => ([300, 10, 10], 3.0),
-            other => panic!("unknown size {other} (3k, 15k, 100k, beam100k)"),
+            // The bake bench's 3k and 15k beams (benches/bake.rs).
+            "bench3k" => ([24, 6, 6], 1.0),
+            "bench15k" => ([45, 9, 9], 2.0),
+            other => panic!("unknown size {other} (3k, 15k, 100k, beam100k, bench3k, bench15k)"),
         };
         let reps = if reps > 0 {
             reps
@@ -76,7 +85,12 @@ fn main() {
         } else {
             5
         };
-        let mesh = TetMesh::structured_box(cells, [len, 0.1, 0.1]);
+        let side = match size.as_str() {
+            "bench3k" => 0.25,
+            "bench15k" => 0.4,
+            _ => 0.1,
+        };
+        let mesh = TetMesh::structured_box(cells, [len, side, side]);
         let (mut ta, mut tf, mut te, mut tt) = (vec![], vec![], vec![], vec![]);
         for _ in 0..reps {
             let t0 = Instant::now();
@@ -89,16 +103,19 @@ fn main() {
                 block,
                 krylov_dim: ncv,
                 threads,
+                tol,
                 ..Default::default()
             };
             let res = solve_lowest(&k, &m, &p, &mut |_| {}).expect("eigensolve");
             let total = t0.elapsed().as_secs_f64();
             println!(
-                "{size},{},{assembly:.4},{:.4},{:.4},{total:.4},{},{},{:.4}",
+                "{size},{},{assembly:.4},{:.4},{:.4},{total:.4},{},{},{},{},{:.4}",
                 k.nrows(),
                 res.info.factor_seconds,
                 res.info.solve_seconds,
                 res.info.block_solves,
+                res.info.restarts,
+                res.info.residual_checks,
                 res.info.factor_nnz,
                 res.frequencies_hz()[0]
             );

@@ -124,6 +124,14 @@ pub enum BakeError {
     /// Writing or reading the `.modes` file failed.
     #[error(transparent)]
     Format(#[from] FormatError),
+    /// The peak-transfer table could not be built (`--transfer-h`); nothing is written.
+    #[error("{file}: {error}")]
+    Transfer {
+        /// Mesh file.
+        file: String,
+        /// What failed.
+        error: Box<crate::transfer::TransferError>,
+    },
 }
 
 /// What a bake reports besides the base: timings (s) and facts about the mesh and the modes.
@@ -171,6 +179,19 @@ pub struct BakeReport {
     pub notes: Vec<String>,
     /// Geometry hash stored in the base.
     pub source_hash: String,
+    /// Seconds computing the transfer table's modes (0 without a table or when the base's own
+    /// modes sufficed).
+    pub transfer_modes_s: f64,
+    /// Seconds building the transfer table (0 without one).
+    pub transfer_s: f64,
+    /// Transfer table: region vertices (0: no table).
+    pub transfer_vertices: usize,
+    /// Transfer table: modes summed.
+    pub transfer_modes: usize,
+    /// Transfer table: samples per step.
+    pub transfer_samples: usize,
+    /// Transfer table: where its modes came from (`base`, `dense`, `lanczos`).
+    pub transfer_mode_source: String,
 }
 
 /// Progress of a bake, for a CLI bar.
@@ -182,6 +203,10 @@ pub enum BakeStage {
     Assemble,
     /// Factoring and iterating; carries the eigensolver's progress.
     Eigensolve(EigenProgress),
+    /// Solving for the transfer table's modes (dense or Lanczos).
+    TransferModes,
+    /// Building the transfer table; carries rows done / total.
+    Transfer(crate::transfer::TransferProgress),
     /// Writing the file.
     Write,
 }
@@ -446,7 +471,10 @@ pub fn bake_mesh(
         // Ten times stricter than the MAX_RESIDUAL a written mode must meet; 1e-10 is below
         // the rounding floor of the higher modes of fine meshes (measured: table, 80 modes,
         // worst 7.4e-10).
-        tol: 1e-9,
+        // The MAX_RESIDUAL a written mode must meet: the solver confirms every pair on the
+        // same explicit residual, so a stricter tolerance only buys iterations (1e-10 is below
+        // the rounding floor of the higher modes of fine meshes).
+        tol: MAX_RESIDUAL,
         ..Default::default()
     };
     let res = eigen::solve_lowest(&kf, &mf, &eparams, &mut |p| {
@@ -553,6 +581,7 @@ pub fn bake_mesh(
             reoriented_tets: reoriented,
         },
         precision: params.precision,
+        transfer: None,
     };
     report.modes = nm;
     report.frequencies_hz = base.frequencies_hz();
@@ -560,6 +589,83 @@ pub fn bake_mesh(
     report.residual_floors = elastic.iter().map(|&j| res.residual_floors[j]).collect();
     report.surface_vertices = base.surface_vertices.len();
     report.surface_triangles = base.surface_triangles.len();
+    Ok((base, report))
+}
+
+/// As [`bake_mesh`], plus (with `transfer`) the bake-time peak-transfer table
+/// ([`crate::transfer`]) over the selected region, built from the base's own modes when it
+/// keeps enough, else from the dense all-mode eigensolve (≤ [`crate::transfer::DENSE_MAX_DOFS`]
+/// free dofs) or a Lanczos bake with that many modes. The table's parameters are recorded in
+/// `meta.bake_params.transfer`; `params_hash` stays that of `params` (the table is checked by
+/// its own entries: h, Rayleigh, modes).
+///
+/// # Errors
+/// As [`bake_mesh`]; [`BakeError::Transfer`] when the table cannot be built.
+pub fn bake_mesh_with_transfer(
+    mesh: TetMesh,
+    params: &BakeParams,
+    transfer: Option<&crate::transfer::TransferParams>,
+    file: &str,
+    progress: &mut dyn FnMut(BakeStage),
+) -> Result<(ModesFile, BakeReport), BakeError> {
+    use crate::transfer::{self as tr, TransferModes};
+    let Some(tp) = transfer else {
+        return bake_mesh(mesh, params, file, progress);
+    };
+    let terr = |error| BakeError::Transfer {
+        file: file.to_string(),
+        error: Box::new(error),
+    };
+    tp.check().map_err(terr)?;
+    let (mut base, mut report) = bake_mesh(mesh.clone(), params, file, progress)?;
+    let t = Instant::now();
+    let enough = matches!(tp.modes, TransferModes::Count(n) if n <= base.num_modes());
+    let set = if enough {
+        report.transfer_mode_source = "base".into();
+        None
+    } else if report.free_dofs <= tr::DENSE_MAX_DOFS {
+        progress(BakeStage::TransferModes);
+        report.transfer_mode_source = "dense".into();
+        Some(tr::mode_set_dense(&base, &mesh, params, tp.modes, file).map_err(terr)?)
+    } else {
+        let TransferModes::Count(n) = tp.modes else {
+            return Err(terr(tr::TransferError::Params(format!(
+                "--transfer-modes all needs the dense eigensolve, but the mesh has {} free dofs (limit {}); give a count",
+                report.free_dofs,
+                tr::DENSE_MAX_DOFS
+            ))));
+        };
+        progress(BakeStage::TransferModes);
+        report.transfer_mode_source = "lanczos".into();
+        Some(tr::mode_set_lanczos(&mesh, params, n, file).map_err(terr)?)
+    };
+    report.transfer_modes_s = t.elapsed().as_secs_f64();
+    let t = Instant::now();
+    let table = tr::build_transfer_table(
+        set.as_ref().unwrap_or(&base),
+        tp,
+        params.rayleigh,
+        &mut |p| progress(BakeStage::Transfer(p)),
+    )
+    .map_err(terr)?;
+    report.transfer_s = t.elapsed().as_secs_f64();
+    report.transfer_vertices = table.len();
+    report.transfer_modes = table.modes as usize;
+    report.transfer_samples = table.samples as usize;
+    if let Some(obj) = base.meta.bake_params.as_object_mut() {
+        obj.insert(
+            "transfer".into(),
+            serde_json::json!({
+                "h": tp.h,
+                "modes": match tp.modes { TransferModes::All => serde_json::json!("all"), TransferModes::Count(n) => serde_json::json!(n) },
+                "regions": tp.boxes,
+                "up": tp.up,
+                "up_min_cos": tp.up_min_cos,
+                "oversample": tp.oversample,
+            }),
+        );
+    }
+    base.transfer = Some(table);
     Ok((base, report))
 }
 
@@ -573,11 +679,31 @@ pub fn bake_file(
     out: &Path,
     progress: &mut dyn FnMut(BakeStage),
 ) -> Result<BakeReport, BakeError> {
+    bake_file_with_transfer(mesh_path, params, None, out, progress)
+}
+
+/// As [`bake_file`], with an optional peak-transfer table ([`bake_mesh_with_transfer`]).
+///
+/// # Errors
+/// A [`BakeError`] naming the file and what failed.
+pub fn bake_file_with_transfer(
+    mesh_path: &Path,
+    params: &BakeParams,
+    transfer: Option<&crate::transfer::TransferParams>,
+    out: &Path,
+    progress: &mut dyn FnMut(BakeStage),
+) -> Result<BakeReport, BakeError> {
     progress(BakeStage::Read);
     let t = Instant::now();
     let mesh = crate::mesh::read_mesh(mesh_path)?;
     let read_s = t.elapsed().as_secs_f64();
-    let (base, mut report) = bake_mesh(mesh, params, &mesh_path.display().to_string(), progress)?;
+    let (base, mut report) = bake_mesh_with_transfer(
+        mesh,
+        params,
+        transfer,
+        &mesh_path.display().to_string(),
+        progress,
+    )?;
     report.read_s = read_s;
     progress(BakeStage::Write);
     let t = Instant::now();

@@ -11,4 +11,5 @@ pub mod bake;
 pub mod eigen;
 pub mod fem;
 pub mod mesh;
+pub mod transfer;
 pub mod truth;

@@ -19,6 +19,11 @@
 //! | `residuals` | f64 | (m,) | relative residual ‖Ku − λMu‖/‖Ku‖ of each mode at bake |
 //! | `meta` | u8 | (bytes,) | UTF-8 JSON: [`ModesMeta`] |
 //!
+//! Optional (all or none): the peak-transfer table ([`TransferTable`]): `transfer_vertices`
+//! u32 (nr,), `transfer_peaks` f32 (nr(nr+1)/2,) packed upper triangle (m per N·s),
+//! `transfer_h` f64 () (s), `transfer_rayleigh` f64 (2,), `transfer_modes` u32 (),
+//! `transfer_samples` u32 (). Readers that predate it ignore these entries.
+//!
 //! Files are written deterministically (fixed zip timestamps, fixed entry order, stored) and
 //! atomically (temporary file in the target directory, then rename).
 
@@ -30,6 +35,8 @@ use ndarray::{Array0, Array1, Array2, Array3, ArrayD};
 use ndarray_npy::npy::header::Header;
 use ndarray_npy::{NpzWriter, ReadNpyExt, ReadableElement};
 use serde::{Deserialize, Serialize};
+
+use super::transfer_table::{TransferTable, TRANSFER_ENTRIES};
 
 /// Current `.modes` schema version.
 pub const FORMAT_VERSION: u32 = 1;
@@ -113,6 +120,8 @@ pub struct ModesFile {
     pub meta: ModesMeta,
     /// Storage precision of `modes` in the file.
     pub precision: ModesPrecision,
+    /// Optional bake-time peak-transfer table (`None`: the base has none).
+    pub transfer: Option<TransferTable>,
 }
 
 /// What went wrong reading or writing a `.modes` file.
@@ -282,6 +291,9 @@ impl ModesFile {
                 self.rayleigh
             )));
         }
+        if let Some(t) = &self.transfer {
+            t.check(ns).map_err(inv)?;
+        }
         Ok(())
     }
 
@@ -384,6 +396,20 @@ impl ModesFile {
         npz.add_array("residuals", &Array1::from(self.residuals.clone()))
             .map_err(e)?;
         npz.add_array("meta", &Array1::from(meta)).map_err(e)?;
+        if let Some(t) = &self.transfer {
+            npz.add_array("transfer_vertices", &Array1::from(t.vertices.clone()))
+                .map_err(e)?;
+            npz.add_array("transfer_peaks", &Array1::from(t.peaks.clone()))
+                .map_err(e)?;
+            npz.add_array("transfer_h", &Array0::from_elem((), t.h))
+                .map_err(e)?;
+            npz.add_array("transfer_rayleigh", &Array1::from(t.rayleigh.to_vec()))
+                .map_err(e)?;
+            npz.add_array("transfer_modes", &Array0::from_elem((), t.modes))
+                .map_err(e)?;
+            npz.add_array("transfer_samples", &Array0::from_elem((), t.samples))
+                .map_err(e)?;
+        }
         Ok(npz.finish().map_err(e)?.into_inner())
     }
 
@@ -449,6 +475,7 @@ impl ModesFile {
         let rayleigh: Vec<f64> = rd.vector("rayleigh", 1024)?;
         let fixed_nodes: Vec<u32> = rd.vector("fixed_nodes", MAX_ENTRY_BYTES)?;
         let residuals: Vec<f64> = rd.vector("residuals", MAX_ENTRY_BYTES)?;
+        let transfer = rd.transfer()?;
 
         let inv = |detail: String| FormatError::Invalid {
             path: path.to_path_buf(),
@@ -491,6 +518,7 @@ impl ModesFile {
             residuals,
             meta,
             precision,
+            transfer,
         };
         out.validate(path)?;
         for (j, (&f, g)) in frequencies.iter().zip(out.frequencies_hz()).enumerate() {
@@ -637,6 +665,45 @@ impl<R: Read + Seek> EntryReader<'_, R> {
             ));
         }
         Ok(v)
+    }
+
+    /// The optional transfer table: `None` when none of its entries is present, an error
+    /// naming the missing one when only some are.
+    fn transfer(&mut self) -> Result<Option<TransferTable>, FormatError> {
+        let present: Vec<&'static str> = TRANSFER_ENTRIES
+            .iter()
+            .copied()
+            .filter(|e| self.zip.index_for_name(&format!("{e}.npy")).is_some())
+            .collect();
+        if present.is_empty() {
+            return Ok(None);
+        }
+        if let Some(missing) = TRANSFER_ENTRIES.iter().find(|e| !present.contains(e)) {
+            return Err(FormatError::Missing {
+                path: self.path.to_path_buf(),
+                entry: missing,
+            });
+        }
+        let vertices: Vec<u32> = self.vector("transfer_vertices", MAX_ENTRY_BYTES)?;
+        let peaks: Vec<f32> = self.vector("transfer_peaks", MAX_ENTRY_BYTES)?;
+        let h: f64 = self.scalar("transfer_h")?;
+        let rayleigh: Vec<f64> = self.vector("transfer_rayleigh", 1024)?;
+        let modes: u32 = self.scalar("transfer_modes")?;
+        let samples: u32 = self.scalar("transfer_samples")?;
+        if rayleigh.len() != 2 {
+            return Err(self.err(
+                "transfer_rayleigh",
+                format!("expected 2 values, found {}", rayleigh.len()),
+            ));
+        }
+        Ok(Some(TransferTable {
+            h,
+            rayleigh: [rayleigh[0], rayleigh[1]],
+            modes,
+            samples,
+            vertices,
+            peaks,
+        }))
     }
 
     fn scalar<A: ReadableElement + Copy>(&mut self, entry: &'static str) -> Result<A, FormatError> {

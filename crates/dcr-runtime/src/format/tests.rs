@@ -41,6 +41,7 @@ pub(crate) fn tiny_base() -> ModesFile {
             reoriented_tets: 0,
         },
         precision: ModesPrecision::F64,
+        transfer: None,
     }
 }
 
@@ -189,4 +190,113 @@ fn hostile_header_is_not_allocated() {
         err.contains("eigenvalues") && err.contains("bytes"),
         "{err}"
     );
+}
+
+/// `tiny_base` with a 3-vertex transfer table (vertices 0, 1, 3).
+fn tiny_with_table() -> ModesFile {
+    let mut b = tiny_base();
+    b.transfer = Some(TransferTable {
+        h: 0.01,
+        rayleigh: [10.0, 1e-7],
+        modes: 40,
+        samples: 123,
+        vertices: vec![0, 1, 3],
+        peaks: vec![1e-4, 2e-5, 3e-6, 4e-4, 5e-5, 6e-4],
+    });
+    b
+}
+
+/// Copies the archive `bytes` without the entries named in `drop` (`name.npy`).
+fn without_entries(bytes: &[u8], drop: &[&str]) -> Vec<u8> {
+    let mut zin = zip::ZipArchive::new(Cursor::new(bytes)).unwrap();
+    let mut zout = zip::ZipWriter::new(Cursor::new(Vec::new()));
+    for i in 0..zin.len() {
+        let f = zin.by_index_raw(i).unwrap();
+        if drop.iter().any(|d| f.name() == format!("{d}.npy")) {
+            continue;
+        }
+        zout.raw_copy_file(f).unwrap();
+    }
+    zout.finish().unwrap().into_inner()
+}
+
+#[test]
+fn transfer_table_round_trips_exactly_and_deterministically() {
+    let dir = tempfile::tempdir().unwrap();
+    let (a, b) = (dir.path().join("a.modes"), dir.path().join("b.modes"));
+    let base = tiny_with_table();
+    base.write_atomic(&a).unwrap();
+    base.write_atomic(&b).unwrap();
+    assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
+    let back = ModesFile::read(&a).unwrap();
+    assert_eq!(back, base);
+    let t = back.transfer.unwrap();
+    // Packed upper triangle: (0,0) (0,1) (0,2) (1,1) (1,2) (2,2); symmetric lookup.
+    assert_eq!(t.peak(1, 2), f64::from(5e-5f32));
+    assert_eq!(t.peak(2, 1), t.peak(1, 2));
+    assert_eq!(t.peak(2, 2), f64::from(6e-4f32));
+    // The modal entries are untouched and a base without a table still reads as before.
+    let plain = tiny_base();
+    let bytes = plain.to_bytes().unwrap();
+    let r = ModesFile::read_from(Cursor::new(bytes), Path::new("p.modes")).unwrap();
+    assert_eq!(r.transfer, None);
+    // Dropping every transfer entry gives back the plain base.
+    let bytes = without_entries(&base.to_bytes().unwrap(), &TRANSFER_ENTRIES_FOR_TEST);
+    let r = ModesFile::read_from(Cursor::new(bytes), Path::new("d.modes")).unwrap();
+    assert_eq!(r, plain);
+}
+
+const TRANSFER_ENTRIES_FOR_TEST: [&str; 6] = [
+    "transfer_vertices",
+    "transfer_peaks",
+    "transfer_h",
+    "transfer_rayleigh",
+    "transfer_modes",
+    "transfer_samples",
+];
+
+#[test]
+fn partial_transfer_table_names_the_missing_entry() {
+    let bytes = without_entries(&tiny_with_table().to_bytes().unwrap(), &["transfer_h"]);
+    let err = ModesFile::read_from(Cursor::new(bytes), Path::new("x.modes")).unwrap_err();
+    assert!(
+        matches!(
+            err,
+            FormatError::Missing {
+                entry: "transfer_h",
+                ..
+            }
+        ),
+        "{err}"
+    );
+}
+
+#[test]
+fn corrupted_transfer_table_is_rejected_with_a_clear_error() {
+    type Corrupt = fn(&mut TransferTable);
+    let cases: [(Corrupt, &str); 8] = [
+        (|t| t.peaks[2] = f32::NAN, "transfer_peaks[2]"),
+        (|t| t.peaks[4] = -1e-6, "transfer_peaks[4]"),
+        (|t| t.peaks[1] = f32::INFINITY, "transfer_peaks[1]"),
+        (|t| t.peaks.truncate(5), "expected nr(nr+1)/2 = 6"),
+        (|t| t.vertices[2] = 4, "names vertex 4"),
+        (|t| t.vertices = vec![0, 3, 1], "not strictly ascending"),
+        (|t| t.h = 0.0, "transfer_h"),
+        (|t| t.rayleigh[1] = f64::NAN, "transfer_rayleigh"),
+    ];
+    for (corrupt, needle) in cases {
+        let mut b = tiny_with_table();
+        corrupt(b.transfer.as_mut().unwrap());
+        // Written bypassing validation (as a hostile or buggy writer would).
+        let bytes = b.to_bytes().unwrap();
+        let err = ModesFile::read_from(Cursor::new(bytes), Path::new("c.modes")).unwrap_err();
+        let msg = err.to_string();
+        assert!(
+            matches!(err, FormatError::Invalid { .. }) && msg.contains(needle),
+            "{needle}: {msg}"
+        );
+        // And never written.
+        let dir = tempfile::tempdir().unwrap();
+        assert!(b.write_atomic(&dir.path().join("w.modes")).is_err());
+    }
 }

@@ -16,4 +16,21 @@ pub struct ContactResponse {
     pub delta_v: f64,
     /// `false`: the contact is farther than `max_map_distance` from the surface: zero response.
     pub mapped: bool,
+    /// Which method produced `peak_displacement` (the modal method also serves the contacts a
+    /// [`crate::Method::Transfer`] table cannot: outside its region, forces, h mismatch).
+    pub served_by: ServedBy,
+}
+
+/// The method that served one contact's response this step.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum ServedBy {
+    /// The truncated modal base (Eq. 9–13).
+    #[default]
+    Modal,
+    /// Spatial attenuation (Eq. 14–16).
+    Attenuation,
+    /// The base's bake-time peak-transfer table ([`crate::format::TransferTable`]).
+    TransferTable,
+    /// Not mapped to the surface: zero response.
+    Unmapped,
 }

@@ -11,10 +11,12 @@
 
 use std::sync::Arc;
 
-use super::peak_kernel::{panel_index, peak_abs_projection, BLOCK};
+mod transfer;
+
+use super::peak_kernel::{peak_abs_rows, LANES};
 use super::{
     ContactResponse, ForceInput, Impact, Method, ParamsError, ResponseParams, RestingContact,
-    StepInfo, Variant,
+    ServedBy, StepInfo, Variant,
 };
 use crate::attenuation::{
     AmplitudeKind, AttenuationParams, DistanceCache, DistanceKind, HeatWorkspace,
@@ -79,6 +81,12 @@ pub struct DistantResponse {
     bank: ModalBank,
     /// g_j(kT), row-major samples × m.
     g_table: Vec<f64>,
+    /// g_j(kT) mode-major (m × `stride`, samples padded with zeros): the kernel's layout.
+    g_t: Vec<f64>,
+    /// Sample stride of `g_t` / `q_t`: S rounded up to a multiple of [`LANES`].
+    stride: usize,
+    /// This step's q_j(kT) mode-major (m × `stride`) when the kernel needs it.
+    q_t: Vec<f64>,
     /// g_j(h) and ġ_j(h): the state at the end of a reset step per unit impulse.
     g_end: Vec<f64>,
     g_dot_end: Vec<f64>,
@@ -90,6 +98,7 @@ pub struct DistantResponse {
     cache: ContactCache,
     slots: Vec<u32>,
     chan: Vec<u32>,
+    /// The step's channel weights, mode-major (m × nch, one column per channel).
     w_step: Vec<f64>,
     /// (cache generation, slots) the current `w_step` was built for.
     w_key: (u64, Vec<u32>),
@@ -102,6 +111,8 @@ pub struct DistantResponse {
     energy_ref: f64,
     info: StepInfo,
     att: Option<AttenuationState>,
+    /// Transfer-table method state (`None`: not requested or the base's table does not apply).
+    transfer: Option<transfer::TransferState>,
 }
 
 fn invalid(field: &'static str, detail: impl Into<String>) -> ParamsError {
@@ -175,6 +186,13 @@ impl DistantResponse {
                 g_table[k * m + j] = f.impulse_response((k + 1) as f64 * period);
             }
         }
+        let stride = samples.div_ceil(LANES) * LANES;
+        let mut g_t = vec![0.0; m * stride];
+        for k in 0..samples {
+            for j in 0..m {
+                g_t[j * stride + k] = g_table[k * m + j];
+            }
+        }
         let g_end = g_table[(samples - 1) * m..].to_vec();
         let g_dot_end: Vec<f64> = bank
             .filters()
@@ -183,8 +201,12 @@ impl DistantResponse {
             .map(|(f, g)| f.free_response(p.h) - 2.0 * f.xi * f.omega * g)
             .collect();
         let att = match &p.method {
-            Method::Modal => None,
+            Method::Modal | Method::Transfer => None,
             Method::Attenuation(a) => Some(Self::attenuation_setup(&model, a, &g_table, samples)?),
+        };
+        let transfer = match p.method {
+            Method::Transfer => transfer::TransferState::new(&model, p.h, rayleigh, p.carry_over),
+            _ => None,
         };
         let remap_tolerance = 0.01 * model.mean_edge_length();
         Ok(DistantResponse {
@@ -194,6 +216,9 @@ impl DistantResponse {
             max_map,
             bank,
             g_table,
+            g_t,
+            stride,
+            q_t: vec![0.0; m * stride],
             g_end,
             g_dot_end,
             q_table: vec![0.0; samples * m],
@@ -215,6 +240,7 @@ impl DistantResponse {
             energy_ref: 0.0,
             info: StepInfo::default(),
             att,
+            transfer,
             model,
             params,
         })
@@ -414,11 +440,17 @@ impl DistantResponse {
                     }
                 });
         }
-        self.slots.clear();
-        for rc in resting {
-            let (s, mapped_now) =
-                self.cache
-                    .lookup(&self.model, rc.id, rc.point, step, self.max_map);
+        // Last step's slot at the same list position is tried first (contact lists repeat).
+        self.slots.resize(resting.len(), u32::MAX);
+        for (i, rc) in resting.iter().enumerate() {
+            let (s, mapped_now) = self.cache.lookup_with_hint(
+                &self.model,
+                rc.id,
+                rc.point,
+                step,
+                self.max_map,
+                self.slots[i],
+            );
             if mapped_now {
                 self.info.contacts_mapped_now += 1;
                 if let Some(a) = self.att.as_mut() {
@@ -428,11 +460,11 @@ impl DistantResponse {
             if self.cache.slot(s).surface.is_none() {
                 self.info.contacts_unmapped += 1;
             }
-            self.slots.push(s);
+            self.slots[i] = s;
         }
         if self.att.is_some() {
             self.step_attenuation(impacts, forces, resting);
-        } else {
+        } else if !self.step_transfer(impacts, forces, resting) {
             self.step_modal(impacts, forces, resting);
         }
         &self.out
@@ -503,12 +535,12 @@ impl DistantResponse {
                 self.chan.push(UNMAPPED);
             }
         }
-        let nch = (nmapped as usize * width).div_ceil(BLOCK) * BLOCK;
+        let nch = nmapped as usize * width;
         if self.peaks.len() < nch {
             self.peaks.resize(nch, 0.0);
         }
-        // Rebuild the step's mode-major channel matrix only when the contact list or the
-        // cache changed (steady state: resting contacts repeat step after step).
+        // Rebuild the step's channel weights only when the contact list or the cache changed
+        // (steady state: resting contacts repeat step after step).
         if self.w_key.0 != self.cache.generation() || self.w_key.1 != self.slots {
             self.w_key.0 = self.cache.generation();
             self.w_key.1.clear();
@@ -517,7 +549,6 @@ impl DistantResponse {
                 self.w_step.resize(nch * m, 0.0);
             }
             let w = &mut self.w_step[..nch * m];
-            w.iter_mut().for_each(|x| *x = 0.0);
             let rows = model.normal_mode_rows();
             for (&s, &c) in self.slots.iter().zip(&self.chan) {
                 if c == UNMAPPED {
@@ -528,12 +559,12 @@ impl DistantResponse {
                     for (corner, v) in model.triangle(sp.triangle).into_iter().enumerate() {
                         let col = c as usize * 3 + corner;
                         for (j, x) in rows[v * m..(v + 1) * m].iter().enumerate() {
-                            w[panel_index(col, j, m)] = *x;
+                            w[j * nch + col] = *x;
                         }
                     }
                 } else {
                     for (j, x) in self.cache.row(s).iter().enumerate() {
-                        w[panel_index(c as usize, j, m)] = *x;
+                        w[j * nch + c as usize] = *x;
                     }
                 }
             }
@@ -549,40 +580,42 @@ impl DistantResponse {
         let peaks = &mut peaks_buf[..nch];
         if active {
             let s = self.samples;
+            let stride = self.stride;
             if !carry && !have_force {
                 // Reset path: q(k) = g(kT) ∘ r. Fold r into whichever operand is smaller:
-                // the S × m table or the m × nch channel matrix.
-                if nch > 0 && s > nch {
+                // the S × m table or the m × nch channel weights. (The comparison uses nch
+                // rounded up to 8, as the earlier 8-channel-panel kernel did, so each
+                // workload keeps its rounding: results are bit-identical to that kernel.)
+                if nch > 0 && s > nch.div_ceil(8) * 8 {
                     if self.w_scaled.len() < nch * m {
                         self.w_scaled.resize(nch * m, 0.0);
                     }
                     let ws = &mut self.w_scaled[..nch * m];
-                    // Panel layout: rows of 8 channels, mode j = row index mod m.
-                    for (row, (dst, src)) in ws
-                        .chunks_exact_mut(BLOCK)
-                        .zip(self.w_step.chunks_exact(BLOCK))
-                        .enumerate()
+                    for ((dst, src), r) in ws
+                        .chunks_exact_mut(nch)
+                        .zip(self.w_step.chunks_exact(nch))
+                        .zip(&self.r)
                     {
-                        let r = self.r[row % m];
                         for (d, x) in dst.iter_mut().zip(src) {
                             *d = x * r;
                         }
                     }
-                    peak_abs_projection(&self.g_table, s, m, ws, nch, peaks);
-                    self.q_stale = true;
-                } else {
-                    self.fill_q_from_table();
-                    if nch > 0 {
-                        peak_abs_projection(
-                            &self.q_table,
-                            s,
-                            m,
-                            &self.w_step[..nch * m],
-                            nch,
-                            peaks,
-                        );
+                    peak_abs_rows(&self.g_t, stride, m, ws, nch, peaks);
+                } else if nch > 0 {
+                    for ((qj, gj), r) in self
+                        .q_t
+                        .chunks_exact_mut(stride)
+                        .zip(self.g_t.chunks_exact(stride))
+                        .zip(&self.r)
+                    {
+                        for (q, g) in qj.iter_mut().zip(gj) {
+                            *q = g * r;
+                        }
                     }
+                    peak_abs_rows(&self.q_t, stride, m, &self.w_step[..nch * m], nch, peaks);
                 }
+                // The row-major samples are filled on demand (`modal_samples`).
+                self.q_stale = true;
                 for j in 0..m {
                     self.tmp_q[j] = self.g_end[j] * self.r[j];
                     self.tmp_v[j] = self.g_dot_end[j] * self.r[j];
@@ -596,7 +629,12 @@ impl DistantResponse {
                 self.bank.run(s, force, &mut self.q_table);
                 self.q_stale = false;
                 if nch > 0 {
-                    peak_abs_projection(&self.q_table, s, m, &self.w_step[..nch * m], nch, peaks);
+                    for (k, qk) in self.q_table[..s * m].chunks_exact(m).enumerate() {
+                        for (j, &q) in qk.iter().enumerate() {
+                            self.q_t[j * stride + k] = q;
+                        }
+                    }
+                    peak_abs_rows(&self.q_t, stride, m, &self.w_step[..nch * m], nch, peaks);
                 }
             }
             if carry {
@@ -640,6 +678,7 @@ impl DistantResponse {
                         peak_displacement: d,
                         delta_v: d / h,
                         mapped: true,
+                        served_by: ServedBy::Modal,
                     }
                 }
                 _ => unmapped_response(rc),
@@ -721,6 +760,7 @@ impl DistantResponse {
                 peak_displacement: total,
                 delta_v: total / h,
                 mapped: true,
+                served_by: ServedBy::Attenuation,
             });
         }
         att.hits = hits;
@@ -735,5 +775,6 @@ fn unmapped_response(rc: &RestingContact) -> ContactResponse {
         peak_displacement: 0.0,
         delta_v: 0.0,
         mapped: false,
+        served_by: ServedBy::Unmapped,
     }
 }

@@ -12,12 +12,12 @@ mod response_params;
 mod resting_contact;
 mod step_info;
 
-pub use contact_response::ContactResponse;
+pub use contact_response::{ContactResponse, ServedBy};
 pub use distant_response::DistantResponse;
 pub use effective_mass::{effective_mass, response_impulse};
 pub use force_input::ForceInput;
 pub use impact::Impact;
-pub use peak_kernel::peak_abs_projection;
+pub use peak_kernel::{peak_abs_projection, peak_abs_rows};
 pub use response_params::{Method, ParamsError, ResponseParams, Variant};
 pub use resting_contact::RestingContact;
 pub use step_info::StepInfo;

@@ -21,6 +21,18 @@ pub enum Method {
     Modal,
     /// Spatial attenuation of a local amplitude (Eq. 14–16).
     Attenuation(AttenuationParams),
+    /// The base's bake-time peak-transfer table (many modes, `modal-bake bake --transfer-h`):
+    /// `d = Σ λ_N Σ_a Σ_b β_a β_b T[a][b]` (normal impulse component only; several impacts'
+    /// peaks are summed, an upper bound). Falls back to [`Method::Modal`] — per step, reported
+    /// in `ContactResponse::served_by` — when the base has no table, its h or Rayleigh damping
+    /// differs (relative tolerance 1e-9), `carry_over` is on, the step has forces, or an impact
+    /// (whole step) or a contact (that contact) is outside the table's region. `sampling` and
+    /// `variant` do not apply to table-served contacts (the table fixed its own sampling; the
+    /// receiver-side blend is Eq. 13's per-node form). Measured (docs/accuracy.md): equal to
+    /// the many-mode sum at region vertices and 1.5–2× cheaper than the 20-mode query, but
+    /// blending peaks inside triangles over-estimates (up to +38 % on the table, +214 % on the
+    /// coarse ground slab), so it is opt-in; the default stays [`Method::Modal`].
+    Transfer,
 }
 
 /// Parameters of a [`crate::DistantResponse`].

@@ -21,4 +21,9 @@ pub struct StepInfo {
     pub distance_fields_computed: u32,
     /// The filter bank was asleep (carry-over mode): no work, zero output.
     pub asleep: bool,
+    /// Resting contacts whose response came from the transfer table ([`crate::Method::Transfer`]).
+    pub contacts_by_table: u32,
+    /// Resting contacts the transfer table could not serve this step (impact or contact outside
+    /// its region, or a force input), served by the modal method instead.
+    pub contacts_table_fallback: u32,
 }

@@ -247,6 +247,7 @@ pub fn synthetic_base(surface: Surface, omega: &[f64], rayleigh: [f64; 2], seed:
             reoriented_tets: 0,
         },
         precision: ModesPrecision::F64,
+        transfer: None,
     }
 }
 

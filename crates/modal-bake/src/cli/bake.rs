@@ -9,6 +9,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use modal_bake::bake::{
     self, BakeParams, BakeReport, BakeStage, MaterialSi, ModeRequest, ModesPrecision,
 };
+use modal_bake::transfer::{TransferModes, TransferParams};
 
 use super::parse;
 
@@ -99,6 +100,58 @@ pub struct BakeArgs {
     /// Print the bake report as one JSON object on stdout.
     #[arg(long)]
     pub json: bool,
+    #[command(flatten)]
+    pub transfer: TransferOptions,
+}
+
+/// The optional bake-time peak-transfer table (`dcr_runtime::Method::Transfer`).
+#[derive(Args, Clone, Debug)]
+pub struct TransferOptions {
+    /// Also store a peak-transfer table for this rigid-body step h (s): the peak normal
+    /// displacement at every region vertex per unit normal impulse at every other, with many
+    /// modes. The runtime uses it only for this h and the base's Rayleigh damping.
+    #[arg(long, value_name = "SECONDS", allow_hyphen_values = true)]
+    pub transfer_h: Option<f64>,
+    /// Modes the table sums: a count or `all` (dense eigensolve; small meshes) [default: 640].
+    #[arg(long, value_name = "N|all", requires = "transfer_h", value_parser = parse_modes)]
+    pub transfer_modes: Option<TransferModes>,
+    /// Region box (m, object frame), repeatable: surface vertices inside any box [default: the
+    /// whole surface].
+    #[arg(long, value_name = "XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX", requires = "transfer_h", value_parser = parse::aabb, allow_hyphen_values = true)]
+    pub transfer_region: Vec<[f64; 6]>,
+    /// Keep only region vertices whose outward normal is within 60° of this direction (e.g.
+    /// `0,0,1` for the top faces).
+    #[arg(long, value_name = "DX,DY,DZ", requires = "transfer_h", value_parser = parse::vec3, allow_hyphen_values = true)]
+    pub transfer_up: Option<[f64; 3]>,
+    /// Peak-search oversampling of the table: T = π/(2 ω_max)/K for its highest mode [default: 2].
+    #[arg(long, value_name = "K", requires = "transfer_h")]
+    pub transfer_oversample: Option<f64>,
+}
+
+fn parse_modes(s: &str) -> Result<TransferModes, String> {
+    if s.eq_ignore_ascii_case("all") {
+        return Ok(TransferModes::All);
+    }
+    match s.trim().parse::<usize>() {
+        Ok(n) if n >= 1 => Ok(TransferModes::Count(n)),
+        _ => Err(format!("expected a mode count ≥ 1 or `all`, got `{s}`")),
+    }
+}
+
+impl TransferOptions {
+    /// The table's parameters, `None` without `--transfer-h`.
+    pub fn params(&self) -> Option<TransferParams> {
+        let h = self.transfer_h?;
+        let d = TransferParams::default();
+        Some(TransferParams {
+            h,
+            modes: self.transfer_modes.unwrap_or(d.modes),
+            boxes: self.transfer_region.clone(),
+            up: self.transfer_up,
+            oversample: self.transfer_oversample.unwrap_or(d.oversample),
+            ..d
+        })
+    }
 }
 
 /// A spinner per stage, a bar for the eigensolve; hidden when stderr is not a terminal.
@@ -132,6 +185,24 @@ impl Progress {
                 self.bar
                     .set_message(format!("Lanczos step {}", p.iteration));
             }
+            BakeStage::TransferModes => {
+                self.bar.set_style(ProgressStyle::default_spinner());
+                self.bar
+                    .set_message("solving for the transfer table's modes");
+            }
+            BakeStage::Transfer(p) => {
+                if self.bar.length() != Some(p.total as u64) {
+                    self.bar.set_style(
+                        ProgressStyle::with_template(
+                            "{spinner} transfer table [{bar:30}] {pos}/{len} rows ({eta} left)",
+                        )
+                        .unwrap_or_else(|_| ProgressStyle::default_bar())
+                        .progress_chars("=> "),
+                    );
+                    self.bar.set_length(p.total as u64);
+                }
+                self.bar.set_position(p.done as u64);
+            }
             BakeStage::Write => {
                 self.bar.set_style(ProgressStyle::default_spinner());
                 self.bar.set_message("writing");
@@ -143,7 +214,14 @@ impl Progress {
 pub fn run(args: &BakeArgs) -> anyhow::Result<()> {
     let params = args.options.params();
     let mut progress = Progress::new();
-    let report = bake::bake_file(&args.mesh, &params, &args.out, &mut |s| progress.update(s));
+    let transfer = args.transfer.params();
+    let report = bake::bake_file_with_transfer(
+        &args.mesh,
+        &params,
+        transfer.as_ref(),
+        &args.out,
+        &mut |s| progress.update(s),
+    );
     progress.bar.finish_and_clear();
     let report = report
         .with_context(|| format!("baking {} failed; nothing was written", args.mesh.display()))?;
@@ -154,13 +232,21 @@ pub fn run(args: &BakeArgs) -> anyhow::Result<()> {
     }
     if args.timings {
         eprintln!(
-            "timings (s): read {:.3}  assemble {:.3}  factor {:.3}  eigensolve {:.3}  write {:.3}  total {:.3}",
+            "timings (s): read {:.3}  assemble {:.3}  factor {:.3}  eigensolve {:.3}  transfer modes {:.3}  transfer table {:.3}  write {:.3}  total {:.3}",
             report.read_s,
             report.assemble_s,
             report.factor_s,
             report.eigensolve_s,
+            report.transfer_modes_s,
+            report.transfer_s,
             report.write_s,
-            report.read_s + report.assemble_s + report.factor_s + report.eigensolve_s + report.write_s
+            report.read_s
+                + report.assemble_s
+                + report.factor_s
+                + report.eigensolve_s
+                + report.transfer_modes_s
+                + report.transfer_s
+                + report.write_s
         );
     }
     Ok(())
@@ -205,4 +291,14 @@ fn print_report(out: &std::path::Path, r: &BakeReport) {
         r.frequencies_hz.last().copied().unwrap_or(0.0),
         worst
     );
+    if r.transfer_vertices > 0 {
+        outln!(
+            "  transfer table: {} region vertices, {} modes ({}), {} samples per step, built in {:.2} s",
+            r.transfer_vertices,
+            r.transfer_modes,
+            r.transfer_mode_source,
+            r.transfer_samples,
+            r.transfer_modes_s + r.transfer_s
+        );
+    }
 }

@@ -42,6 +42,15 @@ pub fn run(args: &InfoArgs) -> anyhow::Result<()> {
             "rayleigh": base.rayleigh,
             "precision": base.precision,
             "bake_params": base.meta.bake_params,
+            "transfer": base.transfer.as_ref().map(|t| serde_json::json!({
+                "h_s": t.h,
+                "rayleigh": t.rayleigh,
+                "modes": t.modes,
+                "samples": t.samples,
+                "region_vertices": t.len(),
+                "packed_values": t.peaks.len(),
+                "max_peak_m_per_ns": t.peaks.iter().fold(0.0f32, |a, &b| a.max(b)),
+            })),
         });
         super::emit(&format!("{}\n", serde_json::to_string_pretty(&v)?));
         return Ok(());
@@ -86,6 +95,22 @@ pub fn run(args: &InfoArgs) -> anyhow::Result<()> {
         base.rayleigh[0], base.rayleigh[1]
     )?;
     writeln!(out, "  geometry hash: {}", base.meta.source_hash)?;
+    match &base.transfer {
+        Some(t) => writeln!(
+            out,
+            "  transfer table: {} region vertices ({} f32 values, {:.1} KiB), h {} s, {} modes, {} samples per step, Rayleigh α0 {} α1 {}, largest peak {:.4e} m per N·s",
+            t.len(),
+            t.peaks.len(),
+            t.peaks.len() as f64 * 4.0 / 1024.0,
+            t.h,
+            t.modes,
+            t.samples,
+            t.rayleigh[0],
+            t.rayleigh[1],
+            t.peaks.iter().fold(0.0f32, |a, &b| a.max(b))
+        )?,
+        None => writeln!(out, "  transfer table: none")?,
+    }
     writeln!(out, "  {} modes:", base.num_modes())?;
     writeln!(out, "     #   freq (Hz)      λ (rad²/s²)    residual")?;
     for (j, (&l, f)) in base.eigenvalues.iter().zip(&freqs).enumerate() {

@@ -22,6 +22,20 @@ pub fn pair(s: &str) -> Result<[f64; 2], String> {
     }
 }
 
+/// Parses `XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX` (six finite numbers, min ≤ max per axis).
+pub fn aabb(s: &str) -> Result<[f64; 6], String> {
+    let v = list(s)?;
+    match v.as_slice() {
+        [a, b, c, d, e, f] if a <= d && b <= e && c <= f => Ok([*a, *b, *c, *d, *e, *f]),
+        [_, _, _, _, _, _] => Err(format!(
+            "box `{s}`: each minimum must be ≤ its maximum (XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX)"
+        )),
+        _ => Err(format!(
+            "expected six comma-separated numbers XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX, got `{s}`"
+        )),
+    }
+}
+
 fn list(s: &str) -> Result<Vec<f64>, String> {
     s.split(',')
         .map(|t| {

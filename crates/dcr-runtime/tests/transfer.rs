@@ -1,0 +1,291 @@
+//! `Method::Transfer`: the base's bake-time peak-transfer table looked up at run time.
+//!
+//! Expectations: at region vertices the response is the table entry × the normal impulse
+//! (exactly, up to f32 → f64); inside triangles it is the barycentric blend Σ β_a β_b T[a][b];
+//! several impacts add; only the normal impulse component counts; contacts outside the region
+//! are served by the modal method (same values as `Method::Modal`), and every step falls back to
+//! the modal method when an impact is outside the region, the step has forces, or h, Rayleigh
+//! damping or carry-over do not match the table.
+
+use std::sync::Arc;
+
+use dcr_runtime::format::{ModesFile, TransferTable};
+use dcr_runtime::testing::{plate_base, SplitMix64};
+use dcr_runtime::{
+    DistantResponse, ForceInput, Impact, Method, ModalModel, ResponseParams, RestingContact,
+    ServedBy,
+};
+
+const H: f64 = 0.01;
+
+/// The plate base (z = 0, normals +z) with a synthetic symmetric table over the vertices with
+/// x ≤ 0.5 m (whole grid cells: the plate's column 6 of 12 is at x = 0.5).
+fn base_with_table() -> ModesFile {
+    let mut b = plate_base();
+    let vertices: Vec<u32> = (0..b.surface_vertices.len())
+        .filter(|&v| b.surface_vertices[v][0] <= 0.5 + 1e-12)
+        .map(|v| v as u32)
+        .collect();
+    let nr = vertices.len();
+    let mut peaks = Vec::with_capacity(TransferTable::packed_len(nr));
+    for i in 0..nr {
+        for j in i..nr {
+            peaks.push(1e-5 * (1.0 + ((i * 7 + j * 13) % 17) as f32));
+        }
+    }
+    b.transfer = Some(TransferTable {
+        h: H,
+        rayleigh: b.rayleigh,
+        modes: 100,
+        samples: 400,
+        vertices,
+        peaks,
+    });
+    b
+}
+
+fn params(method: Method) -> ResponseParams {
+    ResponseParams {
+        h: H,
+        method,
+        ..Default::default()
+    }
+}
+
+fn region_index(t: &TransferTable, v: usize) -> usize {
+    t.vertices.binary_search(&(v as u32)).expect("in region")
+}
+
+fn vertex_contacts(model: &ModalModel, vs: &[usize]) -> Vec<RestingContact> {
+    vs.iter()
+        .enumerate()
+        .map(|(k, &v)| RestingContact {
+            id: k as u64,
+            point: model.base().surface_vertices[v],
+        })
+        .collect()
+}
+
+#[test]
+fn lookup_at_vertices_reproduces_the_table() {
+    let model = Arc::new(ModalModel::from_base(base_with_table()).unwrap());
+    let t = model.base().transfer.clone().unwrap();
+    let mut dr = DistantResponse::new(model.clone(), params(Method::Transfer)).unwrap();
+    assert!(dr.transfer_active());
+    let vs: Vec<usize> = t.vertices.iter().map(|&v| v as usize).step_by(5).collect();
+    let resting = vertex_contacts(&model, &vs);
+    for &src in &vs[..4] {
+        let imp = [Impact {
+            point: model.base().surface_vertices[src],
+            direction: [0.0, 0.0, -1.0],
+            impulse: 2.5,
+        }];
+        let out = dr.step(&imp, &resting).to_vec();
+        let info = dr.last_step_info();
+        assert_eq!(info.contacts_by_table as usize, resting.len());
+        assert_eq!(info.impacts_applied, 1);
+        for (o, &dst) in out.iter().zip(&vs) {
+            assert_eq!(o.served_by, ServedBy::TransferTable);
+            let want = 2.5 * t.peak(region_index(&t, src), region_index(&t, dst));
+            assert!(
+                (o.peak_displacement - want).abs() <= 1e-12 * want,
+                "{src}→{dst}: {} vs {want}",
+                o.peak_displacement
+            );
+            assert!((o.delta_v - o.peak_displacement / H).abs() <= 1e-15);
+        }
+    }
+}
+
+#[test]
+fn inside_triangles_is_the_barycentric_blend_and_impacts_add() {
+    let model = Arc::new(ModalModel::from_base(base_with_table()).unwrap());
+    let t = model.base().transfer.clone().unwrap();
+    let mut dr = DistantResponse::new(model.clone(), params(Method::Transfer)).unwrap();
+    let mut rng = SplitMix64(5);
+    let mut pt = || [rng.range(0.0, 0.5), rng.range(0.0, 0.6), 0.0];
+    let resting: Vec<RestingContact> = (0..12)
+        .map(|i| RestingContact { id: i, point: pt() })
+        .collect();
+    let imps: Vec<Impact> = (0..3)
+        .map(|k| Impact {
+            point: pt(),
+            // Tilted: only the normal component (0.8) counts.
+            direction: if k == 1 {
+                [0.6, 0.0, -0.8]
+            } else {
+                [0.0, 0.0, -1.0]
+            },
+            impulse: 1.0 + k as f64,
+        })
+        .collect();
+    let blend = |a: [f64; 3], b: [f64; 3]| {
+        let sa = model.project(a, 1.0).unwrap();
+        let sb = model.project(b, 1.0).unwrap();
+        let (ta, tb) = (model.triangle(sa.triangle), model.triangle(sb.triangle));
+        let mut p = 0.0;
+        for (&va, ba) in ta.iter().zip(sa.bary) {
+            for (&vb, bb) in tb.iter().zip(sb.bary) {
+                p += ba * bb * t.peak(region_index(&t, va), region_index(&t, vb));
+            }
+        }
+        p
+    };
+    let out = dr.step(&imps, &resting).to_vec();
+    for (o, rc) in out.iter().zip(&resting) {
+        assert_eq!(o.served_by, ServedBy::TransferTable);
+        let want: f64 = imps
+            .iter()
+            .enumerate()
+            .map(|(k, imp)| {
+                let normal = if k == 1 { 0.8 } else { 1.0 };
+                imp.impulse * normal * blend(imp.point, rc.point)
+            })
+            .sum();
+        assert!(
+            (o.peak_displacement - want).abs() <= 1e-12 * want,
+            "{} vs {want}",
+            o.peak_displacement
+        );
+    }
+    // The blend is not the value at a vertex: it must move with the point.
+    assert!((out[0].peak_displacement - out[1].peak_displacement).abs() > 0.0);
+}
+
+/// Steps the same input through a `Method::Modal` instance for comparison.
+fn modal_out(
+    model: &Arc<ModalModel>,
+    p: ResponseParams,
+    imp: &[Impact],
+    rc: &[RestingContact],
+) -> Vec<f64> {
+    let mut dr = DistantResponse::new(
+        model.clone(),
+        ResponseParams {
+            method: Method::Modal,
+            ..p
+        },
+    )
+    .unwrap();
+    dr.step(imp, rc)
+        .iter()
+        .map(|o| o.peak_displacement)
+        .collect()
+}
+
+#[test]
+fn outside_the_region_falls_back_to_the_modal_method() {
+    let model = Arc::new(ModalModel::from_base(base_with_table()).unwrap());
+    let mut dr = DistantResponse::new(model.clone(), params(Method::Transfer)).unwrap();
+    let inside = RestingContact {
+        id: 1,
+        point: [0.2, 0.3, 0.0],
+    };
+    let outside = RestingContact {
+        id: 2,
+        point: [0.9, 0.3, 0.0],
+    };
+    let resting = [inside, outside];
+    let imp_in = [Impact {
+        point: [0.3, 0.2, 0.0],
+        direction: [0.0, 0.0, -1.0],
+        impulse: 3.0,
+    }];
+    let modal = modal_out(&model, params(Method::Modal), &imp_in, &resting);
+    let out = dr.step(&imp_in, &resting).to_vec();
+    assert_eq!(out[0].served_by, ServedBy::TransferTable);
+    assert_eq!(out[1].served_by, ServedBy::Modal);
+    assert_eq!(out[1].peak_displacement, modal[1]);
+    assert_ne!(out[0].peak_displacement, modal[0]);
+    let info = dr.last_step_info();
+    assert_eq!(
+        (info.contacts_by_table, info.contacts_table_fallback),
+        (1, 1)
+    );
+    assert_eq!(info.impacts_applied, 1);
+
+    // An impact outside the region: the whole step is modal.
+    let imp_out = [Impact {
+        point: [0.8, 0.2, 0.0],
+        direction: [0.0, 0.0, -1.0],
+        impulse: 3.0,
+    }];
+    let modal = modal_out(&model, params(Method::Modal), &imp_out, &resting);
+    let out = dr.step(&imp_out, &resting).to_vec();
+    assert!(out.iter().all(|o| o.served_by == ServedBy::Modal));
+    assert_eq!(
+        out.iter().map(|o| o.peak_displacement).collect::<Vec<_>>(),
+        modal
+    );
+    assert_eq!(dr.last_step_info().contacts_by_table, 0);
+
+    // Forces: modal.
+    let f = [ForceInput {
+        point: [0.2, 0.2, 0.0],
+        force: [0.0, 0.0, -1.0],
+    }];
+    let out = dr.step_with_forces(&imp_in, &f, &resting).to_vec();
+    assert!(out.iter().all(|o| o.served_by == ServedBy::Modal));
+
+    // Back in the region: the table again.
+    let out = dr.step(&imp_in, &[inside]).to_vec();
+    assert_eq!(out[0].served_by, ServedBy::TransferTable);
+}
+
+#[test]
+fn mismatched_h_rayleigh_or_carry_over_use_the_modal_method() {
+    let model = Arc::new(ModalModel::from_base(base_with_table()).unwrap());
+    let plain = Arc::new(ModalModel::from_base(plate_base()).unwrap());
+    let resting = [RestingContact {
+        id: 1,
+        point: [0.2, 0.3, 0.0],
+    }];
+    let imp = [Impact {
+        point: [0.3, 0.2, 0.0],
+        direction: [0.0, 0.0, -1.0],
+        impulse: 3.0,
+    }];
+    let base_r = model.base().rayleigh;
+    let cases = [
+        (
+            model.clone(),
+            ResponseParams {
+                h: H * (1.0 + 1e-6),
+                ..params(Method::Transfer)
+            },
+        ),
+        (
+            model.clone(),
+            ResponseParams {
+                rayleigh: Some([base_r[0] * 2.0, base_r[1]]),
+                ..params(Method::Transfer)
+            },
+        ),
+        (
+            model.clone(),
+            ResponseParams {
+                carry_over: true,
+                ..params(Method::Transfer)
+            },
+        ),
+        (plain.clone(), params(Method::Transfer)),
+    ];
+    for (k, (m, p)) in cases.into_iter().enumerate() {
+        let mut dr = DistantResponse::new(m.clone(), p.clone()).unwrap();
+        assert!(!dr.transfer_active(), "case {k}");
+        let want = modal_out(&m, p, &imp, &resting);
+        let out = dr.step(&imp, &resting).to_vec();
+        assert_eq!(out[0].served_by, ServedBy::Modal, "case {k}");
+        assert_eq!(out[0].peak_displacement, want[0], "case {k}");
+    }
+    // Within the 1e-9 tolerance the table applies.
+    let dr = DistantResponse::new(
+        model,
+        ResponseParams {
+            h: H * (1.0 + 1e-12),
+            ..params(Method::Transfer)
+        },
+    )
+    .unwrap();
+    assert!(dr.transfer_active());
+}

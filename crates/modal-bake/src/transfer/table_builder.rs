@@ -1,0 +1,305 @@
+//! [`build_transfer_table`] and the mode sets it takes.
+
+use dcr_runtime::format::{ModesFile, TransferTable, MAX_TRANSFER_VERTICES};
+use dcr_runtime::{damping_ratio, samples_per_step, ModalModel, ModeFilter, Sampling};
+use faer::linalg::matmul::matmul;
+use faer::{Accum, Mat, Par};
+use rayon::prelude::*;
+
+use crate::bake::{bake_mesh, BakeError, BakeParams, ModeRequest};
+use crate::mesh::TetMesh;
+use crate::truth::{ModalAll, TruthError, TruthParams, TruthSystem};
+
+/// Default oversampling of the table's peak search: T = π/(2 ω_max)/2 for its highest mode.
+pub const DEFAULT_OVERSAMPLE: f64 = 2.0;
+
+/// Meshes with at most this many free dofs get their table's modes from the dense all-mode
+/// eigensolve; larger ones from a Lanczos bake.
+pub const DENSE_MAX_DOFS: usize = 6000;
+
+/// Default normal filter for `up`: a vertex is kept when n·û ≥ 0.5 (within 60°), so the edge
+/// vertices of a face (normals averaged with the side faces) stay in the region.
+pub const UP_MIN_COS: f64 = 0.5;
+
+/// How many modes the table sums.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TransferModes {
+    /// The lowest n elastic modes.
+    Count(usize),
+    /// Every elastic mode (dense eigensolve: small meshes only).
+    All,
+}
+
+/// What to tabulate (SI units, object frame).
+#[derive(Clone, Debug, PartialEq)]
+pub struct TransferParams {
+    /// Rigid-body step h (s) the peaks are taken over; the runtime uses the table only for
+    /// this h (relative tolerance 1e-9).
+    pub h: f64,
+    /// Modes summed. Default 640.
+    pub modes: TransferModes,
+    /// Region boxes (m): vertices inside any of them (empty: no box filter).
+    pub boxes: Vec<[f64; 6]>,
+    /// Normal filter: keep vertices with n·û ≥ `up_min_cos` (`None`: no filter).
+    pub up: Option<[f64; 3]>,
+    /// Cosine threshold of the normal filter. Default [`UP_MIN_COS`].
+    pub up_min_cos: f64,
+    /// Peak-search oversampling K ≥ 1: T = π/(2 ω_max)/K for the table's highest mode.
+    /// Default [`DEFAULT_OVERSAMPLE`].
+    pub oversample: f64,
+}
+
+impl Default for TransferParams {
+    fn default() -> Self {
+        TransferParams {
+            h: 0.01,
+            modes: TransferModes::Count(640),
+            boxes: Vec::new(),
+            up: None,
+            up_min_cos: UP_MIN_COS,
+            oversample: DEFAULT_OVERSAMPLE,
+        }
+    }
+}
+
+impl TransferParams {
+    /// Checks ranges.
+    ///
+    /// # Errors
+    /// [`TransferError::Params`] naming the option.
+    pub fn check(&self) -> Result<(), TransferError> {
+        let bad = |s: String| Err(TransferError::Params(s));
+        if !(self.h.is_finite() && self.h > 0.0) {
+            return bad(format!(
+                "--transfer-h must be a positive step in seconds, got {}",
+                self.h
+            ));
+        }
+        if self.modes == TransferModes::Count(0) {
+            return bad("--transfer-modes must be at least 1".into());
+        }
+        for b in &self.boxes {
+            if !b.iter().all(|x| x.is_finite()) || (0..3).any(|k| b[k] > b[k + 3]) {
+                return bad(format!(
+                    "--transfer-region {b:?}: expected finite xmin,ymin,zmin,xmax,ymax,zmax with min ≤ max"
+                ));
+            }
+        }
+        if let Some(u) = self.up {
+            let l = (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt();
+            if !(l.is_finite() && l > 0.0) {
+                return bad(format!(
+                    "--transfer-up {u:?}: expected a finite non-zero direction"
+                ));
+            }
+        }
+        if !(self.up_min_cos.is_finite() && self.up_min_cos.abs() <= 1.0) {
+            return bad(format!(
+                "normal-filter cosine {} must be in [-1, 1]",
+                self.up_min_cos
+            ));
+        }
+        if !(self.oversample.is_finite() && self.oversample >= 1.0) {
+            return bad(format!("oversampling {} must be ≥ 1", self.oversample));
+        }
+        Ok(())
+    }
+}
+
+/// Progress of a table build: source rows done of total.
+#[derive(Clone, Copy, Debug)]
+pub struct TransferProgress {
+    /// Rows done.
+    pub done: usize,
+    /// Rows in all.
+    pub total: usize,
+}
+
+/// Why a table could not be built.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum TransferError {
+    /// Invalid options or an unusable region.
+    #[error("transfer table: {0}")]
+    Params(String),
+    /// The dense eigensolve for the table's modes failed.
+    #[error("transfer table modes: {0}")]
+    Truth(#[from] TruthError),
+    /// The Lanczos bake for the table's modes failed.
+    #[error("transfer table modes: {0}")]
+    Bake(Box<BakeError>),
+}
+
+/// A base-shaped mode set (surface rows of U) of the lowest `modes` dense eigenpairs, in the
+/// layout of `template` (a base baked from the same mesh and options: same surface order).
+///
+/// # Errors
+/// [`TransferError::Truth`] when the system cannot be built or the dense eigensolve fails
+/// (including more than [`DENSE_MAX_DOFS`] free dofs).
+pub fn mode_set_dense(
+    template: &ModesFile,
+    mesh: &TetMesh,
+    params: &BakeParams,
+    modes: TransferModes,
+    file: &str,
+) -> Result<ModesFile, TransferError> {
+    let tp = TruthParams {
+        material: params.material,
+        fixed: params.fixed.clone(),
+        rayleigh: params.rayleigh,
+        lumped: params.lumped,
+        ..Default::default()
+    };
+    let sys = TruthSystem::new(mesh.clone(), &tp, file)?;
+    let ma = ModalAll::new(&sys, DENSE_MAX_DOFS)?;
+    let m = match modes {
+        TransferModes::All => ma.eigenvalues.len(),
+        TransferModes::Count(n) => n.min(ma.eigenvalues.len()),
+    };
+    let mut b = template.clone();
+    let mut rows = Vec::with_capacity(b.surface_to_volume.len() * 3 * m);
+    for &v in &b.surface_to_volume {
+        for ax in 0..3 {
+            match sys.map.free_index(3 * v as usize + ax) {
+                Some(i) => rows.extend((0..m).map(|j| ma.vectors[(i, j)])),
+                None => rows.extend(std::iter::repeat_n(0.0, m)),
+            }
+        }
+    }
+    b.modes = rows;
+    b.eigenvalues = ma.eigenvalues[..m].to_vec();
+    b.residuals = vec![0.0; m];
+    b.transfer = None;
+    Ok(b)
+}
+
+/// A mode set of the lowest `n` modes from a Lanczos bake of `mesh` with `params`.
+///
+/// # Errors
+/// [`TransferError::Bake`] when that bake fails (e.g. the eigensolver does not converge).
+pub fn mode_set_lanczos(
+    mesh: &TetMesh,
+    params: &BakeParams,
+    n: usize,
+    file: &str,
+) -> Result<ModesFile, TransferError> {
+    let p = BakeParams {
+        modes: ModeRequest::Count(n),
+        ..params.clone()
+    };
+    bake_mesh(mesh.clone(), &p, file, &mut |_| {})
+        .map(|(b, _)| b)
+        .map_err(|e| TransferError::Bake(Box::new(e)))
+}
+
+/// Builds the table over the region selected by `params` from the mode set `modes` (a base
+/// with many modes; its own Rayleigh damping is ignored in favour of `rayleigh`).
+///
+/// # Errors
+/// [`TransferError::Params`] for invalid parameters, an empty region, or one larger than
+/// [`MAX_TRANSFER_VERTICES`].
+pub fn build_transfer_table(
+    modes: &ModesFile,
+    params: &TransferParams,
+    rayleigh: [f64; 2],
+    progress: &mut dyn FnMut(TransferProgress),
+) -> Result<TransferTable, TransferError> {
+    params.check()?;
+    let m = match params.modes {
+        TransferModes::All => modes.num_modes(),
+        TransferModes::Count(n) => n.min(modes.num_modes()),
+    };
+    let mut set = modes.clone();
+    set.transfer = None;
+    let model =
+        ModalModel::from_base(set).map_err(|e| TransferError::Params(format!("mode set: {e}")))?;
+    let region = super::select_region(&model, &params.boxes, params.up, params.up_min_cos);
+    let nr = region.len();
+    if nr == 0 {
+        return Err(TransferError::Params(
+            "the region (--transfer-region / --transfer-up) selects no surface vertex".into(),
+        ));
+    }
+    if nr > MAX_TRANSFER_VERTICES {
+        return Err(TransferError::Params(format!(
+            "the region selects {nr} surface vertices, more than the {MAX_TRANSFER_VERTICES} supported; restrict it with --transfer-region / --transfer-up"
+        )));
+    }
+    let mm = model.num_modes();
+    let omega = &model.omega()[..m];
+    let t_req = Sampling::Oversample(params.oversample).period(omega[m - 1]);
+    if params.h / t_req > 1e7 {
+        return Err(TransferError::Params(format!(
+            "{:.0} samples per step (h/T) exceed the limit of 1e7; lower --transfer-modes or --transfer-h",
+            params.h / t_req
+        )));
+    }
+    let s = samples_per_step(params.h, t_req);
+    let period = params.h / s as f64;
+    // G (S × m): g_l(kT), the exact impulse response the runtime uses.
+    let filters: Vec<ModeFilter> = omega
+        .iter()
+        .map(|&w| ModeFilter::new(w, damping_ratio(w, rayleigh), period))
+        .collect();
+    let g = Mat::from_fn(s, m, |k, l| {
+        filters[l].impulse_response((k + 1) as f64 * period)
+    });
+    // W (m × nr): normal rows of the region vertices, one column per vertex.
+    let rows = model.normal_mode_rows();
+    let w = Mat::from_fn(m, nr, |l, c| rows[region[c] as usize * mm + l]);
+
+    let mut peaks = vec![0.0f32; TransferTable::packed_len(nr)];
+    let chunk = 16usize;
+    let mut done = 0;
+    progress(TransferProgress { done, total: nr });
+    for start in (0..nr).step_by(chunk) {
+        let end = (start + chunk).min(nr);
+        let block: Vec<Vec<f32>> = (start..end)
+            .into_par_iter()
+            .map_init(
+                || (Mat::<f64>::zeros(s, m), Mat::<f64>::zeros(s, nr)),
+                |(a, y), i| {
+                    for l in 0..m {
+                        let wi = w[(l, i)];
+                        for k in 0..s {
+                            a[(k, l)] = g[(k, l)] * wi;
+                        }
+                    }
+                    let cols = nr - i;
+                    matmul(
+                        y.as_mut().subcols_mut(0, cols),
+                        Accum::Replace,
+                        a.as_ref(),
+                        w.as_ref().subcols(i, cols),
+                        1.0,
+                        Par::Seq,
+                    );
+                    (0..cols)
+                        .map(|c| {
+                            let col = y.col(c);
+                            (0..s).fold(0.0f64, |p, k| p.max(col[k].abs())) as f32
+                        })
+                        .collect()
+                },
+            )
+            .collect();
+        for (i, row) in (start..end).zip(block) {
+            let at = i * (2 * nr - i + 1) / 2;
+            peaks[at..at + row.len()].copy_from_slice(&row);
+        }
+        done = end;
+        progress(TransferProgress { done, total: nr });
+    }
+    let table = TransferTable {
+        h: params.h,
+        rayleigh,
+        modes: m as u32,
+        samples: s as u32,
+        vertices: region,
+        peaks,
+    };
+    table
+        .check(modes.num_surface_vertices())
+        .map_err(TransferError::Params)?;
+    Ok(table)
+}
