@@ -624,60 +624,8 @@ fn orthonormalize(
                 pre[j]
             };
             for _pass in 0..2 {
-                if locked.ncols() > 0 {
-                    let mut c = Mat::<f64>::zeros(locked.ncols(), 1);
-                    gemm(
-                        c.as_mut(),
-                        Accum::Replace,
-                        mlocked.transpose(),
-                        z.as_ref().subcols(j, 1),
-                        1.0,
-                        par,
-                    );
-                    gemm(
-                        z.as_mut().subcols_mut(j, 1),
-                        Accum::Add,
-                        locked,
-                        c.as_ref(),
-                        -1.0,
-                        par,
-                    );
-                    gemm(
-                        mz.as_mut().subcols_mut(j, 1),
-                        Accum::Add,
-                        mlocked,
-                        c.as_ref(),
-                        -1.0,
-                        par,
-                    );
-                }
-                if v.ncols() > 0 {
-                    let mut c = Mat::<f64>::zeros(v.ncols(), 1);
-                    gemm(
-                        c.as_mut(),
-                        Accum::Replace,
-                        mv.transpose(),
-                        z.as_ref().subcols(j, 1),
-                        1.0,
-                        par,
-                    );
-                    gemm(
-                        z.as_mut().subcols_mut(j, 1),
-                        Accum::Add,
-                        v,
-                        c.as_ref(),
-                        -1.0,
-                        par,
-                    );
-                    gemm(
-                        mz.as_mut().subcols_mut(j, 1),
-                        Accum::Add,
-                        mv,
-                        c.as_ref(),
-                        -1.0,
-                        par,
-                    );
-                }
+                project_out_col(z, mz, j, locked, mlocked, par);
+                project_out_col(z, mz, j, v, mv, par);
                 for i in 0..j {
                     let c: f64 = mz
                         .col(i)
@@ -729,6 +677,46 @@ fn orthonormalize(
         }
     }
     Ok(r)
+}
+
+/// Removes from column `j` of `z` (and of `mz = M z`) its M-projection on the M-orthonormal
+/// `basis` (`mbasis = M basis`).
+fn project_out_col(
+    z: &mut Mat<f64>,
+    mz: &mut Mat<f64>,
+    j: usize,
+    basis: MatRef<'_, f64>,
+    mbasis: MatRef<'_, f64>,
+    par: Par,
+) {
+    if basis.ncols() == 0 {
+        return;
+    }
+    let mut c = Mat::<f64>::zeros(basis.ncols(), 1);
+    gemm(
+        c.as_mut(),
+        Accum::Replace,
+        mbasis.transpose(),
+        z.as_ref().subcols(j, 1),
+        1.0,
+        par,
+    );
+    gemm(
+        z.as_mut().subcols_mut(j, 1),
+        Accum::Add,
+        basis,
+        c.as_ref(),
+        -1.0,
+        par,
+    );
+    gemm(
+        mz.as_mut().subcols_mut(j, 1),
+        Accum::Add,
+        mbasis,
+        c.as_ref(),
+        -1.0,
+        par,
+    );
 }
 
 /// Ritz vectors U = V S, purified by one more shift-invert step (U ← A⁻¹MU, one multi-RHS
