@@ -86,22 +86,23 @@ pub(crate) fn solve(
     let mut res: Vec<Residual> = Vec::new();
     let mut capped = false;
     let mut runs = 0;
+    let mut chunk = CHUNK;
     loop {
         runs += 1;
         let found = locked.ncols();
         let mut cp = params.clone();
         let more = match lam_lim {
             None => {
-                cp.nev = (params.nev - found).min(CHUNK);
+                cp.nev = (params.nev - found).min(chunk);
                 false
             }
             Some(_) => {
-                cp.max_modes = params.max_modes.saturating_sub(found).min(CHUNK);
+                cp.max_modes = params.max_modes.saturating_sub(found).min(chunk);
                 cp.nev = params.nev.saturating_sub(found).min(cp.max_modes);
                 true
             }
         };
-        let ((cv, cu, cres), chunk_capped) = lanczos_chunk(
+        let run = lanczos_chunk(
             k,
             m,
             &fac,
@@ -119,7 +120,28 @@ pub(crate) fn solve(
                     iteration: p.iteration,
                 })
             },
-        )?;
+        );
+        let ((cv, cu, cres), chunk_capped) = match run {
+            // A run that drifts (too many restarts for its size) is retried with fewer pairs;
+            // the pairs already locked are kept.
+            Err(EigenError::NotConverged { .. }) if chunk > MIN_CHUNK => {
+                chunk /= 2;
+                continue;
+            }
+            // Report against the whole request, counting the pairs already locked.
+            Err(EigenError::NotConverged {
+                converged,
+                requested,
+                worst_residual,
+            }) => {
+                return Err(EigenError::NotConverged {
+                    converged: converged + found,
+                    requested: (requested + found).max(if more { 0 } else { params.nev }),
+                    worst_residual,
+                })
+            }
+            other => other?,
+        };
         let mut mcu = Mat::<f64>::zeros(n, cu.ncols());
         sym_spmm(m, cu.as_ref(), mcu.as_mut());
         append_cols(&mut locked, cu.as_ref());
@@ -163,8 +185,13 @@ pub(crate) fn solve(
 /// values θ = 1/(λ − σ) of the wanted pairs span λ_w/λ₁, the dense eigensolver of the projected
 /// matrix is accurate to ε·θ_max, and every thick restart feeds that error back into the
 /// basis — measured on the 1016-node table, 160 modes in one run ended at residuals 1e-7
-/// after 7 restarts, while runs of ≤ 120 modes reach 1e-10.
-const CHUNK: usize = 64;
+/// after 7 restarts. How many pairs a run can hold depends on the block size (restarts come
+/// sooner with smaller blocks): with b = 6, runs of 64 drifted to 5e-7 on a 24×3×3 beam, runs
+/// of 48 converge; a run that fails anyway is retried with half as many pairs.
+const CHUNK: usize = 48;
+
+/// Smallest run size [`CHUNK`] is halved down to when a run fails to converge.
+const MIN_CHUNK: usize = 6;
 
 fn append_cols(a: &mut Mat<f64>, b: MatRef<'_, f64>) {
     let (n, c) = (a.nrows(), a.ncols());

@@ -25,11 +25,11 @@
 //!   λᵢ = uᵢᵀKuᵢ. There is deliberately no final Rayleigh–Ritz rotation of (K, M): its dense
 //!   eigenvectors are accurate only to ε·λ_max/gap and K amplifies that mixture into the low
 //!   modes' residuals (1e-5 measured on the table with 160 modes).
-//! - Many modes: one run computes at most 64 pairs; further pairs come from fresh runs in the
+//! - Many modes: one run computes at most 48 pairs (halved on failure); further pairs come from fresh runs in the
 //!   M-orthogonal complement of those found (deflation), sharing the factorization. A single
 //!   run for hundreds of modes drifts: each thick restart re-injects the ε·θ_max error of the
 //!   projected eigensolve, which is large relative to the small θ of the higher modes
-//!   (measured: 160 modes in one run ended at residuals 1e-7 after 7 restarts; in runs of 64,
+//!   (measured: 160 modes in one run ended at residuals 1e-7 after 7 restarts; in runs of 48,
 //!   640 modes of the same table converge to ≤ 1e-8). `max_iters` applies per run.
 //! - Attainable accuracy: evaluating K u in double precision alone commits a relative error
 //!   ≈ ε·λ_max/λ, which exceeds 1e-10 for fine meshes (λ_max/λ₁ ≈ 10⁸ at 10⁵ dofs) and for rigid
@@ -74,7 +74,9 @@ pub struct EigenParams {
     /// positive definite. 0 suits clamped objects; free-free objects need σ < 0
     /// ([`default_shift`]).
     pub shift: f64,
-    /// Block size b: right-hand sides per factor solve (default 8).
+    /// Block size b: right-hand sides per factor solve (default 6: interleaved timings of
+    /// 4, 6 and 8 on the bake bench's beams (`examples/eigen_timing --block`) put 6 at or below
+    /// 8 at 3k, 15k and 109k dofs, e.g. 109k: 4.9–5.0 s vs 5.2–6.0 s; 4 wins only at 3k).
     pub block: usize,
     /// Maximum Krylov basis size before a thick restart; `None`: nev + max(nev, 4b), rounded
     /// up to a multiple of b (grown automatically in max-frequency mode).
@@ -100,7 +102,7 @@ impl Default for EigenParams {
             nev: 20,
             max_freq_hz: None,
             shift: 0.0,
-            block: 8,
+            block: 6,
             krylov_dim: None,
             tol: 1e-10,
             max_iters: 300,
