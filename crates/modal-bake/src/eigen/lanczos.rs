@@ -798,20 +798,7 @@ fn orthonormalize_ascending(
     par: Par,
 ) -> Result<RitzPairs, EigenError> {
     let (n, w) = (u.nrows(), u.ncols());
-    let mut g = Mat::<f64>::zeros(w, w);
-    gemm(
-        g.as_mut(),
-        Accum::Replace,
-        u.as_ref().transpose(),
-        mu.as_ref(),
-        1.0,
-        par,
-    );
-    let mut g = symmetrized(g.as_ref());
-    small_cholesky(g.as_mut(), 0.0)
-        .map_err(|j| EigenError::Dense(format!("Ritz vectors not M-independent (pivot {j})")))?;
-    let l = Mat::from_fn(w, w, |i, j| if i >= j { g[(i, j)] } else { 0.0 });
-    let li = lower_inverse(l.as_ref());
+    let li = gram_cholesky_inverse(u.as_ref(), mu.as_ref(), par)?;
     let mut q = Mat::<f64>::zeros(n, w);
     gemm(
         q.as_mut(),
@@ -841,6 +828,22 @@ fn orthonormalize_ascending(
     Ok((vals, u, res))
 }
 
+/// L⁻¹ for the Cholesky factor L Lᵀ = UᵀMU of the Gram matrix of `u` (`mu = M u`).
+fn gram_cholesky_inverse(
+    u: MatRef<'_, f64>,
+    mu: MatRef<'_, f64>,
+    par: Par,
+) -> Result<Mat<f64>, EigenError> {
+    let w = u.ncols();
+    let mut g = Mat::<f64>::zeros(w, w);
+    gemm(g.as_mut(), Accum::Replace, u.transpose(), mu, 1.0, par);
+    let mut g = symmetrized(g.as_ref());
+    small_cholesky(g.as_mut(), 0.0)
+        .map_err(|j| EigenError::Dense(format!("Ritz vectors not M-independent (pivot {j})")))?;
+    let l = Mat::from_fn(w, w, |i, j| if i >= j { g[(i, j)] } else { 0.0 });
+    Ok(lower_inverse(l.as_ref()))
+}
+
 #[allow(clippy::too_many_arguments)]
 fn rayleigh_ritz(
     k: &SparseColMat<usize, f64>,
@@ -852,16 +855,8 @@ fn rayleigh_ritz(
     par: Par,
 ) -> Result<RitzPairs, EigenError> {
     let w = u.ncols();
-    let mut g = Mat::<f64>::zeros(w, w);
+    let li = gram_cholesky_inverse(u.as_ref(), mu.as_ref(), par)?;
     let mut a = Mat::<f64>::zeros(w, w);
-    gemm(
-        g.as_mut(),
-        Accum::Replace,
-        u.as_ref().transpose(),
-        mu.as_ref(),
-        1.0,
-        par,
-    );
     gemm(
         a.as_mut(),
         Accum::Replace,
@@ -870,12 +865,7 @@ fn rayleigh_ritz(
         1.0,
         par,
     );
-    let mut g = symmetrized(g.as_ref());
     let a = symmetrized(a.as_ref());
-    small_cholesky(g.as_mut(), 0.0)
-        .map_err(|j| EigenError::Dense(format!("Ritz vectors not M-independent (pivot {j})")))?;
-    let l = Mat::from_fn(w, w, |i, j| if i >= j { g[(i, j)] } else { 0.0 });
-    let li = lower_inverse(l.as_ref());
     let c = symmetrized((&li * &a * li.transpose()).as_ref());
     let (vals, q) = sym_eig(c.as_ref()).map_err(EigenError::Dense)?;
     let x = li.transpose() * &q;
