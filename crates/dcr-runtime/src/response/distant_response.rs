@@ -671,15 +671,7 @@ impl DistantResponse {
                     } else {
                         self.peaks[c as usize]
                     };
-                    ContactResponse {
-                        id: rc.id,
-                        point: sp.point,
-                        normal: sp.normal,
-                        peak_displacement: d,
-                        delta_v: d / h,
-                        mapped: true,
-                        served_by: ServedBy::Modal,
-                    }
+                    mapped_response(rc, &sp, d, h, ServedBy::Modal)
                 }
                 _ => unmapped_response(rc),
             };
@@ -753,17 +745,30 @@ impl DistantResponse {
                     }
                 }
             }
-            self.out.push(ContactResponse {
-                id: rc.id,
-                point: sp.point,
-                normal: sp.normal,
-                peak_displacement: total,
-                delta_v: total / h,
-                mapped: true,
-                served_by: ServedBy::Attenuation,
-            });
+            self.out
+                .push(mapped_response(rc, &sp, total, h, ServedBy::Attenuation));
         }
         att.hits = hits;
+    }
+}
+
+/// The response of a mapped contact: peak normal displacement `d` (m) over the step `h` (s),
+/// Δv = d/h (Eq. 12), at the contact's surface point and normal (object frame).
+fn mapped_response(
+    rc: &RestingContact,
+    sp: &SurfacePoint,
+    d: f64,
+    h: f64,
+    served_by: ServedBy,
+) -> ContactResponse {
+    ContactResponse {
+        id: rc.id,
+        point: sp.point,
+        normal: sp.normal,
+        peak_displacement: d,
+        delta_v: d / h,
+        mapped: true,
+        served_by,
     }
 }
 

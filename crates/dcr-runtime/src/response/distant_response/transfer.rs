@@ -22,9 +22,9 @@
 
 use std::sync::Arc;
 
-use super::{unmapped_response, DistantResponse, UNMAPPED};
+use super::{mapped_response, unmapped_response, DistantResponse, UNMAPPED};
 use crate::math::{dot, normalize};
-use crate::response::{ContactResponse, ForceInput, Impact, RestingContact, ServedBy};
+use crate::response::{ForceInput, Impact, RestingContact, ServedBy};
 
 /// Relative tolerance on h and the Rayleigh coefficients for the table to apply.
 const MATCH_REL_TOL: f64 = 1e-9;
@@ -213,15 +213,7 @@ impl DistantResponse {
             let resp = match self.cache.slot(s).surface {
                 Some(sp) if d.is_finite() => {
                     self.info.contacts_by_table += 1;
-                    ContactResponse {
-                        id: rc.id,
-                        point: sp.point,
-                        normal: sp.normal,
-                        peak_displacement: d,
-                        delta_v: d / h,
-                        mapped: true,
-                        served_by: ServedBy::TransferTable,
-                    }
+                    mapped_response(rc, &sp, d, h, ServedBy::TransferTable)
                 }
                 _ => unmapped_response(rc),
             };
