@@ -65,14 +65,18 @@ fn steps_do_not_allocate_after_warm_up() {
         })
         .map(|v| v as u32)
         .collect();
-    let nr = vertices.len();
+    // With edge midpoints, so the steps run the P2 lookup.
+    let edges =
+        dcr_runtime::format::TransferTable::region_edges(&base.surface_triangles, &vertices);
+    let np = vertices.len() + edges.len();
     base.transfer = Some(dcr_runtime::format::TransferTable {
         h: 0.01,
         rayleigh: base.rayleigh,
         modes: 40,
         samples: 100,
         vertices,
-        peaks: (0..nr * (nr + 1) / 2)
+        edges,
+        peaks: (0..np * (np + 1) / 2)
             .map(|k| 1e-5 * (1 + k % 5) as f32)
             .collect(),
     });

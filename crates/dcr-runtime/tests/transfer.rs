@@ -1,7 +1,9 @@
 //! `Method::Transfer`: the base's bake-time peak-transfer table looked up at run time.
 //!
 //! Expectations: at region vertices the response is the table entry × the normal impulse
-//! (exactly, up to f32 → f64); inside triangles it is the barycentric blend Σ β_a β_b T[a][b];
+//! (exactly, up to f32 → f64); inside triangles it is the barycentric blend Σ β_a β_b T[a][b]
+//! for a vertex-only table, and for a table with edge midpoints the P2 interpolant, which
+//! reproduces a T that is quadratic in each point's position;
 //! several impacts add; only the normal impulse component counts; contacts outside the region
 //! are served by the modal method (same values as `Method::Modal`), and every step falls back to
 //! the modal method when an impact is outside the region, the step has forces, or h, Rayleigh
@@ -39,6 +41,7 @@ fn base_with_table() -> ModesFile {
         modes: 100,
         samples: 400,
         vertices,
+        edges: Vec::new(),
         peaks,
     });
     b
@@ -288,4 +291,82 @@ fn mismatched_h_rayleigh_or_carry_over_use_the_modal_method() {
     )
     .unwrap();
     assert!(dr.transfer_active());
+}
+
+/// A symmetric kernel quadratic in each argument's (x, y) (m): P2 interpolation on flat
+/// triangles reproduces it exactly. Positive on the plate; units m per N·s.
+fn quadratic_kernel(a: [f64; 3], b: [f64; 3]) -> f64 {
+    1e-5 * (3.0 + a[0] * b[1] + a[1] * b[0] + a[1] * a[1] + b[1] * b[1] + a[0] * a[1] * b[0] * b[1]
+        - 0.5 * (a[0] * a[0] + b[0] * b[0]))
+}
+
+#[test]
+fn with_midpoints_the_lookup_reproduces_a_quadratic_table() {
+    let mut b = base_with_table();
+    let x = b.surface_vertices.clone();
+    let t = b.transfer.as_mut().unwrap();
+    t.edges = TransferTable::region_edges(&b.surface_triangles, &t.vertices);
+    assert!(!t.edges.is_empty());
+    let point = |p: usize| -> [f64; 3] {
+        let nr = t.vertices.len();
+        if p < nr {
+            x[t.vertices[p] as usize]
+        } else {
+            let [i, j] = t.edges[p - nr].map(|k| x[t.vertices[k as usize] as usize]);
+            [0, 1, 2].map(|k| 0.5 * (i[k] + j[k]))
+        }
+    };
+    let np = t.num_points();
+    let mut peaks = Vec::with_capacity(TransferTable::packed_len(np));
+    for p in 0..np {
+        for q in p..np {
+            peaks.push(quadratic_kernel(point(p), point(q)) as f32);
+        }
+    }
+    t.peaks = peaks;
+    let model = Arc::new(ModalModel::from_base(b).unwrap());
+    let mut dr = DistantResponse::new(model.clone(), params(Method::Transfer)).unwrap();
+    let mut rng = SplitMix64(11);
+    let mut pt = || [rng.range(0.0, 0.5), rng.range(0.0, 0.6), 0.0];
+    let resting: Vec<RestingContact> = (0..16)
+        .map(|i| RestingContact { id: i, point: pt() })
+        .collect();
+    for _ in 0..4 {
+        let imp = Impact {
+            point: pt(),
+            direction: [0.0, 0.0, -1.0],
+            impulse: 2.0,
+        };
+        let out = dr.step(&[imp], &resting).to_vec();
+        let mut linear_off = 0.0f64;
+        for (o, rc) in out.iter().zip(&resting) {
+            assert_eq!(o.served_by, ServedBy::TransferTable);
+            let want = 2.0 * quadratic_kernel(imp.point, rc.point);
+            let rel = (o.peak_displacement - want).abs() / want;
+            // f32 table entries: ≈ 6e-8 relative each.
+            assert!(
+                rel < 1e-6,
+                "{:?}→{:?}: {} vs {want}",
+                imp.point,
+                rc.point,
+                o.peak_displacement
+            );
+            // The vertex-only blend of the same kernel is off inside triangles (so this test
+            // sees the midpoints).
+            let sa = model.project(imp.point, 1.0).unwrap();
+            let sb = model.project(rc.point, 1.0).unwrap();
+            let (ta, tb) = (model.triangle(sa.triangle), model.triangle(sb.triangle));
+            let mut lin = 0.0;
+            for (&va, ba) in ta.iter().zip(sa.bary) {
+                for (&vb, bb) in tb.iter().zip(sb.bary) {
+                    lin += ba * bb * quadratic_kernel(x[va], x[vb]);
+                }
+            }
+            linear_off = linear_off.max((2.0 * lin - want).abs() / want);
+        }
+        assert!(
+            linear_off > 1e-4,
+            "linear blend unexpectedly exact: {linear_off:e}"
+        );
+    }
 }

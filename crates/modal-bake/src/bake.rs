@@ -186,6 +186,8 @@ pub struct BakeReport {
     pub transfer_s: f64,
     /// Transfer table: region vertices (0: no table).
     pub transfer_vertices: usize,
+    /// Transfer table: region edges whose midpoints are tabulated.
+    pub transfer_edges: usize,
     /// Transfer table: modes summed.
     pub transfer_modes: usize,
     /// Transfer table: samples per step.
@@ -650,6 +652,7 @@ pub fn bake_mesh_with_transfer(
     .map_err(terr)?;
     report.transfer_s = t.elapsed().as_secs_f64();
     report.transfer_vertices = table.len();
+    report.transfer_edges = table.edges.len();
     report.transfer_modes = table.modes as usize;
     report.transfer_samples = table.samples as usize;
     if let Some(obj) = base.meta.bake_params.as_object_mut() {

@@ -2,7 +2,8 @@
 //!
 //! Expectations: every table entry equals the peak `modal-bake probe` reports for the same
 //! modes, sampling, impact vertex (unit inward-normal impulse) and contact vertex — in both
-//! directions, so the stored symmetric table is the reciprocity of the real response; baking
+//! directions, so the stored symmetric table is the reciprocity of the real response; entries
+//! at edge midpoints (inside flat faces) equal the probe at the midpoint; baking
 //! twice gives identical bytes; `info` shows the table; bad options are clear errors.
 
 use std::path::{Path, PathBuf};
@@ -119,6 +120,108 @@ fn table_entries_equal_probe_in_both_directions() {
         assert!(
             (got[0] - got[1]).abs() <= 1e-9 * got[0].abs(),
             "reciprocity: {got:?}"
+        );
+    }
+}
+
+/// Peak (m) `modal-bake probe` (per-contact variant: n_pᵀ Σ β_j u_j) reports for a unit
+/// impulse at `imp` along `dir` seen at `con`, sampled as the table `t` is.
+fn probe_point(
+    base: &Path,
+    t: &dcr_runtime::format::TransferTable,
+    imp: [f64; 3],
+    dir: [f64; 3],
+    con: [f64; 3],
+    method: &str,
+) -> f64 {
+    let fmt = |p: [f64; 3]| format!("{},{},{}", p[0], p[1], p[2]);
+    let o = run(&[
+        "probe",
+        base.to_str().unwrap(),
+        "--impact",
+        &fmt(imp),
+        "--direction",
+        &fmt(dir),
+        "--impulse",
+        "1",
+        "--contact",
+        &fmt(con),
+        "--h",
+        &format!("{}", t.h),
+        "--substep",
+        &format!("{}", t.h / f64::from(t.samples)),
+        "--method",
+        method,
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let want = if method == "transfer" {
+        "transfer_table"
+    } else {
+        method
+    };
+    assert_eq!(v["contacts"][0]["served_by"], want);
+    v["contacts"][0]["peak_displacement_m"].as_f64().unwrap()
+}
+
+#[test]
+fn midpoint_entries_equal_the_probe_at_the_midpoint() {
+    let dir = tempfile::tempdir().unwrap();
+    let with = dir.path().join("beam_m.modes");
+    let o = bake_beam(&with, "8");
+    assert!(o.status.success(), "{}", text(&o));
+    let base = ModesFile::read(&with).unwrap();
+    let t = base.transfer.clone().expect("table stored");
+    let nr = t.len();
+    assert_eq!(
+        t.edges,
+        dcr_runtime::format::TransferTable::region_edges(&base.surface_triangles, &t.vertices)
+    );
+    let model = ModalModel::from_base(base.clone()).unwrap();
+    let (x, n) = (&base.surface_vertices, model.vertex_normals());
+    let vert = |k: u32| t.vertices[k as usize] as usize;
+    // Edges inside flat faces (equal vertex normals, so a midpoint impulse along −n is the
+    // table's ½(−n_a) + ½(−n_b)) with no clamped end.
+    let fixed = |v: usize| base.fixed_nodes.contains(&base.surface_to_volume[v]);
+    let flat: Vec<usize> = (0..t.edges.len())
+        .filter(|&e| {
+            let [a, b] = t.edges[e].map(vert);
+            !fixed(a) && !fixed(b) && (0..3).all(|k| (n[a][k] - n[b][k]).abs() < 1e-12)
+        })
+        .collect();
+    assert!(flat.len() > 10, "{} flat edges", flat.len());
+    let mid = |e: usize| {
+        let [a, b] = t.edges[e].map(vert);
+        [0, 1, 2].map(|k| 0.5 * (x[a][k] + x[b][k]))
+    };
+    let (e1, e2) = (flat[2], flat[flat.len() - 3]);
+    let a = vert(t.edges[e1][0]);
+    let inward = |v: usize| n[v].map(|c| -c);
+    // midpoint → midpoint, vertex → midpoint, midpoint → vertex.
+    for (imp, dir, con, p, q) in [
+        (mid(e1), inward(a), mid(e2), nr + e1, nr + e2),
+        (x[a], inward(a), mid(e2), t.edges[e1][0] as usize, nr + e2),
+        (
+            mid(e2),
+            inward(vert(t.edges[e2][0])),
+            x[a],
+            nr + e2,
+            t.edges[e1][0] as usize,
+        ),
+    ] {
+        let got = probe_point(&with, &t, imp, dir, con, "modal");
+        let table = t.peak(p, q);
+        let rel = (got - table).abs() / table;
+        // `probe --method transfer` serves the point from the table itself (P2 node: exact).
+        let looked_up = probe_point(&with, &t, imp, dir, con, "transfer");
+        assert!(
+            (looked_up - table).abs() <= 1e-12 * table,
+            "points ({p}, {q}): lookup {looked_up:e} vs table {table:e}"
+        );
+        assert!(
+            table > 0.0 && rel < 1e-6,
+            "points ({p}, {q}): probe {got:e} vs table {table:e}"
         );
     }
 }

@@ -6,7 +6,7 @@ mod transfer_table;
 pub use modes_file::{
     FormatError, MaterialSi, ModesFile, ModesMeta, ModesPrecision, FORMAT_VERSION,
 };
-pub use transfer_table::{TransferTable, MAX_TRANSFER_VERTICES};
+pub use transfer_table::{TransferTable, MAX_TRANSFER_POINTS};
 
 #[cfg(test)]
 mod tests;

@@ -20,9 +20,11 @@
 //! | `meta` | u8 | (bytes,) | UTF-8 JSON: [`ModesMeta`] |
 //!
 //! Optional (all or none): the peak-transfer table ([`TransferTable`]): `transfer_vertices`
-//! u32 (nr,), `transfer_peaks` f32 (nr(nr+1)/2,) packed upper triangle (m per N·s),
+//! u32 (nr,), `transfer_peaks` f32 (np(np+1)/2,) packed upper triangle over np = nr + ne points
+//! (m per N·s),
 //! `transfer_h` f64 () (s), `transfer_rayleigh` f64 (2,), `transfer_modes` u32 (),
-//! `transfer_samples` u32 (). Readers that predate it ignore these entries.
+//! `transfer_samples` u32 (), and `transfer_edges` u32 (ne, 2) (absent in tables written
+//! before it: vertex points only). Readers that predate the table ignore these entries.
 //!
 //! Files are written deterministically (fixed zip timestamps, fixed entry order, stored) and
 //! atomically (temporary file in the target directory, then rename).
@@ -36,7 +38,7 @@ use ndarray_npy::npy::header::Header;
 use ndarray_npy::{NpzWriter, ReadNpyExt, ReadableElement};
 use serde::{Deserialize, Serialize};
 
-use super::transfer_table::{TransferTable, TRANSFER_ENTRIES};
+use super::transfer_table::{TransferTable, TRANSFER_EDGES_ENTRY, TRANSFER_ENTRIES};
 
 /// Current `.modes` schema version.
 pub const FORMAT_VERSION: u32 = 1;
@@ -409,6 +411,12 @@ impl ModesFile {
                 .map_err(e)?;
             npz.add_array("transfer_samples", &Array0::from_elem((), t.samples))
                 .map_err(e)?;
+            let edges: Vec<u32> = t.edges.iter().flatten().copied().collect();
+            npz.add_array(
+                TRANSFER_EDGES_ENTRY,
+                &Array2::from_shape_vec((t.edges.len(), 2), edges).map_err(|x| x.to_string())?,
+            )
+            .map_err(e)?;
         }
         Ok(npz.finish().map_err(e)?.into_inner())
     }
@@ -690,6 +698,22 @@ impl<R: Read + Seek> EntryReader<'_, R> {
         let rayleigh: Vec<f64> = self.vector("transfer_rayleigh", 1024)?;
         let modes: u32 = self.scalar("transfer_modes")?;
         let samples: u32 = self.scalar("transfer_samples")?;
+        let edges = if self
+            .zip
+            .index_for_name(&format!("{TRANSFER_EDGES_ENTRY}.npy"))
+            .is_some()
+        {
+            let (flat, shape) = self.array::<u32>(TRANSFER_EDGES_ENTRY, 2)?;
+            if shape[1] != 2 {
+                return Err(self.err(
+                    TRANSFER_EDGES_ENTRY,
+                    format!("expected shape (ne, 2), found {shape:?}"),
+                ));
+            }
+            flat.chunks_exact(2).map(|c| [c[0], c[1]]).collect()
+        } else {
+            Vec::new()
+        };
         if rayleigh.len() != 2 {
             return Err(self.err(
                 "transfer_rayleigh",
@@ -702,6 +726,7 @@ impl<R: Read + Seek> EntryReader<'_, R> {
             modes,
             samples,
             vertices,
+            edges,
             peaks,
         }))
     }

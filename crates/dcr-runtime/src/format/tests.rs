@@ -201,6 +201,7 @@ fn tiny_with_table() -> ModesFile {
         modes: 40,
         samples: 123,
         vertices: vec![0, 1, 3],
+        edges: Vec::new(),
         peaks: vec![1e-4, 2e-5, 3e-6, 4e-4, 5e-5, 6e-4],
     });
     b
@@ -240,13 +241,28 @@ fn transfer_table_round_trips_exactly_and_deterministically() {
     let bytes = plain.to_bytes().unwrap();
     let r = ModesFile::read_from(Cursor::new(bytes), Path::new("p.modes")).unwrap();
     assert_eq!(r.transfer, None);
+    // With midpoints: edges round-trip; a table written before `transfer_edges` existed (the
+    // entry absent) reads as a vertex-only table.
+    let mut with_edges = tiny_with_table();
+    let t = with_edges.transfer.as_mut().unwrap();
+    t.edges = vec![[0, 1], [1, 2]];
+    t.peaks = (0..TransferTable::packed_len(5))
+        .map(|k| 1e-5 * (1 + k) as f32)
+        .collect();
+    let bytes = with_edges.to_bytes().unwrap();
+    let r = ModesFile::read_from(Cursor::new(bytes), Path::new("e.modes")).unwrap();
+    assert_eq!(r, with_edges);
+    let bytes = without_entries(&base.to_bytes().unwrap(), &["transfer_edges"]);
+    let r = ModesFile::read_from(Cursor::new(bytes), Path::new("o.modes")).unwrap();
+    assert_eq!(r, base);
     // Dropping every transfer entry gives back the plain base.
     let bytes = without_entries(&base.to_bytes().unwrap(), &TRANSFER_ENTRIES_FOR_TEST);
     let r = ModesFile::read_from(Cursor::new(bytes), Path::new("d.modes")).unwrap();
     assert_eq!(r, plain);
 }
 
-const TRANSFER_ENTRIES_FOR_TEST: [&str; 6] = [
+const TRANSFER_ENTRIES_FOR_TEST: [&str; 7] = [
+    "transfer_edges",
     "transfer_vertices",
     "transfer_peaks",
     "transfer_h",
@@ -274,11 +290,13 @@ fn partial_transfer_table_names_the_missing_entry() {
 #[test]
 fn corrupted_transfer_table_is_rejected_with_a_clear_error() {
     type Corrupt = fn(&mut TransferTable);
-    let cases: [(Corrupt, &str); 8] = [
+    let cases: [(Corrupt, &str); 10] = [
         (|t| t.peaks[2] = f32::NAN, "transfer_peaks[2]"),
         (|t| t.peaks[4] = -1e-6, "transfer_peaks[4]"),
         (|t| t.peaks[1] = f32::INFINITY, "transfer_peaks[1]"),
-        (|t| t.peaks.truncate(5), "expected nr(nr+1)/2 = 6"),
+        (|t| t.peaks.truncate(5), "expected np(np+1)/2 = 6"),
+        (|t| t.edges = vec![[0, 3]], "transfer_edges row 0"),
+        (|t| t.edges = vec![[0, 2], [0, 1]], "transfer_edges row 1"),
         (|t| t.vertices[2] = 4, "names vertex 4"),
         (|t| t.vertices = vec![0, 3, 1], "not strictly ascending"),
         (|t| t.h = 0.0, "transfer_h"),

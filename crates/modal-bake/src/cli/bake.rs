@@ -108,8 +108,9 @@ pub struct BakeArgs {
 #[derive(Args, Clone, Debug)]
 pub struct TransferOptions {
     /// Also store a peak-transfer table for this rigid-body step h (s): the peak normal
-    /// displacement at every region vertex per unit normal impulse at every other, with many
-    /// modes. The runtime uses it only for this h and the base's Rayleigh damping.
+    /// displacement at every region vertex and edge midpoint per unit normal impulse at every
+    /// other, with many modes (size ≈ (4 × region vertices)²/2 f32). The runtime uses it only
+    /// for this h and the base's Rayleigh damping.
     #[arg(long, value_name = "SECONDS", allow_hyphen_values = true)]
     pub transfer_h: Option<f64>,
     /// Modes the table sums: a count or `all` (dense eigensolve; small meshes) [default: 640].
@@ -293,8 +294,9 @@ fn print_report(out: &std::path::Path, r: &BakeReport) {
     );
     if r.transfer_vertices > 0 {
         outln!(
-            "  transfer table: {} region vertices, {} modes ({}), {} samples per step, built in {:.2} s",
+            "  transfer table: {} region vertices + {} edge midpoints, {} modes ({}), {} samples per step, built in {:.2} s",
             r.transfer_vertices,
+            r.transfer_edges,
             r.transfer_modes,
             r.transfer_mode_source,
             r.transfer_samples,

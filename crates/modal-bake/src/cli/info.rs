@@ -48,6 +48,7 @@ pub fn run(args: &InfoArgs) -> anyhow::Result<()> {
                 "modes": t.modes,
                 "samples": t.samples,
                 "region_vertices": t.len(),
+                "edge_midpoints": t.edges.len(),
                 "packed_values": t.peaks.len(),
                 "max_peak_m_per_ns": t.peaks.iter().fold(0.0f32, |a, &b| a.max(b)),
             })),
@@ -98,8 +99,9 @@ pub fn run(args: &InfoArgs) -> anyhow::Result<()> {
     match &base.transfer {
         Some(t) => writeln!(
             out,
-            "  transfer table: {} region vertices ({} f32 values, {:.1} KiB), h {} s, {} modes, {} samples per step, Rayleigh α0 {} α1 {}, largest peak {:.4e} m per N·s",
+            "  transfer table: {} region vertices + {} edge midpoints ({} f32 values, {:.1} KiB), h {} s, {} modes, {} samples per step, Rayleigh α0 {} α1 {}, largest peak {:.4e} m per N·s",
             t.len(),
+            t.edges.len(),
             t.peaks.len(),
             t.peaks.len() as f64 * 4.0 / 1024.0,
             t.h,

@@ -12,7 +12,7 @@ use std::sync::Arc;
 use anyhow::{bail, Context};
 use dcr_runtime::{
     AttenuationParams, DistantResponse, Impact, Method, ModalModel, ResponseParams, RestingContact,
-    Sampling, SurfacePoint, Variant,
+    Sampling, ServedBy, SurfacePoint, Variant,
 };
 
 /// Distant-response model selectable from the command line.
@@ -22,6 +22,9 @@ pub enum MethodArg {
     Modal,
     /// Spatial attenuation over heat geodesics (Eq. 14–16; s = r^-1 for r > 1 m, 1 closer).
     Attenuation,
+    /// The base's bake-time peak-transfer table (`bake --transfer-h`), modal where it does not
+    /// apply (no table, another h or damping, a point outside its region).
+    Transfer,
 }
 
 /// Peak variant selectable from the command line.
@@ -136,6 +139,7 @@ pub fn run(args: &ProbeArgs) -> anyhow::Result<()> {
     let method = match args.method {
         MethodArg::Modal => Method::Modal,
         MethodArg::Attenuation => Method::Attenuation(AttenuationParams::default()),
+        MethodArg::Transfer => Method::Transfer,
     };
     let params = ResponseParams {
         h: args.h,
@@ -211,6 +215,12 @@ pub fn run(args: &ProbeArgs) -> anyhow::Result<()> {
                 "distance_m": d,
                 "peak_displacement_m": o.peak_displacement,
                 "delta_v_mps": o.delta_v,
+                "served_by": match o.served_by {
+                    ServedBy::Modal => "modal",
+                    ServedBy::Attenuation => "attenuation",
+                    ServedBy::TransferTable => "transfer_table",
+                    ServedBy::Unmapped => "unmapped",
+                },
             })
         })
         .collect();

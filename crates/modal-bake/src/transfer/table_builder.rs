@@ -1,6 +1,6 @@
 //! [`build_transfer_table`] and the mode sets it takes.
 
-use dcr_runtime::format::{ModesFile, TransferTable, MAX_TRANSFER_VERTICES};
+use dcr_runtime::format::{ModesFile, TransferTable, MAX_TRANSFER_POINTS};
 use dcr_runtime::{damping_ratio, samples_per_step, ModalModel, ModeFilter, Sampling};
 use faer::linalg::matmul::matmul;
 use faer::{Accum, Mat, Par};
@@ -196,8 +196,8 @@ pub fn mode_set_lanczos(
 /// with many modes; its own Rayleigh damping is ignored in favour of `rayleigh`).
 ///
 /// # Errors
-/// [`TransferError::Params`] for invalid parameters, an empty region, or one larger than
-/// [`MAX_TRANSFER_VERTICES`].
+/// [`TransferError::Params`] for invalid parameters, an empty region, or one whose vertices
+/// and edge midpoints exceed [`MAX_TRANSFER_POINTS`].
 pub fn build_transfer_table(
     modes: &ModesFile,
     params: &TransferParams,
@@ -220,9 +220,12 @@ pub fn build_transfer_table(
             "the region (--transfer-region / --transfer-up) selects no surface vertex".into(),
         ));
     }
-    if nr > MAX_TRANSFER_VERTICES {
+    let edges = TransferTable::region_edges(&model.base().surface_triangles, &region);
+    let np = nr + edges.len();
+    if np > MAX_TRANSFER_POINTS {
         return Err(TransferError::Params(format!(
-            "the region selects {nr} surface vertices, more than the {MAX_TRANSFER_VERTICES} supported; restrict it with --transfer-region / --transfer-up"
+            "the region selects {nr} surface vertices and {} edges, more than the {MAX_TRANSFER_POINTS} table points supported; restrict it with --transfer-region / --transfer-up",
+            edges.len()
         )));
     }
     let mm = model.num_modes();
@@ -244,51 +247,68 @@ pub fn build_transfer_table(
     let g = Mat::from_fn(s, m, |k, l| {
         filters[l].impulse_response((k + 1) as f64 * period)
     });
-    // W (m × nr): normal rows of the region vertices, one column per vertex.
+    // W (m × nr): normal rows of the region vertices, one column per vertex; a midpoint's row
+    // is the average of its two vertices' (P1).
     let rows = model.normal_mode_rows();
     let w = Mat::from_fn(m, nr, |l, c| rows[region[c] as usize * mm + l]);
+    let point_row = |p: usize, l: usize| -> f64 {
+        if p < nr {
+            w[(l, p)]
+        } else {
+            let [a, b] = edges[p - nr];
+            0.5 * (w[(l, a as usize)] + w[(l, b as usize)])
+        }
+    };
 
-    let mut peaks = vec![0.0f32; TransferTable::packed_len(nr)];
+    // Row p: Y = (G ∘ w_p) W (S × nr), the signals at every region vertex; a midpoint column is
+    // the average of two vertex columns, so one GEMM against the vertices serves all np points.
+    let mut peaks = vec![0.0f32; TransferTable::packed_len(np)];
     let chunk = 16usize;
     let mut done = 0;
-    progress(TransferProgress { done, total: nr });
-    for start in (0..nr).step_by(chunk) {
-        let end = (start + chunk).min(nr);
+    progress(TransferProgress { done, total: np });
+    for start in (0..np).step_by(chunk) {
+        let end = (start + chunk).min(np);
         let block: Vec<Vec<f32>> = (start..end)
             .into_par_iter()
             .map_init(
                 || (Mat::<f64>::zeros(s, m), Mat::<f64>::zeros(s, nr)),
-                |(a, y), i| {
+                |(a, y), p| {
                     for l in 0..m {
-                        let wi = w[(l, i)];
+                        let wp = point_row(p, l);
                         for k in 0..s {
-                            a[(k, l)] = g[(k, l)] * wi;
+                            a[(k, l)] = g[(k, l)] * wp;
                         }
                     }
-                    let cols = nr - i;
                     matmul(
-                        y.as_mut().subcols_mut(0, cols),
+                        y.as_mut(),
                         Accum::Replace,
                         a.as_ref(),
-                        w.as_ref().subcols(i, cols),
+                        w.as_ref(),
                         1.0,
                         Par::Seq,
                     );
-                    (0..cols)
-                        .map(|c| {
-                            let col = y.col(c);
-                            (0..s).fold(0.0f64, |p, k| p.max(col[k].abs())) as f32
+                    (p..np)
+                        .map(|q| {
+                            let peak = if q < nr {
+                                let col = y.col(q);
+                                (0..s).fold(0.0f64, |pk, k| pk.max(col[k].abs()))
+                            } else {
+                                let [ea, eb] = edges[q - nr];
+                                let (ca, cb) = (y.col(ea as usize), y.col(eb as usize));
+                                (0..s).fold(0.0f64, |pk, k| pk.max((0.5 * (ca[k] + cb[k])).abs()))
+                            };
+                            peak as f32
                         })
                         .collect()
                 },
             )
             .collect();
-        for (i, row) in (start..end).zip(block) {
-            let at = i * (2 * nr - i + 1) / 2;
+        for (p, row) in (start..end).zip(block) {
+            let at = p * (2 * np - p + 1) / 2;
             peaks[at..at + row.len()].copy_from_slice(&row);
         }
         done = end;
-        progress(TransferProgress { done, total: nr });
+        progress(TransferProgress { done, total: np });
     }
     let table = TransferTable {
         h: params.h,
@@ -296,6 +316,7 @@ pub fn build_transfer_table(
         modes: m as u32,
         samples: s as u32,
         vertices: region,
+        edges,
         peaks,
     };
     table

@@ -2,15 +2,24 @@
 //! the base's bake-time peak-transfer table ([`crate::format::TransferTable`]) instead of
 //! filtering the truncated modal base.
 //!
-//! For an impact mapped to triangle (a₀, a₁, a₂) with barycentric weights β_a and a resting
-//! contact mapped to (b₀, b₁, b₂) with weights β_b, the peak normal displacement is
-//! `d = Σ_impacts λ_N Σ_a Σ_b β_a β_b T[a][b]`, where λ_N = λ·|d̂·n| is the normal component of
-//! the impulse (N·s; the tangential part is ignored). T is the peak for a unit inward-normal
-//! impulse at a vertex seen at another vertex, computed at bake time with many modes.
+//! The table's points are the region's vertices and its edge midpoints
+//! ([`crate::format::TransferTable`]). A mapped point with barycentric weights β in triangle
+//! (v₀, v₁, v₂) is spread over the triangle's six P2 nodes with the quadratic Lagrange weights
+//! `N_k = β_k(2β_k − 1)` at vertex k and `N_jk = 4β_jβ_k` at the midpoint of edge (j, k); the
+//! peak normal displacement at a resting contact is
+//! `d = Σ_impacts λ_N max(0, Σ_p Σ_q N_p(β_impact) N_q(β_contact) T[p][q])`, where
+//! λ_N = λ·|d̂·n| is the normal component of the impulse (N·s; the tangential part is ignored).
+//! T is the peak for a unit inward-normal impulse at one table point seen at another, computed
+//! at bake time with many modes. The weights sum to 1 and reproduce T exactly at the nodes.
 //!
-//! Bounds, by linearity and the triangle inequality: the blend is ≥ the peak of the bilinearly
-//! interpolated response (equal at vertices), and with several impacts in one step their peaks
-//! are summed, an upper bound of the peak of the summed response.
+//! Why quadratic: the exact peak is a convex function of β on each side (a maximum of absolute
+//! values of linear functions), so the linear blend of vertex peaks overestimates inside
+//! triangles where the vertex responses are out of phase (by up to +214 % on the ground slab);
+//! the P2 interpolant, which also sees the midpoints, is measured in `docs/accuracy.md`. It may
+//! undershoot, hence the clamp at 0. A table without midpoints (written before they existed)
+//! is blended linearly, as is any triangle one of whose needed midpoints is missing. With
+//! several impacts in one step their peaks are summed, an upper bound of the peak of the summed
+//! response.
 //!
 //! The table serves a step only when it applies: the base has a table whose `h` equals the
 //! step's (relative tolerance 1e-9) and whose Rayleigh damping equals the response's, the
@@ -33,33 +42,55 @@ const MATCH_REL_TOL: f64 = 1e-9;
 /// this (a point at a region vertex may map to a neighbouring triangle outside the region).
 const NEGLIGIBLE_WEIGHT: f64 = 1e-9;
 
-/// Region indices of a mapped point's corners and their weights, or `None` when a corner with a
-/// weight above [`NEGLIGIBLE_WEIGHT`] is outside the region (negligible ones get weight 0).
+/// Table nodes of a mapped point (vertices and edge midpoints) with their interpolation
+/// weights; unused slots have weight 0.
+type Nodes = ([u32; 6], [f64; 6]);
+
+/// The P2 (or, lacking midpoints, P1) nodes and weights of a point with barycentric weights
+/// `bary` in surface triangle `t` (corners `tri`), or `None` when a corner with a weight above
+/// [`NEGLIGIBLE_WEIGHT`] is outside the region (negligible ones get weight 0).
 #[inline]
-fn region_corners(local: &[u32], tri: [usize; 3], bary: [f64; 3]) -> Option<([u32; 3], [f64; 3])> {
-    let mut loc = [0u32; 3];
+fn table_nodes(ts: &TransferState, t: u32, tri: [usize; 3], bary: [f64; 3]) -> Option<Nodes> {
+    let mut idx = [0u32; 6];
     let mut w = bary;
     for k in 0..3 {
-        let l = local[tri[k]];
+        let l = ts.local[tri[k]];
         if l == UNMAPPED {
             if bary[k] > NEGLIGIBLE_WEIGHT {
                 return None;
             }
             w[k] = 0.0;
         } else {
-            loc[k] = l;
+            idx[k] = l;
         }
     }
-    Some((loc, w))
+    let mids = ts.tri_mids[t as usize];
+    // Midpoint k sits on the edge opposite corner k.
+    let mid_w = [0, 1, 2].map(|k| 4.0 * w[(k + 1) % 3] * w[(k + 2) % 3]);
+    if (0..3).any(|k| mid_w[k] > 0.0 && mids[k] == UNMAPPED) {
+        return Some((idx, [w[0], w[1], w[2], 0.0, 0.0, 0.0]));
+    }
+    let mut nw = [0.0; 6];
+    for k in 0..3 {
+        nw[k] = w[k] * (2.0 * w[k] - 1.0);
+        if mid_w[k] > 0.0 {
+            idx[3 + k] = mids[k];
+            nw[3 + k] = mid_w[k];
+        }
+    }
+    Some((idx, nw))
 }
 
 /// Per-instance state of the transfer-table method.
 #[derive(Debug)]
 pub(super) struct TransferState {
-    /// Region index of each surface vertex ([`UNMAPPED`]: outside the region).
+    /// Region index (= table point) of each surface vertex ([`UNMAPPED`]: outside the region).
     local: Vec<u32>,
-    /// This step's applied impacts: region indices, barycentric weights, λ_N (N·s).
-    hits: Vec<([u32; 3], [f64; 3], f64)>,
+    /// Per surface triangle: the table point of the midpoint of the edge opposite each corner
+    /// ([`UNMAPPED`]: not tabulated).
+    tri_mids: Vec<[u32; 3]>,
+    /// This step's applied impacts: table nodes and weights, λ_N (N·s).
+    hits: Vec<(Nodes, f64)>,
     /// Table peak per resting contact this step (m); NaN: not served by the table.
     peaks: Vec<f64>,
 }
@@ -89,8 +120,24 @@ impl TransferState {
         for (k, &v) in t.vertices.iter().enumerate() {
             local[v as usize] = k as u32;
         }
+        let nr = t.vertices.len();
+        let tri_mids = (0..model.base().surface_triangles.len())
+            .map(|f| {
+                let tri = model.triangle(f as u32).map(|v| local[v]);
+                [0, 1, 2].map(|k| {
+                    let (a, b) = (tri[(k + 1) % 3], tri[(k + 2) % 3]);
+                    if a == UNMAPPED || b == UNMAPPED {
+                        return UNMAPPED;
+                    }
+                    t.edges
+                        .binary_search(&[a.min(b), a.max(b)])
+                        .map_or(UNMAPPED, |e| (nr + e) as u32)
+                })
+            })
+            .collect();
         Some(TransferState {
             local,
+            tri_mids,
             hits: Vec::new(),
             peaks: Vec::new(),
         })
@@ -150,37 +197,44 @@ impl DistantResponse {
                 unmapped += 1;
                 continue;
             };
-            let Some((loc, w)) = region_corners(&ts.local, model.triangle(sp.triangle), sp.bary)
+            let Some(nodes) = table_nodes(ts, sp.triangle, model.triangle(sp.triangle), sp.bary)
             else {
                 self.info.contacts_table_fallback += resting.len() as u32;
                 return false;
             };
             let lambda_n = imp.impulse * dot(normalize(imp.direction), sp.normal).abs();
-            ts.hits.push((loc, w, lambda_n));
+            ts.hits.push((nodes, lambda_n));
         }
         ts.peaks.clear();
         let mut outside = 0u32;
         for &s in &self.slots {
             let d = match self.cache.slot(s).surface {
-                Some(sp) => match region_corners(&ts.local, model.triangle(sp.triangle), sp.bary) {
-                    None => {
-                        outside += 1;
-                        f64::NAN
-                    }
-                    Some((loc, wb)) => {
-                        let mut d = 0.0;
-                        for (src, beta, lambda_n) in &ts.hits {
-                            let mut p = 0.0;
-                            for (a, ba) in src.iter().zip(beta) {
-                                for (b, bb) in loc.iter().zip(&wb) {
-                                    p += ba * bb * table.peak(*a as usize, *b as usize);
-                                }
-                            }
-                            d += lambda_n * p;
+                Some(sp) => {
+                    match table_nodes(ts, sp.triangle, model.triangle(sp.triangle), sp.bary) {
+                        None => {
+                            outside += 1;
+                            f64::NAN
                         }
-                        d
+                        Some((loc, wb)) => {
+                            let mut d = 0.0;
+                            for ((src, beta), lambda_n) in &ts.hits {
+                                let mut p = 0.0;
+                                for (a, ba) in src.iter().zip(beta) {
+                                    if *ba == 0.0 {
+                                        continue;
+                                    }
+                                    for (b, bb) in loc.iter().zip(&wb) {
+                                        if *bb != 0.0 {
+                                            p += ba * bb * table.peak(*a as usize, *b as usize);
+                                        }
+                                    }
+                                }
+                                d += lambda_n * p.max(0.0);
+                            }
+                            d
+                        }
                     }
-                },
+                }
                 None => f64::NAN,
             };
             ts.peaks.push(d);
