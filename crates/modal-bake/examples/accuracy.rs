@@ -41,6 +41,8 @@ struct Scene {
     fixed: Vec<String>,
     material: MaterialSi,
     max_modes: usize,
+    /// Region box of the transfer study (m), `None`: all upward faces.
+    transfer_box: Option<[f64; 6]>,
 }
 
 /// Sampling variants in table order.
@@ -483,6 +485,7 @@ fn main() {
                 density: 770.0,
             },
             max_modes: 640,
+            transfer_box: None,
         },
         Scene {
             name: "ground",
@@ -495,6 +498,10 @@ fn main() {
                 density: 500.0,
             },
             max_modes: 640,
+            // The middle of the slab's top (x ∈ [−7.5, 7.5] m, z ∈ [−5, 0] m of 30 × 10 m), where
+            // the truck runs: small enough for an all-mode table (its distant peaks live in
+            // modes above the 640th).
+            transfer_box: Some([-7.5, -0.5, -5.0, 7.5, 0.5, 0.0]),
         },
         Scene {
             name: "scaffold",
@@ -507,6 +514,7 @@ fn main() {
                 density: 100.0,
             },
             max_modes: 80,
+            transfer_box: None,
         },
     ];
     if quick {
@@ -528,7 +536,7 @@ fn main() {
     writeln!(md, "- Truth: the sum over **every** elastic mode (dense eigensolve) where free dofs ≤ {DENSE_MAX}, sampled at Δt = min(1 µs, π/(4ω_max)); otherwise full-order implicit Newmark (β = ¼, γ = ½) at Δt = {NEWMARK_DT:.0e} s (the scaffold, ≈ 15 000 dofs — a modest step to keep the run short; average-acceleration Newmark is unconditionally stable and loses accuracy only for modes above ≈ 1/(20 Δt) = 5 kHz, far above the bases' highest modes there).").unwrap();
     writeln!(md, "- Bases: `bake_mesh` (the `modal-bake bake` pipeline, f64 storage) with m modes, read through `ModalModel` and stepped through `DistantResponse` exactly as the engine does (`carry_over = false`, Rayleigh from the base (10 1/s, 1e-7 s)).").unwrap();
     writeln!(md, "- Error = |peak_runtime − peak_truth| / peak_truth in %, over the 16 pairs (median and max). Samplings: `paper T` = π/(2ω_m) (the default), `2×`/`4×` = `Sampling::Oversample(2|4)`, `≈Δt` = `Sampling::Substep(truth Δt, ≥ 1 µs)`; `per-node (T)` = Eq. 13 `Variant::PerNode` at paper T (all others `PerContact`).").unwrap();
-    writeln!(md, "- Transfer table (`modal-bake bake --transfer-h`, `Method::Transfer`; issue #5 item 3): per object, a `### …: transfer table` block below its sweep — the 20-mode base plus a bake-time table of single-impact peak transfer between the upward-facing surface vertices, computed with 160 / 640 / all modes, looked up with barycentric weights on both sides at run time; errors at vertices and inside triangles, query cost against the 20-mode modal query in the same run.").unwrap();
+    writeln!(md, "- Transfer table (`modal-bake bake --transfer-h`, `Method::Transfer`; issue #5 item 3): per object, a `### …: transfer table` block below its sweep — the 20-mode base plus a bake-time table of single-impact peak transfer between the upward-facing surface vertices and the midpoints of their edges, computed with 160 / 640 modes (the scaffold: 160 / 320, Lanczos), interpolated quadratically (P2) over each triangle's vertices and edge midpoints on both sides at run time; errors at vertices and inside triangles, against the same table blended linearly over vertices only, query cost against the 20-mode modal query in the same run.").unwrap();
     writeln!(md, "- Bake seconds: whole `bake_mesh` (assembly, factorization, Lanczos) on this machine (2 shared cores); bytes: the written `.modes` file; query: one `DistantResponse::step` (1 impact, 8 resting contacts, paper T, warm), mean of 20.\n").unwrap();
 
     let mut cost_bake: Vec<CostSeries> = vec![];
@@ -731,6 +739,7 @@ fn main() {
                 density: 770.0,
             },
             max_modes: 80,
+            transfer_box: None,
         };
         let truth = compute_truth(&s, 1, Some((imp_pts.clone(), con_pts.clone())));
         let (rows, _) = sweep(&s, &truth);
@@ -855,10 +864,14 @@ fn vertex_only(t: &TransferTable) -> TransferTable {
 
 /// Region of a scene's table: the upward faces (outward normal within 60° of +y; every scene
 /// mesh is y-up).
-fn transfer_params(n: modal_bake::transfer::TransferModes) -> modal_bake::transfer::TransferParams {
+fn transfer_params(
+    s: &Scene,
+    n: modal_bake::transfer::TransferModes,
+) -> modal_bake::transfer::TransferParams {
     modal_bake::transfer::TransferParams {
         h: H,
         modes: n,
+        boxes: s.transfer_box.into_iter().collect(),
         up: Some([0.0, 1.0, 0.0]),
         ..Default::default()
     }
@@ -897,12 +910,28 @@ fn transfer_study(s: &Scene, truth: &Truth, md: &mut String) {
     let mut notes = Vec::new();
     match &truth.dense {
         Some((sys, ma)) => {
-            // 160 and 640 modes: with edge midpoints the table's build grows ≈ 8×, which puts
-            // an all-mode table (S in the thousands) out of reach of this harness.
-            for n in [160, 640] {
-                if n <= ma.eigenvalues.len() {
-                    sets.push((n.to_string(), dense_base(&base20, sys, ma, n), ma.solve_s));
+            // 160 and 640 modes, and every mode where the table's build (≈ 2·np·nr·S·m flops,
+            // np ≈ 4 nr points) stays within a few minutes here (a boxed region).
+            let n_all = ma.eigenvalues.len();
+            let nr = modal_bake::transfer::select_region(
+                &model20,
+                &transfer_params(s, TransferModes::All).boxes,
+                Some([0.0, 1.0, 0.0]),
+                modal_bake::transfer::UP_MIN_COS,
+            )
+            .len() as f64;
+            let s_all = 2.0 * H * ma.eigenvalues[n_all - 1].sqrt() / std::f64::consts::FRAC_PI_2;
+            let all_ok = 8.0 * nr * nr * s_all * n_all as f64 <= 3e12;
+            for n in [160, 640, n_all] {
+                if n > n_all || (n == n_all && !all_ok) {
+                    continue;
                 }
+                let label = if n == n_all {
+                    format!("all {n}")
+                } else {
+                    n.to_string()
+                };
+                sets.push((label, dense_base(&base20, sys, ma, n), ma.solve_s));
             }
         }
         None => {
@@ -925,10 +954,11 @@ fn transfer_study(s: &Scene, truth: &Truth, md: &mut String) {
             }
         }
     }
+    let tp = transfer_params(s, TransferModes::Count(TRANSFER_BASE_MODES));
     let region = modal_bake::transfer::select_region(
         &model20,
-        &[],
-        transfer_params(TransferModes::Count(TRANSFER_BASE_MODES)).up,
+        &tp.boxes,
+        tp.up,
         modal_bake::transfer::UP_MIN_COS,
     );
     let mut local = vec![u32::MAX; base20.num_surface_vertices()];
@@ -1114,7 +1144,7 @@ fn transfer_study(s: &Scene, truth: &Truth, md: &mut String) {
         let t = Instant::now();
         let table = build_transfer_table(
             set,
-            &transfer_params(TransferModes::Count(n)),
+            &transfer_params(s, TransferModes::Count(n)),
             base20.rayleigh,
             &mut |_| {},
         )
@@ -1191,7 +1221,11 @@ fn transfer_study(s: &Scene, truth: &Truth, md: &mut String) {
     writeln!(md, "### {}: transfer table (`Method::Transfer`)\n", s.name).unwrap();
     writeln!(
         md,
-        "- region: upward faces (`--transfer-up 0,1,0`: vertex normal within 60° of +y; the meshes are y-up), {} vertices and {} edge midpoints; table at h = {H} s, base Rayleigh, peak search at 2× the paper T of its highest mode; runtime base: {TRANSFER_BASE_MODES} modes + table.",
+        "- region: upward faces (`--transfer-up 0,1,0`: vertex normal within 60° of +y; the meshes are y-up){}, {} vertices and {} edge midpoints; table at h = {H} s, base Rayleigh, peak search at 2× the paper T of its highest mode; runtime base: {TRANSFER_BASE_MODES} modes + table.",
+        match s.transfer_box {
+            Some(b) => format!(" in the box `--transfer-region {},{},{},{},{},{}` (m)", b[0], b[1], b[2], b[3], b[4], b[5]),
+            None => String::new(),
+        },
         region.len(),
         TransferTable::region_edges(&base20.surface_triangles, &region).len()
     )
