@@ -18,7 +18,7 @@ use faer::sparse::SymbolicSparseColMatRef;
 use faer::Side;
 
 use super::sparse_llt::Pattern;
-use crate::math::{cross, dot, norm, scale, sub};
+use crate::math::{cross, dot, norm, sub};
 use crate::model::SurfacePoint;
 
 /// Why a [`HeatGeodesic`] could not be built.
@@ -49,10 +49,26 @@ pub enum GeodesicError {
     Factorization(String),
 }
 
+/// One operator's factor values in [`Pattern`] order and its inverse diagonal (1/L_kk).
+struct Factor {
+    vals: Vec<f64>,
+    inv_diag: Vec<f64>,
+}
+
+impl Factor {
+    fn new(pattern: &Pattern, vals: Vec<f64>) -> Self {
+        let inv_diag = pattern.col_ptr[..pattern.n()]
+            .iter()
+            .map(|&p| 1.0 / vals[p as usize])
+            .collect();
+        Factor { vals, inv_diag }
+    }
+}
+
 /// Reusable scratch for [`HeatGeodesic`] queries, so repeated queries do not allocate.
 pub struct HeatWorkspace {
+    /// Heat u, then the divergence b / distance φ, in the factor's (permuted) order.
     u: Vec<f64>,
-    /// Right-hand side / solution in the factor's (permuted) order.
     x: Vec<f64>,
 }
 
@@ -67,17 +83,23 @@ impl std::fmt::Debug for HeatWorkspace {
 /// Heat-method geodesic distances (m) on a fixed triangle surface: factor once, many sources.
 pub struct HeatGeodesic {
     n: usize,
+    /// The surface's triangles (original vertex indices), for point sources.
     triangles: Vec<[u32; 3]>,
-    /// Per face: A_f ∇φ_i for its three corners (m), i.e. N × e_i / 2.
-    grad_area: Vec<[[f64; 3]; 3]>,
+    /// The triangles with vertices renumbered to factor rows, and per triangle the Gram matrix
+    /// ¼[e₁·e₁, e₁·e₂, e₂·e₂] (m²) of its edges e₁ = x₀ − x₂, e₂ = x₁ − x₀, i.e. of A∇φ₁,
+    /// A∇φ₂ (A the area, φ_i the hat functions): the whole per-source face loop works in the
+    /// factor's order on these, without a permutation pass.
+    faces: Vec<[u32; 3]>,
+    gram: Vec<[f64; 3]>,
     symbolic: SymbolicCholesky<u32>,
     /// Simplicial factor pattern (Pᵀ A P = L Lᵀ) shared by both operators.
     pattern: Pattern,
-    /// Factor values of (M + tL) and (L + εM), in `pattern` order.
-    heat: Vec<f64>,
-    poisson: Vec<f64>,
-    /// Fill-reducing permutation: factor row i is vertex `perm[i]`.
+    /// Factors of (M + tL) and (L + εM).
+    heat: Factor,
+    poisson: Factor,
+    /// Fill-reducing permutation: factor row i is vertex `perm[i]`, vertex v is row `iperm[v]`.
     perm: Vec<u32>,
+    iperm: Vec<u32>,
     mean_edge: f64,
 }
 
@@ -128,12 +150,17 @@ impl HeatGeodesic {
         Ok(HeatGeodesic {
             n,
             triangles: triangles.to_vec(),
-            grad_area: asm.grad_area,
+            faces: triangles
+                .iter()
+                .map(|t| t.map(|v| iperm[v as usize]))
+                .collect(),
+            gram: asm.gram,
             symbolic,
-            heat: vals.iter().map(|v| v[0]).collect(),
-            poisson: vals.iter().map(|v| v[1]).collect(),
+            heat: Factor::new(&pattern, vals.iter().map(|v| v[0]).collect()),
+            poisson: Factor::new(&pattern, vals.iter().map(|v| v[1]).collect()),
             pattern,
             perm,
+            iperm,
             mean_edge: asm.mean_edge,
         })
     }
@@ -209,48 +236,55 @@ impl HeatGeodesic {
         self.distances_with(&src, out, ws);
     }
 
-    /// Core: heat from a weighted vertex source, normalised gradient, divergence, Poisson, shift.
+    /// Core: heat from a weighted vertex source, normalised gradient, divergence, Poisson, shift;
+    /// all in the factor's order until the final scatter to `out`.
     fn distances_with(&self, source: &[(usize, f64)], out: &mut [f64], ws: &mut HeatWorkspace) {
         assert_eq!(out.len(), self.n);
-        let u = &mut ws.u;
+        let (u, b) = (&mut ws.u, &mut ws.x);
         u.iter_mut().for_each(|x| *x = 0.0);
         for &(v, w) in source {
-            u[v] += w;
+            u[self.iperm[v] as usize] += w;
         }
-        self.solve(&self.heat, u, &mut ws.x);
-        out.iter_mut().for_each(|x| *x = 0.0);
-        for (f, tri) in self.triangles.iter().enumerate() {
-            let ga = &self.grad_area[f];
-            let mut grad = [0.0; 3];
-            for i in 0..3 {
-                let ui = u[tri[i] as usize];
-                for k in 0..3 {
-                    grad[k] += ui * ga[i][k];
-                }
-            }
-            // grad = A ∇u; X = −∇u/|∇u| (direction only, so the A scale drops out).
-            let len = norm(grad);
-            if !(len > 0.0) {
+        self.pattern.solve(&self.heat.vals, &self.heat.inv_diag, u);
+        b.iter_mut().for_each(|x| *x = 0.0);
+        // With d_i = u_i − u₀ and g_i = A∇φ_i: A∇u = d₁g₁ + d₂g₂, X = −∇u/|∇u|, and
+        // b_i += X·g_i (b₀ gets minus the other two) needs only the Gram matrix of g₁, g₂.
+        for (f, g) in self.faces.iter().zip(&self.gram) {
+            let [a0, a1, a2] = f.map(|v| v as usize);
+            let u0 = u[a0];
+            let (d1, d2) = (u[a1] - u0, u[a2] - u0);
+            let p1 = d1 * g[0] + d2 * g[1];
+            let p2 = d1 * g[1] + d2 * g[2];
+            let len2 = d1 * p1 + d2 * p2;
+            if !(len2 > 0.0) {
                 continue;
             }
-            let x = scale(grad, -1.0 / len);
-            for i in 0..3 {
-                out[tri[i] as usize] += dot(x, ga[i]);
-            }
+            let inv = 1.0 / len2.sqrt();
+            let (c1, c2) = (p1 * inv, p2 * inv);
+            b[a0] += c1 + c2;
+            b[a1] -= c1;
+            b[a2] -= c2;
         }
-        self.solve(&self.poisson, out, &mut ws.x);
-        let shift: f64 = source.iter().map(|&(v, w)| w * out[v]).sum();
-        for d in out.iter_mut() {
-            *d = (*d - shift).max(0.0);
+        self.pattern
+            .solve(&self.poisson.vals, &self.poisson.inv_diag, b);
+        let shift: f64 = source
+            .iter()
+            .map(|&(v, w)| w * b[self.iperm[v] as usize])
+            .sum();
+        for (&d, &p) in b.iter().zip(&self.perm) {
+            out[p as usize] = (d - shift).max(0.0);
         }
     }
 
-    /// `rhs ← A⁻¹ rhs` through the permuted simplicial factor (Pᵀ A P = L Lᵀ).
-    fn solve(&self, factor: &[f64], rhs: &mut [f64], x: &mut [f64]) {
+    /// `rhs ← A⁻¹ rhs` (original vertex order) through the permuted factor, for tests:
+    /// `which` 0 = heat, 1 = Poisson.
+    #[cfg(test)]
+    pub(crate) fn solve_own(&self, which: usize, rhs: &mut [f64], x: &mut [f64]) {
+        let factor = [&self.heat, &self.poisson][which];
         for (xi, &p) in x.iter_mut().zip(&self.perm) {
             *xi = rhs[p as usize];
         }
-        self.pattern.solve(factor, x);
+        self.pattern.solve(&factor.vals, &factor.inv_diag, x);
         for (xi, &p) in x.iter().zip(&self.perm) {
             rhs[p as usize] = *xi;
         }
@@ -259,7 +293,7 @@ impl HeatGeodesic {
     /// Factor values by index, for tests: `which` 0 = heat, 1 = Poisson.
     #[cfg(test)]
     pub(crate) fn factor(&self, which: usize) -> &[f64] {
-        [&self.heat, &self.poisson][which]
+        &[&self.heat, &self.poisson][which].vals
     }
 
     /// faer's solve on the same factor (the implementation [`Pattern::solve`] replaced), for
@@ -276,12 +310,6 @@ impl HeatGeodesic {
             Par::Seq,
             MemStack::new(&mut buf),
         );
-    }
-
-    /// [`HeatGeodesic::solve`] by index, for tests: `which` 0 = heat, 1 = Poisson.
-    #[cfg(test)]
-    pub(crate) fn solve_own(&self, which: usize, rhs: &mut [f64], x: &mut [f64]) {
-        self.solve(self.factor(which), rhs, x);
     }
 
     /// faer's numeric factors (the implementation [`Pattern::factor_pair`] replaced) of the two
@@ -343,7 +371,8 @@ struct Assembly {
     val: Vec<f64>,
     /// Lumped vertex mass (m²).
     mass: Vec<f64>,
-    grad_area: Vec<[[f64; 3]; 3]>,
+    /// Per face: ¼[e₁·e₁, e₁·e₂, e₂·e₂] (m²), see [`HeatGeodesic`].
+    gram: Vec<[f64; 3]>,
     /// Mean edge length (m).
     mean_edge: f64,
 }
@@ -357,7 +386,7 @@ impl Assembly {
             return Err(GeodesicError::Empty);
         }
         let mut mass = vec![0.0; n];
-        let mut grad_area = Vec::with_capacity(triangles.len());
+        let mut gram = Vec::with_capacity(triangles.len());
         // (lower vertex, upper vertex, w) per face corner's opposite edge.
         let mut half: Vec<(u32, u32, f64)> = Vec::with_capacity(triangles.len() * 3);
         let mut edge_sum = 0.0;
@@ -381,8 +410,11 @@ impl Assembly {
                 });
             }
             edge_sum += norm(e[0]) + norm(e[1]) + norm(e[2]);
-            let unit = scale(nn, 1.0 / two_a);
-            grad_area.push([0, 1, 2].map(|i| scale(cross(unit, e[i]), 0.5)));
+            gram.push([
+                0.25 * dot(e[1], e[1]),
+                0.25 * dot(e[1], e[2]),
+                0.25 * dot(e[2], e[2]),
+            ]);
             for &v in tri {
                 mass[v as usize] += two_a / 6.0;
             }
@@ -440,7 +472,7 @@ impl Assembly {
             row_idx,
             val,
             mass,
-            grad_area,
+            gram,
             mean_edge,
         })
     }

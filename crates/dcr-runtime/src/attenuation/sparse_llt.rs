@@ -22,6 +22,8 @@ pub(super) struct Pattern {
     /// columns, position of L_jk in `row_idx`.
     run_ptr: Vec<u32>,
     runs: Vec<[u32; 3]>,
+    /// Fundamental supernodes: columns `sn_ptr[s]..sn_ptr[s + 1]`.
+    sn_ptr: Vec<u32>,
 }
 
 /// Longest run of supernode columns one update pass combines.
@@ -79,11 +81,15 @@ impl Pattern {
                 }
             }
         }
+        let sn_ptr = std::iter::once(0)
+            .chain(supernodes.iter().map(|&(_, k1)| k1 as u32 + 1))
+            .collect();
         Pattern {
             col_ptr,
             row_idx,
             run_ptr,
             runs,
+            sn_ptr,
         }
     }
 
@@ -176,45 +182,203 @@ impl Pattern {
         Ok(())
     }
 
-    /// `x ← A⁻¹ x` for A = L Lᵀ (x in the factor's order).
+    /// `x ← A⁻¹ x` for A = L Lᵀ (x in the factor's order; `inv_diag` = 1/L_kk).
     ///
-    /// The forward sweep skips columns whose entry is still zero, so a right-hand side with a
-    /// few non-zeros only walks their elimination-tree ancestors. Column axpy forward, row dot
-    /// backward (summed in four partial sums, so results differ from faer's in the last bits).
-    pub(super) fn solve(&self, l: &[f64], x: &mut [f64]) {
+    /// Supernode by supernode: the dense triangle of its diagonal block on contiguous x, then
+    /// its rows below in passes of up to [`MAX_RUN`] columns (one index load and one x access
+    /// per row and pass instead of per entry). The forward sweep skips supernodes whose entries
+    /// are still zero, so a right-hand side with a few non-zeros only walks their
+    /// elimination-tree ancestors. Results differ from faer's in the last bits (summation
+    /// order).
+    pub(super) fn solve(&self, l: &[f64], inv_diag: &[f64], x: &mut [f64]) {
+        #[cfg(target_arch = "x86_64")]
+        if let Some(simd) = pulp::x86::V3::try_new() {
+            return pulp::Simd::vectorize(
+                simd,
+                SolveKernel {
+                    pattern: self,
+                    l,
+                    inv_diag,
+                    x,
+                },
+            );
+        }
+        self.solve_impl::<false>(l, inv_diag, x);
+    }
+
+    #[inline(always)]
+    fn solve_impl<const FMA: bool>(&self, l: &[f64], inv_diag: &[f64], x: &mut [f64]) {
         let (cp, ri) = (&self.col_ptr, &self.row_idx);
-        // L y = b, column by column (diagonal first in each column).
-        for j in 0..self.n() {
-            let (start, end) = (cp[j] as usize, cp[j + 1] as usize);
-            let yj = x[j];
-            if yj == 0.0 {
+        let ns = self.sn_ptr.len() - 1;
+        // Column k of supernode [k0, k1]: L_kk, the block rows k+1..=k1, then the rows below.
+        let block = |k: usize, k1: usize| cp[k] as usize + 1..cp[k] as usize + 1 + (k1 - k);
+        let below_start = |k: usize, k1: usize| cp[k] as usize + 1 + (k1 - k);
+        // L y = b.
+        for s in 0..ns {
+            let (k0, k1) = (self.sn_ptr[s] as usize, self.sn_ptr[s + 1] as usize - 1);
+            if k0 == k1 {
+                // A lone column (most supernodes): plain column axpy.
+                let (start, end) = (cp[k0] as usize, cp[k0 + 1] as usize);
+                if x[k0] == 0.0 {
+                    continue;
+                }
+                let xk = x[k0] * inv_diag[k0];
+                x[k0] = xk;
+                for (&i, &lv) in ri[start + 1..end].iter().zip(&l[start + 1..end]) {
+                    let xi = &mut x[i as usize];
+                    *xi = fmadd::<FMA>(-lv, xk, *xi);
+                }
                 continue;
             }
-            let yj = yj / l[start];
-            x[j] = yj;
-            for (&i, &lij) in ri[start + 1..end].iter().zip(&l[start + 1..end]) {
-                x[i as usize] -= lij * yj;
+            if x[k0..=k1].iter().all(|&v| v == 0.0) {
+                continue;
             }
-        }
-        // Lᵀ z = y, last row first. The column dot products use four partial sums: one chain
-        // would be bound by add latency (≈ 23 entries per column on ~5k-vertex surfaces).
-        for j in (0..self.n()).rev() {
-            let (start, end) = (cp[j] as usize, cp[j + 1] as usize);
-            let (ri, lj) = (&ri[start + 1..end], &l[start + 1..end]);
-            let mut acc = [0.0f64; 4];
-            let mut ri4 = ri.chunks_exact(4);
-            let mut lj4 = lj.chunks_exact(4);
-            for (i4, l4) in (&mut ri4).zip(&mut lj4) {
-                for k in 0..4 {
-                    acc[k] += l4[k] * x[i4[k] as usize];
+            for k in k0..=k1 {
+                let xk = x[k] * inv_diag[k];
+                x[k] = xk;
+                for (xi, &lv) in x[k + 1..=k1].iter_mut().zip(&l[block(k, k1)]) {
+                    *xi = fmadd::<FMA>(-lv, xk, *xi);
                 }
             }
-            for (&i, &lij) in ri4.remainder().iter().zip(lj4.remainder()) {
-                acc[0] += lij * x[i as usize];
+            let rows = &ri[below_start(k1, k1)..cp[k1 + 1] as usize];
+            if rows.is_empty() {
+                continue;
             }
-            x[j] = (x[j] - ((acc[0] + acc[1]) + (acc[2] + acc[3]))) / l[start];
+            for ka in (k0..=k1).step_by(MAX_RUN as usize) {
+                let m = (k1 + 1 - ka).min(MAX_RUN as usize);
+                let mut offs = [0usize; MAX_RUN as usize];
+                let mut xs = [0.0f64; MAX_RUN as usize];
+                for i in 0..m {
+                    offs[i] = below_start(ka + i, k1);
+                    xs[i] = x[ka + i];
+                }
+                match m {
+                    1 => forward_below::<1, FMA>(rows, &offs, &xs, l, x),
+                    2 => forward_below::<2, FMA>(rows, &offs, &xs, l, x),
+                    3 => forward_below::<3, FMA>(rows, &offs, &xs, l, x),
+                    4 => forward_below::<4, FMA>(rows, &offs, &xs, l, x),
+                    5 => forward_below::<5, FMA>(rows, &offs, &xs, l, x),
+                    6 => forward_below::<6, FMA>(rows, &offs, &xs, l, x),
+                    7 => forward_below::<7, FMA>(rows, &offs, &xs, l, x),
+                    _ => forward_below::<{ MAX_RUN as usize }, FMA>(rows, &offs, &xs, l, x),
+                }
+            }
+        }
+        // Lᵀ z = y, last supernode first.
+        for s in (0..ns).rev() {
+            let (k0, k1) = (self.sn_ptr[s] as usize, self.sn_ptr[s + 1] as usize - 1);
+            let rows = &ri[below_start(k1, k1)..cp[k1 + 1] as usize];
+            if k0 == k1 {
+                // A lone column: one dot product in four partial sums (add latency).
+                let lk = &l[below_start(k1, k1)..cp[k1 + 1] as usize];
+                let mut acc = [0.0f64; 4];
+                let (ri4, lk4) = (rows.chunks_exact(4), lk.chunks_exact(4));
+                let (ri_r, lk_r) = (ri4.remainder(), lk4.remainder());
+                for (i4, l4) in ri4.zip(lk4) {
+                    for i in 0..4 {
+                        acc[i] = fmadd::<FMA>(l4[i], x[i4[i] as usize], acc[i]);
+                    }
+                }
+                for (&i, &lv) in ri_r.iter().zip(lk_r) {
+                    acc[0] = fmadd::<FMA>(lv, x[i as usize], acc[0]);
+                }
+                x[k0] = (x[k0] - ((acc[0] + acc[1]) + (acc[2] + acc[3]))) * inv_diag[k0];
+                continue;
+            }
+            if !rows.is_empty() {
+                for ka in (k0..=k1).step_by(MAX_RUN as usize) {
+                    let m = (k1 + 1 - ka).min(MAX_RUN as usize);
+                    let mut offs = [0usize; MAX_RUN as usize];
+                    for (i, o) in offs[..m].iter_mut().enumerate() {
+                        *o = below_start(ka + i, k1);
+                    }
+                    // Few columns: split each dot product into partial sums (add latency).
+                    let dots: [f64; MAX_RUN as usize] = match m {
+                        1 => backward_below::<1, 4, FMA>(rows, &offs, l, x),
+                        2 => backward_below::<2, 2, FMA>(rows, &offs, l, x),
+                        3 => backward_below::<3, 2, FMA>(rows, &offs, l, x),
+                        4 => backward_below::<4, 1, FMA>(rows, &offs, l, x),
+                        5 => backward_below::<5, 1, FMA>(rows, &offs, l, x),
+                        6 => backward_below::<6, 1, FMA>(rows, &offs, l, x),
+                        7 => backward_below::<7, 1, FMA>(rows, &offs, l, x),
+                        _ => backward_below::<{ MAX_RUN as usize }, 1, FMA>(rows, &offs, l, x),
+                    };
+                    for (xk, d) in x[ka..ka + m].iter_mut().zip(dots) {
+                        *xk -= d;
+                    }
+                }
+            }
+            for k in (k0..=k1).rev() {
+                let (col, xb) = (&l[block(k, k1)], &x[k + 1..=k1]);
+                let mut acc = [0.0f64; 4];
+                let (col4, xb4) = (col.chunks_exact(4), xb.chunks_exact(4));
+                let (col_r, xb_r) = (col4.remainder(), xb4.remainder());
+                for (c4, x4) in col4.zip(xb4) {
+                    for i in 0..4 {
+                        acc[i] = fmadd::<FMA>(c4[i], x4[i], acc[i]);
+                    }
+                }
+                for (&c, &xv) in col_r.iter().zip(xb_r) {
+                    acc[0] = fmadd::<FMA>(c, xv, acc[0]);
+                }
+                x[k] = (x[k] - ((acc[0] + acc[1]) + (acc[2] + acc[3]))) * inv_diag[k];
+            }
         }
     }
+}
+
+/// `x[rows[r]] −= Σ_m L[offs[m] + r] · xs[m]`: M columns of one supernode on its rows below.
+#[inline(always)]
+fn forward_below<const M: usize, const FMA: bool>(
+    rows: &[u32],
+    offs: &[usize],
+    xs: &[f64],
+    l: &[f64],
+    x: &mut [f64],
+) {
+    let len = rows.len();
+    let cols: [&[f64]; M] = std::array::from_fn(|m| &l[offs[m]..offs[m] + len]);
+    for (r, &i) in rows.iter().enumerate() {
+        let mut s = 0.0;
+        for m in 0..M {
+            s = fmadd::<FMA>(cols[m][r], xs[m], s);
+        }
+        x[i as usize] -= s;
+    }
+}
+
+/// `Σ_r L[offs[m] + r] · x[rows[r]]` for M columns of one supernode on its rows below, each in
+/// P partial sums; unused entries of the result are zero.
+#[inline(always)]
+fn backward_below<const M: usize, const P: usize, const FMA: bool>(
+    rows: &[u32],
+    offs: &[usize],
+    l: &[f64],
+    x: &[f64],
+) -> [f64; MAX_RUN as usize] {
+    let len = rows.len();
+    let cols: [&[f64]; M] = std::array::from_fn(|m| &l[offs[m]..offs[m] + len]);
+    let mut acc = [[0.0f64; M]; P];
+    let full = len / P * P;
+    for r0 in (0..full).step_by(P) {
+        for p in 0..P {
+            let xi = x[rows[r0 + p] as usize];
+            for m in 0..M {
+                acc[p][m] = fmadd::<FMA>(cols[m][r0 + p], xi, acc[p][m]);
+            }
+        }
+    }
+    for r in full..len {
+        let xi = x[rows[r] as usize];
+        for m in 0..M {
+            acc[0][m] = fmadd::<FMA>(cols[m][r], xi, acc[0][m]);
+        }
+    }
+    let mut out = [0.0; MAX_RUN as usize];
+    for m in 0..M {
+        out[m] = acc.iter().map(|a| a[m]).sum();
+    }
+    out
 }
 
 /// `w[rows[q]] −= Σ_m L[p_m + q] · L[p_m]` for M columns of one supernode whose entries of row
@@ -254,5 +418,22 @@ impl pulp::WithSimd for FactorKernel<'_> {
     #[inline(always)]
     fn with_simd<S: pulp::Simd>(self, _simd: S) -> Self::Output {
         self.pattern.factor_pair_impl::<true>(self.vals, self.w)
+    }
+}
+
+/// [`Pattern::solve`]'s arguments, run under `pulp` dispatch.
+struct SolveKernel<'a> {
+    pattern: &'a Pattern,
+    l: &'a [f64],
+    inv_diag: &'a [f64],
+    x: &'a mut [f64],
+}
+
+impl pulp::WithSimd for SolveKernel<'_> {
+    type Output = ();
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, _simd: S) {
+        self.pattern
+            .solve_impl::<true>(self.l, self.inv_diag, self.x);
     }
 }
