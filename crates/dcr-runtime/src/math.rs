@@ -44,3 +44,14 @@ pub(crate) fn normalize(a: [f64; 3]) -> [f64; 3] {
         [0.0; 3]
     }
 }
+
+/// `a·b + c`: one fused multiply-add when `FMA` (callers compile that path with FMA enabled,
+/// e.g. under `pulp` dispatch), else a separate multiply and add.
+#[inline(always)]
+pub(crate) fn fmadd<const FMA: bool>(a: f64, b: f64, c: f64) -> f64 {
+    if FMA {
+        a.mul_add(b, c)
+    } else {
+        c + a * b
+    }
+}

@@ -3,21 +3,22 @@
 //!
 //! Set-up: cotan Laplacian L (positive semi-definite, `L_ij = −½(cot α_ij + cot β_ij)`), lumped
 //! vertex mass M (⅓ of the incident triangle areas), t = (mean edge length)²; one symbolic
-//! sparse Cholesky (faer, AMD ordering) shared by the two numeric factors of (M + tL) and
-//! (L + εM), ε = 1e-8/t (scale-free regularisation of the closed-surface null space).
+//! sparse Cholesky (faer, AMD ordering, simplicial pattern) shared by the two numeric factors
+//! of (M + tL) and (L + εM), ε = 1e-8/t (scale-free regularisation of the closed-surface null
+//! space), both computed in one left-looking sweep ([`super::sparse_llt`]).
 //! Per source: heat solve (M + tL) u = δ, X = −∇u/|∇u| per face, integrated divergence
 //! b_i = Σ_f A_f X_f·∇φ_i, Poisson solve (L + εM) φ = b, shift so the source is at 0.
 //! No boundary-condition averaging (open surfaces get the natural Neumann condition).
 
-use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky, CholeskySymbolicParams, SymbolicCholesky, SymbolicCholeskyRaw,
 };
 use faer::sparse::linalg::SupernodalThreshold;
-use faer::sparse::{SparseColMat, Triplet};
-use faer::{Par, Side};
+use faer::sparse::SymbolicSparseColMatRef;
+use faer::Side;
 
-use crate::math::{cross, dot, norm, scale, sub};
+use super::sparse_llt::Pattern;
+use crate::math::{cross, dot, norm, sub};
 use crate::model::SurfacePoint;
 
 /// Why a [`HeatGeodesic`] could not be built.
@@ -48,17 +49,26 @@ pub enum GeodesicError {
     Factorization(String),
 }
 
-/// Simplicial factors: measured faster to solve than supernodal ones on ~5k-vertex surfaces.
-const SUPERNODAL: SupernodalThreshold = SupernodalThreshold::FORCE_SIMPLICIAL;
-
+/// One operator's factor values in [`Pattern`] order and its inverse diagonal (1/L_kk).
 struct Factor {
-    values: Vec<f64>,
+    vals: Vec<f64>,
+    inv_diag: Vec<f64>,
+}
+
+impl Factor {
+    fn new(pattern: &Pattern, vals: Vec<f64>) -> Self {
+        let inv_diag = pattern.col_ptr[..pattern.n()]
+            .iter()
+            .map(|&p| 1.0 / vals[p as usize])
+            .collect();
+        Factor { vals, inv_diag }
+    }
 }
 
 /// Reusable scratch for [`HeatGeodesic`] queries, so repeated queries do not allocate.
 pub struct HeatWorkspace {
+    /// Heat u, then the divergence b / distance φ, in the factor's (permuted) order.
     u: Vec<f64>,
-    /// Right-hand side / solution in the factor's (permuted) order.
     x: Vec<f64>,
 }
 
@@ -73,17 +83,23 @@ impl std::fmt::Debug for HeatWorkspace {
 /// Heat-method geodesic distances (m) on a fixed triangle surface: factor once, many sources.
 pub struct HeatGeodesic {
     n: usize,
+    /// The surface's triangles (original vertex indices), for point sources.
     triangles: Vec<[u32; 3]>,
-    /// Per face: A_f ∇φ_i for its three corners (m), i.e. N × e_i / 2.
-    grad_area: Vec<[[f64; 3]; 3]>,
-    symbolic: SymbolicCholesky<usize>,
+    /// The triangles with vertices renumbered to factor rows, and per triangle the Gram matrix
+    /// ¼[e₁·e₁, e₁·e₂, e₂·e₂] (m²) of its edges e₁ = x₀ − x₂, e₂ = x₁ − x₀, i.e. of A∇φ₁,
+    /// A∇φ₂ (A the area, φ_i the hat functions): the whole per-source face loop works in the
+    /// factor's order on these, without a permutation pass.
+    faces: Vec<[u32; 3]>,
+    gram: Vec<[f64; 3]>,
+    symbolic: SymbolicCholesky<u32>,
+    /// Simplicial factor pattern (Pᵀ A P = L Lᵀ) shared by both operators.
+    pattern: Pattern,
+    /// Factors of (M + tL) and (L + εM).
     heat: Factor,
     poisson: Factor,
-    /// Pattern of the simplicial factor L (CSC, diagonal first in each column), as u32.
-    l_col_ptr: Vec<u32>,
-    l_row_idx: Vec<u32>,
-    /// Fill-reducing permutation: factor row i is vertex `perm[i]`.
+    /// Fill-reducing permutation: factor row i is vertex `perm[i]`, vertex v is row `iperm[v]`.
     perm: Vec<u32>,
+    iperm: Vec<u32>,
     mean_edge: f64,
 }
 
@@ -104,147 +120,65 @@ impl HeatGeodesic {
     /// [`GeodesicError`] for an empty surface, bad indices, degenerate triangles, or a failed
     /// factorisation (e.g. unused vertices).
     pub fn new(vertices: &[[f64; 3]], triangles: &[[u32; 3]]) -> Result<Self, GeodesicError> {
-        Self::with_threshold(vertices, triangles, SUPERNODAL)
-    }
-
-    pub(crate) fn with_threshold(
-        vertices: &[[f64; 3]],
-        triangles: &[[u32; 3]],
-        threshold: SupernodalThreshold,
-    ) -> Result<Self, GeodesicError> {
+        let asm = Assembly::new(vertices, triangles)?;
         let n = vertices.len();
-        if n == 0 || triangles.is_empty() {
-            return Err(GeodesicError::Empty);
-        }
-        let mut mass = vec![0.0; n];
-        let mut grad_area = Vec::with_capacity(triangles.len());
-        let mut trip: Vec<Triplet<usize, usize, f64>> = Vec::with_capacity(triangles.len() * 9 + n);
-        let mut edge_sum = 0.0;
-        for (f, tri) in triangles.iter().enumerate() {
-            if tri.iter().any(|&i| i as usize >= n) {
-                return Err(GeodesicError::BadIndex {
-                    triangle: f,
-                    vertices: n,
-                });
-            }
-            let x = tri.map(|i| vertices[i as usize]);
-            // e[i]: edge opposite corner i, counter-clockwise.
-            let e = [sub(x[2], x[1]), sub(x[0], x[2]), sub(x[1], x[0])];
-            let nn = cross(e[2], sub(x[2], x[0]));
-            let two_a = norm(nn);
-            let scale_len = dot(e[0], e[0]) + dot(e[1], e[1]) + dot(e[2], e[2]);
-            if !(two_a > 1e-12 * scale_len) {
-                return Err(GeodesicError::Degenerate {
-                    triangle: f,
-                    area: 0.5 * two_a,
-                });
-            }
-            edge_sum += norm(e[0]) + norm(e[1]) + norm(e[2]);
-            let unit = scale(nn, 1.0 / two_a);
-            grad_area.push([0, 1, 2].map(|i| scale(cross(unit, e[i]), 0.5)));
-            for &v in tri {
-                mass[v as usize] += two_a / 6.0;
-            }
-            // Cotangent of corner i = (e_j · e_k)/(2A) with the two edges leaving corner i.
-            for i in 0..3 {
-                let (j, k) = ((i + 1) % 3, (i + 2) % 3);
-                let cot = -dot(e[j], e[k]) / two_a;
-                let w = 0.5 * cot;
-                let (a, b) = (tri[j] as usize, tri[k] as usize);
-                trip.push(Triplet::new(a.max(b), a.min(b), -w));
-                trip.push(Triplet::new(a, a, w));
-                trip.push(Triplet::new(b, b, w));
-            }
-        }
-        let mean_edge = edge_sum / (3.0 * triangles.len() as f64);
-        let t = mean_edge * mean_edge;
+        let t = asm.mean_edge * asm.mean_edge;
         let eps = 1e-8 / t;
-        // L (lower triangle) once; both operators share its pattern and differ on the diagonal.
-        for i in 0..n {
-            trip.push(Triplet::new(i, i, 0.0));
-        }
-        let lap = SparseColMat::<usize, f64>::try_new_from_triplets(n, n, &trip)
-            .map_err(|e| GeodesicError::Factorization(format!("{e:?}")))?;
-        let diag: Vec<usize> = {
-            let (col_ptr, row_idx) = (lap.symbolic().col_ptr(), lap.symbolic().row_idx());
-            (0..n)
-                .map(|j| {
-                    (col_ptr[j]..col_ptr[j + 1])
-                        .find(|&k| row_idx[k] == j)
-                        .expect("diagonal present")
-                })
-                .collect()
-        };
-        let with_diag = |a: f64, b: f64| {
-            let mut mat = lap.clone();
-            let vals = mat.val_mut();
-            vals.iter_mut().for_each(|x| *x *= a);
-            for (i, &k) in diag.iter().enumerate() {
-                vals[k] += b * mass[i];
-            }
-            mat
-        };
-        let heat_mat = with_diag(t, 1.0);
-        let poisson_mat = with_diag(1.0, eps);
-        let symbolic = factorize_symbolic_cholesky(
-            heat_mat.symbolic(),
-            Side::Lower,
-            Default::default(),
-            CholeskySymbolicParams {
-                supernodal_flop_ratio_threshold: threshold,
-                ..Default::default()
-            },
-        )
-        .map_err(|e| GeodesicError::Factorization(format!("{e:?}")))?;
-        let par = Par::Seq;
-        // The two numeric factorisations are independent: run them on two threads.
-        let numeric = |a: &SparseColMat<usize, f64>| -> Result<Factor, GeodesicError> {
-            let mut buf = MemBuffer::new(
-                symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default()),
-            );
-            let mut values = vec![0.0; symbolic.len_val()];
-            symbolic
-                .factorize_numeric_llt::<f64>(
-                    &mut values,
-                    a.as_ref(),
-                    Side::Lower,
-                    Default::default(),
-                    par,
-                    MemStack::new(&mut buf),
-                    Default::default(),
-                )
-                .map_err(|e| GeodesicError::Factorization(format!("{e:?}")))?;
-            Ok(Factor { values })
-        };
-        let (heat, poisson) = std::thread::scope(|scope| {
-            let h = scope.spawn(|| numeric(&heat_mat));
-            let p = numeric(&poisson_mat);
-            (h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)), p)
-        });
-        let (heat, poisson) = (heat?, poisson?);
+        let symbolic = Self::symbolic(&asm)?;
         let SymbolicCholeskyRaw::Simplicial(simp) = symbolic.raw() else {
-            return Err(GeodesicError::Factorization(
-                "expected a simplicial factor".into(),
-            ));
+            unreachable!("simplicial factorisation forced")
         };
-        let to_u32 = |x: &[usize]| -> Vec<u32> { x.iter().map(|&i| i as u32).collect() };
-        let (l_col_ptr, l_row_idx) = (to_u32(simp.col_ptr()), to_u32(simp.row_idx()));
-        let perm = match symbolic.perm() {
-            Some(p) => to_u32(p.arrays().0),
-            None => (0..n as u32).collect(),
+        let pattern = Pattern::new(simp.col_ptr().to_vec(), simp.row_idx().to_vec());
+        let (perm, iperm) = match symbolic.perm() {
+            Some(p) => (p.arrays().0.to_vec(), p.arrays().1.to_vec()),
+            None => ((0..n as u32).collect(), (0..n as u32).collect()),
         };
+        // Both operators' lower triangles, permuted, scattered into the factor's pattern.
+        let mut vals = vec![[0.0f64; 2]; pattern.row_idx.len()];
+        for c in 0..n {
+            for q in asm.col_ptr[c] as usize..asm.col_ptr[c + 1] as usize {
+                let (r, lv) = (asm.row_idx[q] as usize, asm.val[q]);
+                let (pr, pc) = (iperm[r], iperm[c]);
+                let m = if r == c { asm.mass[c] } else { 0.0 };
+                vals[pattern.position(pr.max(pc), pr.min(pc))] = [t * lv + m, lv + eps * m];
+            }
+        }
+        let mut w = vec![[0.0f64; 2]; n];
+        pattern.factor_pair(&mut vals, &mut w).map_err(|j| {
+            GeodesicError::Factorization(format!("pivot of vertex {} is not positive", perm[j]))
+        })?;
         Ok(HeatGeodesic {
             n,
             triangles: triangles.to_vec(),
-            grad_area,
+            faces: triangles
+                .iter()
+                .map(|t| t.map(|v| iperm[v as usize]))
+                .collect(),
+            gram: asm.gram,
             symbolic,
-            heat,
-            poisson,
-            l_col_ptr,
-            l_row_idx,
+            heat: Factor::new(&pattern, vals.iter().map(|v| v[0]).collect()),
+            poisson: Factor::new(&pattern, vals.iter().map(|v| v[1]).collect()),
+            pattern,
             perm,
-            mean_edge,
+            iperm,
+            mean_edge: asm.mean_edge,
         })
+    }
+
+    /// AMD-ordered simplicial symbolic Cholesky of the Laplacian's pattern (faer).
+    fn symbolic(asm: &Assembly) -> Result<SymbolicCholesky<u32>, GeodesicError> {
+        let n = asm.mass.len();
+        let lap = SymbolicSparseColMatRef::new_checked(n, n, &asm.col_ptr, None, &asm.row_idx);
+        factorize_symbolic_cholesky(
+            lap,
+            Side::Lower,
+            Default::default(),
+            CholeskySymbolicParams {
+                supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SIMPLICIAL,
+                ..Default::default()
+            },
+        )
+        .map_err(|e| GeodesicError::Factorization(format!("{e:?}")))
     }
 
     /// Stored values of the Cholesky factor (fill), for diagnostics.
@@ -302,103 +236,75 @@ impl HeatGeodesic {
         self.distances_with(&src, out, ws);
     }
 
-    /// Core: heat from a weighted vertex source, normalised gradient, divergence, Poisson, shift.
+    /// Core: heat from a weighted vertex source, normalised gradient, divergence, Poisson, shift;
+    /// all in the factor's order until the final scatter to `out`.
     fn distances_with(&self, source: &[(usize, f64)], out: &mut [f64], ws: &mut HeatWorkspace) {
         assert_eq!(out.len(), self.n);
-        let u = &mut ws.u;
+        let (u, b) = (&mut ws.u, &mut ws.x);
         u.iter_mut().for_each(|x| *x = 0.0);
         for &(v, w) in source {
-            u[v] += w;
+            u[self.iperm[v] as usize] += w;
         }
-        self.solve(&self.heat, u, &mut ws.x);
-        out.iter_mut().for_each(|x| *x = 0.0);
-        for (f, tri) in self.triangles.iter().enumerate() {
-            let ga = &self.grad_area[f];
-            let mut grad = [0.0; 3];
-            for i in 0..3 {
-                let ui = u[tri[i] as usize];
-                for k in 0..3 {
-                    grad[k] += ui * ga[i][k];
-                }
-            }
-            // grad = A ∇u; X = −∇u/|∇u| (direction only, so the A scale drops out).
-            let len = norm(grad);
-            if !(len > 0.0) {
+        self.pattern.solve(&self.heat.vals, &self.heat.inv_diag, u);
+        b.iter_mut().for_each(|x| *x = 0.0);
+        // With d_i = u_i − u₀ and g_i = A∇φ_i: A∇u = d₁g₁ + d₂g₂, X = −∇u/|∇u|, and
+        // b_i += X·g_i (b₀ gets minus the other two) needs only the Gram matrix of g₁, g₂.
+        for (f, g) in self.faces.iter().zip(&self.gram) {
+            let [a0, a1, a2] = f.map(|v| v as usize);
+            let u0 = u[a0];
+            let (d1, d2) = (u[a1] - u0, u[a2] - u0);
+            let p1 = d1 * g[0] + d2 * g[1];
+            let p2 = d1 * g[1] + d2 * g[2];
+            let len2 = d1 * p1 + d2 * p2;
+            if !(len2 > 0.0) {
                 continue;
             }
-            let x = scale(grad, -1.0 / len);
-            for i in 0..3 {
-                out[tri[i] as usize] += dot(x, ga[i]);
-            }
+            let inv = 1.0 / len2.sqrt();
+            let (c1, c2) = (p1 * inv, p2 * inv);
+            b[a0] += c1 + c2;
+            b[a1] -= c1;
+            b[a2] -= c2;
         }
-        self.solve(&self.poisson, out, &mut ws.x);
-        let shift: f64 = source.iter().map(|&(v, w)| w * out[v]).sum();
-        for d in out.iter_mut() {
-            *d = (*d - shift).max(0.0);
+        self.pattern
+            .solve(&self.poisson.vals, &self.poisson.inv_diag, b);
+        let shift: f64 = source
+            .iter()
+            .map(|&(v, w)| w * b[self.iperm[v] as usize])
+            .sum();
+        for (&d, &p) in b.iter().zip(&self.perm) {
+            out[p as usize] = (d - shift).max(0.0);
         }
     }
 
-    /// `rhs ← A⁻¹ rhs` through the permuted simplicial factor (Pᵀ A P = L Lᵀ).
-    ///
-    /// Hand-written rather than faer's `LltRef::solve_in_place_with_conj` (which this replaced)
-    /// for two reasons measured on ~5k-vertex surfaces: the forward sweep skips columns whose
-    /// entry is still zero, so the heat solve's three-vertex source only walks its elimination
-    /// tree ancestors; and u32 indices with one flat loop per column halve the index traffic.
-    /// Column axpy forward, row dot backward (summed in four partial sums, so results differ from
-    /// faer's in the last bits).
-    fn solve(&self, factor: &Factor, rhs: &mut [f64], x: &mut [f64]) {
-        let (cp, ri, l) = (&self.l_col_ptr, &self.l_row_idx, &factor.values);
+    /// `rhs ← A⁻¹ rhs` (original vertex order) through the permuted factor, for tests:
+    /// `which` 0 = heat, 1 = Poisson.
+    #[cfg(test)]
+    pub(crate) fn solve_own(&self, which: usize, rhs: &mut [f64], x: &mut [f64]) {
+        let factor = [&self.heat, &self.poisson][which];
         for (xi, &p) in x.iter_mut().zip(&self.perm) {
             *xi = rhs[p as usize];
         }
-        // L y = P b, column by column (diagonal first in each column).
-        for j in 0..self.n {
-            let (start, end) = (cp[j] as usize, cp[j + 1] as usize);
-            let yj = x[j];
-            if yj == 0.0 {
-                continue;
-            }
-            let yj = yj / l[start];
-            x[j] = yj;
-            for (&i, &lij) in ri[start + 1..end].iter().zip(&l[start + 1..end]) {
-                x[i as usize] -= lij * yj;
-            }
-        }
-        // Lᵀ z = y, last row first. The column dot products use four partial sums: one chain
-        // would be bound by add latency (≈ 23 entries per column here).
-        for j in (0..self.n).rev() {
-            let (start, end) = (cp[j] as usize, cp[j + 1] as usize);
-            let (ri, lj) = (&ri[start + 1..end], &l[start + 1..end]);
-            let mut acc = [0.0f64; 4];
-            let mut ri4 = ri.chunks_exact(4);
-            let mut lj4 = lj.chunks_exact(4);
-            for (i4, l4) in (&mut ri4).zip(&mut lj4) {
-                for k in 0..4 {
-                    acc[k] += l4[k] * x[i4[k] as usize];
-                }
-            }
-            for (&i, &lij) in ri4.remainder().iter().zip(lj4.remainder()) {
-                acc[0] += lij * x[i as usize];
-            }
-            x[j] = (x[j] - ((acc[0] + acc[1]) + (acc[2] + acc[3]))) / l[start];
-        }
+        self.pattern.solve(&factor.vals, &factor.inv_diag, x);
         for (xi, &p) in x.iter().zip(&self.perm) {
             rhs[p as usize] = *xi;
         }
     }
 
-    /// faer's solve on the same factor (the implementation [`HeatGeodesic::solve`] replaced),
-    /// for tests and the timing probe: `which` 0 = heat, 1 = Poisson.
+    /// Factor values by index, for tests: `which` 0 = heat, 1 = Poisson.
+    #[cfg(test)]
+    pub(crate) fn factor(&self, which: usize) -> &[f64] {
+        &[&self.heat, &self.poisson][which].vals
+    }
+
+    /// faer's solve on the same factor (the implementation [`Pattern::solve`] replaced), for
+    /// tests and the timing probe: `which` 0 = heat, 1 = Poisson.
     #[cfg(test)]
     pub(crate) fn solve_faer(&self, which: usize, rhs: &mut [f64]) {
+        use faer::dyn_stack::{MemBuffer, MemStack};
         use faer::sparse::linalg::cholesky::LltRef;
-        let factor = if which == 0 {
-            &self.heat
-        } else {
-            &self.poisson
-        };
+        use faer::Par;
         let mut buf = MemBuffer::new(self.symbolic.solve_in_place_scratch::<f64>(1, Par::Seq));
-        LltRef::<usize, f64>::new(&self.symbolic, &factor.values).solve_in_place_with_conj(
+        LltRef::<u32, f64>::new(&self.symbolic, self.factor(which)).solve_in_place_with_conj(
             faer::Conj::No,
             faer::MatMut::from_column_major_slice_mut(rhs, self.n, 1),
             Par::Seq,
@@ -406,14 +312,168 @@ impl HeatGeodesic {
         );
     }
 
-    /// [`HeatGeodesic::solve`] by index, for tests: `which` 0 = heat, 1 = Poisson.
+    /// faer's numeric factors (the implementation [`Pattern::factor_pair`] replaced) of the two
+    /// operators of the surface this was built from, on the same symbolic analysis, for tests
+    /// and the timing probe: `[heat, poisson]` values in the factor's pattern order.
     #[cfg(test)]
-    pub(crate) fn solve_own(&self, which: usize, rhs: &mut [f64], x: &mut [f64]) {
-        let factor = if which == 0 {
-            &self.heat
-        } else {
-            &self.poisson
-        };
-        self.solve(factor, rhs, x);
+    pub(crate) fn factors_faer(
+        &self,
+        vertices: &[[f64; 3]],
+        triangles: &[[u32; 3]],
+    ) -> [Vec<f64>; 2] {
+        use faer::dyn_stack::{MemBuffer, MemStack};
+        use faer::sparse::{SparseColMat, SymbolicSparseColMat};
+        use faer::Par;
+        let asm = Assembly::new(vertices, triangles).unwrap();
+        let n = self.n;
+        let t = asm.mean_edge * asm.mean_edge;
+        [(t, 1.0), (1.0, 1e-8 / t)].map(|(a, b)| {
+            let mut val: Vec<f64> = asm.val.iter().map(|v| a * v).collect();
+            for c in 0..n {
+                // The diagonal leads each column.
+                val[asm.col_ptr[c] as usize] += b * asm.mass[c];
+            }
+            let pat = SymbolicSparseColMat::new_checked(
+                n,
+                n,
+                asm.col_ptr.clone(),
+                None,
+                asm.row_idx.clone(),
+            );
+            let mat = SparseColMat::new(pat, val);
+            let mut buf = MemBuffer::new(
+                self.symbolic
+                    .factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default()),
+            );
+            let mut values = vec![0.0; self.symbolic.len_val()];
+            self.symbolic
+                .factorize_numeric_llt::<f64>(
+                    &mut values,
+                    mat.as_ref(),
+                    Side::Lower,
+                    Default::default(),
+                    Par::Seq,
+                    MemStack::new(&mut buf),
+                    Default::default(),
+                )
+                .unwrap();
+            values
+        })
+    }
+}
+
+/// The cotan Laplacian's lower triangle (CSC, original vertex order, diagonal first, rows
+/// ascending), lumped mass and per-face gradient data of a surface.
+struct Assembly {
+    col_ptr: Vec<u32>,
+    row_idx: Vec<u32>,
+    /// L values (m⁰): diagonal Σ w, off-diagonal −w, w = ½(cot α + cot β) summed over faces.
+    val: Vec<f64>,
+    /// Lumped vertex mass (m²).
+    mass: Vec<f64>,
+    /// Per face: ¼[e₁·e₁, e₁·e₂, e₂·e₂] (m²), see [`HeatGeodesic`].
+    gram: Vec<[f64; 3]>,
+    /// Mean edge length (m).
+    mean_edge: f64,
+}
+
+impl Assembly {
+    /// Per face: geometry checks, mass, gradient data, three cotan half-edge weights; then the
+    /// half-edges bucketed by their lower vertex and merged (no triplet sort).
+    fn new(vertices: &[[f64; 3]], triangles: &[[u32; 3]]) -> Result<Self, GeodesicError> {
+        let n = vertices.len();
+        if n == 0 || triangles.is_empty() {
+            return Err(GeodesicError::Empty);
+        }
+        let mut mass = vec![0.0; n];
+        let mut gram = Vec::with_capacity(triangles.len());
+        // (lower vertex, upper vertex, w) per face corner's opposite edge.
+        let mut half: Vec<(u32, u32, f64)> = Vec::with_capacity(triangles.len() * 3);
+        let mut edge_sum = 0.0;
+        for (f, tri) in triangles.iter().enumerate() {
+            if tri.iter().any(|&i| i as usize >= n) {
+                return Err(GeodesicError::BadIndex {
+                    triangle: f,
+                    vertices: n,
+                });
+            }
+            let x = tri.map(|i| vertices[i as usize]);
+            // e[i]: edge opposite corner i, counter-clockwise.
+            let e = [sub(x[2], x[1]), sub(x[0], x[2]), sub(x[1], x[0])];
+            let nn = cross(e[2], sub(x[2], x[0]));
+            let two_a = norm(nn);
+            let scale_len = dot(e[0], e[0]) + dot(e[1], e[1]) + dot(e[2], e[2]);
+            if !(two_a > 1e-12 * scale_len) {
+                return Err(GeodesicError::Degenerate {
+                    triangle: f,
+                    area: 0.5 * two_a,
+                });
+            }
+            edge_sum += norm(e[0]) + norm(e[1]) + norm(e[2]);
+            gram.push([
+                0.25 * dot(e[1], e[1]),
+                0.25 * dot(e[1], e[2]),
+                0.25 * dot(e[2], e[2]),
+            ]);
+            for &v in tri {
+                mass[v as usize] += two_a / 6.0;
+            }
+            // Cotangent of corner i = (e_j · e_k)/(2A) with the two edges leaving corner i.
+            for i in 0..3 {
+                let (j, k) = ((i + 1) % 3, (i + 2) % 3);
+                let w = -0.5 * dot(e[j], e[k]) / two_a;
+                let (a, b) = (tri[j], tri[k]);
+                half.push((a.min(b), a.max(b), w));
+            }
+        }
+        let mean_edge = edge_sum / (3.0 * triangles.len() as f64);
+        // Bucket the half-edges by lower vertex (column).
+        let mut start = vec![0u32; n + 1];
+        for h in &half {
+            start[h.0 as usize + 1] += 1;
+        }
+        for c in 0..n {
+            start[c + 1] += start[c];
+        }
+        let mut next = start.clone();
+        let mut bucket = vec![(0u32, 0.0f64); half.len()];
+        for &(lo, hi, w) in &half {
+            bucket[next[lo as usize] as usize] = (hi, w);
+            next[lo as usize] += 1;
+        }
+        // Per column: diagonal, then the merged rows ascending.
+        let mut col_ptr = Vec::with_capacity(n + 1);
+        let mut row_idx = Vec::with_capacity(n + half.len());
+        let mut val = Vec::with_capacity(n + half.len());
+        let mut diag = vec![0.0; n];
+        col_ptr.push(0u32);
+        for c in 0..n {
+            let seg = &mut bucket[start[c] as usize..start[c + 1] as usize];
+            seg.sort_unstable_by_key(|&(r, _)| r);
+            row_idx.push(c as u32);
+            val.push(0.0); // the diagonal, set once every column has contributed
+            for &(r, w) in seg.iter() {
+                if *row_idx.last().expect("diagonal pushed") == r {
+                    *val.last_mut().expect("diagonal pushed") -= w;
+                } else {
+                    row_idx.push(r);
+                    val.push(-w);
+                }
+                diag[c] += w;
+                diag[r as usize] += w;
+            }
+            col_ptr.push(row_idx.len() as u32);
+        }
+        for c in 0..n {
+            val[col_ptr[c] as usize] = diag[c];
+        }
+        Ok(Assembly {
+            col_ptr,
+            row_idx,
+            val,
+            mass,
+            gram,
+            mean_edge,
+        })
     }
 }

@@ -6,6 +6,7 @@
 mod attenuation_params;
 mod distance_cache;
 mod heat_geodesic;
+mod sparse_llt;
 
 pub use attenuation_params::{AmplitudeKind, AttenuationLaw, AttenuationParams, DistanceKind};
 pub(crate) use distance_cache::DistanceCache;

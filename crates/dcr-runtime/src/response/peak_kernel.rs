@@ -18,6 +18,8 @@
 //! the kernels are compiled for those features and picked at run time (`pulp` dispatch);
 //! elsewhere the baseline build is used.
 
+use crate::math::fmadd;
+
 /// Samples per SIMD vector in [`peak_abs_rows`] (its sample stride is a multiple of this).
 pub const LANES: usize = 4;
 
@@ -242,15 +244,6 @@ pub fn peak_abs_projection(
         return;
     }
     kernel::<false>(q, m, w, peaks);
-}
-
-#[inline(always)]
-fn fmadd<const FMA: bool>(a: f64, b: f64, c: f64) -> f64 {
-    if FMA {
-        a.mul_add(b, c)
-    } else {
-        c + a * b
-    }
 }
 
 /// One register block: `NP` panels (8·NP channels) × `NS` samples of accumulators

@@ -1,0 +1,439 @@
+//! Simplicial sparse LLᵀ on a pattern from faer's symbolic analysis: the numeric factors of two
+//! matrices with that pattern in one sweep, and the triangular solves.
+//!
+//! Hand-written rather than faer's `factorize_numeric_llt` / `LltRef::solve_in_place_with_conj`
+//! (which these replaced) because faer could not reach the heat-geodesic targets on ~5k-vertex
+//! surfaces (issue #3): its simplicial numeric factor (up-looking, one elimination-tree reach per
+//! row, `usize` indices) took ≈ 8 ms per operator, its solve ≈ 0.3 ms. Here the pattern is known
+//! up front, so the factor is left-looking over a precomputed row pattern (each update a plain
+//! suffix of an earlier column), both operators share every index load (values stored as
+//! `[heat, poisson]` pairs), and all indices are `u32`.
+
+use crate::math::fmadd;
+
+/// Lower-triangular CSC pattern of the factor (rows ascending, diagonal first in each column),
+/// plus its row-wise transpose grouped by supernode for the left-looking factorisation.
+pub(super) struct Pattern {
+    pub(super) col_ptr: Vec<u32>,
+    pub(super) row_idx: Vec<u32>,
+    /// Row j's off-diagonal entries L_jk (k < j) as runs of consecutive columns of one
+    /// (fundamental) supernode, which share their rows from j down:
+    /// `runs[run_ptr[j]..run_ptr[j + 1]]`, per run `[k, m, p]`: first column, m ≤ [`MAX_RUN`]
+    /// columns, position of L_jk in `row_idx`.
+    run_ptr: Vec<u32>,
+    runs: Vec<[u32; 3]>,
+    /// Fundamental supernodes: columns `sn_ptr[s]..sn_ptr[s + 1]`.
+    sn_ptr: Vec<u32>,
+}
+
+/// Longest run of supernode columns one update pass combines.
+const MAX_RUN: u32 = 8;
+
+impl Pattern {
+    pub(super) fn new(col_ptr: Vec<u32>, row_idx: Vec<u32>) -> Self {
+        let n = col_ptr.len() - 1;
+        let (cp, ri) = (&col_ptr, &row_idx);
+        let len = |k: usize| cp[k + 1] - cp[k];
+        // Fundamental supernodes [k0, k1]: struct(k) = {k} ∪ struct(k + 1) inside.
+        let mut supernodes = Vec::new();
+        let mut k0 = 0;
+        for k in 0..n {
+            let continues = k + 1 < n
+                && len(k) >= 2
+                && ri[cp[k] as usize + 1] as usize == k + 1
+                && len(k) == len(k + 1) + 1;
+            if !continues {
+                supernodes.push((k0, k));
+                k0 = k + 1;
+            }
+        }
+        // Rows below a supernode's last column; rows inside it see only the earlier columns.
+        let below = |k1: usize| &ri[cp[k1] as usize + 1..cp[k1 + 1] as usize];
+        let mut run_ptr = vec![0u32; n + 1];
+        for &(k0, k1) in &supernodes {
+            for j in k0 + 1..=k1 {
+                run_ptr[j + 1] += ((j - k0) as u32).div_ceil(MAX_RUN);
+            }
+            let s = (k1 - k0 + 1) as u32;
+            for &j in below(k1) {
+                run_ptr[j as usize + 1] += s.div_ceil(MAX_RUN);
+            }
+        }
+        for j in 0..n {
+            run_ptr[j + 1] += run_ptr[j];
+        }
+        let mut next: Vec<u32> = run_ptr[..n].to_vec();
+        let mut runs = vec![[0u32; 3]; run_ptr[n] as usize];
+        let mut push = |j: usize, k: usize, end: usize, p: u32| {
+            runs[next[j] as usize] = [k as u32, (end - k) as u32, p];
+            next[j] += 1;
+        };
+        for &(k0, k1) in &supernodes {
+            for j in k0 + 1..=k1 {
+                for k in (k0..j).step_by(MAX_RUN as usize) {
+                    push(j, k, j.min(k + MAX_RUN as usize), cp[k] + (j - k) as u32);
+                }
+            }
+            for (r, &j) in below(k1).iter().enumerate() {
+                for k in (k0..=k1).step_by(MAX_RUN as usize) {
+                    let p = cp[k] + (k1 - k + 1 + r) as u32;
+                    push(j as usize, k, (k1 + 1).min(k + MAX_RUN as usize), p);
+                }
+            }
+        }
+        let sn_ptr = std::iter::once(0)
+            .chain(supernodes.iter().map(|&(_, k1)| k1 as u32 + 1))
+            .collect();
+        Pattern {
+            col_ptr,
+            row_idx,
+            run_ptr,
+            runs,
+            sn_ptr,
+        }
+    }
+
+    pub(super) fn n(&self) -> usize {
+        self.col_ptr.len() - 1
+    }
+
+    /// Position of entry (row, col) (row ≥ col, in the pattern) in `row_idx`.
+    pub(super) fn position(&self, row: u32, col: u32) -> usize {
+        let start = self.col_ptr[col as usize] as usize;
+        let rows = &self.row_idx[start..self.col_ptr[col as usize + 1] as usize];
+        start
+            + rows
+                .binary_search(&row)
+                .expect("entry in the factor pattern")
+    }
+
+    /// In place: `vals` holds the lower triangles of two matrices A₀, A₁ (pairs per entry,
+    /// zeros on fill) and becomes their Cholesky factors. Left-looking: column j gathers the
+    /// updates −L_jk · L_{j:,k} from the columns k of row j's pattern into a dense scatter
+    /// workspace (`w`, length n), then scales by the pivot. Columns of one supernode share their
+    /// rows, so up to [`MAX_RUN`] of them update `w` in one pass (one index load and one
+    /// read-modify-write of `w` per row instead of one per column).
+    ///
+    /// # Errors
+    /// The first column whose pivot is not positive (either matrix).
+    pub(super) fn factor_pair(
+        &self,
+        vals: &mut [[f64; 2]],
+        w: &mut [[f64; 2]],
+    ) -> Result<(), usize> {
+        #[cfg(target_arch = "x86_64")]
+        if let Some(simd) = pulp::x86::V3::try_new() {
+            // Through `WithSimd` (as the peak kernel): compiled with AVX2/FMA.
+            return pulp::Simd::vectorize(
+                simd,
+                FactorKernel {
+                    pattern: self,
+                    vals,
+                    w,
+                },
+            );
+        }
+        self.factor_pair_impl::<false>(vals, w)
+    }
+
+    #[inline(always)]
+    fn factor_pair_impl<const FMA: bool>(
+        &self,
+        vals: &mut [[f64; 2]],
+        w: &mut [[f64; 2]],
+    ) -> Result<(), usize> {
+        let (cp, ri) = (&self.col_ptr, &self.row_idx);
+        for j in 0..self.n() {
+            let (start, end) = (cp[j] as usize, cp[j + 1] as usize);
+            for (&i, &v) in ri[start..end].iter().zip(&vals[start..end]) {
+                w[i as usize] = v;
+            }
+            for &[k, m, p] in &self.runs[self.run_ptr[j] as usize..self.run_ptr[j + 1] as usize] {
+                let (k, m, p) = (k as usize, m as usize, p as usize);
+                let rows = &ri[p..cp[k + 1] as usize];
+                // Row j sits one entry further from the top in each earlier supernode column.
+                let mut ps = [p; MAX_RUN as usize];
+                for i in 1..m {
+                    ps[i] = ps[i - 1] + (cp[k + i] - cp[k + i - 1]) as usize - 1;
+                }
+                match m {
+                    1 => update::<1, FMA>(rows, &ps, vals, w),
+                    2 => update::<2, FMA>(rows, &ps, vals, w),
+                    3 => update::<3, FMA>(rows, &ps, vals, w),
+                    4 => update::<4, FMA>(rows, &ps, vals, w),
+                    5 => update::<5, FMA>(rows, &ps, vals, w),
+                    6 => update::<6, FMA>(rows, &ps, vals, w),
+                    7 => update::<7, FMA>(rows, &ps, vals, w),
+                    _ => update::<{ MAX_RUN as usize }, FMA>(rows, &ps, vals, w),
+                }
+            }
+            let d = w[j];
+            if !(d[0] > 0.0 && d[1] > 0.0) {
+                return Err(j);
+            }
+            let d = [d[0].sqrt(), d[1].sqrt()];
+            let inv = [1.0 / d[0], 1.0 / d[1]];
+            vals[start] = d;
+            for (&i, v) in ri[start + 1..end].iter().zip(&mut vals[start + 1..end]) {
+                let wi = w[i as usize];
+                *v = [wi[0] * inv[0], wi[1] * inv[1]];
+            }
+        }
+        Ok(())
+    }
+
+    /// `x ← A⁻¹ x` for A = L Lᵀ (x in the factor's order; `inv_diag` = 1/L_kk).
+    ///
+    /// Supernode by supernode: the dense triangle of its diagonal block on contiguous x, then
+    /// its rows below in passes of up to [`MAX_RUN`] columns (one index load and one x access
+    /// per row and pass instead of per entry). The forward sweep skips supernodes whose entries
+    /// are still zero, so a right-hand side with a few non-zeros only walks their
+    /// elimination-tree ancestors. Results differ from faer's in the last bits (summation
+    /// order).
+    pub(super) fn solve(&self, l: &[f64], inv_diag: &[f64], x: &mut [f64]) {
+        #[cfg(target_arch = "x86_64")]
+        if let Some(simd) = pulp::x86::V3::try_new() {
+            return pulp::Simd::vectorize(
+                simd,
+                SolveKernel {
+                    pattern: self,
+                    l,
+                    inv_diag,
+                    x,
+                },
+            );
+        }
+        self.solve_impl::<false>(l, inv_diag, x);
+    }
+
+    #[inline(always)]
+    fn solve_impl<const FMA: bool>(&self, l: &[f64], inv_diag: &[f64], x: &mut [f64]) {
+        let (cp, ri) = (&self.col_ptr, &self.row_idx);
+        let ns = self.sn_ptr.len() - 1;
+        // Column k of supernode [k0, k1]: L_kk, the block rows k+1..=k1, then the rows below.
+        let block = |k: usize, k1: usize| cp[k] as usize + 1..cp[k] as usize + 1 + (k1 - k);
+        let below_start = |k: usize, k1: usize| cp[k] as usize + 1 + (k1 - k);
+        // L y = b.
+        for s in 0..ns {
+            let (k0, k1) = (self.sn_ptr[s] as usize, self.sn_ptr[s + 1] as usize - 1);
+            if k0 == k1 {
+                // A lone column (most supernodes): plain column axpy.
+                let (start, end) = (cp[k0] as usize, cp[k0 + 1] as usize);
+                if x[k0] == 0.0 {
+                    continue;
+                }
+                let xk = x[k0] * inv_diag[k0];
+                x[k0] = xk;
+                for (&i, &lv) in ri[start + 1..end].iter().zip(&l[start + 1..end]) {
+                    let xi = &mut x[i as usize];
+                    *xi = fmadd::<FMA>(-lv, xk, *xi);
+                }
+                continue;
+            }
+            if x[k0..=k1].iter().all(|&v| v == 0.0) {
+                continue;
+            }
+            for k in k0..=k1 {
+                let xk = x[k] * inv_diag[k];
+                x[k] = xk;
+                for (xi, &lv) in x[k + 1..=k1].iter_mut().zip(&l[block(k, k1)]) {
+                    *xi = fmadd::<FMA>(-lv, xk, *xi);
+                }
+            }
+            let rows = &ri[below_start(k1, k1)..cp[k1 + 1] as usize];
+            if rows.is_empty() {
+                continue;
+            }
+            for ka in (k0..=k1).step_by(MAX_RUN as usize) {
+                let m = (k1 + 1 - ka).min(MAX_RUN as usize);
+                let mut offs = [0usize; MAX_RUN as usize];
+                let mut xs = [0.0f64; MAX_RUN as usize];
+                for i in 0..m {
+                    offs[i] = below_start(ka + i, k1);
+                    xs[i] = x[ka + i];
+                }
+                match m {
+                    1 => forward_below::<1, FMA>(rows, &offs, &xs, l, x),
+                    2 => forward_below::<2, FMA>(rows, &offs, &xs, l, x),
+                    3 => forward_below::<3, FMA>(rows, &offs, &xs, l, x),
+                    4 => forward_below::<4, FMA>(rows, &offs, &xs, l, x),
+                    5 => forward_below::<5, FMA>(rows, &offs, &xs, l, x),
+                    6 => forward_below::<6, FMA>(rows, &offs, &xs, l, x),
+                    7 => forward_below::<7, FMA>(rows, &offs, &xs, l, x),
+                    _ => forward_below::<{ MAX_RUN as usize }, FMA>(rows, &offs, &xs, l, x),
+                }
+            }
+        }
+        // Lᵀ z = y, last supernode first.
+        for s in (0..ns).rev() {
+            let (k0, k1) = (self.sn_ptr[s] as usize, self.sn_ptr[s + 1] as usize - 1);
+            let rows = &ri[below_start(k1, k1)..cp[k1 + 1] as usize];
+            if k0 == k1 {
+                // A lone column: one dot product in four partial sums (add latency).
+                let lk = &l[below_start(k1, k1)..cp[k1 + 1] as usize];
+                let mut acc = [0.0f64; 4];
+                let (ri4, lk4) = (rows.chunks_exact(4), lk.chunks_exact(4));
+                let (ri_r, lk_r) = (ri4.remainder(), lk4.remainder());
+                for (i4, l4) in ri4.zip(lk4) {
+                    for i in 0..4 {
+                        acc[i] = fmadd::<FMA>(l4[i], x[i4[i] as usize], acc[i]);
+                    }
+                }
+                for (&i, &lv) in ri_r.iter().zip(lk_r) {
+                    acc[0] = fmadd::<FMA>(lv, x[i as usize], acc[0]);
+                }
+                x[k0] = (x[k0] - ((acc[0] + acc[1]) + (acc[2] + acc[3]))) * inv_diag[k0];
+                continue;
+            }
+            if !rows.is_empty() {
+                for ka in (k0..=k1).step_by(MAX_RUN as usize) {
+                    let m = (k1 + 1 - ka).min(MAX_RUN as usize);
+                    let mut offs = [0usize; MAX_RUN as usize];
+                    for (i, o) in offs[..m].iter_mut().enumerate() {
+                        *o = below_start(ka + i, k1);
+                    }
+                    // Few columns: split each dot product into partial sums (add latency).
+                    let dots: [f64; MAX_RUN as usize] = match m {
+                        1 => backward_below::<1, 4, FMA>(rows, &offs, l, x),
+                        2 => backward_below::<2, 2, FMA>(rows, &offs, l, x),
+                        3 => backward_below::<3, 2, FMA>(rows, &offs, l, x),
+                        4 => backward_below::<4, 1, FMA>(rows, &offs, l, x),
+                        5 => backward_below::<5, 1, FMA>(rows, &offs, l, x),
+                        6 => backward_below::<6, 1, FMA>(rows, &offs, l, x),
+                        7 => backward_below::<7, 1, FMA>(rows, &offs, l, x),
+                        _ => backward_below::<{ MAX_RUN as usize }, 1, FMA>(rows, &offs, l, x),
+                    };
+                    for (xk, d) in x[ka..ka + m].iter_mut().zip(dots) {
+                        *xk -= d;
+                    }
+                }
+            }
+            for k in (k0..=k1).rev() {
+                let (col, xb) = (&l[block(k, k1)], &x[k + 1..=k1]);
+                let mut acc = [0.0f64; 4];
+                let (col4, xb4) = (col.chunks_exact(4), xb.chunks_exact(4));
+                let (col_r, xb_r) = (col4.remainder(), xb4.remainder());
+                for (c4, x4) in col4.zip(xb4) {
+                    for i in 0..4 {
+                        acc[i] = fmadd::<FMA>(c4[i], x4[i], acc[i]);
+                    }
+                }
+                for (&c, &xv) in col_r.iter().zip(xb_r) {
+                    acc[0] = fmadd::<FMA>(c, xv, acc[0]);
+                }
+                x[k] = (x[k] - ((acc[0] + acc[1]) + (acc[2] + acc[3]))) * inv_diag[k];
+            }
+        }
+    }
+}
+
+/// `x[rows[r]] −= Σ_m L[offs[m] + r] · xs[m]`: M columns of one supernode on its rows below.
+#[inline(always)]
+fn forward_below<const M: usize, const FMA: bool>(
+    rows: &[u32],
+    offs: &[usize],
+    xs: &[f64],
+    l: &[f64],
+    x: &mut [f64],
+) {
+    let len = rows.len();
+    let cols: [&[f64]; M] = std::array::from_fn(|m| &l[offs[m]..offs[m] + len]);
+    for (r, &i) in rows.iter().enumerate() {
+        let mut s = 0.0;
+        for m in 0..M {
+            s = fmadd::<FMA>(cols[m][r], xs[m], s);
+        }
+        x[i as usize] -= s;
+    }
+}
+
+/// `Σ_r L[offs[m] + r] · x[rows[r]]` for M columns of one supernode on its rows below, each in
+/// P partial sums; unused entries of the result are zero.
+#[inline(always)]
+fn backward_below<const M: usize, const P: usize, const FMA: bool>(
+    rows: &[u32],
+    offs: &[usize],
+    l: &[f64],
+    x: &[f64],
+) -> [f64; MAX_RUN as usize] {
+    let len = rows.len();
+    let cols: [&[f64]; M] = std::array::from_fn(|m| &l[offs[m]..offs[m] + len]);
+    let mut acc = [[0.0f64; M]; P];
+    let full = len / P * P;
+    for r0 in (0..full).step_by(P) {
+        for p in 0..P {
+            let xi = x[rows[r0 + p] as usize];
+            for m in 0..M {
+                acc[p][m] = fmadd::<FMA>(cols[m][r0 + p], xi, acc[p][m]);
+            }
+        }
+    }
+    for r in full..len {
+        let xi = x[rows[r] as usize];
+        for m in 0..M {
+            acc[0][m] = fmadd::<FMA>(cols[m][r], xi, acc[0][m]);
+        }
+    }
+    let mut out = [0.0; MAX_RUN as usize];
+    for m in 0..M {
+        out[m] = acc.iter().map(|a| a[m]).sum();
+    }
+    out
+}
+
+/// `w[rows[q]] −= Σ_m L[p_m + q] · L[p_m]` for M columns of one supernode whose entries of row
+/// j sit at positions `ps` (pairs: both matrices at once).
+#[inline(always)]
+fn update<const M: usize, const FMA: bool>(
+    rows: &[u32],
+    ps: &[usize],
+    vals: &[[f64; 2]],
+    w: &mut [[f64; 2]],
+) {
+    let len = rows.len();
+    let cols: [&[[f64; 2]]; M] = std::array::from_fn(|m| &vals[ps[m]..ps[m] + len]);
+    let ljk: [[f64; 2]; M] = std::array::from_fn(|m| cols[m][0]);
+    for (q, &i) in rows.iter().enumerate() {
+        let mut s = [0.0f64; 2];
+        for m in 0..M {
+            let l = cols[m][q];
+            s[0] = fmadd::<FMA>(l[0], ljk[m][0], s[0]);
+            s[1] = fmadd::<FMA>(l[1], ljk[m][1], s[1]);
+        }
+        let wi = &mut w[i as usize];
+        wi[0] -= s[0];
+        wi[1] -= s[1];
+    }
+}
+
+/// [`Pattern::factor_pair`]'s arguments, run under `pulp` dispatch.
+struct FactorKernel<'a> {
+    pattern: &'a Pattern,
+    vals: &'a mut [[f64; 2]],
+    w: &'a mut [[f64; 2]],
+}
+
+impl pulp::WithSimd for FactorKernel<'_> {
+    type Output = Result<(), usize>;
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, _simd: S) -> Self::Output {
+        self.pattern.factor_pair_impl::<true>(self.vals, self.w)
+    }
+}
+
+/// [`Pattern::solve`]'s arguments, run under `pulp` dispatch.
+struct SolveKernel<'a> {
+    pattern: &'a Pattern,
+    l: &'a [f64],
+    inv_diag: &'a [f64],
+    x: &'a mut [f64],
+}
+
+impl pulp::WithSimd for SolveKernel<'_> {
+    type Output = ();
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, _simd: S) {
+        self.pattern
+            .solve_impl::<true>(self.l, self.inv_diag, self.x);
+    }
+}
