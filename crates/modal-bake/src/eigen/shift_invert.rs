@@ -3,7 +3,6 @@
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::LltRegularization;
 use faer::perm::PermRef;
-use faer::sparse::linalg::amd;
 use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky, CholeskySymbolicParams, LltRef, SymbolicCholesky,
     SymmetricOrdering,
@@ -11,7 +10,7 @@ use faer::sparse::linalg::cholesky::{
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 use faer::{Conj, MatMut, Par, Side, Spec};
 
-use super::EigenError;
+use super::{ordering, EigenError};
 
 /// K − σM on the union of the two patterns (both full symmetric storage, rows sorted).
 pub(crate) fn shifted(
@@ -65,11 +64,11 @@ pub(crate) fn lin_comb(
     )
 }
 
-/// AMD on the node graph when the pattern is made of full 3×3 node blocks (node-major dofs, as
-/// assembled by [`crate::fem`]), expanded to the dofs of each node in order. Same fill as AMD
-/// on the dof graph (AMD merges the indistinguishable dofs of a node anyway), ~2× faster to
-/// compute. `None` when the pattern is not blocked.
-fn node_amd(a: &SparseColMat<usize, f64>) -> Option<(Vec<usize>, Vec<usize>)> {
+/// The node graph when the pattern is made of full 3×3 node blocks (node-major dofs, as
+/// assembled by [`crate::fem`]); `None` when it is not blocked. Orderings computed on it and
+/// expanded to the dofs of each node ([`expand_to_dofs`]) give the same fill as on the dof
+/// graph (AMD merges the indistinguishable dofs of a node anyway) at ~1/9 of the size.
+fn node_graph(a: &SparseColMat<usize, f64>) -> Option<SymbolicSparseColMat<usize>> {
     let n = a.nrows();
     if !n.is_multiple_of(3) || n == 0 {
         return None;
@@ -98,31 +97,64 @@ fn node_amd(a: &SparseColMat<usize, f64>) -> Option<(Vec<usize>, Vec<usize>)> {
         }
         ncp.push(nri.len());
     }
-    let g = SymbolicSparseColMat::new_checked(nn, nn, ncp, None, nri);
-    let mut fwd = vec![0usize; nn];
-    let mut inv = vec![0usize; nn];
-    let mut mem = MemBuffer::try_new(amd::order_scratch::<usize>(nn, g.row_idx().len())).ok()?;
-    amd::order(
-        &mut fwd,
-        &mut inv,
-        g.as_ref(),
-        amd::Control::default(),
-        MemStack::new(&mut mem),
-    )
-    .ok()?;
+    Some(SymbolicSparseColMat::new_checked(nn, nn, ncp, None, nri))
+}
+
+/// A node ordering expanded to the three dofs of each node: (fwd, inv) dof permutations.
+fn expand_to_dofs(fwd: &[usize]) -> (Vec<usize>, Vec<usize>) {
     let fwd3: Vec<usize> = fwd
         .iter()
         .flat_map(|&v| [3 * v, 3 * v + 1, 3 * v + 2])
         .collect();
-    let mut inv3 = vec![0usize; n];
-    for (i, &p) in fwd3.iter().enumerate() {
-        inv3[p] = i;
-    }
-    Some((fwd3, inv3))
+    let inv3 = ordering::inverse(&fwd3);
+    (fwd3, inv3)
 }
 
-/// Sparse LLᵀ factor of an SPD matrix (here A = K − σM, Newmark's K_eff and M), AMD ordering on
-/// nodes, faer's supernodal/simplicial choice.
+/// Symbolic factorization of `a` under the dof permutation `perm` (or faer's AMD on the dofs).
+fn symbolic(
+    a: &SparseColMat<usize, f64>,
+    perm: Option<&(Vec<usize>, Vec<usize>)>,
+) -> Result<SymbolicCholesky<usize>, EigenError> {
+    let ordering = match perm {
+        Some((fwd, inv)) => SymmetricOrdering::Custom(PermRef::new_checked(fwd, inv, a.nrows())),
+        None => SymmetricOrdering::Amd,
+    };
+    factorize_symbolic_cholesky(
+        a.symbolic(),
+        Side::Lower,
+        ordering,
+        CholeskySymbolicParams::default(),
+    )
+    .map_err(|e| EigenError::Factorization(format!("symbolic analysis failed: {e:?}")))
+}
+
+/// The symbolic factorization of `a` under the node ordering (AMD or nested dissection, see
+/// [`ordering`]) whose factor of the node graph has fewer entries; faer's AMD on the dofs when
+/// the pattern is not node-blocked. The fill is compared on the node graph (1/9 of the
+/// entries), so choosing costs one small symbolic analysis per candidate.
+fn best_symbolic(a: &SparseColMat<usize, f64>) -> Result<SymbolicCholesky<usize>, EigenError> {
+    let Some(g) = node_graph(a) else {
+        return symbolic(a, None);
+    };
+    let mut best: Option<(usize, Vec<usize>)> = None;
+    for order in [ordering::amd_order(&g), ordering::nested_dissection(&g)]
+        .into_iter()
+        .flatten()
+    {
+        let fill = ordering::factor_entries(&g, &order);
+        // Ties keep the first candidate (AMD).
+        if best.as_ref().is_none_or(|(f, _)| fill < *f) {
+            best = Some((fill, order));
+        }
+    }
+    match best {
+        Some((_, order)) => symbolic(a, Some(&expand_to_dofs(&order))),
+        None => symbolic(a, None),
+    }
+}
+
+/// Sparse LLᵀ factor of an SPD matrix (here A = K − σM, Newmark's K_eff and M), ordered by AMD
+/// or nested dissection on nodes (the one with less fill), faer's supernodal/simplicial choice.
 pub(crate) struct ShiftInvert {
     symbolic: SymbolicCholesky<usize>,
     values: Vec<f64>,
@@ -132,20 +164,7 @@ pub(crate) struct ShiftInvert {
 impl ShiftInvert {
     /// Factors `a` (symmetric positive definite, full storage; the lower triangle is read).
     pub fn new(a: &SparseColMat<usize, f64>, par: Par) -> Result<ShiftInvert, EigenError> {
-        let node_perm = node_amd(a);
-        let ordering = match &node_perm {
-            Some((fwd, inv)) => {
-                SymmetricOrdering::Custom(PermRef::new_checked(fwd, inv, a.nrows()))
-            }
-            None => SymmetricOrdering::Amd,
-        };
-        let symbolic = factorize_symbolic_cholesky(
-            a.symbolic(),
-            Side::Lower,
-            ordering,
-            CholeskySymbolicParams::default(),
-        )
-        .map_err(|e| EigenError::Factorization(format!("symbolic analysis failed: {e:?}")))?;
+        let symbolic = best_symbolic(a)?;
         let mut values = vec![0.0f64; symbolic.len_val()];
         let scratch = symbolic.factorize_numeric_llt_scratch::<f64>(par, Spec::default());
         let mut mem = MemBuffer::try_new(scratch)
