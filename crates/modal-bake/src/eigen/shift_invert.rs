@@ -134,15 +134,27 @@ fn symbolic(
 /// ~14% faster; on the slender 109k-dof beam 4% fewer entries made neither faster.
 const ND_FILL_RATIO: f64 = 0.9;
 
+/// Below this many dofs nested dissection is not tried: there it does not reach
+/// [`ND_FILL_RATIO`] on the meshes measured (16³-cell block, 14.7k dofs: 0.92× AMD's fill; the
+/// bake bench's 3.5k and 13.5k beams: 1.66× and 1.03×), and trying it (ordering plus two
+/// node-graph symbolic analyses) cost ~10% of the factorization at 13.5k dofs.
+const ND_MIN_DOFS: usize = 30_000;
+
 /// The symbolic factorization of `a` under AMD or, when it fills clearly less
-/// ([`ND_FILL_RATIO`]), nested dissection on the node graph (see [`ordering`]); faer's AMD on
-/// the dofs when the pattern is not node-blocked. The fill is compared on the node graph (1/9
-/// of the entries), so choosing costs two small symbolic analyses.
+/// ([`ND_FILL_RATIO`], tried from [`ND_MIN_DOFS`] on), nested dissection on the node graph (see
+/// [`ordering`]); faer's AMD on the dofs when the pattern is not node-blocked. The fill is
+/// compared on the node graph (1/9 of the entries), so choosing costs two small symbolic
+/// analyses.
 fn best_symbolic(a: &SparseColMat<usize, f64>) -> Result<SymbolicCholesky<usize>, EigenError> {
     let Some(g) = node_graph(a) else {
         return symbolic(a, None);
     };
-    let order = match (ordering::amd_order(&g), ordering::nested_dissection(&g)) {
+    let nd = if a.nrows() >= ND_MIN_DOFS {
+        ordering::nested_dissection(&g)
+    } else {
+        None
+    };
+    let order = match (ordering::amd_order(&g), nd) {
         (Some(amd), Some(nd)) => {
             let (f_amd, f_nd) = (
                 ordering::factor_entries(&g, &amd),
