@@ -2,7 +2,7 @@
 //! factorization of K − σM and the shift-invert block Lanczos eigensolve.
 //!
 //! `cargo run --release -p modal-bake --example eigen_timing -- [sizes...] [--nev N] [--reps R]`
-//! with sizes among `3k 15k 100k beam100k bench3k bench15k` (default: the first three), optional `--block B`,
+//! with sizes among `3k 15k 100k beam100k bench3k bench15k stout` (default: the first three), optional `--block B`,
 //! `--ncv D` (Krylov dimension), `--tol T` (default: the bake's 1e-8) and `--threads T` (`EigenParams::threads`). Prints one CSV row
 //! per run and a median summary per size. Speed is measured here, never asserted in tests.
 
@@ -76,7 +76,11 @@ fn main() {
             // The bake bench's 3k and 15k beams (benches/bake.rs).
             "bench3k" => ([24, 6, 6], 1.0),
             "bench15k" => ([45, 9, 9], 2.0),
-            other => panic!("unknown size {other} (3k, 15k, 100k, beam100k, bench3k, bench15k)"),
+            // The bake bench's 100k-stout beam (4 m × 0.72 m × 0.72 m).
+            "stout" => ([100, 18, 18], 4.0),
+            other => {
+                panic!("unknown size {other} (3k, 15k, 100k, beam100k, bench3k, bench15k, stout)")
+            }
         };
         let reps = if reps > 0 {
             reps
@@ -88,6 +92,7 @@ fn main() {
         let side = match size.as_str() {
             "bench3k" => 0.25,
             "bench15k" => 0.4,
+            "stout" => 0.72,
             _ => 0.1,
         };
         let mesh = TetMesh::structured_box(cells, [len, side, side]);

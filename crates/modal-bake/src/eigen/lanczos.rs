@@ -808,23 +808,29 @@ fn orthonormalize_ascending(
         1.0,
         par,
     );
-    let mut kq = Mat::<f64>::zeros(n, w);
-    sym_spmm(k, q.as_ref(), kq.as_mut());
+    // The products for the Rayleigh quotients also serve the residuals (columns are
+    // independent in the products, so computing them before the sort changes no bit).
+    let prods = Products::new(k, m, q.as_ref());
     let rq: Vec<f64> = (0..w)
         .map(|j| {
             q.col(j)
                 .iter()
-                .zip(kq.col(j).iter())
+                .zip(prods.ku.col(j).iter())
                 .map(|(a, b)| a * b)
                 .sum::<f64>()
         })
         .collect();
+    let res = prods.residuals(&rq, sigma);
     // Ascending by Rayleigh quotient (a stable sort keeps near-ties in Lanczos order).
     let mut idx: Vec<usize> = (0..w).collect();
     idx.sort_by(|&a, &b| rq[a].total_cmp(&rq[b]));
     let vals: Vec<f64> = idx.iter().map(|&j| rq[j]).collect();
     let u = Mat::from_fn(n, w, |i, j| q[(i, idx[j])]);
-    let res = residuals(k, m, u.as_ref(), &vals, sigma);
+    let mut res: Vec<Option<Residual>> = res.into_iter().map(Some).collect();
+    let res = idx
+        .iter()
+        .map(|&j| res[j].take().expect("a permutation"))
+        .collect();
     Ok((vals, u, res))
 }
 
@@ -903,33 +909,55 @@ fn residuals(
     lam: &[f64],
     sigma: f64,
 ) -> Vec<Residual> {
-    let (n, w) = (u.nrows(), u.ncols());
-    let mut ku = Mat::<f64>::zeros(n, w);
-    let mut mu = Mat::<f64>::zeros(n, w);
-    let mut aku = Mat::<f64>::zeros(n, w);
-    let mut amu = Mat::<f64>::zeros(n, w);
-    sym_spmm_with_abs(k, u, ku.as_mut(), aku.as_mut());
-    sym_spmm_with_abs(m, u, mu.as_mut(), amu.as_mut());
-    (0..w)
-        .map(|j| {
-            let l = lam[j];
-            let (mut r2, mut k2, mut m2, mut ak2, mut am2) = (0.0, 0.0, 0.0, 0.0, 0.0);
-            for i in 0..n {
-                let (kv, mvv) = (ku[(i, j)], mu[(i, j)]);
-                let r = kv - l * mvv;
-                r2 += r * r;
-                k2 += kv * kv;
-                m2 += mvv * mvv;
-                ak2 += aku[(i, j)] * aku[(i, j)];
-                am2 += amu[(i, j)] * amu[(i, j)];
-            }
-            let den = (k2.sqrt() + sigma.abs() * m2.sqrt()).max(f64::MIN_POSITIVE);
-            Residual {
-                rel: r2.sqrt() / den,
-                floor: f64::EPSILON * (ak2.sqrt() + l.abs() * am2.sqrt()) / den,
-            }
-        })
-        .collect()
+    Products::new(k, m, u).residuals(lam, sigma)
+}
+
+/// K u, M u and their rounding scales |K||u|, |M||u| for the columns of u.
+struct Products {
+    ku: Mat<f64>,
+    mu: Mat<f64>,
+    aku: Mat<f64>,
+    amu: Mat<f64>,
+}
+
+impl Products {
+    fn new(k: &SparseColMat<usize, f64>, m: &SparseColMat<usize, f64>, u: MatRef<'_, f64>) -> Self {
+        let (n, w) = (u.nrows(), u.ncols());
+        let mut p = Products {
+            ku: Mat::zeros(n, w),
+            mu: Mat::zeros(n, w),
+            aku: Mat::zeros(n, w),
+            amu: Mat::zeros(n, w),
+        };
+        sym_spmm_with_abs(k, u, p.ku.as_mut(), p.aku.as_mut());
+        sym_spmm_with_abs(m, u, p.mu.as_mut(), p.amu.as_mut());
+        p
+    }
+
+    /// [`Residual`] of each column j for the eigenvalue `lam[j]`.
+    fn residuals(&self, lam: &[f64], sigma: f64) -> Vec<Residual> {
+        let (ku, mu, aku, amu) = (&self.ku, &self.mu, &self.aku, &self.amu);
+        (0..ku.ncols())
+            .map(|j| {
+                let l = lam[j];
+                let (mut r2, mut k2, mut m2, mut ak2, mut am2) = (0.0, 0.0, 0.0, 0.0, 0.0);
+                for i in 0..ku.nrows() {
+                    let (kv, mvv) = (ku[(i, j)], mu[(i, j)]);
+                    let r = kv - l * mvv;
+                    r2 += r * r;
+                    k2 += kv * kv;
+                    m2 += mvv * mvv;
+                    ak2 += aku[(i, j)] * aku[(i, j)];
+                    am2 += amu[(i, j)] * amu[(i, j)];
+                }
+                let den = (k2.sqrt() + sigma.abs() * m2.sqrt()).max(f64::MIN_POSITIVE);
+                Residual {
+                    rel: r2.sqrt() / den,
+                    floor: f64::EPSILON * (ak2.sqrt() + l.abs() * am2.sqrt()) / den,
+                }
+            })
+            .collect()
+    }
 }
 
 /// Drops the verification pair in max-frequency mode and applies the sign convention.

@@ -4,7 +4,8 @@
 //! Algorithm: **shift-invert block Lanczos** with thick restart (Wu & Simon 2000; the block
 //! form as in Grimes, Lewis & Simon 1994) in the M-inner product:
 //!
-//! - A = K − σM is factored once by faer's sparse Cholesky (AMD ordering, supernodal LLᵀ), so
+//! - A = K − σM is factored once by faer's sparse Cholesky (supernodal LLᵀ) under the node
+//!   ordering AMD, or a level-set nested dissection when it fills clearly less (`ordering.rs`), so
 //!   σ must lie strictly below the lowest eigenvalue (free-free objects: σ < 0, see
 //!   [`default_shift`]). The operator T = A⁻¹M is M-self-adjoint with eigenvalues
 //!   θ = 1/(λ − σ), largest θ ↔ lowest λ.
@@ -50,6 +51,7 @@
 
 mod kernels;
 mod lanczos;
+mod ordering;
 mod shift_invert;
 
 use faer::sparse::SparseColMat;

@@ -3,7 +3,6 @@
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::LltRegularization;
 use faer::perm::PermRef;
-use faer::sparse::linalg::amd;
 use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky, CholeskySymbolicParams, LltRef, SymbolicCholesky,
     SymmetricOrdering,
@@ -11,7 +10,7 @@ use faer::sparse::linalg::cholesky::{
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 use faer::{Conj, MatMut, Par, Side, Spec};
 
-use super::EigenError;
+use super::{ordering, EigenError};
 
 /// K − σM on the union of the two patterns (both full symmetric storage, rows sorted).
 pub(crate) fn shifted(
@@ -65,11 +64,11 @@ pub(crate) fn lin_comb(
     )
 }
 
-/// AMD on the node graph when the pattern is made of full 3×3 node blocks (node-major dofs, as
-/// assembled by [`crate::fem`]), expanded to the dofs of each node in order. Same fill as AMD
-/// on the dof graph (AMD merges the indistinguishable dofs of a node anyway), ~2× faster to
-/// compute. `None` when the pattern is not blocked.
-fn node_amd(a: &SparseColMat<usize, f64>) -> Option<(Vec<usize>, Vec<usize>)> {
+/// The node graph when the pattern is made of full 3×3 node blocks (node-major dofs, as
+/// assembled by [`crate::fem`]); `None` when it is not blocked. Orderings computed on it and
+/// expanded to the dofs of each node ([`expand_to_dofs`]) give the same fill as on the dof
+/// graph (AMD merges the indistinguishable dofs of a node anyway) at ~1/9 of the size.
+fn node_graph(a: &SparseColMat<usize, f64>) -> Option<SymbolicSparseColMat<usize>> {
     let n = a.nrows();
     if !n.is_multiple_of(3) || n == 0 {
         return None;
@@ -98,31 +97,83 @@ fn node_amd(a: &SparseColMat<usize, f64>) -> Option<(Vec<usize>, Vec<usize>)> {
         }
         ncp.push(nri.len());
     }
-    let g = SymbolicSparseColMat::new_checked(nn, nn, ncp, None, nri);
-    let mut fwd = vec![0usize; nn];
-    let mut inv = vec![0usize; nn];
-    let mut mem = MemBuffer::try_new(amd::order_scratch::<usize>(nn, g.row_idx().len())).ok()?;
-    amd::order(
-        &mut fwd,
-        &mut inv,
-        g.as_ref(),
-        amd::Control::default(),
-        MemStack::new(&mut mem),
-    )
-    .ok()?;
+    Some(SymbolicSparseColMat::new_checked(nn, nn, ncp, None, nri))
+}
+
+/// A node ordering expanded to the three dofs of each node: (fwd, inv) dof permutations.
+fn expand_to_dofs(fwd: &[usize]) -> (Vec<usize>, Vec<usize>) {
     let fwd3: Vec<usize> = fwd
         .iter()
         .flat_map(|&v| [3 * v, 3 * v + 1, 3 * v + 2])
         .collect();
-    let mut inv3 = vec![0usize; n];
-    for (i, &p) in fwd3.iter().enumerate() {
-        inv3[p] = i;
-    }
-    Some((fwd3, inv3))
+    let inv3 = ordering::inverse(&fwd3);
+    (fwd3, inv3)
 }
 
-/// Sparse LLᵀ factor of an SPD matrix (here A = K − σM, Newmark's K_eff and M), AMD ordering on
-/// nodes, faer's supernodal/simplicial choice.
+/// Symbolic factorization of `a` under the dof permutation `perm` (or faer's AMD on the dofs).
+fn symbolic(
+    a: &SparseColMat<usize, f64>,
+    perm: Option<&(Vec<usize>, Vec<usize>)>,
+) -> Result<SymbolicCholesky<usize>, EigenError> {
+    let ordering = match perm {
+        Some((fwd, inv)) => SymmetricOrdering::Custom(PermRef::new_checked(fwd, inv, a.nrows())),
+        None => SymmetricOrdering::Amd,
+    };
+    factorize_symbolic_cholesky(
+        a.symbolic(),
+        Side::Lower,
+        ordering,
+        CholeskySymbolicParams::default(),
+    )
+    .map_err(|e| EigenError::Factorization(format!("symbolic analysis failed: {e:?}")))
+}
+
+/// Nested dissection replaces AMD only when its factor of the node graph has fewer than this
+/// fraction of AMD's entries. Measured single-threaded (`eigen_timing --threads 1`): on the
+/// stout 108k-dof beam 21% fewer entries made the factorization ~30% faster and the eigensolve
+/// ~14% faster; on the slender 109k-dof beam 4% fewer entries made neither faster.
+const ND_FILL_RATIO: f64 = 0.9;
+
+/// Below this many dofs nested dissection is not tried: there it does not reach
+/// [`ND_FILL_RATIO`] on the meshes measured (16³-cell block, 14.7k dofs: 0.92× AMD's fill; the
+/// bake bench's 3.5k and 13.5k beams: 1.66× and 1.03×), and trying it (ordering plus two
+/// node-graph symbolic analyses) cost ~10% of the factorization at 13.5k dofs.
+const ND_MIN_DOFS: usize = 30_000;
+
+/// The symbolic factorization of `a` under AMD or, when it fills clearly less
+/// ([`ND_FILL_RATIO`], tried from [`ND_MIN_DOFS`] on), nested dissection on the node graph (see
+/// [`ordering`]); faer's AMD on the dofs when the pattern is not node-blocked. The fill is
+/// compared on the node graph (1/9 of the entries), so choosing costs two small symbolic
+/// analyses.
+fn best_symbolic(a: &SparseColMat<usize, f64>) -> Result<SymbolicCholesky<usize>, EigenError> {
+    let Some(g) = node_graph(a) else {
+        return symbolic(a, None);
+    };
+    let nd = if a.nrows() >= ND_MIN_DOFS {
+        ordering::nested_dissection(&g)
+    } else {
+        None
+    };
+    let order = match (ordering::amd_order(&g), nd) {
+        (Some(amd), Some(nd)) => {
+            let (f_amd, f_nd) = (
+                ordering::factor_entries(&g, &amd),
+                ordering::factor_entries(&g, &nd),
+            );
+            if (f_nd as f64) < ND_FILL_RATIO * f_amd as f64 {
+                nd
+            } else {
+                amd
+            }
+        }
+        (Some(o), None) | (None, Some(o)) => o,
+        (None, None) => return symbolic(a, None),
+    };
+    symbolic(a, Some(&expand_to_dofs(&order)))
+}
+
+/// Sparse LLᵀ factor of an SPD matrix (here A = K − σM, Newmark's K_eff and M), ordered by AMD
+/// or nested dissection on nodes ([`best_symbolic`]), faer's supernodal/simplicial choice.
 pub(crate) struct ShiftInvert {
     symbolic: SymbolicCholesky<usize>,
     values: Vec<f64>,
@@ -132,20 +183,7 @@ pub(crate) struct ShiftInvert {
 impl ShiftInvert {
     /// Factors `a` (symmetric positive definite, full storage; the lower triangle is read).
     pub fn new(a: &SparseColMat<usize, f64>, par: Par) -> Result<ShiftInvert, EigenError> {
-        let node_perm = node_amd(a);
-        let ordering = match &node_perm {
-            Some((fwd, inv)) => {
-                SymmetricOrdering::Custom(PermRef::new_checked(fwd, inv, a.nrows()))
-            }
-            None => SymmetricOrdering::Amd,
-        };
-        let symbolic = factorize_symbolic_cholesky(
-            a.symbolic(),
-            Side::Lower,
-            ordering,
-            CholeskySymbolicParams::default(),
-        )
-        .map_err(|e| EigenError::Factorization(format!("symbolic analysis failed: {e:?}")))?;
+        let symbolic = best_symbolic(a)?;
         let mut values = vec![0.0f64; symbolic.len_val()];
         let scratch = symbolic.factorize_numeric_llt_scratch::<f64>(par, Spec::default());
         let mut mem = MemBuffer::try_new(scratch)
