@@ -197,25 +197,6 @@ fn compute_truth(
     out
 }
 
-/// A base of the lowest `m` dense eigenpairs, in the layout of `template` (a base baked from
-/// the same mesh and options: same surface order), for counts the Lanczos bake cannot reach.
-fn dense_base(template: &ModesFile, sys: &TruthSystem, ma: &ModalAll, m: usize) -> ModesFile {
-    let mut b = template.clone();
-    let mut modes = Vec::with_capacity(b.surface_to_volume.len() * 3 * m);
-    for &v in &b.surface_to_volume {
-        for ax in 0..3 {
-            match sys.map.free_index(3 * v as usize + ax) {
-                Some(i) => modes.extend((0..m).map(|j| ma.vectors[(i, j)])),
-                None => modes.extend(std::iter::repeat_n(0.0, m)),
-            }
-        }
-    }
-    b.modes = modes;
-    b.eigenvalues = ma.eigenvalues[..m].to_vec();
-    b.residuals = vec![0.0; m];
-    b
-}
-
 fn runtime_peaks(
     model: &Arc<ModalModel>,
     truth: &Truth,
@@ -288,7 +269,7 @@ fn sweep(s: &Scene, truth: &Truth) -> (Vec<Row>, Vec<String>) {
             Err(e) if truth.dense.is_some() && template.is_some() => {
                 let (sys, ma) = truth.dense.as_ref().unwrap();
                 notes.push(format!("{m} modes: the Lanczos bake failed after {:.0} s ({e}); the base was built from the dense eigenpairs instead (bake time not measured)", t.elapsed().as_secs_f64()));
-                dense_base(template.as_ref().unwrap(), sys, ma, m)
+                modal_bake::transfer::mode_set_from_dense(template.as_ref().unwrap(), sys, ma, m)
             }
             Err(e) => {
                 eprintln!("  {} m = {m}: bake failed: {e}", s.name);
@@ -931,7 +912,11 @@ fn transfer_study(s: &Scene, truth: &Truth, md: &mut String) {
                 } else {
                     n.to_string()
                 };
-                sets.push((label, dense_base(&base20, sys, ma, n), ma.solve_s));
+                sets.push((
+                    label,
+                    modal_bake::transfer::mode_set_from_dense(&base20, sys, ma, n),
+                    ma.solve_s,
+                ));
             }
         }
         None => {
@@ -1120,18 +1105,22 @@ fn transfer_study(s: &Scene, truth: &Truth, md: &mut String) {
         let _ = std::fs::remove_file(&tmp);
         n
     };
-    let mut out_rows = Vec::new();
-    // Baseline: the 20-mode modal query.
-    let mut dr20 = DistantResponse::new(
-        model20.clone(),
-        ResponseParams {
+    // Peaks at every (impact, contact) and the query time (µs) of the default method on a base,
+    // asserting which method served.
+    let run = |base: ModesFile, served: ServedBy| -> (Vec<Vec<f64>>, f64) {
+        let model = Arc::new(ModalModel::from_base(base).expect("model"));
+        let params = ResponseParams {
             h: H,
+            method: Method::Transfer,
             ..Default::default()
-        },
-    )
-    .expect("params");
-    let pk20 = peaks_of(&mut dr20, Some(ServedBy::Modal));
-    let q20 = time_steps(&mut dr20, &impacts[..1], &resting[..8]) * 1e6;
+        };
+        let mut dr = DistantResponse::new(model, params).expect("params");
+        let pk = peaks_of(&mut dr, Some(served));
+        (pk, time_steps(&mut dr, &impacts[..1], &resting[..8]) * 1e6)
+    };
+    let mut out_rows = Vec::new();
+    // Baseline: the 20-mode modal query (the base has no table).
+    let (pk20, q20) = run(base20.clone(), ServedBy::Modal);
     out_rows.push(score(
         format!("modal, {TRANSFER_BASE_MODES} modes (paper T)"),
         &pk20,
@@ -1150,65 +1139,28 @@ fn transfer_study(s: &Scene, truth: &Truth, md: &mut String) {
         )
         .expect("table");
         let build_s = t.elapsed().as_secs_f64();
-        let mut b = base20.clone();
-        b.transfer = Some(table.clone());
-        let bytes = base_bytes(&b);
-        let model = Arc::new(ModalModel::from_base(b).expect("model"));
-        let mut dr = DistantResponse::new(
-            model,
-            ResponseParams {
-                h: H,
-                method: Method::Transfer,
-                ..Default::default()
-            },
-        )
-        .expect("params");
-        assert!(dr.transfer_active());
-        let pk = peaks_of(&mut dr, Some(ServedBy::TransferTable));
-        let q = time_steps(&mut dr, &impacts[..1], &resting[..8]) * 1e6;
-        out_rows.push(score(
-            format!("transfer table, {label} modes (S = {})", table.samples),
-            &pk,
-            build_s + modes_s,
-            bytes,
-            q,
-        ));
-        // The same table without its midpoints: the runtime then blends vertex peaks linearly.
-        let mut b = base20.clone();
-        b.transfer = Some(vertex_only(&table));
-        let model = Arc::new(ModalModel::from_base(b).expect("model"));
-        let mut dr = DistantResponse::new(
-            model,
-            ResponseParams {
-                h: H,
-                method: Method::Transfer,
-                ..Default::default()
-            },
-        )
-        .expect("params");
-        let pk = peaks_of(&mut dr, Some(ServedBy::TransferTable));
-        let q = time_steps(&mut dr, &impacts[..1], &resting[..8]) * 1e6;
-        out_rows.push(score(
-            format!("same, vertices only (linear blend), {label} modes"),
-            &pk,
-            build_s + modes_s,
-            base_bytes(&base20) + 4 * TransferTable::packed_len(table.len()) as u64,
-            q,
-        ));
+        // The table, and the same table without its midpoints (the runtime then blends vertex
+        // peaks linearly).
+        for (row_label, t) in [
+            (
+                format!("transfer table, {label} modes (S = {})", table.samples),
+                table.clone(),
+            ),
+            (
+                format!("same, vertices only (linear blend), {label} modes"),
+                vertex_only(&table),
+            ),
+        ] {
+            let mut b = base20.clone();
+            b.transfer = Some(t);
+            let bytes = base_bytes(&b);
+            let (pk, q) = run(b, ServedBy::TransferTable);
+            out_rows.push(score(row_label, &pk, build_s + modes_s, bytes, q));
+        }
     }
     // The modal query with as many modes as the best table, for cost reference.
     if let Some((label, set, _)) = sets.iter().rev().find(|(_, b, _)| b.num_modes() <= 640) {
-        let model = Arc::new(ModalModel::from_base(set.clone()).expect("model"));
-        let mut dr = DistantResponse::new(
-            model,
-            ResponseParams {
-                h: H,
-                ..Default::default()
-            },
-        )
-        .expect("params");
-        let pk = peaks_of(&mut dr, Some(ServedBy::Modal));
-        let q = time_steps(&mut dr, &impacts[..1], &resting[..8]) * 1e6;
+        let (pk, q) = run(set.clone(), ServedBy::Modal);
         out_rows.push(score(
             format!("modal, {label} modes (paper T)"),
             &pk,
@@ -1236,7 +1188,7 @@ fn transfer_study(s: &Scene, truth: &Truth, md: &mut String) {
         truth_s
     )
     .unwrap();
-    writeln!(md, "- `at vertices`: vertex impact → vertex contact (table entries themselves); `inside triangles`: any impact → contact inside a triangle (interpolation: P2 over the triangle's vertices and edge midpoints on both sides). `vertices only`: the same table with its midpoints dropped, so the runtime blends vertex peaks linearly (the pre-midpoint method; base size as it would be). Query: one `step` (1 impact, 8 contacts), the least of 15 batch means of 400 warm steps; ×20-mode = query / the 20-mode modal query in the same run. Build: table build + the eigensolve of its modes.\n").unwrap();
+    writeln!(md, "- `at vertices`: vertex impact → vertex contact (table entries themselves); `inside triangles`: any impact → contact inside a triangle (interpolation: P2 over the triangle's vertices and edge midpoints on both sides). `vertices only`: the same table with its midpoints dropped, so the runtime blends vertex peaks linearly (the pre-midpoint method). Query: one `step` (1 impact, 8 contacts), the least of 15 batch means of 400 warm steps; ×20-mode = query / the 20-mode modal query in the same run. Build: table build + the eigensolve of its modes.\n").unwrap();
     writeln!(md, "| method | at vertices: median / max \\|err\\| % | inside triangles: median / max \\|err\\| % | all pairs: median / max \\|err\\| % | pairs ≥ {TRANSFER_FAR} m: median / max \\|err\\| % | signed min / max % | query (µs) | × 20-mode query | build (s) | base (KiB) |").unwrap();
     writeln!(md, "|---|---|---|---|---|---|---|---|---|---|").unwrap();
     for r in &out_rows {

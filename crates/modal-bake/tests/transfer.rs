@@ -34,11 +34,11 @@ fn text(o: &Output) -> String {
     )
 }
 
-/// Bakes the beam (clamped) with 8 runtime modes and a table over every surface vertex with
-/// `modes` table modes.
-fn bake_beam(out: &Path, modes: &str) -> Output {
+/// Bakes the beam (clamped) with 8 runtime modes and a table with `modes` table modes over
+/// every surface vertex (or the region `extra` options select).
+fn bake_beam_with(out: &Path, modes: &str, extra: &[&str]) -> Output {
     let mesh = data("data/meshes/beam.msh");
-    run(&[
+    let mut args = vec![
         "bake",
         mesh.to_str().unwrap(),
         "-o",
@@ -51,7 +51,13 @@ fn bake_beam(out: &Path, modes: &str) -> Output {
         "0.004",
         "--transfer-modes",
         modes,
-    ])
+    ];
+    args.extend_from_slice(extra);
+    run(&args)
+}
+
+fn bake_beam(out: &Path, modes: &str) -> Output {
+    bake_beam_with(out, modes, &[])
 }
 
 #[test]
@@ -78,31 +84,10 @@ fn table_entries_equal_probe_in_both_directions() {
         (free[nf / 3], free[2 * nf / 3]),
         (free[5], free[nf / 2]),
     ];
-    let substep = format!("{}", t.h / f64::from(t.samples));
     for (a, b) in pairs {
         let mut got = [0.0; 2];
         for (k, (i, j)) in [(a, b), (b, a)].into_iter().enumerate() {
-            let fmt = |p: [f64; 3]| format!("{},{},{}", p[0], p[1], p[2]);
-            let o = run(&[
-                "probe",
-                with.to_str().unwrap(),
-                "--impact",
-                &fmt(x[i]),
-                "--direction",
-                &fmt(n[i].map(|c| -c)),
-                "--impulse",
-                "1",
-                "--contact",
-                &fmt(x[j]),
-                "--h",
-                "0.004",
-                "--substep",
-                &substep,
-                "--json",
-            ]);
-            assert!(o.status.success(), "{}", text(&o));
-            let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
-            got[k] = v["contacts"][0]["peak_displacement_m"].as_f64().unwrap();
+            got[k] = probe_point(&with, &t, x[i], n[i].map(|c| -c), x[j], "modal");
         }
         let ta = t.vertices.binary_search(&(a as u32)).unwrap();
         let tb = t.vertices.binary_search(&(b as u32)).unwrap();
@@ -258,7 +243,6 @@ fn baking_twice_is_bit_identical_and_info_shows_the_table() {
 fn region_options_select_vertices() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("r.modes");
-    let mesh = data("data/meshes/beam.msh");
     let all = {
         let o = bake_beam(&out, "8");
         assert!(o.status.success(), "{}", text(&o));
@@ -267,24 +251,11 @@ fn region_options_select_vertices() {
     let x = &all.surface_vertices;
     let xmax = x.iter().fold(f64::NEG_INFINITY, |a, p| a.max(p[0]));
     let half = format!("-1e9,-1e9,-1e9,{},1e9,1e9", 0.5 * xmax);
-    let o = run(&[
-        "bake",
-        mesh.to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-        "--fixed",
-        "clamp",
-        "--modes",
+    let o = bake_beam_with(
+        &out,
         "8",
-        "--transfer-h",
-        "0.004",
-        "--transfer-modes",
-        "8",
-        "--transfer-region",
-        &half,
-        "--transfer-up",
-        "0,0,1",
-    ]);
+        &["--transfer-region", &half, "--transfer-up", "0,0,1"],
+    );
     assert!(o.status.success(), "{}", text(&o));
     let b = ModesFile::read(&out).unwrap();
     let t = b.transfer.unwrap();

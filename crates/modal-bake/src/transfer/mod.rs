@@ -20,6 +20,7 @@ mod table_builder;
 
 pub use region::{select_region, RegionBox};
 pub use table_builder::{
-    build_transfer_table, mode_set_dense, mode_set_lanczos, TransferError, TransferModes,
-    TransferParams, TransferProgress, DEFAULT_OVERSAMPLE, DENSE_MAX_DOFS, UP_MIN_COS,
+    build_transfer_table, mode_set_dense, mode_set_from_dense, mode_set_lanczos, TransferError,
+    TransferModes, TransferParams, TransferProgress, DEFAULT_OVERSAMPLE, DENSE_MAX_DOFS,
+    UP_MIN_COS,
 };

@@ -156,6 +156,17 @@ pub fn mode_set_dense(
         TransferModes::All => ma.eigenvalues.len(),
         TransferModes::Count(n) => n.min(ma.eigenvalues.len()),
     };
+    Ok(mode_set_from_dense(template, &sys, &ma, m))
+}
+
+/// The lowest `m` eigenpairs of a dense all-mode solve `ma` of `sys` as a base-shaped mode set
+/// in the layout of `template` (surface rows of U; fixed dofs zero; no table).
+pub fn mode_set_from_dense(
+    template: &ModesFile,
+    sys: &TruthSystem,
+    ma: &ModalAll,
+    m: usize,
+) -> ModesFile {
     let mut b = template.clone();
     let mut rows = Vec::with_capacity(b.surface_to_volume.len() * 3 * m);
     for &v in &b.surface_to_volume {
@@ -170,7 +181,7 @@ pub fn mode_set_dense(
     b.eigenvalues = ma.eigenvalues[..m].to_vec();
     b.residuals = vec![0.0; m];
     b.transfer = None;
-    Ok(b)
+    b
 }
 
 /// A mode set of the lowest `n` modes from a Lanczos bake of `mesh` with `params`.
