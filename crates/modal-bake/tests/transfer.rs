@@ -60,15 +60,25 @@ fn bake_beam(out: &Path, modes: &str) -> Output {
     bake_beam_with(out, modes, &[])
 }
 
+/// The beam baked into `dir/name` with a table of the base's own 8 modes over every surface
+/// vertex: (path, base, table).
+fn beam_with_own_mode_table(
+    dir: &Path,
+    name: &str,
+) -> (PathBuf, ModesFile, dcr_runtime::format::TransferTable) {
+    let path = dir.join(name);
+    let o = bake_beam(&path, "8");
+    assert!(o.status.success(), "{}", text(&o));
+    let base = ModesFile::read(&path).unwrap();
+    let t = base.transfer.clone().expect("table stored");
+    (path, base, t)
+}
+
 #[test]
 fn table_entries_equal_probe_in_both_directions() {
     let dir = tempfile::tempdir().unwrap();
-    let with = dir.path().join("beam_t.modes");
     // Table with the base's own 8 modes at the table's sampling: the probe must reproduce it.
-    let o = bake_beam(&with, "8");
-    assert!(o.status.success(), "{}", text(&o));
-    let base = ModesFile::read(&with).unwrap();
-    let t = base.transfer.clone().expect("table stored");
+    let (with, base, t) = beam_with_own_mode_table(dir.path(), "beam_t.modes");
     assert_eq!(t.modes, 8);
     assert_eq!(t.len(), base.num_surface_vertices());
     let model = ModalModel::from_base(base.clone()).unwrap();
@@ -153,11 +163,7 @@ fn probe_point(
 #[test]
 fn midpoint_entries_equal_the_probe_at_the_midpoint() {
     let dir = tempfile::tempdir().unwrap();
-    let with = dir.path().join("beam_m.modes");
-    let o = bake_beam(&with, "8");
-    assert!(o.status.success(), "{}", text(&o));
-    let base = ModesFile::read(&with).unwrap();
-    let t = base.transfer.clone().expect("table stored");
+    let (with, base, t) = beam_with_own_mode_table(dir.path(), "beam_m.modes");
     let nr = t.len();
     assert_eq!(
         t.edges,
