@@ -656,20 +656,27 @@ pub fn bake_mesh_with_transfer(
     report.transfer_modes = table.modes as usize;
     report.transfer_samples = table.samples as usize;
     if let Some(obj) = base.meta.bake_params.as_object_mut() {
-        obj.insert(
-            "transfer".into(),
-            serde_json::json!({
-                "h": tp.h,
-                "modes": match tp.modes { TransferModes::All => serde_json::json!("all"), TransferModes::Count(n) => serde_json::json!(n) },
-                "regions": tp.boxes,
-                "up": tp.up,
-                "up_min_cos": tp.up_min_cos,
-                "oversample": tp.oversample,
-            }),
-        );
+        obj.insert("transfer".into(), transfer_meta(tp));
     }
     base.transfer = Some(table);
     Ok((base, report))
+}
+
+/// The record of a transfer table's parameters in `meta.bake_params.transfer` (what
+/// [`is_up_to_date_with_transfer`] compares).
+fn transfer_meta(tp: &crate::transfer::TransferParams) -> serde_json::Value {
+    use crate::transfer::TransferModes;
+    serde_json::json!({
+        "h": tp.h,
+        "modes": match tp.modes {
+            TransferModes::All => serde_json::json!("all"),
+            TransferModes::Count(n) => serde_json::json!(n),
+        },
+        "regions": tp.boxes,
+        "up": tp.up,
+        "up_min_cos": tp.up_min_cos,
+        "oversample": tp.oversample,
+    })
 }
 
 /// Reads `mesh_path`, bakes it and writes `out` atomically (nothing is left on failure).
@@ -727,7 +734,29 @@ pub fn is_up_to_date(
     params: &BakeParams,
     modes: &Path,
 ) -> Result<bool, BakeError> {
+    is_up_to_date_with_transfer(mesh_path, params, None, modes)
+}
+
+/// As [`is_up_to_date`], also for the peak-transfer table: `transfer` as passed to
+/// [`bake_file_with_transfer`]. A base is stale when it has a table and none is asked for, has
+/// none and one is asked for, or its table was built with other parameters (step h, modes,
+/// region, up direction, oversampling).
+///
+/// # Errors
+/// As [`is_up_to_date`]; invalid transfer parameters.
+pub fn is_up_to_date_with_transfer(
+    mesh_path: &Path,
+    params: &BakeParams,
+    transfer: Option<&crate::transfer::TransferParams>,
+    modes: &Path,
+) -> Result<bool, BakeError> {
     params.check()?;
+    if let Some(tp) = transfer {
+        tp.check().map_err(|error| BakeError::Transfer {
+            file: mesh_path.display().to_string(),
+            error: Box::new(error),
+        })?;
+    }
     let mesh = crate::mesh::read_mesh(mesh_path)?;
     let prepared = prepare(mesh, params, &mesh_path.display().to_string())?;
     if !modes.exists() {
@@ -735,7 +764,16 @@ pub fn is_up_to_date(
     }
     Ok(match ModesFile::read(modes) {
         Ok(base) => {
-            base.meta.source_hash == prepared.hash && base.meta.params_hash == params.hash()
+            let table_matches = match transfer {
+                None => base.transfer.is_none(),
+                Some(tp) => {
+                    base.transfer.is_some()
+                        && base.meta.bake_params.get("transfer") == Some(&transfer_meta(tp))
+                }
+            };
+            base.meta.source_hash == prepared.hash
+                && base.meta.params_hash == params.hash()
+                && table_matches
         }
         Err(_) => false,
     })

@@ -106,6 +106,52 @@ fn check_exit_codes_follow_staleness() {
         Some(2),
         "unreadable mesh → 2"
     );
+    // The peak-transfer table is part of what a base is: asking for one (or another one) makes
+    // a base without it (or with another) stale, and a base with one is stale for a plain check.
+    let table = [
+        "--modes",
+        "6",
+        "--transfer-h",
+        "0.01",
+        "--transfer-modes",
+        "6",
+    ];
+    let check = |extra: &[&str]| {
+        let mut args = vec!["check", m, o];
+        args.extend_from_slice(extra);
+        run(&args).status.code()
+    };
+    assert_eq!(check(&table), Some(1), "table asked, base has none → 1");
+    let o2 = bake(&mesh, &out, &table);
+    assert!(
+        o2.status.success(),
+        "{}",
+        String::from_utf8_lossy(&o2.stderr)
+    );
+    assert_eq!(check(&table), Some(0), "same table → 0");
+    assert_eq!(check(&["--modes", "6"]), Some(1), "no table asked → 1");
+    assert_eq!(
+        check(&[
+            "--modes",
+            "6",
+            "--transfer-h",
+            "0.02",
+            "--transfer-modes",
+            "6"
+        ]),
+        Some(1),
+        "other step → 1"
+    );
+    assert_eq!(
+        check(&[&table[..], &["--transfer-up", "0,0,1"]].concat()),
+        Some(1),
+        "other region → 1"
+    );
+    assert_eq!(
+        check(&["--modes", "6", "--transfer-h", "-1"]),
+        Some(2),
+        "invalid table parameters → 2"
+    );
     std::fs::write(&out, b"garbage").unwrap();
     assert_eq!(
         run(&["check", m, o, "--modes", "6"]).status.code(),
@@ -203,4 +249,38 @@ fn an_inverted_tet_is_reoriented_and_counted() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(v["reoriented_tets"], 1);
+}
+
+/// The readable `probe` output names, per contact, what served it (as `--json`'s `served_by`).
+#[test]
+fn probe_text_reports_what_served_each_contact() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("c.modes");
+    assert!(bake(&data("meshes/cube_v41.msh"), &out, &["--modes", "6"])
+        .status
+        .success());
+    let o = out.to_str().unwrap();
+    let probe = |method: &str| {
+        let r = run(&[
+            "probe",
+            o,
+            "--impact",
+            "0.5,0.5,1",
+            "--impulse",
+            "1",
+            "--contact",
+            "0.2,0.3,1",
+            "--method",
+            method,
+        ]);
+        assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+        String::from_utf8(r.stdout).unwrap()
+    };
+    // No table in this base: the default transfer method runs the modal one.
+    for (method, served) in [("transfer", "modal"), ("attenuation", "attenuation")] {
+        let text = probe(method);
+        let mut lines = text.lines().skip(1);
+        assert!(lines.next().unwrap().ends_with("served_by"), "{text}");
+        assert!(lines.next().unwrap().ends_with(served), "{method}: {text}");
+    }
 }

@@ -182,8 +182,10 @@ fn own_solve_matches_faer() {
 }
 
 /// Timing probe (not a test of speed): `cargo test --release -p dcr-runtime heat_timing -- --ignored --nocapture`.
-/// Interleaved best-of batches (robust to a loaded machine): set-up, one source, and the two
-/// solves with the hand-written sweep vs faer's.
+/// Interleaved best-of batches (robust to a loaded machine): set-up, one source (triangle 7, the
+/// criterion bench's), the spread over 40 sources across the surface (a source's forward heat
+/// sweep walks only its elimination-tree ancestors, so the cost depends on where it is), and
+/// the two solves with the hand-written sweep vs faer's.
 #[test]
 #[ignore]
 fn heat_timing() {
@@ -221,6 +223,20 @@ fn heat_timing() {
         5,
         60,
     );
+    let mut spread: Vec<f64> = (0..40)
+        .map(|s| {
+            let sp = crate::SurfacePoint {
+                triangle: (s * 251 % t.len()) as u32,
+                ..sp
+            };
+            best(
+                &mut || heat.distances_from_point_with(&sp, &mut out, &mut ws),
+                1,
+                15,
+            )
+        })
+        .collect();
+    spread.sort_by(f64::total_cmp);
     let n = v.len();
     let mut rhs = vec![0.0; n];
     let mut x = vec![0.0; n];
@@ -253,11 +269,15 @@ fn heat_timing() {
         }
     }
     println!(
-        "nnz(L) {} setup {:.2} ms, source {:.3} ms; heat solve own {:.3} / faer {:.3} ms; \
+        "nnz(L) {} setup {:.2} ms, source {:.3} ms (40 sources: min {:.3} median {:.3} max {:.3} \
+         ms); heat solve own {:.3} / faer {:.3} ms; \
          poisson solve own {:.3} / faer {:.3} ms (best of interleaved batches)",
         heat.factor_len(),
         setup * 1e3,
         source * 1e3,
+        spread[0] * 1e3,
+        spread[20] * 1e3,
+        spread[39] * 1e3,
         own[0] * 1e3,
         faer[0] * 1e3,
         own[1] * 1e3,

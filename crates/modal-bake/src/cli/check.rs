@@ -6,7 +6,7 @@ use std::process::ExitCode;
 use clap::Args;
 use modal_bake::bake;
 
-use super::bake::BakeOptions;
+use super::bake::{BakeOptions, TransferOptions};
 
 #[derive(Args)]
 pub struct CheckArgs {
@@ -16,10 +16,20 @@ pub struct CheckArgs {
     pub out: PathBuf,
     #[command(flatten)]
     pub options: BakeOptions,
+    /// The transfer-table options the base was baked with (a base with another table, or a
+    /// table when none is asked for, is stale).
+    #[command(flatten)]
+    pub transfer: TransferOptions,
 }
 
 pub fn run(args: &CheckArgs) -> ExitCode {
-    match bake::is_up_to_date(&args.mesh, &args.options.params(), &args.out) {
+    let transfer = args.transfer.params();
+    match bake::is_up_to_date_with_transfer(
+        &args.mesh,
+        &args.options.params(),
+        transfer.as_ref(),
+        &args.out,
+    ) {
         Ok(true) => {
             outln!("{}: up to date", args.out.display());
             ExitCode::SUCCESS

@@ -237,7 +237,7 @@ pub fn run(args: &ProbeArgs) -> anyhow::Result<()> {
             direction
         );
         outln!(
-            "{:>3} {:>8} {:>26} {:>12} {:>14} {:>12}",
+            "{:>3} {:>8} {:>26} {:>12} {:>14} {:>12}  served_by",
             "#",
             "triangle",
             "bary",
@@ -248,7 +248,7 @@ pub fn run(args: &ProbeArgs) -> anyhow::Result<()> {
         for (i, r) in rows.iter().enumerate() {
             let b = &r["bary"];
             outln!(
-                "{:>3} {:>8} {:>8.5},{:>8.5},{:>8.5} {:>12.5e} {:>14.5e} {:>12.5e}",
+                "{:>3} {:>8} {:>8.5},{:>8.5},{:>8.5} {:>12.5e} {:>14.5e} {:>12.5e}  {}",
                 i + 1,
                 r["triangle"],
                 b[0].as_f64().unwrap_or(0.0),
@@ -257,6 +257,7 @@ pub fn run(args: &ProbeArgs) -> anyhow::Result<()> {
                 r["distance_m"].as_f64().unwrap_or(0.0),
                 r["peak_displacement_m"].as_f64().unwrap_or(0.0),
                 r["delta_v_mps"].as_f64().unwrap_or(0.0),
+                r["served_by"].as_str().unwrap_or("?"),
             );
         }
     }
