@@ -175,6 +175,31 @@ fn geodesic(c: &mut Criterion) {
             black_box(out[17])
         })
     });
+    // A source's forward heat sweep walks only its elimination-tree ancestors, so its cost
+    // depends on where it is: this row cycles through 24 sources, four on each face.
+    let sources: Vec<_> = (0..24)
+        .map(|i| {
+            let (face, k) = (i / 4, i % 4);
+            let (a, b) = (0.2 + 0.2 * k as f64, 0.8 - 0.15 * k as f64);
+            let p = match face {
+                0 => [1.2 * a, 0.8 * b, 0.0],
+                1 => [1.2 * a, 0.8 * b, 0.6],
+                2 => [1.2 * a, 0.0, 0.6 * b],
+                3 => [1.2 * a, 0.8, 0.6 * b],
+                4 => [0.0, 0.8 * a, 0.6 * b],
+                _ => [1.2, 0.8 * a, 0.6 * b],
+            };
+            model.project(p, 1.0).unwrap()
+        })
+        .collect();
+    let mut next = 0;
+    c.bench_function(&format!("heat/source-cycle24/{}v", v.len()), |b| {
+        b.iter(|| {
+            heat.distances_from_point_with(&sources[next], &mut out, &mut ws);
+            next = (next + 1) % sources.len();
+            black_box(out[17])
+        })
+    });
 }
 
 /// The pre-2026-11 peak kernel (8 channels × 4 samples blocking), kept for same-run A/B.
