@@ -129,28 +129,28 @@ fn symbolic(
 }
 
 /// Nested dissection replaces AMD only when its factor of the node graph has fewer than this
-/// fraction of AMD's entries. Measured single-threaded (`eigen_timing --threads 1`): on the
-/// stout 108k-dof beam 21% fewer entries made the factorization ~30% faster and the eigensolve
-/// ~14% faster; on the slender 109k-dof beam 4% fewer entries made neither faster.
+/// fraction of AMD's entries. Measured single-threaded (`eigen_timing --threads 1`, user CPU
+/// seconds, old level-set dissection → METIS, 2026-11-22): the stout 108k-dof beam (83.5M vs
+/// 97.2M dof-factor entries; AMD 123.6M) 15.6–18.8 s → 13.3–13.4 s, the slender 109k-dof
+/// beam (44.2M vs AMD's 54.1M) 7.1–7.7 s → 6.3–6.4 s.
 const ND_FILL_RATIO: f64 = 0.9;
 
-/// Below this many dofs nested dissection is not tried: there it does not reach
-/// [`ND_FILL_RATIO`] on the meshes measured (16³-cell block, 14.7k dofs: 0.92× AMD's fill; the
-/// bake bench's 3.5k and 13.5k beams: 1.66× and 1.03×), and trying it (ordering plus two
-/// node-graph symbolic analyses) cost ~10% of the factorization at 13.5k dofs.
+/// Below this many dofs nested dissection is not tried: on the bake bench's 13.5k-dof beam
+/// METIS fills 11% less than AMD (4.30M vs 4.83M entries), but ordering it and comparing the
+/// two fills costs what the smaller factor saves (factor + eigensolve 0.79 s vs 0.78 s).
 const ND_MIN_DOFS: usize = 30_000;
 
 /// The symbolic factorization of `a` under AMD or, when it fills clearly less
-/// ([`ND_FILL_RATIO`], tried from [`ND_MIN_DOFS`] on), nested dissection on the node graph (see
-/// [`ordering`]); faer's AMD on the dofs when the pattern is not node-blocked. The fill is
-/// compared on the node graph (1/9 of the entries), so choosing costs two small symbolic
-/// analyses.
+/// ([`ND_FILL_RATIO`], tried from [`ND_MIN_DOFS`] on), METIS nested dissection on the node
+/// graph (see [`ordering`]); faer's AMD on the dofs when the pattern is not node-blocked. The
+/// fill is compared on the node graph (1/9 of the entries), so choosing costs two small
+/// symbolic analyses.
 fn best_symbolic(a: &SparseColMat<usize, f64>) -> Result<SymbolicCholesky<usize>, EigenError> {
     let Some(g) = node_graph(a) else {
         return symbolic(a, None);
     };
     let nd = if a.nrows() >= ND_MIN_DOFS {
-        ordering::nested_dissection(&g)
+        ordering::metis_nested_dissection(&g)
     } else {
         None
     };
@@ -256,7 +256,7 @@ mod tests {
         let (_, kf, mf) = reduce_fixed(&k, &m, &mesh.groups["xmin"]).unwrap();
         let a = shifted(&kf, &mf, -1.0);
         let g = node_graph(&a).expect("node-blocked pattern");
-        let nd = ordering::nested_dissection(&g).expect("nd ordering");
+        let nd = ordering::metis_nested_dissection(&g).expect("nd ordering");
         let amd = ordering::amd_order(&g).expect("amd ordering");
         assert_ne!(nd, amd, "the test must exercise a different ordering");
         let by = |order: &[usize]| {
