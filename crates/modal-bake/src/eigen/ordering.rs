@@ -5,8 +5,8 @@
 //! local and on 3-D meshes leaves a factor close to a banded one; nested dissection orders two
 //! halves of the mesh before the nodes that separate them, so the fill of each half stays
 //! inside it. METIS's multilevel vertex separators (`METIS_NodeND`) are much smaller than the
-//! breadth-first level sets this module used before (node-graph factor entries of the bake
-//! bench's stout 100 × 18 × 18-cell beam: AMD 14.8M, level sets 11.7M, METIS 9.1M; see the
+//! breadth-first level sets this module used before (factor entries of the bake bench's stout
+//! 100 × 18 × 18-cell, 108k-dof beam: AMD 123.6M, level sets 97.2M, METIS 83.5M; see the
 //! tests for a block). The safe `metis` crate does not wrap
 //! `METIS_NodeND`, so [`metis_nested_dissection`] calls the `metis-sys` FFI directly: the one
 //! `unsafe` block of the crate. Deterministic: METIS reseeds its random generator (fixed seed)
