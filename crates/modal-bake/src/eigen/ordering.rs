@@ -12,6 +12,7 @@
 //! `unsafe` block of the crate. Deterministic: METIS reseeds its random generator (fixed seed)
 //! on every call, but that generator is process-global C state, so calls are serialised by a
 //! lock (two bakes ordering at once on two threads would otherwise interleave one stream).
+
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::perm::PermRef;
 use faer::sparse::linalg::amd;
