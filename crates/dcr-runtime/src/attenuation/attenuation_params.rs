@@ -41,7 +41,11 @@ impl AttenuationLaw {
 /// How the impact → resting-contact distance r is measured.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum DistanceKind {
-    /// Heat-method geodesic distance on the surface (cached per resting contact).
+    /// Heat-method geodesic distance on the surface (m), a field per resting contact, cached.
+    /// A step whose uncached contacts outnumber twice its impacts caches the fields of only as
+    /// many contacts as there are impacts and serves the rest from one field per impact (the
+    /// distance is symmetric up to the method's discretisation error): at most 2 × impacts
+    /// heat solves per step.
     Heat,
     /// Straight-line distance between the mapped surface points.
     Euclidean,
@@ -69,7 +73,8 @@ pub struct AttenuationParams {
     /// Local amplitude source.
     pub amplitude: AmplitudeKind,
     /// Most heat-method distance fields kept (one per resting contact, least recently used
-    /// evicted; memory ns × 8 bytes each). 0: recompute every time.
+    /// evicted; memory ns × 8 bytes each). 0: nothing kept; each step solves one field per
+    /// impact (or per contact, if there are fewer contacts).
     pub cache_capacity: usize,
 }
 

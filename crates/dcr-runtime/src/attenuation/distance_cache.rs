@@ -45,6 +45,20 @@ impl DistanceCache {
         }
     }
 
+    /// Whether `slot`'s field is cached (a [`DistanceCache::get`] would not compute).
+    pub(crate) fn contains(&self, slot: u32) -> bool {
+        self.capacity > 0
+            && self
+                .slot_field
+                .get(slot as usize)
+                .is_some_and(|&f| f != NONE)
+    }
+
+    /// Whether fields are kept across steps at all (capacity > 0).
+    pub(crate) fn caches(&self) -> bool {
+        self.capacity > 0
+    }
+
     /// The field of `slot`, computing it with `compute` on a miss.
     pub(crate) fn get(&mut self, slot: u32, step: u64, compute: impl FnOnce(&mut [f64])) -> &[f64] {
         let ns = self.ns;

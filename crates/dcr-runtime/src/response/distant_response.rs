@@ -43,6 +43,9 @@ struct AttenuationState {
     ws: Option<HeatWorkspace>,
     /// This step's applied impacts: surface point and local displacement Δx_c (m).
     hits: Vec<(SurfacePoint, f64)>,
+    /// Heat distance fields (m) from this step's impacts, one per hit (`hits.len() × ns`),
+    /// when they serve the uncached contacts (see [`DistantResponse::step`]'s cost rule).
+    hit_fields: Vec<f64>,
 }
 
 /// The distant collision response of one object instance (paper §4.2–4.5).
@@ -324,6 +327,7 @@ impl DistantResponse {
             fields: DistanceCache::new(ns, capacity),
             ws,
             hits: Vec::new(),
+            hit_fields: Vec::new(),
         })
     }
 
@@ -715,6 +719,33 @@ impl DistantResponse {
         let att = self.att.as_mut().expect("attenuation");
         let law = att.params.law;
         let distance = att.params.distance;
+        // Heat distances: a contact's field, cached, is the cheap path over many steps, but a
+        // step that brings many new contacts and few impacts would solve once per contact. When
+        // the uncached contacts outnumber twice the impacts, this step computes (and caches)
+        // the fields of only as many of them as there are impacts, and serves the rest from
+        // one field per impact (the heat distance is symmetric up to its discretisation
+        // error): at most 2 × impacts solves per step, and a stream of new contacts still ends
+        // up cached. Without a cache (capacity 0) only the impact fields are solved.
+        let mut budget = usize::MAX;
+        if distance == DistanceKind::Heat && !hits.is_empty() {
+            let uncached = resting
+                .iter()
+                .zip(&self.slots)
+                .filter(|&(_, &s)| self.cache.slot(s).surface.is_some() && !att.fields.contains(s))
+                .count();
+            let solves = if att.fields.caches() { 2 } else { 1 } * hits.len();
+            if uncached > solves {
+                budget = if att.fields.caches() { hits.len() } else { 0 };
+                let heat = model.heat_geodesic().expect("checked at set-up");
+                let ws = att.ws.as_mut().expect("heat workspace");
+                let ns = model.num_vertices();
+                att.hit_fields.resize(hits.len() * ns, 0.0);
+                for ((hp, _), field) in hits.iter().zip(att.hit_fields.chunks_exact_mut(ns)) {
+                    heat.distances_from_point_with(hp, field, ws);
+                }
+                self.info.distance_fields_computed += hits.len() as u32;
+            }
+        }
         self.out.clear();
         for (rc, &s) in resting.iter().zip(&self.slots) {
             let Some(sp) = self.cache.slot(s).surface else {
@@ -729,6 +760,15 @@ impl DistantResponse {
                             total += law.factor(norm(sub(hp.point, sp.point))) * dx;
                         }
                     }
+                    DistanceKind::Heat if budget == 0 && !att.fields.contains(s) => {
+                        // Served from the impacts' fields, read at the contact.
+                        let ns = model.num_vertices();
+                        let vs = model.triangle(sp.triangle);
+                        for ((_, dx), field) in hits.iter().zip(att.hit_fields.chunks_exact(ns)) {
+                            let r: f64 = (0..3).map(|i| sp.bary[i] * field[vs[i]]).sum();
+                            total += law.factor(r) * dx;
+                        }
+                    }
                     DistanceKind::Heat => {
                         let heat = model.heat_geodesic().expect("checked at set-up");
                         let ws = att.ws.as_mut().expect("heat workspace");
@@ -741,7 +781,9 @@ impl DistantResponse {
                             let r: f64 = (0..3).map(|i| hp.bary[i] * field[vs[i]]).sum();
                             total += law.factor(r) * dx;
                         }
-                        self.info.distance_fields_computed += (att.fields.computed - before) as u32;
+                        let computed = (att.fields.computed - before) as usize;
+                        budget = budget.saturating_sub(computed);
+                        self.info.distance_fields_computed += computed as u32;
                     }
                 }
             }

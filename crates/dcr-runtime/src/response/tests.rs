@@ -401,8 +401,9 @@ fn attenuation_follows_eq15_16() {
     }
 }
 
-/// Attenuation with heat distances: distance fields cached per contact (computed once), and the
-/// farther contact gets the smaller response.
+/// Attenuation with heat distances: distance fields cached per contact (computed once: three
+/// impacts, so five new contacts are not more than twice the impacts), and the farther contact
+/// gets the smaller response.
 #[test]
 fn attenuation_heat_fields_are_cached() {
     let params = ResponseParams {
@@ -419,7 +420,7 @@ fn attenuation_heat_fields_are_cached() {
     };
     let mut r = DistantResponse::new(plate(), params).unwrap();
     let cs = contacts();
-    let imp = [hit([0.12, 0.1, 0.0], 1.0)];
+    let imp = [0.1, 0.11, 0.12].map(|x| hit([x, 0.1, 0.0], 1.0 / 3.0));
     let a = r.step(&imp, &cs).to_vec();
     assert_eq!(r.last_step_info().distance_fields_computed, 5);
     let b = r.step(&imp, &cs).to_vec();
@@ -427,6 +428,81 @@ fn attenuation_heat_fields_are_cached() {
     assert_eq!(a, b);
     // Contact 0 sits next to the impact (s clamped to 1), contact 1 is ~0.9 m away.
     assert!(a[0].delta_v > a[1].delta_v && a[1].delta_v > 0.0);
+}
+
+/// Heat distances, one impact, five new contacts: each step solves at most 2 fields (one
+/// contact's, cached, and the impact's, which serves the other new contacts) until all are
+/// cached. Every response is the law at the distance read from the field that served it, and
+/// an impact-served contact differs from its own-field response by the heat method's
+/// asymmetry only (a few %).
+#[test]
+fn attenuation_heat_new_contacts_cost_two_fields_per_impact() {
+    let law = AttenuationLaw::Full {
+        alpha: 0.0,
+        beta: 1.0,
+        r0: 0.05,
+    };
+    let model = plate();
+    let params = ResponseParams {
+        method: Method::Attenuation(AttenuationParams {
+            law,
+            amplitude: AmplitudeKind::Mean,
+            ..Default::default()
+        }),
+        ..Default::default()
+    };
+    let mut r = DistantResponse::new(Arc::clone(&model), params).unwrap();
+    let cs = contacts();
+    let imp = [hit([0.12, 0.1, 0.0], 1.0)];
+    let mut steps = Vec::new();
+    let mut computed = Vec::new();
+    for _ in 0..5 {
+        steps.push(r.step(&imp, &cs).to_vec());
+        computed.push(r.last_step_info().distance_fields_computed);
+    }
+    assert_eq!(computed, [2, 2, 2, 2, 0]);
+    // Distances from each contact's own field (read at the impact) and from the impact's
+    // field (read at the contact).
+    let heat = model.heat_geodesic().unwrap();
+    let n = model.num_vertices();
+    let at = |field: &[f64], sp: &crate::SurfacePoint| -> f64 {
+        let vs = model.triangle(sp.triangle);
+        (0..3).map(|i| sp.bary[i] * field[vs[i]]).sum()
+    };
+    let hp = model.project(imp[0].point, 1.0).unwrap();
+    let mut from_hit = vec![0.0; n];
+    heat.distances_from_point(&hp, &mut from_hit);
+    let mut field = vec![0.0; n];
+    let (mut own, mut read) = (Vec::new(), Vec::new());
+    for c in &cs {
+        let sp = model.project(c.point, 1.0).unwrap();
+        heat.distances_from_point(&sp, &mut field);
+        own.push(law.factor(at(&field, &hp)));
+        read.push(law.factor(at(&from_hit, &sp)));
+    }
+    // Step k caches contact k − 1 (in order) and serves contacts k.. from the impact's field;
+    // by step 4 the last two are both computed, step 5 reads only the cache. All responses
+    // share Δx_c / h, so each is that constant times the law.
+    let unit = steps[4][0].delta_v / own[0];
+    for (k, out) in steps.iter().enumerate() {
+        for (c, o) in out.iter().enumerate() {
+            let want = if c <= k || k >= 3 { own[c] } else { read[c] };
+            assert!(
+                rel(o.delta_v, unit * want) < 1e-12,
+                "step {k} contact {c}: {} vs {}",
+                o.delta_v,
+                unit * want
+            );
+        }
+    }
+    for c in 0..cs.len() {
+        assert!(
+            rel(own[c], read[c]) < 0.1,
+            "contact {c}: {} vs {}",
+            own[c],
+            read[c]
+        );
+    }
 }
 
 /// Eq. 17: point mass → m; lever arm adds (r×n)ᵀI⁻¹(r×n); Eq. 18 impulse along n.
