@@ -154,6 +154,13 @@ impl ModalModel {
         self.base.surface_triangles[t as usize].map(|i| i as usize)
     }
 
+    /// A per-vertex field (one value per surface vertex, any unit) read at a surface point:
+    /// linear in its triangle, Σ bary_i · field[v_i].
+    pub fn interpolate(&self, field: &[f64], sp: &SurfacePoint) -> f64 {
+        let vs = self.triangle(sp.triangle);
+        (0..3).map(|i| sp.bary[i] * field[vs[i]]).sum()
+    }
+
     /// Projects `p` (object frame, m) onto the surface with the BVH; `None` if the surface is
     /// farther than `max_distance` (m). Never snaps a far point.
     pub fn project(&self, p: [f64; 3], max_distance: f64) -> Option<SurfacePoint> {

@@ -44,7 +44,7 @@ struct AttenuationState {
     /// This step's applied impacts: surface point and local displacement Δx_c (m).
     hits: Vec<(SurfacePoint, f64)>,
     /// Heat distance fields (m) from this step's impacts, one per hit (`hits.len() × ns`),
-    /// when they serve the uncached contacts (see [`DistantResponse::step`]'s cost rule).
+    /// when they serve the uncached contacts (the cost rule of [`DistanceKind::Heat`]).
     hit_fields: Vec<f64>,
 }
 
@@ -707,10 +707,7 @@ impl DistantResponse {
             // λ_N: the impulse's component along the surface normal (q̂ is per unit normal impulse).
             let lambda_n = imp.impulse * dot(normalize(imp.direction), sp.normal).abs();
             let amp = match att.params.amplitude {
-                AmplitudeKind::PerVertex => {
-                    let vs = model.triangle(sp.triangle);
-                    (0..3).map(|i| sp.bary[i] * att.amplitude[vs[i]]).sum()
-                }
+                AmplitudeKind::PerVertex => model.interpolate(&att.amplitude, &sp),
                 _ => att.mean,
             };
             hits.push((sp, amp * lambda_n));
@@ -763,10 +760,8 @@ impl DistantResponse {
                     DistanceKind::Heat if budget == 0 && !att.fields.contains(s) => {
                         // Served from the impacts' fields, read at the contact.
                         let ns = model.num_vertices();
-                        let vs = model.triangle(sp.triangle);
                         for ((_, dx), field) in hits.iter().zip(att.hit_fields.chunks_exact(ns)) {
-                            let r: f64 = (0..3).map(|i| sp.bary[i] * field[vs[i]]).sum();
-                            total += law.factor(r) * dx;
+                            total += law.factor(model.interpolate(field, &sp)) * dx;
                         }
                     }
                     DistanceKind::Heat => {
@@ -777,9 +772,7 @@ impl DistantResponse {
                             .fields
                             .get(s, step, |out| heat.distances_from_point_with(&sp, out, ws));
                         for (hp, dx) in &hits {
-                            let vs = model.triangle(hp.triangle);
-                            let r: f64 = (0..3).map(|i| hp.bary[i] * field[vs[i]]).sum();
-                            total += law.factor(r) * dx;
+                            total += law.factor(model.interpolate(field, hp)) * dx;
                         }
                         let computed = (att.fields.computed - before) as usize;
                         budget = budget.saturating_sub(computed);

@@ -465,10 +465,6 @@ fn attenuation_heat_new_contacts_cost_two_fields_per_impact() {
     // field (read at the contact).
     let heat = model.heat_geodesic().unwrap();
     let n = model.num_vertices();
-    let at = |field: &[f64], sp: &crate::SurfacePoint| -> f64 {
-        let vs = model.triangle(sp.triangle);
-        (0..3).map(|i| sp.bary[i] * field[vs[i]]).sum()
-    };
     let hp = model.project(imp[0].point, 1.0).unwrap();
     let mut from_hit = vec![0.0; n];
     heat.distances_from_point(&hp, &mut from_hit);
@@ -477,8 +473,8 @@ fn attenuation_heat_new_contacts_cost_two_fields_per_impact() {
     for c in &cs {
         let sp = model.project(c.point, 1.0).unwrap();
         heat.distances_from_point(&sp, &mut field);
-        own.push(law.factor(at(&field, &hp)));
-        read.push(law.factor(at(&from_hit, &sp)));
+        own.push(law.factor(model.interpolate(&field, &hp)));
+        read.push(law.factor(model.interpolate(&from_hit, &sp)));
     }
     // Step k caches contact k − 1 (in order) and serves contacts k.. from the impact's field;
     // by step 4 the last two are both computed, step 5 reads only the cache. All responses

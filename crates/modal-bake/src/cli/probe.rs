@@ -206,8 +206,7 @@ pub fn run(args: &ProbeArgs) -> anyhow::Result<()> {
         .iter()
         .zip(&mapped)
         .map(|(o, sp)| {
-            let vs = model.triangle(sp.triangle);
-            let d: f64 = (0..3).map(|i| sp.bary[i] * field[vs[i]]).sum();
+            let d = model.interpolate(&field, sp);
             serde_json::json!({
                 "point": sp.point,
                 "triangle": sp.triangle,
