@@ -52,6 +52,7 @@
 mod kernels;
 mod lanczos;
 mod ordering;
+mod panel_solve;
 mod shift_invert;
 
 use faer::sparse::SparseColMat;
