@@ -541,12 +541,12 @@ fn check_input(
     Ok(())
 }
 
-/// Krylov basis size for `wanted` pairs: the parameter, or wanted + max(wanted, 4b), at least
+/// Krylov basis size for `wanted` pairs: the parameter, or wanted + max(wanted, 4b) + b, at least
 /// wanted + 2b, rounded up to a multiple of b.
 fn krylov_dim(params: &EigenParams, wanted: usize, b: usize) -> usize {
     let base = params
         .krylov_dim
-        .unwrap_or_else(|| wanted + wanted.max(4 * b));
+        .unwrap_or_else(|| wanted + wanted.max(4 * b) + b);
     let d = base.max(wanted + 2 * b);
     d.div_ceil(b) * b
 }

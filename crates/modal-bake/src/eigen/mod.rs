@@ -77,12 +77,18 @@ pub struct EigenParams {
     /// positive definite. 0 suits clamped objects; free-free objects need σ < 0
     /// ([`default_shift`]).
     pub shift: f64,
-    /// Block size b: right-hand sides per factor solve (default 6: interleaved timings of
-    /// 4, 6 and 8 on the bake bench's beams (`examples/eigen_timing --block`) put 6 at or below
-    /// 8 at 3k, 15k and 109k dofs, e.g. 109k: 4.9–5.0 s vs 5.2–6.0 s; 4 wins only at 3k).
+    /// Block size b: right-hand sides per factor solve (default 8). With the block solves of
+    /// `panel_solve.rs` a block of 8 costs about what a block of 6 does once the factor no
+    /// longer fits in cache (109k dofs: 181–199 ms vs 198–204 ms), and the larger block
+    /// converges in fewer solves (bake bench, 20 modes: 3.5k 19 vs 22, 13.5k 15 vs 18, 109k 11
+    /// vs 13). Interleaved `examples/eigen_timing` runs, eigensolve min/median: 109k 3.9/4.2 s
+    /// vs 5.0/5.5 s (block 6, Krylov dimension 48); 13.5k and 3.5k within the noise of a
+    /// loaded machine (13.5k: 0.50/0.52 s vs 0.50/0.55 s in one series, 0.59/0.79 s vs
+    /// 0.59/0.75 s in another; 3.5k: 0.113/0.121 s vs 0.112/0.132 s).
     pub block: usize,
-    /// Maximum Krylov basis size before a thick restart; `None`: nev + max(nev, 4b), rounded
-    /// up to a multiple of b (grown automatically in max-frequency mode).
+    /// Maximum Krylov basis size before a thick restart; `None`: nev + max(nev, 4b) + b,
+    /// rounded up to a multiple of b (grown automatically in max-frequency mode); 64 for 20
+    /// pairs in blocks of 8.
     pub krylov_dim: Option<usize>,
     /// Tolerance on the relative residual (see the module docs), default 1e-10.
     pub tol: f64,
@@ -105,7 +111,7 @@ impl Default for EigenParams {
             nev: 20,
             max_freq_hz: None,
             shift: 0.0,
-            block: 6,
+            block: 8,
             krylov_dim: None,
             tol: 1e-10,
             max_iters: 300,
