@@ -9,10 +9,15 @@
 //!   σ must lie strictly below the lowest eigenvalue (free-free objects: σ < 0, see
 //!   [`default_shift`]). The operator T = A⁻¹M is M-self-adjoint with eigenvalues
 //!   θ = 1/(λ − σ), largest θ ↔ lowest λ.
-//! - The Krylov basis grows by a block of b vectors per step; each step is *one* multi-RHS
-//!   solve (the factor is read once for b vectors), followed by full M-reorthogonalisation
-//!   (two passes of block classical Gram–Schmidt) and Cholesky-QR of the block (twice; random
-//!   replacement on breakdown).
+//! - The Krylov basis grows by a block of b = 8 vectors per step; each step is *one* multi-RHS
+//!   solve (the factor is read once for b vectors: our row-major panel sweeps over faer's
+//!   supernodal factor, `panel_solve.rs`, on two subtree groups at once when the elimination
+//!   tree splits evenly), followed by full M-reorthogonalisation (two passes of block
+//!   classical Gram–Schmidt: the first pass always removes more than 1 − 1/√2 of the new
+//!   block's M-norm here, measured 0.01–0.61 remaining, so "twice is enough" would never skip
+//!   the second) and Cholesky-QR of the block (twice; random replacement on breakdown). The
+//!   dense products run sequentially (faer's parallel path is far slower on these
+//!   tall-skinny shapes; `kernels.rs`).
 //! - Rayleigh–Ritz on the projected H = VᵀMTV with faer's dense symmetric eigensolver.
 //!   When the basis reaches its maximum size it is restarted with the best Ritz vectors plus
 //!   the newest block (thick restart).
@@ -41,9 +46,9 @@
 //!   each eigenvector is signed so its entry of largest magnitude (first on ties) is positive.
 //!
 //! Determinism: the results are bit-identical across runs and across thread counts. Our own
-//! kernels (sparse products, Gram–Schmidt bookkeeping) split work by fixed chunk sizes, never by
-//! the thread count, and sum in a fixed order. faer 0.24.4's supernodal factorization, solves
-//! and dense products were measured to give bit-identical results with `Par::rayon(1)`, `(2)`
+//! kernels (sparse products, Gram–Schmidt bookkeeping, the panel solves) split work by fixed
+//! chunk sizes or by the factor's tree, never by the thread count, and sum in a fixed order.
+//! faer 0.24.4's supernodal factorization, solves and dense products were measured to give bit-identical results with `Par::rayon(1)`, `(2)`
 //! and `(3)`, equal to `Par::Seq`, on rayon pools of 1 and 2 threads (`tests/fem_eigen.rs`
 //! guards Seq = rayon(1) = rayon(2) on both pools);
 //! the small dense eigensolves run with `Par::Seq`. Bits may differ between machines with
