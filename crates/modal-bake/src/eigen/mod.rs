@@ -101,10 +101,12 @@ pub struct EigenParams {
     pub max_iters: usize,
     /// Cap on the number of modes returned in max-frequency mode (default 2000).
     pub max_modes: usize,
-    /// Threads given to faer's factorization, solves and dense products as `Par::rayon(n)`;
-    /// 0 (default): sequential below 20 000 dofs, else the current rayon pool's size. Results
-    /// do not depend on it (measured:
-    /// bit-identical for 1, 2 and 3 threads on faer 0.24.4; `tests/fem_eigen.rs` guards it).
+    /// Threads given to faer's factorization (and to its solves of single vectors or blocks
+    /// wider than 8) as `Par::rayon(n)`; 0 (default): sequential below 20 000 dofs, else the
+    /// current rayon pool's size. The Lanczos block solves and the split panel sweeps use the
+    /// current rayon pool; dense products are sequential. Results do not depend on it
+    /// (measured: bit-identical for 1, 2 and 3 threads on faer 0.24.4; `tests/fem_eigen.rs`
+    /// guards it).
     pub threads: usize,
     /// Seed of the start block.
     pub seed: u64,
