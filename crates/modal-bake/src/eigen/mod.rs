@@ -5,7 +5,7 @@
 //! form as in Grimes, Lewis & Simon 1994) in the M-inner product:
 //!
 //! - A = K − σM is factored once by faer's sparse Cholesky (supernodal LLᵀ) under the node
-//!   ordering AMD, or a level-set nested dissection when it fills clearly less (`ordering.rs`), so
+//!   ordering AMD, or a level-set nested dissection when it fills less (`ordering.rs`), so
 //!   σ must lie strictly below the lowest eigenvalue (free-free objects: σ < 0, see
 //!   [`default_shift`]). The operator T = A⁻¹M is M-self-adjoint with eigenvalues
 //!   θ = 1/(λ − σ), largest θ ↔ lowest λ.

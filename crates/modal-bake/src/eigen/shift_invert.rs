@@ -130,11 +130,16 @@ fn symbolic(
     .map_err(|e| EigenError::Factorization(format!("symbolic analysis failed: {e:?}")))
 }
 
-/// Nested dissection replaces AMD only when its factor of the node graph has fewer than this
-/// fraction of AMD's entries. Measured single-threaded (`eigen_timing --threads 1`): on the
-/// stout 108k-dof beam 21% fewer entries made the factorization ~30% faster and the eigensolve
-/// ~14% faster; on the slender 109k-dof beam 4% fewer entries made neither faster.
-const ND_FILL_RATIO: f64 = 0.9;
+/// Nested dissection replaces AMD when its factor of the node graph has fewer than this
+/// fraction of AMD's entries, i.e. whenever it fills less. Its balanced elimination tree is
+/// what lets faer's factorization and the panel sweeps (`panel_solve.rs`) use both threads,
+/// which AMD's near-chain tree on a slender beam does not. Measured (`eigen_timing`, 2
+/// interleaved runs each, min/median): on the slender 109k-dof beam, where nested dissection
+/// fills 4% less, factorization 2.20/2.22 s vs 2.48/2.52 s and eigensolve 3.27/3.41 s vs
+/// 4.44/4.57 s against AMD. (Single-threaded, before the panel sweeps, those 4% made neither
+/// faster; a ratio of 0.9 kept AMD there. On the stout 108k beam, 21% fewer entries: the
+/// factorization ~30% and the eigensolve ~14% faster single-threaded.)
+const ND_FILL_RATIO: f64 = 1.0;
 
 /// Below this many dofs nested dissection is not tried: there it does not reach
 /// [`ND_FILL_RATIO`] on the meshes measured (16³-cell block, 14.7k dofs: 0.92× AMD's fill; the
@@ -142,7 +147,7 @@ const ND_FILL_RATIO: f64 = 0.9;
 /// node-graph symbolic analyses) cost ~10% of the factorization at 13.5k dofs.
 const ND_MIN_DOFS: usize = 30_000;
 
-/// The symbolic factorization of `a` under AMD or, when it fills clearly less
+/// The symbolic factorization of `a` under AMD or, when it fills less
 /// ([`ND_FILL_RATIO`], tried from [`ND_MIN_DOFS`] on), nested dissection on the node graph (see
 /// [`ordering`]); faer's AMD on the dofs when the pattern is not node-blocked. The fill is
 /// compared on the node graph (1/9 of the entries), so choosing costs two small symbolic
