@@ -143,16 +143,22 @@ fn spmm_panel(a: &SparseColMat<usize, f64>, xr: &[f64], out: &mut [f64], with_ab
 /// Rows below which [`sym_spmm`] runs sequentially.
 const SPMM_SEQ_BELOW: usize = 20_000;
 
-/// `dst (+)= alpha · lhs · rhs` with faer's dense kernel at parallelism `par`.
+/// `dst (+)= alpha · lhs · rhs` with faer's dense kernel, sequential.
+///
+/// The Lanczos products are tall and skinny (n × ≤ 100 against n × b, or n × ≤ 100 times a
+/// small matrix), memory-bound, and faer 0.24.4's parallel path is much slower on them than
+/// its sequential one: measured on 2 cores at n = 108 900 (the 100k bake bench beam),
+/// `Vᵀ Z` with V n × 48 and Z n × 6 took 164–200 ms with `Par::rayon(2)` against 9.6–9.8 ms
+/// with `Par::Seq` (n × 20 against n × 20: 64–142 ms vs 4.9–5.8 ms), and `Z − V C` 13–20 ms
+/// against 11.3–11.4 ms.
 pub(crate) fn gemm(
     dst: MatMut<'_, f64>,
     accum: Accum,
     lhs: MatRef<'_, f64>,
     rhs: MatRef<'_, f64>,
     alpha: f64,
-    par: Par,
 ) {
-    faer::linalg::matmul::matmul(dst, accum, lhs, rhs, alpha, par);
+    faer::linalg::matmul::matmul(dst, accum, lhs, rhs, alpha, Par::Seq);
 }
 
 /// Eigen-decomposition of a small symmetric matrix (both triangles filled): eigenvalues

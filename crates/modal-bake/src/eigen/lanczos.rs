@@ -17,6 +17,9 @@ use super::{EigenError, EigenInfo, EigenParams, EigenProgress, EigenResult};
 /// Ascending eigenvalues (rad²/s²), their vectors (columns) and residuals.
 type RitzPairs = (Vec<f64>, Mat<f64>, Vec<Residual>);
 
+/// [`RitzPairs`] and M times their vectors (kg), from the residual check's products.
+type CheckedPairs = (RitzPairs, Mat<f64>);
+
 /// Problems with at most this many dofs beyond the Krylov basis size are solved densely.
 const DENSE_MARGIN: usize = 16;
 
@@ -108,7 +111,6 @@ pub(crate) fn solve(
             &fac,
             &cp,
             lam_lim,
-            par,
             locked.as_ref(),
             mlocked.as_ref(),
             &mut info,
@@ -121,7 +123,7 @@ pub(crate) fn solve(
                 })
             },
         );
-        let ((cv, cu, cres), chunk_capped) = match run {
+        let (((cv, cu, cres), mcu), chunk_capped) = match run {
             // A run that drifts (too many restarts for its size) is retried with fewer pairs;
             // the pairs already locked are kept.
             Err(EigenError::NotConverged { .. }) if chunk > MIN_CHUNK => {
@@ -142,8 +144,6 @@ pub(crate) fn solve(
             }
             other => other?,
         };
-        let mut mcu = Mat::<f64>::zeros(n, cu.ncols());
-        sym_spmm(m, cu.as_ref(), mcu.as_mut());
         append_cols(&mut locked, cu.as_ref());
         append_cols(&mut mlocked, mcu.as_ref());
         vals.extend_from_slice(&cv);
@@ -163,7 +163,7 @@ pub(crate) fn solve(
     // One Cholesky-QR over all chunks (ascending λ, so each vector only mixes in lower ones)
     // restores UᵀMU = I across chunk boundaries; residuals are measured on the result.
     let (vals, u, res) = if runs > 1 {
-        orthonormalize_ascending(k, m, locked, mlocked, sigma, par)?
+        orthonormalize_ascending(k, m, locked, mlocked, sigma)?.0
     } else {
         (vals, locked, res)
     };
@@ -203,20 +203,13 @@ fn append_cols(a: &mut Mat<f64>, b: MatRef<'_, f64>) {
 
 /// Subtracts from the columns of `z` their M-projection on the (M-orthonormal) `locked`
 /// vectors: z ← z − L (MLᵀ z).
-fn deflate(z: MatMut<'_, f64>, locked: MatRef<'_, f64>, mlocked: MatRef<'_, f64>, par: Par) {
+fn deflate(z: MatMut<'_, f64>, locked: MatRef<'_, f64>, mlocked: MatRef<'_, f64>) {
     if locked.ncols() == 0 {
         return;
     }
     let mut c = Mat::<f64>::zeros(locked.ncols(), z.ncols());
-    gemm(
-        c.as_mut(),
-        Accum::Replace,
-        mlocked.transpose(),
-        z.rb(),
-        1.0,
-        par,
-    );
-    gemm(z, Accum::Add, locked, c.as_ref(), -1.0, par);
+    gemm(c.as_mut(), Accum::Replace, mlocked.transpose(), z.rb(), 1.0);
+    gemm(z, Accum::Add, locked, c.as_ref(), -1.0);
 }
 
 /// One shift-invert block Lanczos run for the `params.nev` (or, with `lam_lim`, up to
@@ -229,12 +222,11 @@ fn lanczos_chunk(
     fac: &ShiftInvert,
     params: &EigenParams,
     lam_lim: Option<f64>,
-    par: Par,
     locked: MatRef<'_, f64>,
     mlocked: MatRef<'_, f64>,
     info: &mut EigenInfo,
     progress: &mut dyn FnMut(EigenProgress),
-) -> Result<(RitzPairs, bool), EigenError> {
+) -> Result<(CheckedPairs, bool), EigenError> {
     let n = k.nrows();
     let sigma = params.shift;
     let b = params.block.min(n).max(1);
@@ -266,8 +258,8 @@ fn lanczos_chunk(
         z.copy_from(&mz);
         fac.solve_in_place(z.as_mut(), &mut solve_buf);
         info.block_solves += 1;
-        deflate(z.as_mut(), locked, mlocked, par);
-        deflate(z.as_mut(), locked, mlocked, par);
+        deflate(z.as_mut(), locked, mlocked);
+        deflate(z.as_mut(), locked, mlocked);
         sym_spmm(m, z.as_ref(), mz.as_mut());
         let pre: Vec<f64> = (0..b).map(|j| m_norm(z.as_ref(), mz.as_ref(), j)).collect();
         orthonormalize(
@@ -279,7 +271,6 @@ fn lanczos_chunk(
             &pre,
             m,
             &mut rng,
-            par,
         )?;
         v.as_mut().subcols_mut(0, b).copy_from(&z);
         mv.as_mut().subcols_mut(0, b).copy_from(&mz);
@@ -297,7 +288,7 @@ fn lanczos_chunk(
         info.block_solves += 1;
         let mut c = Mat::<f64>::zeros(nb, b);
         for _pass in 0..2 {
-            deflate(z.as_mut(), locked, mlocked, par);
+            deflate(z.as_mut(), locked, mlocked);
             let mut cp = Mat::<f64>::zeros(nb, b);
             gemm(
                 cp.as_mut(),
@@ -305,7 +296,6 @@ fn lanczos_chunk(
                 mv.as_ref().subcols(0, nb).transpose(),
                 z.as_ref(),
                 1.0,
-                par,
             );
             gemm(
                 z.as_mut(),
@@ -313,7 +303,6 @@ fn lanczos_chunk(
                 v.as_ref().subcols(0, nb),
                 cp.as_ref(),
                 -1.0,
-                par,
             );
             c += &cp;
         }
@@ -334,7 +323,6 @@ fn lanczos_chunk(
             &pre,
             m,
             &mut rng,
-            par,
         )?;
         v.as_mut().subcols_mut(nb, b).copy_from(&z);
         mv.as_mut().subcols_mut(nb, b).copy_from(&mz);
@@ -409,7 +397,7 @@ fn lanczos_chunk(
         if ready || out_of_steps {
             info.residual_checks += 1;
             let sel = select_cols(s_asc.as_ref(), &order[..wanted.min(kk)]);
-            let (vals, u, res) = finalize(
+            let ((vals, u, res), mu) = finalize(
                 k,
                 m,
                 fac,
@@ -417,12 +405,11 @@ fn lanczos_chunk(
                 mv.as_ref().subcols(0, kk),
                 sel.as_ref(),
                 sigma,
-                par,
             )?;
             let worst = res.iter().map(|r| r.rel).fold(0.0, f64::max);
             let good = res.iter().filter(|r| r.converged(params.tol)).count();
             if good == res.len() && wanted <= kk {
-                return Ok(((vals, u, res), capped));
+                return Ok((((vals, u, res), mu), capped));
             }
             // More steps cannot help once the explicit residuals stop improving between
             // checks (rounding floor, or the basis has lost orthogonality): fail now rather
@@ -483,7 +470,6 @@ fn lanczos_chunk(
                 v.as_ref().subcols(0, kk),
                 sp.as_ref(),
                 1.0,
-                par,
             );
             gemm(
                 mv2.as_mut().subcols_mut(0, p),
@@ -491,7 +477,6 @@ fn lanczos_chunk(
                 mv.as_ref().subcols(0, kk),
                 sp.as_ref(),
                 1.0,
-                par,
             );
             v2.as_mut()
                 .subcols_mut(p, b)
@@ -508,7 +493,6 @@ fn lanczos_chunk(
                 r_last.as_ref(),
                 sp.as_ref().subrows(kk - b, b),
                 1.0,
-                Par::Seq,
             );
             h.fill(0.0);
             for i in 0..p {
@@ -557,12 +541,12 @@ fn check_input(
     Ok(())
 }
 
-/// Krylov basis size for `wanted` pairs: the parameter, or wanted + max(wanted, 4b), at least
+/// Krylov basis size for `wanted` pairs: the parameter, or wanted + max(wanted, 4b) + b, at least
 /// wanted + 2b, rounded up to a multiple of b.
 fn krylov_dim(params: &EigenParams, wanted: usize, b: usize) -> usize {
     let base = params
         .krylov_dim
-        .unwrap_or_else(|| wanted + wanted.max(4 * b));
+        .unwrap_or_else(|| wanted + wanted.max(4 * b) + b);
     let d = base.max(wanted + 2 * b);
     d.div_ceil(b) * b
 }
@@ -606,7 +590,6 @@ fn orthonormalize(
     pre: &[f64],
     m: &SparseColMat<usize, f64>,
     rng: &mut SplitMix64,
-    par: Par,
 ) -> Result<Mat<f64>, EigenError> {
     let b = z.ncols();
     let healthy =
@@ -622,7 +605,6 @@ fn orthonormalize(
                 z.as_ref().transpose(),
                 mz.as_ref(),
                 1.0,
-                Par::Seq,
             );
             let mut g = symmetrized(g.as_ref());
             if small_cholesky(g.as_mut(), 1e-14).is_err() {
@@ -631,8 +613,8 @@ fn orthonormalize(
             }
             let l = Mat::from_fn(b, b, |i, j| if i >= j { g[(i, j)] } else { 0.0 });
             // z ← z L⁻ᵀ, i.e. zᵀ ← L⁻¹ zᵀ, in place.
-            solve_lower_triangular_in_place(l.as_ref(), z.as_mut().transpose_mut(), par);
-            solve_lower_triangular_in_place(l.as_ref(), mz.as_mut().transpose_mut(), par);
+            solve_lower_triangular_in_place(l.as_ref(), z.as_mut().transpose_mut(), Par::Seq);
+            solve_lower_triangular_in_place(l.as_ref(), mz.as_mut().transpose_mut(), Par::Seq);
             r_total = l.transpose() * &r_total;
         }
         if ok {
@@ -651,8 +633,8 @@ fn orthonormalize(
                 pre[j]
             };
             for _pass in 0..2 {
-                project_out_col(z, mz, j, locked, mlocked, par);
-                project_out_col(z, mz, j, v, mv, par);
+                project_out_col(z, mz, j, locked, mlocked);
+                project_out_col(z, mz, j, v, mv);
                 for i in 0..j {
                     let c: f64 = mz
                         .col(i)
@@ -714,7 +696,6 @@ fn project_out_col(
     j: usize,
     basis: MatRef<'_, f64>,
     mbasis: MatRef<'_, f64>,
-    par: Par,
 ) {
     if basis.ncols() == 0 {
         return;
@@ -726,7 +707,6 @@ fn project_out_col(
         mbasis.transpose(),
         z.as_ref().subcols(j, 1),
         1.0,
-        par,
     );
     gemm(
         z.as_mut().subcols_mut(j, 1),
@@ -734,7 +714,6 @@ fn project_out_col(
         basis,
         c.as_ref(),
         -1.0,
-        par,
     );
     gemm(
         mz.as_mut().subcols_mut(j, 1),
@@ -742,7 +721,6 @@ fn project_out_col(
         mbasis,
         c.as_ref(),
         -1.0,
-        par,
     );
 }
 
@@ -760,12 +738,11 @@ fn finalize(
     mv: MatRef<'_, f64>,
     s: MatRef<'_, f64>,
     sigma: f64,
-    par: Par,
-) -> Result<RitzPairs, EigenError> {
+) -> Result<CheckedPairs, EigenError> {
     let n = v.nrows();
     let w = s.ncols();
     let mut u = Mat::<f64>::zeros(n, w);
-    gemm(u.as_mut(), Accum::Replace, mv, s, 1.0, par);
+    gemm(u.as_mut(), Accum::Replace, mv, s, 1.0);
     let mut buf = fac.solve_buffer(w);
     fac.solve_in_place(u.as_mut(), &mut buf);
     let _ = v;
@@ -779,11 +756,12 @@ fn finalize(
             mu.as_mut().col_mut(j).iter_mut().for_each(|x| *x *= inv);
         }
     }
-    orthonormalize_ascending(k, m, u, mu, sigma, par)
+    orthonormalize_ascending(k, m, u, mu, sigma)
 }
 
 /// M-orthonormalises purified Ritz vectors (columns in ascending λ) by one Cholesky-QR,
-/// U ← U L⁻ᵀ with LLᵀ = UᵀMU, and takes λᵢ = uᵢᵀKuᵢ. No Rayleigh–Ritz rotation of (K, M):
+/// U ← U L⁻ᵀ with LLᵀ = UᵀMU, and takes λᵢ = uᵢᵀKuᵢ; also returns M U (from the residual
+/// products, so deflation against these vectors needs no further product). No Rayleigh–Ritz rotation of (K, M):
 /// the projected K is *graded* (its entries span λ₁ … λ_w), so a dense eigensolver resolves
 /// its eigenvectors only to ε·λ_w/gap, and K amplifies the resulting mixture into the
 /// residuals of the low modes by λ_w/λ₁ (measured on the 1016-node table with 160 modes:
@@ -795,19 +773,11 @@ fn orthonormalize_ascending(
     u: Mat<f64>,
     mu: Mat<f64>,
     sigma: f64,
-    par: Par,
-) -> Result<RitzPairs, EigenError> {
+) -> Result<CheckedPairs, EigenError> {
     let (n, w) = (u.nrows(), u.ncols());
-    let li = gram_cholesky_inverse(u.as_ref(), mu.as_ref(), par)?;
+    let li = gram_cholesky_inverse(u.as_ref(), mu.as_ref())?;
     let mut q = Mat::<f64>::zeros(n, w);
-    gemm(
-        q.as_mut(),
-        Accum::Replace,
-        u.as_ref(),
-        li.transpose(),
-        1.0,
-        par,
-    );
+    gemm(q.as_mut(), Accum::Replace, u.as_ref(), li.transpose(), 1.0);
     // The products for the Rayleigh quotients also serve the residuals (columns are
     // independent in the products, so computing them before the sort changes no bit).
     let prods = Products::new(k, m, q.as_ref());
@@ -825,24 +795,27 @@ fn orthonormalize_ascending(
     let mut idx: Vec<usize> = (0..w).collect();
     idx.sort_by(|&a, &b| rq[a].total_cmp(&rq[b]));
     let vals: Vec<f64> = idx.iter().map(|&j| rq[j]).collect();
-    let u = Mat::from_fn(n, w, |i, j| q[(i, idx[j])]);
+    let permuted = |a: &Mat<f64>| {
+        let mut out = Mat::<f64>::zeros(n, w);
+        for (j, &from) in idx.iter().enumerate() {
+            out.as_mut().col_mut(j).copy_from(a.col(from));
+        }
+        out
+    };
+    let (u, mu) = (permuted(&q), permuted(&prods.mu));
     let mut res: Vec<Option<Residual>> = res.into_iter().map(Some).collect();
     let res = idx
         .iter()
         .map(|&j| res[j].take().expect("a permutation"))
         .collect();
-    Ok((vals, u, res))
+    Ok(((vals, u, res), mu))
 }
 
 /// L⁻¹ for the Cholesky factor L Lᵀ = UᵀMU of the Gram matrix of `u` (`mu = M u`).
-fn gram_cholesky_inverse(
-    u: MatRef<'_, f64>,
-    mu: MatRef<'_, f64>,
-    par: Par,
-) -> Result<Mat<f64>, EigenError> {
+fn gram_cholesky_inverse(u: MatRef<'_, f64>, mu: MatRef<'_, f64>) -> Result<Mat<f64>, EigenError> {
     let w = u.ncols();
     let mut g = Mat::<f64>::zeros(w, w);
-    gemm(g.as_mut(), Accum::Replace, u.transpose(), mu, 1.0, par);
+    gemm(g.as_mut(), Accum::Replace, u.transpose(), mu, 1.0);
     let mut g = symmetrized(g.as_ref());
     small_cholesky(g.as_mut(), 0.0)
         .map_err(|j| EigenError::Dense(format!("Ritz vectors not M-independent (pivot {j})")))?;
@@ -858,10 +831,9 @@ fn rayleigh_ritz(
     mu: Mat<f64>,
     ku: Mat<f64>,
     sigma: f64,
-    par: Par,
 ) -> Result<RitzPairs, EigenError> {
     let w = u.ncols();
-    let li = gram_cholesky_inverse(u.as_ref(), mu.as_ref(), par)?;
+    let li = gram_cholesky_inverse(u.as_ref(), mu.as_ref())?;
     let mut a = Mat::<f64>::zeros(w, w);
     gemm(
         a.as_mut(),
@@ -869,7 +841,6 @@ fn rayleigh_ritz(
         u.as_ref().transpose(),
         ku.as_ref(),
         1.0,
-        par,
     );
     let a = symmetrized(a.as_ref());
     let c = symmetrized((&li * &a * li.transpose()).as_ref());
@@ -877,7 +848,7 @@ fn rayleigh_ritz(
     let x = li.transpose() * &q;
     let apply = |y: &Mat<f64>| {
         let mut o = Mat::<f64>::zeros(y.nrows(), w);
-        gemm(o.as_mut(), Accum::Replace, y.as_ref(), x.as_ref(), 1.0, par);
+        gemm(o.as_mut(), Accum::Replace, y.as_ref(), x.as_ref(), 1.0);
         o
     };
     let _ = (mu, ku);
@@ -1040,7 +1011,7 @@ fn solve_dense(
     let u = li.transpose() * q.as_ref().subcols(0, wanted);
     let mu = &md_copy * &u;
     let ku = &kd * &u;
-    let (vals, u, res) = rayleigh_ritz(k, m, u, mu, ku, params.shift, Par::Seq)?;
+    let (vals, u, res) = rayleigh_ritz(k, m, u, mu, ku, params.shift)?;
     info.dense = true;
     info.iterations = 1;
     info.krylov_dim = n;

@@ -5,14 +5,19 @@
 //! form as in Grimes, Lewis & Simon 1994) in the M-inner product:
 //!
 //! - A = K − σM is factored once by faer's sparse Cholesky (supernodal LLᵀ) under the node
-//!   ordering AMD, or METIS nested dissection when it fills clearly less (`ordering.rs`), so
+//!   ordering AMD, or METIS nested dissection when it fills less (`ordering.rs`), so
 //!   σ must lie strictly below the lowest eigenvalue (free-free objects: σ < 0, see
 //!   [`default_shift`]). The operator T = A⁻¹M is M-self-adjoint with eigenvalues
 //!   θ = 1/(λ − σ), largest θ ↔ lowest λ.
-//! - The Krylov basis grows by a block of b vectors per step; each step is *one* multi-RHS
-//!   solve (the factor is read once for b vectors), followed by full M-reorthogonalisation
-//!   (two passes of block classical Gram–Schmidt) and Cholesky-QR of the block (twice; random
-//!   replacement on breakdown).
+//! - The Krylov basis grows by a block of b = 8 vectors per step; each step is *one* multi-RHS
+//!   solve (the factor is read once for b vectors: our row-major panel sweeps over faer's
+//!   supernodal factor, `panel_solve.rs`, on two subtree groups at once when the elimination
+//!   tree splits evenly), followed by full M-reorthogonalisation (two passes of block
+//!   classical Gram–Schmidt: the first pass always removes more than 1 − 1/√2 of the new
+//!   block's M-norm here, measured 0.01–0.61 remaining, so "twice is enough" would never skip
+//!   the second) and Cholesky-QR of the block (twice; random replacement on breakdown). The
+//!   dense products run sequentially (faer's parallel path is far slower on these
+//!   tall-skinny shapes; `kernels.rs`).
 //! - Rayleigh–Ritz on the projected H = VᵀMTV with faer's dense symmetric eigensolver.
 //!   When the basis reaches its maximum size it is restarted with the best Ritz vectors plus
 //!   the newest block (thick restart).
@@ -41,9 +46,9 @@
 //!   each eigenvector is signed so its entry of largest magnitude (first on ties) is positive.
 //!
 //! Determinism: the results are bit-identical across runs and across thread counts. Our own
-//! kernels (sparse products, Gram–Schmidt bookkeeping) split work by fixed chunk sizes, never by
-//! the thread count, and sum in a fixed order. faer 0.24.4's supernodal factorization, solves
-//! and dense products were measured to give bit-identical results with `Par::rayon(1)`, `(2)`
+//! kernels (sparse products, Gram–Schmidt bookkeeping, the panel solves) split work by fixed
+//! chunk sizes or by the factor's tree, never by the thread count, and sum in a fixed order.
+//! faer 0.24.4's supernodal factorization, solves and dense products were measured to give bit-identical results with `Par::rayon(1)`, `(2)`
 //! and `(3)`, equal to `Par::Seq`, on rayon pools of 1 and 2 threads (`tests/fem_eigen.rs`
 //! guards Seq = rayon(1) = rayon(2) on both pools);
 //! the small dense eigensolves run with `Par::Seq`. Bits may differ between machines with
@@ -52,6 +57,7 @@
 mod kernels;
 mod lanczos;
 mod ordering;
+mod panel_solve;
 mod shift_invert;
 
 use faer::sparse::SparseColMat;
@@ -76,12 +82,18 @@ pub struct EigenParams {
     /// positive definite. 0 suits clamped objects; free-free objects need σ < 0
     /// ([`default_shift`]).
     pub shift: f64,
-    /// Block size b: right-hand sides per factor solve (default 6: interleaved timings of
-    /// 4, 6 and 8 on the bake bench's beams (`examples/eigen_timing --block`) put 6 at or below
-    /// 8 at 3k, 15k and 109k dofs, e.g. 109k: 4.9–5.0 s vs 5.2–6.0 s; 4 wins only at 3k).
+    /// Block size b: right-hand sides per factor solve (default 8). With the block solves of
+    /// `panel_solve.rs` a block of 8 costs about what a block of 6 does once the factor no
+    /// longer fits in cache (109k dofs: 181–199 ms vs 198–204 ms), and the larger block
+    /// converges in fewer solves (bake bench, 20 modes: 3.5k 19 vs 22, 13.5k 15 vs 18, 109k 11
+    /// vs 13). Interleaved `examples/eigen_timing` runs, eigensolve min/median: 109k 3.9/4.2 s
+    /// vs 5.0/5.5 s (block 6, Krylov dimension 48); 13.5k and 3.5k within the noise of a
+    /// loaded machine (13.5k: 0.50/0.52 s vs 0.50/0.55 s in one series, 0.59/0.79 s vs
+    /// 0.59/0.75 s in another; 3.5k: 0.113/0.121 s vs 0.112/0.132 s).
     pub block: usize,
-    /// Maximum Krylov basis size before a thick restart; `None`: nev + max(nev, 4b), rounded
-    /// up to a multiple of b (grown automatically in max-frequency mode).
+    /// Maximum Krylov basis size before a thick restart; `None`: nev + max(nev, 4b) + b,
+    /// rounded up to a multiple of b (grown automatically in max-frequency mode); 64 for 20
+    /// pairs in blocks of 8.
     pub krylov_dim: Option<usize>,
     /// Tolerance on the relative residual (see the module docs), default 1e-10.
     pub tol: f64,
@@ -89,10 +101,12 @@ pub struct EigenParams {
     pub max_iters: usize,
     /// Cap on the number of modes returned in max-frequency mode (default 2000).
     pub max_modes: usize,
-    /// Threads given to faer's factorization, solves and dense products as `Par::rayon(n)`;
-    /// 0 (default): sequential below 20 000 dofs, else the current rayon pool's size. Results
-    /// do not depend on it (measured:
-    /// bit-identical for 1, 2 and 3 threads on faer 0.24.4; `tests/fem_eigen.rs` guards it).
+    /// Threads given to faer's factorization (and to its solves of single vectors or blocks
+    /// wider than 8) as `Par::rayon(n)`; 0 (default): sequential below 20 000 dofs, else the
+    /// current rayon pool's size. The Lanczos block solves and the split panel sweeps use the
+    /// current rayon pool; dense products are sequential. Results do not depend on it
+    /// (measured: bit-identical for 1, 2 and 3 threads on faer 0.24.4; `tests/fem_eigen.rs`
+    /// guards it).
     pub threads: usize,
     /// Seed of the start block.
     pub seed: u64,
@@ -104,7 +118,7 @@ impl Default for EigenParams {
             nev: 20,
             max_freq_hz: None,
             shift: 0.0,
-            block: 6,
+            block: 8,
             krylov_dim: None,
             tol: 1e-10,
             max_iters: 300,

@@ -1,15 +1,17 @@
 //! The shifted operator A = K − σM, its sparse Cholesky factor, and block solves.
 
-use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::llt::factor::LltRegularization;
 use faer::perm::PermRef;
+use faer::reborrow::{Reborrow, ReborrowMut};
 use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky, CholeskySymbolicParams, LltRef, SymbolicCholesky,
-    SymmetricOrdering,
+    SymbolicCholeskyRaw, SymmetricOrdering,
 };
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 use faer::{Conj, MatMut, Par, Side, Spec};
 
+use super::panel_solve::{PanelSolve, PANEL_WIDTHS};
 use super::{ordering, EigenError};
 
 /// K − σM on the union of the two patterns (both full symmetric storage, rows sorted).
@@ -128,23 +130,28 @@ fn symbolic(
     .map_err(|e| EigenError::Factorization(format!("symbolic analysis failed: {e:?}")))
 }
 
-/// Nested dissection replaces AMD only when its factor of the node graph has fewer than this
-/// fraction of AMD's entries. Measured single-threaded (`eigen_timing --threads 1`, user CPU
-/// seconds, old level-set dissection → METIS, 2026-11-22): the stout 108k-dof beam (83.5M vs
-/// 97.2M dof-factor entries; AMD 123.6M) 15.6–18.8 s → 13.3–13.4 s, the slender 109k-dof
-/// beam (44.2M vs AMD's 54.1M) 7.1–7.7 s → 6.3–6.4 s.
-const ND_FILL_RATIO: f64 = 0.9;
+/// Nested dissection replaces AMD when its factor of the node graph has fewer than this
+/// fraction of AMD's entries, i.e. whenever it fills less. Its balanced elimination tree is
+/// what lets faer's factorization and the panel sweeps (`panel_solve.rs`) use both threads,
+/// which AMD's near-chain tree on a slender beam does not. Measured (`eigen_timing`, 2
+/// interleaved runs each, min/median, level-set dissection then): on the slender 109k-dof
+/// beam, where it filled 4% less, factorization 2.20/2.22 s vs 2.48/2.52 s and eigensolve
+/// 3.27/3.41 s vs 4.44/4.57 s against AMD. METIS (2026-11-22, `eigen_timing --threads 1`,
+/// user CPU seconds, level sets → METIS) fills less still: the stout 108k-dof beam 83.5M vs
+/// 97.2M dof-factor entries (AMD 123.6M), 15.6–18.8 s → 13.3–13.4 s; the slender beam 44.2M
+/// (AMD 54.1M), 7.1–7.7 s → 6.3–6.4 s.
+const ND_FILL_RATIO: f64 = 1.0;
 
 /// Below this many dofs nested dissection is not tried: on the bake bench's 13.5k-dof beam
 /// METIS fills 11% less than AMD (4.30M vs 4.83M entries), but ordering it and comparing the
 /// two fills costs what the smaller factor saves (factor + eigensolve 0.79 s vs 0.78 s).
 const ND_MIN_DOFS: usize = 30_000;
 
-/// The symbolic factorization of `a` under AMD or, when it fills clearly less
-/// ([`ND_FILL_RATIO`], tried from [`ND_MIN_DOFS`] on), METIS nested dissection on the node
-/// graph (see [`ordering`]); faer's AMD on the dofs when the pattern is not node-blocked. The
-/// fill is compared on the node graph (1/9 of the entries), so choosing costs two small
-/// symbolic analyses.
+/// The symbolic factorization of `a` under AMD or, when it fills less ([`ND_FILL_RATIO`],
+/// tried from [`ND_MIN_DOFS`] on), METIS nested dissection on the node graph (see
+/// [`ordering`]); faer's AMD on the dofs when the pattern is not node-blocked. The fill is
+/// compared on the node graph (1/9 of the entries), so choosing costs two small symbolic
+/// analyses.
 fn best_symbolic(a: &SparseColMat<usize, f64>) -> Result<SymbolicCholesky<usize>, EigenError> {
     let Some(g) = node_graph(a) else {
         return symbolic(a, None);
@@ -177,7 +184,19 @@ fn best_symbolic(a: &SparseColMat<usize, f64>) -> Result<SymbolicCholesky<usize>
 pub(crate) struct ShiftInvert {
     symbolic: SymbolicCholesky<usize>,
     values: Vec<f64>,
+    /// Our block solves on a supernodal factor ([`PanelSolve`]); `None`: faer's (simplicial).
+    panel: Option<PanelSolve>,
     par: Par,
+}
+
+/// Scratch of [`ShiftInvert::solve_in_place`].
+pub(crate) struct SolveBuffer {
+    /// faer's solve scratch (simplicial factors).
+    mem: MemBuffer,
+    /// Row-major panel of the right-hand sides in the factor's order.
+    panel: Vec<f64>,
+    /// Second panel for the split sweeps of [`PanelSolve::solve`].
+    panel2: Vec<f64>,
 }
 
 impl ShiftInvert {
@@ -209,9 +228,14 @@ impl ShiftInvert {
             .map_err(|e| {
                 EigenError::Factorization(format!("matrix is not positive definite ({e:?})"))
             })?;
+        let panel = match symbolic.raw() {
+            SymbolicCholeskyRaw::Supernodal(sym) => Some(PanelSolve::new(sym, &values)),
+            SymbolicCholeskyRaw::Simplicial(_) => None,
+        };
         Ok(ShiftInvert {
             symbolic,
             values,
+            panel,
             par,
         })
     }
@@ -221,19 +245,64 @@ impl ShiftInvert {
         self.values.len()
     }
 
-    /// Overwrites every column of `rhs` with A⁻¹ rhs.
-    pub fn solve_in_place(&self, rhs: MatMut<'_, f64>, mem: &mut MemBuffer) {
-        LltRef::new(&self.symbolic, &self.values).solve_in_place_with_conj(
-            Conj::No,
-            rhs,
-            self.par,
-            MemStack::new(mem),
-        );
+    /// Overwrites every column of `rhs` with A⁻¹ rhs: blocks of 2 to 8 columns on a supernodal
+    /// factor through [`PanelSolve`] (one pass over the factor for the block), others through
+    /// faer's solve (single columns: its vector path is as fast; wider blocks: its packed
+    /// GEMM is faster). Each call site uses a fixed width, so results stay reproducible.
+    pub fn solve_in_place(&self, mut rhs: MatMut<'_, f64>, buf: &mut SolveBuffer) {
+        let (n, w) = (rhs.nrows(), rhs.ncols());
+        let panel = match &self.panel {
+            Some(p) if PANEL_WIDTHS.contains(&w) => p,
+            _ => {
+                LltRef::new(&self.symbolic, &self.values).solve_in_place_with_conj(
+                    Conj::No,
+                    rhs,
+                    self.par,
+                    MemStack::new(&mut buf.mem),
+                );
+                return;
+            }
+        };
+        let identity: Vec<usize>;
+        let (fwd, inv) = match self.symbolic.perm() {
+            Some(p) => p.arrays(),
+            None => {
+                identity = (0..n).collect();
+                (&identity[..], &identity[..])
+            }
+        };
+        buf.panel.resize(n * w, 0.0);
+        let x = &mut buf.panel[..];
+        for c in 0..w {
+            let col = rhs.rb().col(c);
+            for (i, &f) in fwd.iter().enumerate() {
+                x[i * w + c] = col[f];
+            }
+        }
+        panel.solve(&self.values, x, w, &mut buf.panel2);
+        for c in 0..w {
+            let mut col = rhs.rb_mut().col_mut(c);
+            for (i, &v) in inv.iter().enumerate() {
+                col[i] = x[v * w + c];
+            }
+        }
     }
 
-    /// Scratch buffer for solves of up to `ncols` right-hand sides.
-    pub fn solve_buffer(&self, ncols: usize) -> MemBuffer {
-        MemBuffer::new(self.symbolic.solve_in_place_scratch::<f64>(ncols, self.par))
+    /// Scratch buffer for solves of `ncols` right-hand sides.
+    pub fn solve_buffer(&self, ncols: usize) -> SolveBuffer {
+        let use_panel = self.panel.is_some() && PANEL_WIDTHS.contains(&ncols);
+        let (mem, panel) = if use_panel {
+            let n = self.symbolic.nrows();
+            (MemBuffer::new(StackReq::EMPTY), vec![0.0; n * ncols])
+        } else {
+            let req = self.symbolic.solve_in_place_scratch::<f64>(ncols, self.par);
+            (MemBuffer::new(req), Vec::new())
+        };
+        SolveBuffer {
+            mem,
+            panel,
+            panel2: Vec::new(),
+        }
     }
 }
 
@@ -247,7 +316,7 @@ mod tests {
     /// solves like the AMD one: forced here on a small clamped block, A⁻¹b agrees to 1e-10.
     #[test]
     fn nested_dissection_factor_solves_like_amd() {
-        let mesh = TetMesh::structured_box([8, 8, 8], [1.0, 1.0, 1.0]);
+        let mesh = TetMesh::structured_box([16, 4, 4], [1.0, 1.0, 1.0]);
         let mat = Material::new(1e9, 0.3, 1000.0).unwrap();
         let (k, m) = (
             assemble_stiffness(&mesh, &mat),
@@ -282,5 +351,115 @@ mod tests {
             "residual {:e}",
             r.norm_l2()
         );
+    }
+
+    /// The block solves on a supernodal factor ([`PanelSolve`], 2–8 columns) agree with faer's
+    /// solve to 1e-12, solve A x = b, and give each column the same bits whatever block it is
+    /// solved in (what makes the Lanczos results independent of how columns are grouped).
+    #[test]
+    fn panel_solve_matches_faer_and_is_independent_of_grouping() {
+        let mesh = TetMesh::structured_box([16, 5, 5], [1.0, 0.3, 0.3]);
+        let mat = Material::new(1e9, 0.3, 1000.0).unwrap();
+        let (k, m) = (
+            assemble_stiffness(&mesh, &mat),
+            assemble_mass(&mesh, &mat, false),
+        );
+        let (_, kf, mf) = reduce_fixed(&k, &m, &mesh.groups["xmin"]).unwrap();
+        let a = shifted(&kf, &mf, -1.0);
+        let fac = ShiftInvert::new(&a, Par::Seq).unwrap();
+        assert!(fac.panel.is_some(), "the test needs a supernodal factor");
+        let n = a.nrows();
+        let b = faer::Mat::<f64>::from_fn(n, 8, |i, j| ((i * 7 + j * 13) % 11) as f64 - 5.0);
+        let solve = |x: &mut faer::Mat<f64>| {
+            let mut buf = fac.solve_buffer(x.ncols());
+            fac.solve_in_place(x.as_mut(), &mut buf);
+        };
+        for w in [2, 6, 8] {
+            let mut x = b.as_ref().subcols(0, w).to_owned();
+            solve(&mut x);
+            let mut y = b.as_ref().subcols(0, w).to_owned();
+            let mut mem = MemBuffer::new(fac.symbolic.solve_in_place_scratch::<f64>(w, Par::Seq));
+            LltRef::new(&fac.symbolic, &fac.values).solve_in_place_with_conj(
+                Conj::No,
+                y.as_mut(),
+                Par::Seq,
+                MemStack::new(&mut mem),
+            );
+            let rel = (&x - &y).norm_l2() / y.norm_l2();
+            assert!(rel < 1e-12, "{w} columns: panel vs faer {rel:e}");
+            let r = &a * &x - b.as_ref().subcols(0, w);
+            assert!(
+                r.norm_l2() < 1e-8 * b.norm_l2(),
+                "residual {:e}",
+                r.norm_l2()
+            );
+        }
+        // Column 5 solved among 8, among 6 and beside column 0 only: the same bits.
+        let mut x8 = b.clone();
+        solve(&mut x8);
+        let mut x6 = b.as_ref().subcols(0, 6).to_owned();
+        solve(&mut x6);
+        let mut x2 = faer::Mat::<f64>::from_fn(n, 2, |i, j| b[(i, [0, 5][j])]);
+        solve(&mut x2);
+        for i in 0..n {
+            assert_eq!(x8[(i, 5)].to_bits(), x6[(i, 5)].to_bits(), "row {i}");
+            assert_eq!(x8[(i, 5)].to_bits(), x2[(i, 1)].to_bits(), "row {i}");
+        }
+    }
+
+    /// The two-thread sweeps of [`PanelSolve`] (forced here on a small beam ordered by nested
+    /// dissection, whose tree branches at the top) agree with faer's solve to 1e-12 and give
+    /// the same bits on rayon pools of 1 and 2 threads.
+    #[test]
+    fn split_panel_solve_matches_faer_and_does_not_depend_on_threads() {
+        let mesh = TetMesh::structured_box([16, 4, 4], [1.0, 1.0, 1.0]);
+        let mat = Material::new(1e9, 0.3, 1000.0).unwrap();
+        let (k, m) = (
+            assemble_stiffness(&mesh, &mat),
+            assemble_mass(&mesh, &mat, false),
+        );
+        let (_, kf, mf) = reduce_fixed(&k, &m, &mesh.groups["xmin"]).unwrap();
+        let a = shifted(&kf, &mf, -1.0);
+        let g = node_graph(&a).expect("node-blocked pattern");
+        let nd = ordering::metis_nested_dissection(&g).expect("nd ordering");
+        let sym = symbolic(&a, Some(&expand_to_dofs(&nd))).unwrap();
+        let mut fac = ShiftInvert::with_symbolic(&a, sym, Par::Seq).unwrap();
+        let SymbolicCholeskyRaw::Supernodal(sn) = fac.symbolic.raw() else {
+            panic!("the test needs a supernodal factor");
+        };
+        let split = PanelSolve::with_split_from(sn, &fac.values, 0);
+        assert!(split.is_split(), "the nested-dissection tree must split");
+        fac.panel = Some(split);
+        let n = a.nrows();
+        let b = faer::Mat::<f64>::from_fn(n, 6, |i, j| ((i * 7 + j * 13) % 11) as f64 - 5.0);
+        let solve = || {
+            let mut x = b.clone();
+            let mut buf = fac.solve_buffer(6);
+            fac.solve_in_place(x.as_mut(), &mut buf);
+            x
+        };
+        let x = solve();
+        let mut y = b.clone();
+        let mut mem = MemBuffer::new(fac.symbolic.solve_in_place_scratch::<f64>(6, Par::Seq));
+        LltRef::new(&fac.symbolic, &fac.values).solve_in_place_with_conj(
+            Conj::No,
+            y.as_mut(),
+            Par::Seq,
+            MemStack::new(&mut mem),
+        );
+        let rel = (&x - &y).norm_l2() / y.norm_l2();
+        assert!(rel < 1e-12, "split sweeps vs faer: {rel:e}");
+        let bits = |x: &faer::Mat<f64>| -> Vec<u64> {
+            (0..6)
+                .flat_map(|c| x.col(c).iter().map(|v| v.to_bits()).collect::<Vec<_>>())
+                .collect()
+        };
+        for threads in [1, 2] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            assert_eq!(bits(&x), bits(&pool.install(solve)), "pool of {threads}");
+        }
     }
 }
