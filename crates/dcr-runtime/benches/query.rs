@@ -158,6 +158,17 @@ fn geodesic(c: &mut Criterion) {
     c.bench_function(&format!("heat/setup/{}v", v.len()), |b| {
         b.iter(|| black_box(HeatGeodesic::new(&v, &t).unwrap()))
     });
+    // As a base from `modal-bake bake` loads: under the stored `surface_order` (METIS nested
+    // dissection; needs `--features metis` to plan it here, else the rows below use AMD).
+    #[cfg(feature = "metis")]
+    let heat = {
+        let order = HeatGeodesic::plan_ordering(&v, &t).unwrap();
+        c.bench_function(&format!("heat/setup-stored-order/{}v", v.len()), |b| {
+            b.iter(|| black_box(HeatGeodesic::with_ordering(&v, &t, Some(&order)).unwrap()))
+        });
+        HeatGeodesic::with_ordering(&v, &t, Some(&order)).unwrap()
+    };
+    #[cfg(not(feature = "metis"))]
     let heat = HeatGeodesic::new(&v, &t).unwrap();
     let model = ModalModel::from_base(synthetic_base(
         (v.clone(), t.clone()),

@@ -59,6 +59,7 @@ use crate::eigen::{self, EigenError, EigenParams, EigenProgress};
 use crate::fem::{self, Material, MaterialError};
 use crate::mesh::{MeshError, DEFAULT_DEGENERATE_REL_TOL};
 use dcr_runtime::format::{FormatError, ModesMeta, FORMAT_VERSION};
+use dcr_runtime::HeatGeodesic;
 
 /// `modal-bake <version>`, stored in every base.
 pub const TOOL_VERSION: &str = concat!("modal-bake ", env!("CARGO_PKG_VERSION"));
@@ -560,7 +561,7 @@ pub fn bake_mesh(
     }
     let eigenvalues: Vec<f64> = elastic.iter().map(|&j| res.eigenvalues[j]).collect();
     let residuals: Vec<f64> = elastic.iter().map(|&j| res.residuals[j]).collect();
-    let base = ModesFile {
+    let mut base = ModesFile {
         eigenvalues,
         surface_vertices: surf.iter().map(|&v| mesh.nodes[v]).collect(),
         surface_triangles: tris.iter().map(|t| t.map(|v| local[v])).collect(),
@@ -584,7 +585,13 @@ pub fn bake_mesh(
         },
         precision: params.precision,
         transfer: None,
+        surface_order: None,
     };
+    // The heat geodesic's elimination order, so loading skips AMD and factors less fill.
+    // A surface the heat method cannot factor (degenerate triangles) simply stores none; the
+    // runtime reports the problem if the heat method is used.
+    base.surface_order =
+        HeatGeodesic::plan_ordering(&base.surface_vertices, &base.surface_triangles).ok();
     report.modes = nm;
     report.frequencies_hz = base.frequencies_hz();
     report.residuals = base.residuals.clone();

@@ -61,6 +61,24 @@ fn every_input_form_gives_a_byte_identical_base_and_rebaking_is_identical() {
     .status
     .success());
     assert!(first.unwrap() == std::fs::read(&again).unwrap());
+    // The base carries the heat geodesic's elimination order, and loading under it gives the
+    // distances of an AMD factor computed at load.
+    let base = dcr_runtime::format::ModesFile::read(&again).unwrap();
+    let order = base
+        .surface_order
+        .as_deref()
+        .expect("the bake stores surface_order");
+    let (v, t) = (&base.surface_vertices, &base.surface_triangles);
+    let stored = dcr_runtime::HeatGeodesic::with_ordering(v, t, Some(order)).unwrap();
+    let amd = dcr_runtime::HeatGeodesic::new(v, t).unwrap();
+    let (mut a, mut b) = (vec![0.0; v.len()], vec![0.0; v.len()]);
+    stored.distances_from_vertex(0, &mut a);
+    amd.distances_from_vertex(0, &mut b);
+    let scale = b.iter().fold(0.0f64, |m, x| m.max(*x));
+    assert!(scale > 0.0);
+    for (x, y) in a.iter().zip(&b) {
+        assert!((x - y).abs() <= 1e-9 * scale, "{x} vs {y}");
+    }
 }
 
 #[test]

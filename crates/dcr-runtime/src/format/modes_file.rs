@@ -19,6 +19,10 @@
 //! | `residuals` | f64 | (m,) | relative residual ‖Ku − λMu‖/‖Ku‖ of each mode at bake |
 //! | `meta` | u8 | (bytes,) | UTF-8 JSON: [`ModesMeta`] |
 //!
+//! Optional: `surface_order` u32 (ns,), a fill-reducing elimination order of the surface
+//! vertices (a permutation of 0..ns) for the heat-geodesic factor, chosen at bake time
+//! ([`crate::HeatGeodesic::plan_ordering`]); without it the runtime orders with AMD at load.
+//!
 //! Optional (all or none): the peak-transfer table ([`TransferTable`]): `transfer_vertices`
 //! u32 (nr,), `transfer_peaks` f32 (np(np+1)/2,) packed upper triangle over np = nr + ne points
 //! (m per N·s),
@@ -124,6 +128,10 @@ pub struct ModesFile {
     pub precision: ModesPrecision,
     /// Optional bake-time peak-transfer table (`None`: the base has none).
     pub transfer: Option<TransferTable>,
+    /// Optional fill-reducing elimination order of the surface vertices for the heat-geodesic
+    /// factor (`order[k]` = the vertex eliminated k-th; a permutation of 0..ns). `None`: the
+    /// runtime computes AMD when it first needs the factor.
+    pub surface_order: Option<Vec<u32>>,
 }
 
 /// What went wrong reading or writing a `.modes` file.
@@ -296,6 +304,22 @@ impl ModesFile {
         if let Some(t) = &self.transfer {
             t.check(ns).map_err(inv)?;
         }
+        if let Some(order) = &self.surface_order {
+            if order.len() != ns {
+                return Err(inv(format!(
+                    "surface_order has {} entries for {ns} surface vertices",
+                    order.len()
+                )));
+            }
+            let mut seen = vec![false; ns];
+            for (k, &v) in order.iter().enumerate() {
+                if v as usize >= ns || std::mem::replace(&mut seen[v as usize], true) {
+                    return Err(inv(format!(
+                        "surface_order is not a permutation: entry {k} is {v} (repeated or ≥ {ns})"
+                    )));
+                }
+            }
+        }
         Ok(())
     }
 
@@ -398,6 +422,10 @@ impl ModesFile {
         npz.add_array("residuals", &Array1::from(self.residuals.clone()))
             .map_err(e)?;
         npz.add_array("meta", &Array1::from(meta)).map_err(e)?;
+        if let Some(order) = &self.surface_order {
+            npz.add_array("surface_order", &Array1::from(order.clone()))
+                .map_err(e)?;
+        }
         if let Some(t) = &self.transfer {
             npz.add_array("transfer_vertices", &Array1::from(t.vertices.clone()))
                 .map_err(e)?;
@@ -484,6 +512,11 @@ impl ModesFile {
         let fixed_nodes: Vec<u32> = rd.vector("fixed_nodes", MAX_ENTRY_BYTES)?;
         let residuals: Vec<f64> = rd.vector("residuals", MAX_ENTRY_BYTES)?;
         let transfer = rd.transfer()?;
+        let surface_order = if rd.zip.index_for_name("surface_order.npy").is_some() {
+            Some(rd.vector::<u32>("surface_order", MAX_ENTRY_BYTES)?)
+        } else {
+            None
+        };
 
         let inv = |detail: String| FormatError::Invalid {
             path: path.to_path_buf(),
@@ -527,6 +560,7 @@ impl ModesFile {
             meta,
             precision,
             transfer,
+            surface_order,
         };
         out.validate(path)?;
         for (j, (&f, g)) in frequencies.iter().zip(out.frequencies_hz()).enumerate() {

@@ -42,6 +42,7 @@ pub(crate) fn tiny_base() -> ModesFile {
         },
         precision: ModesPrecision::F64,
         transfer: None,
+        surface_order: None,
     }
 }
 
@@ -306,6 +307,41 @@ fn corrupted_transfer_table_is_rejected_with_a_clear_error() {
             "{needle}: {msg}"
         );
         // And never written.
+        let dir = tempfile::tempdir().unwrap();
+        assert!(b.write_atomic(&dir.path().join("w.modes")).is_err());
+    }
+}
+
+#[test]
+fn surface_order_round_trips_and_a_bad_one_is_named() {
+    let mut b = tiny_base();
+    b.surface_order = Some(vec![2, 0, 3, 1]);
+    let bytes = b.to_bytes().unwrap();
+    let back = ModesFile::read_from(Cursor::new(&bytes[..]), Path::new("o.modes")).unwrap();
+    assert_eq!(back, b);
+    // Absent entry: None (bases baked before it existed still load).
+    assert_eq!(
+        ModesFile::read_from(Cursor::new(tiny_base().to_bytes().unwrap()), Path::new("o"))
+            .unwrap()
+            .surface_order,
+        None
+    );
+    for (order, needle) in [
+        (
+            vec![2, 0, 3],
+            "surface_order has 3 entries for 4 surface vertices",
+        ),
+        (vec![2, 0, 2, 1], "entry 2 is 2 (repeated"),
+        (vec![2, 0, 4, 1], "entry 2 is 4 (repeated or ≥ 4)"),
+    ] {
+        b.surface_order = Some(order);
+        let bytes = b.to_bytes().unwrap();
+        let err = ModesFile::read_from(Cursor::new(bytes), Path::new("o.modes")).unwrap_err();
+        let msg = err.to_string();
+        assert!(
+            matches!(err, FormatError::Invalid { .. }) && msg.contains(needle),
+            "{needle}: {msg}"
+        );
         let dir = tempfile::tempdir().unwrap();
         assert!(b.write_atomic(&dir.path().join("w.modes")).is_err());
     }

@@ -238,15 +238,19 @@ impl ModalModel {
         self.add_reduced_impulse(sp, sp.normal, 1.0, w);
     }
 
-    /// The heat-method geodesic solver of this surface, factored on first use and shared by
-    /// every instance using the model.
+    /// The heat-method geodesic solver of this surface, factored on first use (under the
+    /// base's stored `surface_order`, else AMD) and shared by every instance using the model.
     ///
     /// # Errors
     /// The [`GeodesicError`] from building it (e.g. degenerate triangles, unused vertices).
     pub fn heat_geodesic(&self) -> Result<&HeatGeodesic, &GeodesicError> {
         self.heat
             .get_or_init(|| {
-                HeatGeodesic::new(&self.base.surface_vertices, &self.base.surface_triangles)
+                HeatGeodesic::with_ordering(
+                    &self.base.surface_vertices,
+                    &self.base.surface_triangles,
+                    self.base.surface_order.as_deref(),
+                )
             })
             .as_ref()
     }

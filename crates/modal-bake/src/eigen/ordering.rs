@@ -8,10 +8,11 @@
 //! breadth-first level sets this module used before (factor entries of the bake bench's stout
 //! 100 × 18 × 18-cell, 108k-dof beam: AMD 123.6M, level sets 97.2M, METIS 83.5M; see the
 //! tests for a block). The safe `metis` crate does not wrap
-//! `METIS_NodeND`, so [`metis_nested_dissection`] calls the `metis-sys` FFI directly: the one
-//! `unsafe` block of the crate. Deterministic: METIS reseeds its random generator (fixed seed)
-//! on every call, but that generator is process-global C state, so calls are serialised by a
-//! lock (two bakes ordering at once on two threads would otherwise interleave one stream).
+//! `METIS_NodeND`; the runtime's `metis` feature holds the one FFI call
+//! ([`dcr_runtime::attenuation::nested_dissection`]), shared with the surface ordering of the
+//! heat geodesic. Deterministic: METIS reseeds its random generator (fixed seed) on every
+//! call, but that generator is process-global C state, so calls are serialised by one lock
+//! there (two bakes ordering at once on two threads would otherwise interleave one stream).
 
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::perm::PermRef;
@@ -66,57 +67,10 @@ pub(crate) fn factor_entries(g: &SymbolicSparseColMat<usize>, fwd: &[usize]) -> 
 /// given by its adjacency lists (column pointers and row indices, both triangles; self loops
 /// allowed and ignored). `fwd[k]`: the vertex placed at position k. `None` when the graph does
 /// not fit METIS's 32-bit indices or METIS fails (out of memory): callers fall back to AMD.
+/// The one METIS call site is the runtime's (it serialises calls: METIS uses libc's global
+/// random state).
 pub(crate) fn metis_nested_dissection(g: &SymbolicSparseColMat<usize>) -> Option<Vec<usize>> {
-    use metis_sys::idx_t;
-    let n = g.nrows();
-    let mut xadj: Vec<idx_t> = Vec::with_capacity(n + 1);
-    let mut adjncy: Vec<idx_t> = Vec::with_capacity(g.row_idx().len());
-    xadj.push(0);
-    for v in 0..n {
-        for &u in &g.row_idx()[g.col_ptr()[v]..g.col_ptr()[v + 1]] {
-            if u != v {
-                adjncy.push(idx_t::try_from(u).ok()?);
-            }
-        }
-        xadj.push(idx_t::try_from(adjncy.len()).ok()?);
-    }
-    if n == 0 {
-        return Some(Vec::new());
-    }
-    let mut nvtxs = idx_t::try_from(n).ok()?;
-    let (mut perm, mut iperm) = (vec![0 as idx_t; n], vec![0 as idx_t; n]);
-    // METIS's random generator is global C state: one ordering at a time (poisoning is
-    // irrelevant, the lock guards no Rust data).
-    static METIS: std::sync::Mutex<()> = std::sync::Mutex::new(());
-    let _one_at_a_time = METIS.lock().unwrap_or_else(|e| e.into_inner());
-    // SAFETY: `METIS_NodeND` reads nvtxs, xadj (nvtxs + 1 entries, non-decreasing, last =
-    // adjncy.len()) and adjncy (entries in 0..nvtxs, no self loops; symmetric because `g` is),
-    // and writes nvtxs entries to perm and iperm; all buffers are sized so above and outlive
-    // the call. Null vwgt and options ask for unit weights and the default options.
-    #[allow(unsafe_code)]
-    let status = unsafe {
-        metis_sys::METIS_NodeND(
-            &mut nvtxs,
-            xadj.as_mut_ptr(),
-            adjncy.as_mut_ptr(),
-            std::ptr::null_mut(),
-            std::ptr::null_mut(),
-            perm.as_mut_ptr(),
-            iperm.as_mut_ptr(),
-        )
-    };
-    if status != metis_sys::rstatus_et_METIS_OK {
-        return None;
-    }
-    // perm[k] is the vertex at position k (METIS manual, "METIS_NodeND").
-    let fwd: Vec<usize> = perm
-        .iter()
-        .map(|&v| usize::try_from(v).ok())
-        .collect::<Option<_>>()?;
-    let mut seen = vec![false; n];
-    fwd.iter()
-        .all(|&v| v < n && !std::mem::replace(&mut seen[v], true))
-        .then_some(fwd)
+    dcr_runtime::attenuation::nested_dissection(g.col_ptr(), g.row_idx())
 }
 
 #[cfg(test)]
