@@ -198,6 +198,10 @@ fn info_json_has_the_documented_keys() {
     );
     assert!(v["surface_vertices"].as_u64().unwrap() > 0);
     assert!(v["surface_triangles"].as_u64().unwrap() > 0);
+    assert_eq!(
+        v["surface_order"], true,
+        "the bake stores the heat ordering"
+    );
     assert!(v["source_hash"].as_str().unwrap().starts_with("sha256:"));
     // f = √λ / 2π for every mode.
     for (f, l) in v["frequencies_hz"]

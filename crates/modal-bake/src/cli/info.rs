@@ -42,6 +42,7 @@ pub fn run(args: &InfoArgs) -> anyhow::Result<()> {
             "rayleigh": base.rayleigh,
             "precision": base.precision,
             "bake_params": base.meta.bake_params,
+            "surface_order": base.surface_order.is_some(),
             "transfer": base.transfer.as_ref().map(|t| serde_json::json!({
                 "h_s": t.h,
                 "rayleigh": t.rayleigh,
@@ -96,6 +97,15 @@ pub fn run(args: &InfoArgs) -> anyhow::Result<()> {
         base.rayleigh[0], base.rayleigh[1]
     )?;
     writeln!(out, "  geometry hash: {}", base.meta.source_hash)?;
+    writeln!(
+        out,
+        "  heat-geodesic elimination order: {}",
+        if base.surface_order.is_some() {
+            "stored"
+        } else {
+            "none (AMD at load)"
+        }
+    )?;
     match &base.transfer {
         Some(t) => writeln!(
             out,
