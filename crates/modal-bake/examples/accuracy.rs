@@ -125,11 +125,10 @@ fn centroid(sys: &TruthSystem, t: usize) -> [f64; 3] {
     [0, 1, 2].map(|k| (v[0][k] + v[1][k] + v[2][k]) / 3.0)
 }
 
-fn compute_truth(
-    s: &Scene,
-    seed: u64,
-    fixed_points: Option<(Vec<[f64; 3]>, Vec<[f64; 3]>)>,
-) -> Truth {
+/// Fixed impact and contact points (m, object frame), instead of random ones.
+type FixedPoints = (Vec<[f64; 3]>, Vec<[f64; 3]>);
+
+fn compute_truth(s: &Scene, seed: u64, fixed_points: Option<FixedPoints>) -> Truth {
     let p = params(s);
     let t0 = Instant::now();
     let sys = TruthSystem::new(s.mesh.clone(), &p, &s.file).expect("system");

@@ -386,7 +386,7 @@ pub fn extract_surface(mesh: &TetMesh) -> (Vec<usize>, Vec<[usize; 3]>) {
             faces.push((key, f));
         }
     }
-    faces.sort_unstable_by(|x, y| x.0.cmp(&y.0));
+    faces.sort_unstable_by_key(|x| x.0);
     let mut tris = Vec::new();
     let mut i = 0;
     while i < faces.len() {

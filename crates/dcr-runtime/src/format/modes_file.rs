@@ -288,9 +288,8 @@ impl ModesFile {
             poisson,
             density,
         } = self.material;
-        if !(youngs.is_finite() && youngs > 0.0 && density.is_finite() && density > 0.0)
-            || !(poisson > -1.0 && poisson < 0.5)
-        {
+        let positive = |x: f64| x.is_finite() && x > 0.0;
+        if !(positive(youngs) && positive(density) && poisson > -1.0 && poisson < 0.5) {
             return Err(inv(format!(
                 "material out of range: E={youngs} ν={poisson} ρ={density}"
             )));

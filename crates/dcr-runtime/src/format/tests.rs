@@ -159,7 +159,7 @@ fn hostile_header_is_not_allocated() {
     let mut npy = Vec::new();
     let header = "{'descr': '<f8', 'fortran_order': False, 'shape': (1000000000000,), }";
     let mut h = header.to_string();
-    while (10 + h.len() + 1) % 64 != 0 {
+    while !(10 + h.len() + 1).is_multiple_of(64) {
         h.push(' ');
     }
     h.push('\n');

@@ -226,7 +226,7 @@ pub fn peak_abs_projection(
     peaks: &mut [f64],
 ) {
     assert!(
-        nch % BLOCK == 0,
+        nch.is_multiple_of(BLOCK),
         "channel count must be padded to a multiple of {BLOCK}"
     );
     assert!(q.len() >= samples * m && w.len() >= m * nch && peaks.len() >= nch);

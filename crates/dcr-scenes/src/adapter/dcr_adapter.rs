@@ -461,7 +461,7 @@ impl DcrAdapter {
             }
         }
         // Forget contacts not seen for a while (bounded memory).
-        if step % 64 == 0 {
+        if step.is_multiple_of(64) {
             slot.ages.retain(|_, a| a.last_step + 8 >= step);
         }
     }
