@@ -2,7 +2,7 @@
 //! cells, 4 m × 0.72 m × 0.72 m, ~108k free dofs): reading its meshio JSON and assembling
 //! K and M restricted to the free dofs.
 //!
-//! `cargo run --release -p modal-bake --example read_assemble_timing -- [--reps R] [--only read|assemble]`
+//! `cargo run --release -p modal-bake --example read_assemble_timing -- [--reps R] [--only read|assemble] [--write PATH]`
 //! Prints per-rep seconds and the min/median, and a SHA-256 of the assembled matrices (pattern
 //! and value bits) so that a faster assembly can be checked to be bit-identical. Speed is
 //! measured here, never asserted in tests.
@@ -35,7 +35,8 @@ fn main() {
         "cell_sets": {"clamp": [[], (0..clamp.len()).collect::<Vec<_>>()]},
     });
     let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("stout.json");
+    // `--write PATH` keeps the JSON (e.g. to bake it with two builds of the CLI and compare).
+    let path = arg("--write").map_or_else(|| dir.path().join("stout.json"), Into::into);
     std::fs::write(&path, serde_json::to_vec(&v).unwrap()).unwrap();
     let mat = Material::new(2.0e9, 0.3, 1200.0).unwrap();
     let (mut tr, mut ta) = (Vec::new(), Vec::new());
