@@ -442,10 +442,8 @@ pub fn bake_mesh(
 
     progress(BakeStage::Assemble);
     let t = Instant::now();
-    let k = fem::assemble_stiffness(&mesh, &mat);
-    let m = fem::assemble_mass(&mesh, &mat, params.lumped);
-    let (map, kf, mf) =
-        fem::reduce_fixed(&k, &m, &fixed).map_err(|e| BakeError::Params(format!("{file}: {e}")))?;
+    let (map, kf, mf) = fem::assemble_clamped(&mesh, &mat, params.lumped, &fixed)
+        .map_err(|e| BakeError::Params(format!("{file}: {e}")))?;
     report.assemble_s = t.elapsed().as_secs_f64();
     report.free_dofs = map.n_free();
     report.mass_kg = mat.density * mesh.volume();

@@ -10,7 +10,7 @@
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 use rayon::prelude::*;
 
-use super::Material;
+use super::{DofMap, DofMapError, Material};
 use crate::mesh::TetMesh;
 
 /// Node adjacency and node → tetrahedron incidence of a mesh.
@@ -22,6 +22,13 @@ pub(crate) struct NodeGraph {
     pub inc_ptr: Vec<usize>,
     pub inc: Vec<(u32, u8)>,
 }
+
+/// Nodes per rayon task in the per-node loops: enough work per task that the per-task
+/// scratch (one mark per mesh node) costs little.
+const NODES_PER_TASK: usize = 256;
+
+/// Marks of a per-node neighbour scatter: `UNMARKED` or the position in the node's list.
+const UNMARKED: u32 = u32::MAX;
 
 impl NodeGraph {
     pub fn new(mesh: &TetMesh) -> NodeGraph {
@@ -43,18 +50,32 @@ impl NodeGraph {
                 fill[v] += 1;
             }
         }
+        // Each node's distinct neighbours through a mark array (each neighbour appears in
+        // ~6 of the node's tetrahedra), so only the distinct ones are sorted.
         let lists: Vec<Vec<usize>> = (0..n)
             .into_par_iter()
-            .map(|a| {
-                let mut l: Vec<usize> = Vec::with_capacity(4 * (inc_ptr[a + 1] - inc_ptr[a]) + 1);
-                l.push(a);
-                for &(t, _) in &inc[inc_ptr[a]..inc_ptr[a + 1]] {
-                    l.extend_from_slice(&mesh.tets[t as usize]);
-                }
-                l.sort_unstable();
-                l.dedup();
-                l
-            })
+            .with_min_len(NODES_PER_TASK)
+            .map_init(
+                || vec![false; n],
+                |seen, a| {
+                    let mut l: Vec<usize> = Vec::with_capacity(32);
+                    seen[a] = true;
+                    l.push(a);
+                    for &(t, _) in &inc[inc_ptr[a]..inc_ptr[a + 1]] {
+                        for &b in &mesh.tets[t as usize] {
+                            if !seen[b] {
+                                seen[b] = true;
+                                l.push(b);
+                            }
+                        }
+                    }
+                    for &b in &l {
+                        seen[b] = false;
+                    }
+                    l.sort_unstable();
+                    l
+                },
+            )
             .collect();
         let mut adj_ptr = Vec::with_capacity(n + 1);
         adj_ptr.push(0);
@@ -71,25 +92,75 @@ impl NodeGraph {
         }
     }
 
-    fn neighbours(&self, a: usize) -> &[usize] {
-        &self.adj[self.adj_ptr[a]..self.adj_ptr[a + 1]]
+    fn incidences(&self, a: usize) -> &[(u32, u8)] {
+        &self.inc[self.inc_ptr[a]..self.inc_ptr[a + 1]]
+    }
+}
+
+/// The node-level pattern of the matrices restricted to the kept (free) nodes: the kept
+/// nodes in ascending order and, for each, its kept neighbours (ascending). With no node
+/// fixed it is the whole node graph.
+struct KeptPattern {
+    /// Mesh node of each kept node, ascending.
+    kept: Vec<usize>,
+    /// Kept index of each mesh node, `usize::MAX` when fixed.
+    index: Vec<usize>,
+    /// `nb[ptr[k]..ptr[k+1]]`: kept neighbours (mesh node indices, ascending) of kept node k.
+    ptr: Vec<usize>,
+    nb: Vec<usize>,
+}
+
+impl KeptPattern {
+    /// `fixed`: strictly ascending mesh node indices, all `< n` (checked by [`DofMap::new`]).
+    fn new(graph: &NodeGraph, fixed: &[usize]) -> KeptPattern {
+        let n = graph.adj_ptr.len() - 1;
+        let mut index = vec![0usize; n];
+        for &v in fixed {
+            index[v] = usize::MAX;
+        }
+        let mut kept = Vec::with_capacity(n - fixed.len());
+        for (v, slot) in index.iter_mut().enumerate() {
+            if *slot == 0 {
+                *slot = kept.len();
+                kept.push(v);
+            }
+        }
+        let mut ptr = Vec::with_capacity(kept.len() + 1);
+        ptr.push(0);
+        let mut nb = Vec::with_capacity(graph.adj.len());
+        for &a in &kept {
+            let all = &graph.adj[graph.adj_ptr[a]..graph.adj_ptr[a + 1]];
+            nb.extend(all.iter().copied().filter(|&b| index[b] != usize::MAX));
+            ptr.push(nb.len());
+        }
+        KeptPattern {
+            kept,
+            index,
+            ptr,
+            nb,
+        }
     }
 
-    /// CSC pattern on `3n` dofs (node-major). `full_blocks`: every node pair couples all 3×3
-    /// axis pairs (stiffness); otherwise only equal axes (consistent mass).
+    fn neighbours(&self, k: usize) -> &[usize] {
+        &self.nb[self.ptr[k]..self.ptr[k + 1]]
+    }
+
+    /// CSC pattern on the `3·kept` dofs (node-major). `full_blocks`: every node pair couples
+    /// all 3×3 axis pairs (stiffness); otherwise only equal axes (consistent mass).
     fn dof_pattern(&self, full_blocks: bool) -> SymbolicSparseColMat<usize> {
-        let n = self.adj_ptr.len() - 1;
+        let n = self.kept.len();
         let per = if full_blocks { 3 } else { 1 };
         let mut col_ptr = Vec::with_capacity(3 * n + 1);
-        let mut row_idx = Vec::with_capacity(3 * per * self.adj.len());
+        let mut row_idx = Vec::with_capacity(3 * per * self.nb.len());
         col_ptr.push(0);
-        for a in 0..n {
+        for k in 0..n {
             for i in 0..3 {
-                for &b in self.neighbours(a) {
+                for &b in self.neighbours(k) {
+                    let r = 3 * self.index[b];
                     if full_blocks {
-                        row_idx.extend_from_slice(&[3 * b, 3 * b + 1, 3 * b + 2]);
+                        row_idx.extend_from_slice(&[r, r + 1, r + 2]);
                     } else {
-                        row_idx.push(3 * b + i);
+                        row_idx.push(r + i);
                     }
                 }
                 col_ptr.push(row_idx.len());
@@ -98,23 +169,50 @@ impl NodeGraph {
         SymbolicSparseColMat::new_checked(3 * n, 3 * n, col_ptr, None, row_idx)
     }
 
-    /// Splits `values` into the per-node column-block slices (`len_per_neighbour` values per
-    /// neighbour).
+    /// Splits `values` into the per-kept-node column-block slices (`len_per_neighbour`
+    /// values per neighbour).
     fn node_slices<'a>(
         &self,
         values: &'a mut [f64],
         len_per_neighbour: usize,
     ) -> Vec<&'a mut [f64]> {
-        let n = self.adj_ptr.len() - 1;
-        let mut out = Vec::with_capacity(n);
+        let mut out = Vec::with_capacity(self.kept.len());
         let mut rest = values;
-        for a in 0..n {
-            let len = len_per_neighbour * (self.adj_ptr[a + 1] - self.adj_ptr[a]);
+        for k in 0..self.kept.len() {
+            let len = len_per_neighbour * (self.ptr[k + 1] - self.ptr[k]);
             let (head, tail) = rest.split_at_mut(len);
             out.push(head);
             rest = tail;
         }
         out
+    }
+
+    /// Runs `f(node, d, marks, out)` on every kept mesh node in parallel, with `d` its number
+    /// of kept neighbours, `out` its column-block slice and `marks[b]` the position of `b` in
+    /// its kept neighbour list (`UNMARKED` for a fixed node): an O(1) slot lookup instead of
+    /// a search per element entry.
+    fn for_each_node<F>(&self, slices: Vec<&mut [f64]>, f: F)
+    where
+        F: Fn(usize, usize, &[u32], &mut [f64]) + Sync,
+    {
+        let n = self.index.len();
+        slices
+            .into_par_iter()
+            .enumerate()
+            .with_min_len(NODES_PER_TASK)
+            .for_each_init(
+                || vec![UNMARKED; n],
+                |marks, (k, out)| {
+                    let nb = self.neighbours(k);
+                    for (slot, &b) in nb.iter().enumerate() {
+                        marks[b] = slot as u32;
+                    }
+                    f(self.kept[k], nb.len(), marks, out);
+                    for &b in nb {
+                        marks[b] = UNMARKED;
+                    }
+                },
+            );
     }
 }
 
@@ -171,27 +269,32 @@ fn element_geometry(mesh: &TetMesh, t: &[usize; 4]) -> ([[f64; 3]; 4], f64) {
 /// ```
 pub fn assemble_stiffness(mesh: &TetMesh, mat: &Material) -> SparseColMat<usize, f64> {
     let graph = NodeGraph::new(mesh);
-    assemble_stiffness_with_graph(mesh, mat, &graph)
+    let pattern = KeptPattern::new(&graph, &[]);
+    stiffness(mesh, mat, &graph, &pattern, &geometries(mesh))
 }
 
-pub(crate) fn assemble_stiffness_with_graph(
+/// Shape-function gradients and volumes of every tetrahedron ([`element_geometry`]).
+fn geometries(mesh: &TetMesh) -> Vec<([[f64; 3]; 4], f64)> {
+    mesh.tets
+        .par_iter()
+        .map(|t| element_geometry(mesh, t))
+        .collect()
+}
+
+/// K on the kept nodes of `pattern`.
+fn stiffness(
     mesh: &TetMesh,
     mat: &Material,
     graph: &NodeGraph,
+    pattern: &KeptPattern,
+    geo: &[([[f64; 3]; 4], f64)],
 ) -> SparseColMat<usize, f64> {
     let (lam, mu) = mat.lame();
-    let geo: Vec<([[f64; 3]; 4], f64)> = mesh
-        .tets
-        .par_iter()
-        .map(|t| element_geometry(mesh, t))
-        .collect();
-    let pattern = graph.dof_pattern(true);
-    let mut values = vec![0.0f64; pattern.row_idx().len()];
-    let slices = graph.node_slices(&mut values, 9);
-    slices.into_par_iter().enumerate().for_each(|(a, out)| {
-        let nb = graph.neighbours(a);
-        let d = nb.len();
-        for &(t, p) in &graph.inc[graph.inc_ptr[a]..graph.inc_ptr[a + 1]] {
+    let sym = pattern.dof_pattern(true);
+    let mut values = vec![0.0f64; sym.row_idx().len()];
+    let slices = pattern.node_slices(&mut values, 9);
+    pattern.for_each_node(slices, |a, d, marks, out| {
+        for &(t, p) in graph.incidences(a) {
             let (g, v) = &geo[t as usize];
             if *v == 0.0 {
                 continue;
@@ -199,7 +302,11 @@ pub(crate) fn assemble_stiffness_with_graph(
             let ga = g[p as usize];
             let tet = &mesh.tets[t as usize];
             for (q, &b) in tet.iter().enumerate() {
-                let k = nb.binary_search(&b).expect("neighbour in pattern");
+                let k = marks[b];
+                if k == UNMARKED {
+                    continue; // a fixed node: its rows are not stored
+                }
+                let k = k as usize;
                 let gb = g[q];
                 let dot = ga[0] * gb[0] + ga[1] * gb[1] + ga[2] * gb[2];
                 // Entry (row 3b+j, col 3a+i), written so that (a,i)↔(b,j) swaps factors of
@@ -217,7 +324,7 @@ pub(crate) fn assemble_stiffness_with_graph(
             }
         }
     });
-    SparseColMat::new(pattern, values)
+    SparseColMat::new(sym, values)
 }
 
 /// Assembles the P1 mass matrix M (kg), `3n × 3n`, node-major dofs, both triangles stored.
@@ -234,57 +341,52 @@ pub(crate) fn assemble_stiffness_with_graph(
 /// assert!((total - 3.0 * 1000.0).abs() < 1e-9);
 /// ```
 pub fn assemble_mass(mesh: &TetMesh, mat: &Material, lumped: bool) -> SparseColMat<usize, f64> {
+    let graph = NodeGraph::new(mesh);
+    let pattern = KeptPattern::new(&graph, &[]);
+    mass(mesh, mat, lumped, &graph, &pattern, &geometries(mesh))
+}
+
+/// M on the kept nodes of `pattern`.
+fn mass(
+    mesh: &TetMesh,
+    mat: &Material,
+    lumped: bool,
+    graph: &NodeGraph,
+    pattern: &KeptPattern,
+    geo: &[([[f64; 3]; 4], f64)],
+) -> SparseColMat<usize, f64> {
     let rho = mat.density;
-    let n = mesh.nodes.len();
     if lumped {
-        let graph = NodeGraph::new(mesh);
-        let vols: Vec<f64> = mesh
-            .tets
-            .par_iter()
-            .map(|t| element_geometry(mesh, t).1)
-            .collect();
+        let n = pattern.kept.len();
         let mut values = vec![0.0f64; 3 * n];
-        values.par_chunks_mut(3).enumerate().for_each(|(a, out)| {
+        values.par_chunks_mut(3).enumerate().for_each(|(k, out)| {
             let mut m = 0.0;
-            for &(t, _) in &graph.inc[graph.inc_ptr[a]..graph.inc_ptr[a + 1]] {
-                m += rho * vols[t as usize] / 4.0;
+            for &(t, _) in graph.incidences(pattern.kept[k]) {
+                m += rho * geo[t as usize].1 / 4.0;
             }
             out.fill(m);
         });
-        let pattern = SymbolicSparseColMat::new_checked(
+        let sym = SymbolicSparseColMat::new_checked(
             3 * n,
             3 * n,
             (0..=3 * n).collect(),
             None,
             (0..3 * n).collect(),
         );
-        return SparseColMat::new(pattern, values);
+        return SparseColMat::new(sym, values);
     }
-    let graph = NodeGraph::new(mesh);
-    assemble_consistent_mass_with_graph(mesh, mat, &graph)
-}
-
-pub(crate) fn assemble_consistent_mass_with_graph(
-    mesh: &TetMesh,
-    mat: &Material,
-    graph: &NodeGraph,
-) -> SparseColMat<usize, f64> {
-    let rho = mat.density;
-    let vols: Vec<f64> = mesh
-        .tets
-        .par_iter()
-        .map(|t| element_geometry(mesh, t).1)
-        .collect();
-    let pattern = graph.dof_pattern(false);
-    let mut values = vec![0.0f64; pattern.row_idx().len()];
-    let slices = graph.node_slices(&mut values, 3);
-    slices.into_par_iter().enumerate().for_each(|(a, out)| {
-        let nb = graph.neighbours(a);
-        let d = nb.len();
-        for &(t, _) in &graph.inc[graph.inc_ptr[a]..graph.inc_ptr[a + 1]] {
-            let m = rho * vols[t as usize] / 20.0;
+    let sym = pattern.dof_pattern(false);
+    let mut values = vec![0.0f64; sym.row_idx().len()];
+    let slices = pattern.node_slices(&mut values, 3);
+    pattern.for_each_node(slices, |a, d, marks, out| {
+        for &(t, _) in graph.incidences(a) {
+            let m = rho * geo[t as usize].1 / 20.0;
             for &b in &mesh.tets[t as usize] {
-                let k = nb.binary_search(&b).expect("neighbour in pattern");
+                let k = marks[b];
+                if k == UNMARKED {
+                    continue; // a fixed node: its rows are not stored
+                }
+                let k = k as usize;
                 let w = if b == a { 2.0 * m } else { m };
                 for i in 0..3 {
                     out[d * i + k] += w;
@@ -292,7 +394,39 @@ pub(crate) fn assemble_consistent_mass_with_graph(
             }
         }
     });
-    SparseColMat::new(pattern, values)
+    SparseColMat::new(sym, values)
+}
+
+/// K (N/m) and M (kg) of `mesh` restricted to the free dofs left by clamping
+/// `fixed_nodes` (strictly ascending), with their [`DofMap`]: bit for bit
+/// `reduce_fixed(&assemble_stiffness(..), &assemble_mass(..), fixed_nodes)`, without
+/// assembling the full matrices (one node graph and one pass over the element geometry for
+/// both, and no entries in fixed rows or columns).
+///
+/// # Errors
+/// [`DofMapError`] if the node list is invalid for the mesh.
+///
+/// ```
+/// use modal_bake::{fem::{assemble_clamped, Material}, mesh::TetMesh};
+/// let mesh = TetMesh::structured_box([2, 1, 1], [2.0, 1.0, 1.0]);
+/// let mat = Material::new(1e9, 0.3, 1000.0).unwrap();
+/// let (map, k, m) = assemble_clamped(&mesh, &mat, false, &mesh.groups["xmin"]).unwrap();
+/// assert_eq!((k.nrows(), m.nrows()), (map.n_free(), map.n_free()));
+/// ```
+#[allow(clippy::type_complexity)]
+pub fn assemble_clamped(
+    mesh: &TetMesh,
+    mat: &Material,
+    lumped: bool,
+    fixed_nodes: &[usize],
+) -> Result<(DofMap, SparseColMat<usize, f64>, SparseColMat<usize, f64>), DofMapError> {
+    let map = DofMap::new(mesh.nodes.len(), fixed_nodes)?;
+    let graph = NodeGraph::new(mesh);
+    let pattern = KeptPattern::new(&graph, fixed_nodes);
+    let geo = geometries(mesh);
+    let k = stiffness(mesh, mat, &graph, &pattern, &geo);
+    let m = mass(mesh, mat, lumped, &graph, &pattern, &geo);
+    Ok((map, k, m))
 }
 
 /// The six rigid-body motions of `mesh` as columns of a `3n × 6` matrix (m per unit

@@ -5,7 +5,8 @@
 //!   Dofs are node-major (`3·node + axis`), matrices are stored with both triangles, rows
 //!   sorted. Summation order is fixed, so the matrices are bit-identical for any thread count.
 //! - [`DofMap`] / [`reduce_fixed`]: clamp nodes (restrict K, M to the free dofs, expand modes
-//!   back with zeros).
+//!   back with zeros); [`assemble_clamped`] assembles the restricted K and M directly (what
+//!   the bake uses: bit-identical, without the full matrices).
 //! - [`rigid_body_modes`]: the 6-dimensional null space of the free-free K.
 //!
 //! Unsupported: anisotropic or heterogeneous materials, quadratic (tet10) elements.
@@ -14,6 +15,6 @@ mod assembly;
 mod dof_map;
 mod material;
 
-pub use assembly::{assemble_mass, assemble_stiffness, rigid_body_modes};
+pub use assembly::{assemble_clamped, assemble_mass, assemble_stiffness, rigid_body_modes};
 pub use dof_map::{reduce_fixed, DofMap, DofMapError};
 pub use material::{Material, MaterialError};

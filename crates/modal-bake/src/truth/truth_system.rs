@@ -81,9 +81,7 @@ impl TruthSystem {
                 "{file}: --fixed fixes every node; nothing can vibrate"
             )));
         }
-        let k = fem::assemble_stiffness(&mesh, &mat);
-        let m = fem::assemble_mass(&mesh, &mat, params.lumped);
-        let (map, k, m) = fem::reduce_fixed(&k, &m, &fixed)
+        let (map, k, m) = fem::assemble_clamped(&mesh, &mat, params.lumped, &fixed)
             .map_err(|e| TruthError::Params(format!("{file}: {e}")))?;
         let rigid = if fixed.is_empty() {
             Some(m_orthonormal(&m, fem::rigid_body_modes(&mesh)))
