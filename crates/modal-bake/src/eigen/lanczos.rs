@@ -279,6 +279,9 @@ fn lanczos_chunk(
     let mut kk = 0usize; // Rayleigh–Ritz size; the newest block sits at kk..kk+b
     let mut trigger = params.tol;
     let mut last_worst = f64::INFINITY;
+    // Whether the newest block is coupled to the whole basis (right after a thick restart: to
+    // every kept Ritz vector) rather than only to the block before it (Lanczos recurrence).
+    let mut coupled_to_all = true;
 
     loop {
         // --- expand: Z = T W = A⁻¹ M W, M-orthogonalise against the basis ------------------
@@ -287,25 +290,34 @@ fn lanczos_chunk(
         fac.solve_in_place(z.as_mut(), &mut solve_buf);
         info.block_solves += 1;
         let mut c = Mat::<f64>::zeros(nb, b);
-        for _pass in 0..2 {
+        for pass in 0..2 {
+            // First pass: only the blocks Z is coupled to in exact arithmetic (the newest
+            // and the one before it, or all after a restart); second pass: the whole basis.
+            let lo = if pass == 0 && !coupled_to_all {
+                kk - b
+            } else {
+                0
+            };
             deflate(z.as_mut(), locked, mlocked);
-            let mut cp = Mat::<f64>::zeros(nb, b);
+            let mut cp = Mat::<f64>::zeros(nb - lo, b);
             gemm(
                 cp.as_mut(),
                 Accum::Replace,
-                mv.as_ref().subcols(0, nb).transpose(),
+                mv.as_ref().subcols(lo, nb - lo).transpose(),
                 z.as_ref(),
                 1.0,
             );
             gemm(
                 z.as_mut(),
                 Accum::Add,
-                v.as_ref().subcols(0, nb),
+                v.as_ref().subcols(lo, nb - lo),
                 cp.as_ref(),
                 -1.0,
             );
-            c += &cp;
+            let mut cs = c.as_mut().subrows_mut(lo, nb - lo);
+            cs += &cp;
         }
+        coupled_to_all = false;
         h.as_mut().submatrix_mut(0, kk, nb, b).copy_from(&c);
         sym_spmm(m, z.as_ref(), mz.as_mut());
         let pre: Vec<f64> = (0..b)
@@ -500,6 +512,7 @@ fn lanczos_chunk(
             }
             h.as_mut().submatrix_mut(p, 0, b, p).copy_from(&coupling);
             kk = p;
+            coupled_to_all = true;
             info.restarts += 1;
         }
     }

@@ -16,8 +16,12 @@
 //!   classical Gram–Schmidt: the first pass always removes more than 1 − 1/√2 of the new
 //!   block's M-norm here, measured 0.01–0.61 remaining, so "twice is enough" would never skip
 //!   the second) and Cholesky-QR of the block (twice; random replacement on breakdown). The
-//!   dense products run sequentially (faer's parallel path is far slower on these
-//!   tall-skinny shapes; `kernels.rs`).
+//!   first pass only runs against the blocks the new one is coupled to in exact arithmetic
+//!   (the newest and the one before it; the whole basis right after a thick restart, which
+//!   couples it to every kept Ritz vector): those hold the large components, and the second,
+//!   full pass removes the rounding-level rest, as a second full pass did (same residuals,
+//!   about half the Gram–Schmidt memory traffic). The dense products run sequentially
+//!   (faer's parallel path is far slower on these tall-skinny shapes; `kernels.rs`).
 //! - Rayleigh–Ritz on the projected H = VᵀMTV with faer's dense symmetric eigensolver.
 //!   When the basis reaches its maximum size it is restarted with the best Ritz vectors plus
 //!   the newest block (thick restart).
