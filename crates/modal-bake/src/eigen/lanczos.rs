@@ -31,6 +31,16 @@ const AUTO_SEQ_BELOW: usize = 20_000;
 /// fraction of its norm before is treated as lying in the current basis.
 const BREAKDOWN: f64 = 1e-12;
 
+/// Dofs for which the default Krylov dimension grows by [`SMALL_EXTRA_BLOCKS`] blocks.
+const SMALL_KRYLOV_DOFS: std::ops::Range<usize> = 1000..AUTO_SEQ_BELOW;
+
+/// Extra blocks of the default Krylov dimension for small problems.
+const SMALL_EXTRA_BLOCKS: usize = 8;
+
+/// Fraction of the steps a geometric extrapolation of the worst wanted residual estimate says
+/// remain before convergence during which the Rayleigh–Ritz solve is skipped.
+const RR_SKIP_FRACTION: f64 = 0.3;
+
 /// A pair whose relative residual is within this factor of its rounding floor counts as
 /// converged even above `tol` (see [`Residual`]).
 pub const FLOOR_FACTOR: f64 = 8.0;
@@ -63,7 +73,7 @@ pub(crate) fn solve(
         });
     }
     let b = params.block.min(n).max(1);
-    let ncv0 = krylov_dim(params, params.nev.max(1), b);
+    let ncv0 = krylov_dim(params, params.nev.max(1), b, n);
     if n <= ncv0 + b + DENSE_MARGIN {
         return solve_dense(k, m, params, lam_lim, info, progress);
     }
@@ -230,7 +240,7 @@ fn lanczos_chunk(
     let n = k.nrows();
     let sigma = params.shift;
     let b = params.block.min(n).max(1);
-    let ncv0 = krylov_dim(params, params.nev.max(1), b);
+    let ncv0 = krylov_dim(params, params.nev.max(1), b, n);
     // --- Lanczos state ----------------------------------------------------------------------
     let mut ncv = ncv0;
     let mut cap = ncv + b;
@@ -279,6 +289,14 @@ fn lanczos_chunk(
     let mut kk = 0usize; // Rayleigh–Ritz size; the newest block sits at kk..kk+b
     let mut trigger = params.tol;
     let mut last_worst = f64::INFINITY;
+    // Whether the newest block is coupled to the whole basis (right after a thick restart: to
+    // every kept Ritz vector) rather than only to the block before it (Lanczos recurrence).
+    let mut coupled_to_all = true;
+    // Next step with a Rayleigh–Ritz solve; the last (step, worst wanted estimate); the last
+    // converged count (for progress reports on skipped steps).
+    let mut rr_at = 0usize;
+    let mut last_est: Option<(usize, f64)> = None;
+    let mut last_conv = 0usize;
 
     loop {
         // --- expand: Z = T W = A⁻¹ M W, M-orthogonalise against the basis ------------------
@@ -287,25 +305,34 @@ fn lanczos_chunk(
         fac.solve_in_place(z.as_mut(), &mut solve_buf);
         info.block_solves += 1;
         let mut c = Mat::<f64>::zeros(nb, b);
-        for _pass in 0..2 {
+        for pass in 0..2 {
+            // First pass: only the blocks Z is coupled to in exact arithmetic (the newest
+            // and the one before it, or all after a restart); second pass: the whole basis.
+            let lo = if pass == 0 && !coupled_to_all {
+                kk - b
+            } else {
+                0
+            };
             deflate(z.as_mut(), locked, mlocked);
-            let mut cp = Mat::<f64>::zeros(nb, b);
+            let mut cp = Mat::<f64>::zeros(nb - lo, b);
             gemm(
                 cp.as_mut(),
                 Accum::Replace,
-                mv.as_ref().subcols(0, nb).transpose(),
+                mv.as_ref().subcols(lo, nb - lo).transpose(),
                 z.as_ref(),
                 1.0,
             );
             gemm(
                 z.as_mut(),
                 Accum::Add,
-                v.as_ref().subcols(0, nb),
+                v.as_ref().subcols(lo, nb - lo),
                 cp.as_ref(),
                 -1.0,
             );
-            c += &cp;
+            let mut cs = c.as_mut().subrows_mut(lo, nb - lo);
+            cs += &cp;
         }
+        coupled_to_all = false;
         h.as_mut().submatrix_mut(0, kk, nb, b).copy_from(&c);
         sym_spmm(m, z.as_ref(), mz.as_mut());
         let pre: Vec<f64> = (0..b)
@@ -332,6 +359,18 @@ fn lanczos_chunk(
         info.krylov_dim = info.krylov_dim.max(kk);
 
         // --- Rayleigh–Ritz on H = VᵀMTV ----------------------------------------------------
+        // Skipped while the last two estimates predict no convergence yet (count mode only;
+        // never when the basis must be restarted or the step budget is spent).
+        let restart_due = kk + 2 * b > cap;
+        let budget_left = info.block_solves - solves_at_start < params.max_iters;
+        if lam_lim.is_none() && !restart_due && budget_left && info.iterations < rr_at {
+            progress(EigenProgress {
+                converged: last_conv,
+                requested: params.nev.min(n),
+                iteration: info.iterations,
+            });
+            continue;
+        }
         let hk = symmetrized(h.as_ref().submatrix(0, 0, kk, kk));
         let (theta_asc, s_asc) = sym_eig(hk.as_ref()).map_err(EigenError::Dense)?;
         // Descending θ = ascending λ.
@@ -388,6 +427,21 @@ fn lanczos_chunk(
             requested: wanted,
             iteration: info.iterations,
         });
+        last_conv = conv;
+        if wanted <= kk {
+            let worst_est = est.iter().take(wanted).fold(0.0f64, |a, &e| a.max(e));
+            rr_at = info.iterations + 1;
+            if let Some((step0, est0)) = last_est {
+                if worst_est > trigger && worst_est < est0 {
+                    // Steps to go at the observed geometric rate; Lanczos converges
+                    // superlinearly, so only a fraction of them is skipped.
+                    let rate = (est0 / worst_est).ln() / (info.iterations - step0) as f64;
+                    let to_go = (worst_est / trigger).ln() / rate;
+                    rr_at += (RR_SKIP_FRACTION * to_go).floor() as usize;
+                }
+            }
+            last_est = Some((info.iterations, worst_est));
+        }
 
         let ready = wanted <= kk
             && est.iter().take(wanted).all(|&e| e <= trigger)
@@ -441,7 +495,7 @@ fn lanczos_chunk(
         }
 
         // --- make room: grow (max-frequency mode) or thick-restart --------------------------
-        let need = krylov_dim(params, wanted, b);
+        let need = krylov_dim(params, wanted, b, n);
         if need > ncv {
             ncv = need;
             let new_cap = ncv + b;
@@ -500,6 +554,7 @@ fn lanczos_chunk(
             }
             h.as_mut().submatrix_mut(p, 0, b, p).copy_from(&coupling);
             kk = p;
+            coupled_to_all = true;
             info.restarts += 1;
         }
     }
@@ -541,12 +596,18 @@ fn check_input(
     Ok(())
 }
 
-/// Krylov basis size for `wanted` pairs: the parameter, or wanted + max(wanted, 4b) + b, at least
-/// wanted + 2b, rounded up to a multiple of b.
-fn krylov_dim(params: &EigenParams, wanted: usize, b: usize) -> usize {
-    let base = params
-        .krylov_dim
-        .unwrap_or_else(|| wanted + wanted.max(4 * b) + b);
+/// Krylov basis size for `wanted` pairs of a problem with `n` dofs: the parameter, or
+/// wanted + max(wanted, 4b) + b (+ [`SMALL_EXTRA_BLOCKS`]·b for n in [`SMALL_KRYLOV_DOFS`]),
+/// at least wanted + 2b, rounded up to a multiple of b.
+fn krylov_dim(params: &EigenParams, wanted: usize, b: usize, n: usize) -> usize {
+    let base = params.krylov_dim.unwrap_or_else(|| {
+        let extra = if SMALL_KRYLOV_DOFS.contains(&n) {
+            SMALL_EXTRA_BLOCKS * b
+        } else {
+            0
+        };
+        wanted + wanted.max(4 * b) + b + extra
+    });
     let d = base.max(wanted + 2 * b);
     d.div_ceil(b) * b
 }

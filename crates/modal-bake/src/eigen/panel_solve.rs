@@ -256,14 +256,29 @@ impl PanelSolve {
                 }
                 let xs: [[f64; W]; PASS] =
                     std::array::from_fn(|t| if t < m { x[c0 + j0 + t] } else { [0.0; W] });
-                let cols: [&[f64]; PASS] =
-                    std::array::from_fn(|t| if t < m { &col(j0 + t)[j0 + m..] } else { &[] });
-                let targets = (c0 + j0 + m..c0 + nc).chain(rows.iter().copied());
+                // Rows below the pass: the rest of the diagonal block (contiguous), then the
+                // pattern rows. Each column slice has exactly `len` entries, so the indexing
+                // in the loops needs no bounds checks.
+                let first = c0 + j0 + m;
+                let nrest = c0 + nc - first;
+                let len = nrest + rows.len();
+                let cols: [&[f64]; PASS] = std::array::from_fn(|t| {
+                    if t < m {
+                        &col(j0 + t)[j0 + m..j0 + m + len]
+                    } else {
+                        &[]
+                    }
+                });
                 if m == PASS {
-                    for (r, i) in targets.enumerate() {
-                        x[i] = update_row::<W, PASS, FMA>(x[i], &cols, r, &xs);
+                    let (rest, below) = cols_split::<PASS>(&cols, nrest);
+                    for (r, xi) in x[first..first + nrest].iter_mut().enumerate() {
+                        *xi = update_row::<W, PASS, FMA>(*xi, &rest, r, &xs);
+                    }
+                    for (r, &i) in rows.iter().enumerate() {
+                        x[i] = update_row::<W, PASS, FMA>(x[i], &below, r, &xs);
                     }
                 } else {
+                    let targets = (first..first + nrest).chain(rows.iter().copied());
                     for (r, i) in targets.enumerate() {
                         x[i] = update_row_dyn::<W, FMA>(x[i], &cols[..m], r, &xs[..m]);
                     }
@@ -294,12 +309,23 @@ impl PanelSolve {
                 let cols: [&[f64]; PASS] =
                     std::array::from_fn(|t| if t < m { &col(j0 + t)[j0 + m..] } else { &[] });
                 let mut acc = [[0.0f64; W]; PASS];
-                let targets = (c0 + j0 + m..c0 + nc).chain(rows.iter().copied());
+                let first = c0 + j0 + m;
+                let nrest = c0 + nc - first;
+                let targets = (first..first + nrest).chain(rows.iter().copied());
                 if m == PASS {
-                    for (r, i) in targets.enumerate() {
+                    // As in the forward sweep: contiguous rows, then pattern rows, on column
+                    // slices of exact length (no bounds checks in the loops).
+                    let (rest, below) = cols_split::<PASS>(&cols, nrest);
+                    for (r, xi) in x[first..first + nrest].iter().enumerate() {
+                        for t in 0..PASS {
+                            axpy::<W, FMA>(&mut acc[t], rest[t][r], xi);
+                        }
+                    }
+                    let below: [&[f64]; PASS] = std::array::from_fn(|t| &below[t][..rows.len()]);
+                    for (r, &i) in rows.iter().enumerate() {
                         let xi = x[i];
                         for t in 0..PASS {
-                            axpy::<W, FMA>(&mut acc[t], cols[t][r], &xi);
+                            axpy::<W, FMA>(&mut acc[t], below[t][r], &xi);
                         }
                     }
                 } else {
@@ -324,6 +350,18 @@ impl PanelSolve {
             }
         }
     }
+}
+
+/// The first `n` entries of each column and the rest.
+#[inline(always)]
+fn cols_split<'a, const P: usize>(
+    cols: &[&'a [f64]; P],
+    n: usize,
+) -> ([&'a [f64]; P], [&'a [f64]; P]) {
+    (
+        std::array::from_fn(|t| &cols[t][..n]),
+        std::array::from_fn(|t| &cols[t][n..]),
+    )
 }
 
 /// `x_i − Σ_t cols[t][r]·xs[t]` for one row (PASS columns; two partial sums for FMA latency).
