@@ -12,15 +12,7 @@ use modal_bake::mesh::TetMesh;
 
 /// Writes `mesh` as meshio-style JSON with its groups as `cell_sets` over a vertex block.
 fn write_json(mesh: &TetMesh, path: &Path) {
-    let clamp = &mesh.groups["xmin"];
-    let v = serde_json::json!({
-        "points": mesh.nodes,
-        "cells": [
-            {"type": "tetra", "data": mesh.tets},
-            {"type": "vertex", "data": clamp.iter().map(|&i| [i]).collect::<Vec<_>>()},
-        ],
-        "cell_sets": {"clamp": [[], (0..clamp.len()).collect::<Vec<_>>()]},
-    });
+    let v = mesh.to_meshio_json("xmin", "clamp");
     std::fs::write(path, serde_json::to_vec(&v).unwrap()).unwrap();
 }
 

@@ -26,14 +26,7 @@ fn main() {
     let mesh = TetMesh::structured_box([100, 18, 18], [4.0, 0.72, 0.72]);
     // As benches/bake.rs writes it: the clamp as cell_sets over a vertex block.
     let clamp = &mesh.groups["xmin"];
-    let v = serde_json::json!({
-        "points": mesh.nodes,
-        "cells": [
-            {"type": "tetra", "data": mesh.tets},
-            {"type": "vertex", "data": clamp.iter().map(|&i| [i]).collect::<Vec<_>>()},
-        ],
-        "cell_sets": {"clamp": [[], (0..clamp.len()).collect::<Vec<_>>()]},
-    });
+    let v = mesh.to_meshio_json("xmin", "clamp");
     let dir = tempfile::tempdir().unwrap();
     // `--write PATH` keeps the JSON (e.g. to bake it with two builds of the CLI and compare).
     let path = arg("--write").map_or_else(|| dir.path().join("stout.json"), Into::into);

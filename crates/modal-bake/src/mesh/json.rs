@@ -899,15 +899,7 @@ mod tests {
             state ^= state << 17;
             *x += (state >> 11) as f64 * 2f64.powi(-53) * 1e-3;
         }
-        let clamp = &mesh.groups["xmin"];
-        let v = serde_json::json!({
-            "points": mesh.nodes,
-            "cells": [
-                {"type": "tetra", "data": mesh.tets},
-                {"type": "vertex", "data": clamp.iter().map(|&i| [i]).collect::<Vec<_>>()},
-            ],
-            "cell_sets": {"clamp": [[], (0..clamp.len()).collect::<Vec<_>>()]},
-        });
+        let v = mesh.to_meshio_json("xmin", "clamp");
         serde_json::to_vec(&v).unwrap()
     }
 

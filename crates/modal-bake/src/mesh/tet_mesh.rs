@@ -51,6 +51,24 @@ pub(crate) fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
 }
 
 impl TetMesh {
+    /// This mesh as meshio-style JSON that [`crate::mesh::read_mesh`] reads back: `points`
+    /// (m), a `tetra` block, a `vertex` block of the nodes of `group`, and `cell_sets` naming
+    /// that block `set_name` (benches and tests write their meshes this way).
+    ///
+    /// # Panics
+    /// If the mesh has no group `group`.
+    pub fn to_meshio_json(&self, group: &str, set_name: &str) -> serde_json::Value {
+        let nodes = &self.groups[group];
+        serde_json::json!({
+            "points": self.nodes,
+            "cells": [
+                {"type": "tetra", "data": self.tets},
+                {"type": "vertex", "data": nodes.iter().map(|&i| [i]).collect::<Vec<_>>()},
+            ],
+            "cell_sets": {set_name: [[], (0..nodes.len()).collect::<Vec<_>>()]},
+        })
+    }
+
     /// A structured box `[0,lx]×[0,ly]×[0,lz]` (m) split into `nx×ny×nz` hexahedra, each cut into
     /// six positively oriented tetrahedra (Kuhn subdivision, conforming across faces).
     ///
