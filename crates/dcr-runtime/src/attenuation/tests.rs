@@ -340,9 +340,11 @@ fn stored_orderings_give_the_same_distances() {
     let n = v.len();
     let amd = HeatGeodesic::new(&v, &t).unwrap();
     let reversed: Vec<u32> = (0..n as u32).rev().collect();
-    let mut orders = vec![reversed];
-    #[cfg(feature = "metis")]
-    orders.push(HeatGeodesic::plan_ordering(&v, &t).unwrap());
+    let orders = [
+        reversed,
+        #[cfg(feature = "metis")]
+        HeatGeodesic::plan_ordering(&v, &t).unwrap(),
+    ];
     let (mut a, mut b) = (vec![0.0; n], vec![0.0; n]);
     for order in &orders {
         let other = HeatGeodesic::with_ordering(&v, &t, Some(order)).unwrap();

@@ -298,18 +298,22 @@ fn corrupted_transfer_table_is_rejected_with_a_clear_error() {
     for (corrupt, needle) in cases {
         let mut b = tiny_with_table();
         corrupt(b.transfer.as_mut().unwrap());
-        // Written bypassing validation (as a hostile or buggy writer would).
-        let bytes = b.to_bytes().unwrap();
-        let err = ModesFile::read_from(Cursor::new(bytes), Path::new("c.modes")).unwrap_err();
-        let msg = err.to_string();
-        assert!(
-            matches!(err, FormatError::Invalid { .. }) && msg.contains(needle),
-            "{needle}: {msg}"
-        );
-        // And never written.
-        let dir = tempfile::tempdir().unwrap();
-        assert!(b.write_atomic(&dir.path().join("w.modes")).is_err());
+        assert_refused(&b, needle);
     }
+}
+
+/// `b`, written bypassing validation (as a hostile or buggy writer would), is refused on read
+/// as invalid with a message containing `needle`, and `write_atomic` never writes it.
+fn assert_refused(b: &ModesFile, needle: &str) {
+    let bytes = b.to_bytes().unwrap();
+    let err = ModesFile::read_from(Cursor::new(bytes), Path::new("c.modes")).unwrap_err();
+    let msg = err.to_string();
+    assert!(
+        matches!(err, FormatError::Invalid { .. }) && msg.contains(needle),
+        "{needle}: {msg}"
+    );
+    let dir = tempfile::tempdir().unwrap();
+    assert!(b.write_atomic(&dir.path().join("w.modes")).is_err());
 }
 
 #[test]
@@ -335,14 +339,6 @@ fn surface_order_round_trips_and_a_bad_one_is_named() {
         (vec![2, 0, 4, 1], "entry 2 is 4 (repeated or ≥ 4)"),
     ] {
         b.surface_order = Some(order);
-        let bytes = b.to_bytes().unwrap();
-        let err = ModesFile::read_from(Cursor::new(bytes), Path::new("o.modes")).unwrap_err();
-        let msg = err.to_string();
-        assert!(
-            matches!(err, FormatError::Invalid { .. }) && msg.contains(needle),
-            "{needle}: {msg}"
-        );
-        let dir = tempfile::tempdir().unwrap();
-        assert!(b.write_atomic(&dir.path().join("w.modes")).is_err());
+        assert_refused(&b, needle);
     }
 }
