@@ -147,6 +147,7 @@ fn attenuation(c: &mut Criterion) {
                 distance: DistanceKind::Heat,
                 amplitude: AmplitudeKind::PerVertex,
                 cache_capacity: 64,
+                parallel_heat: false,
             })
         },
         &rows,
@@ -183,6 +184,16 @@ fn geodesic(c: &mut Criterion) {
     c.bench_function(&format!("heat/source/{}v", v.len()), |b| {
         b.iter(|| {
             heat.distances_from_point_with(&sp, &mut out, &mut ws);
+            black_box(out[17])
+        })
+    });
+    // The same query on two threads (the stored order splits the elimination tree in two;
+    // without `--features metis` the AMD order does not, and this row is serial).
+    let mut ws_par = heat.workspace();
+    ws_par.set_parallel(true);
+    c.bench_function(&format!("heat/source-2threads/{}v", v.len()), |b| {
+        b.iter(|| {
+            heat.distances_from_point_with(&sp, &mut out, &mut ws_par);
             black_box(out[17])
         })
     });

@@ -15,7 +15,7 @@ use std::sync::Arc;
 use dcr_runtime::testing::{box_surface, geometric_omegas, synthetic_base, SplitMix64};
 use dcr_runtime::{
     AmplitudeKind, AttenuationLaw, AttenuationParams, DistanceKind, DistantResponse, ForceInput,
-    Impact, Method, ModalModel, ResponseParams, RestingContact, Variant,
+    HeatGeodesic, Impact, Method, ModalModel, ResponseParams, RestingContact, Variant,
 };
 
 struct Counting;
@@ -83,11 +83,26 @@ fn steps_do_not_allocate_after_warm_up() {
     let model = Arc::new(ModalModel::from_base(base).unwrap());
     // Several random streams: which buffers the warm-up fills first depends on the inputs.
     for seed in [99, 7, 23] {
-        steps_do_not_allocate_with(&model, seed);
+        steps_do_not_allocate_with(&model, seed, false);
     }
+    // Two-thread heat queries inside a rayon pool (the worker's allocations count too): a
+    // surface large enough to fork, under a nested-dissection order that splits.
+    let surface = box_surface(20, [1.0, 0.6, 0.4]);
+    let order = dcr_runtime::testing::bisection_order(surface.0.len(), &surface.1);
+    let mut base = synthetic_base(surface, &om, [1.0, 1e-6], 3);
+    base.surface_order = Some(order);
+    let model = Arc::new(ModalModel::from_base(base).unwrap());
+    let heat = model.heat_geodesic().unwrap();
+    assert!(heat.splits_in_two() && heat.factor_len() >= HeatGeodesic::PARALLEL_MIN_ENTRIES);
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(2)
+        .build()
+        .unwrap();
+    pool.install(|| steps_do_not_allocate_with(&model, 5, true));
 }
 
-fn steps_do_not_allocate_with(model: &Arc<ModalModel>, seed: u64) {
+/// `parallel`: only the heat configurations, with two-thread queries.
+fn steps_do_not_allocate_with(model: &Arc<ModalModel>, seed: u64, parallel: bool) {
     let mut rng = SplitMix64(seed);
     let resting: Vec<RestingContact> = (0..30)
         .map(|i| RestingContact {
@@ -95,7 +110,7 @@ fn steps_do_not_allocate_with(model: &Arc<ModalModel>, seed: u64) {
             point: surface_point(&mut rng),
         })
         .collect();
-    let heat = |capacity| {
+    let heat = |capacity, parallel_heat| {
         Method::Attenuation(AttenuationParams {
             law: AttenuationLaw::Full {
                 alpha: 0.1,
@@ -105,6 +120,7 @@ fn steps_do_not_allocate_with(model: &Arc<ModalModel>, seed: u64) {
             distance: DistanceKind::Heat,
             amplitude: AmplitudeKind::PerVertex,
             cache_capacity: capacity,
+            parallel_heat,
         })
     };
     let euclid = Method::Attenuation(AttenuationParams {
@@ -115,7 +131,17 @@ fn steps_do_not_allocate_with(model: &Arc<ModalModel>, seed: u64) {
     let mut configs = Vec::new();
     for variant in [Variant::PerContact, Variant::PerNode] {
         for carry_over in [false, true] {
-            for method in [Method::Modal, heat(64), heat(0), euclid.clone()] {
+            let methods = if parallel {
+                vec![heat(64, true), heat(0, true)]
+            } else {
+                vec![
+                    Method::Modal,
+                    heat(64, false),
+                    heat(0, false),
+                    euclid.clone(),
+                ]
+            };
+            for method in methods {
                 configs.push(ResponseParams {
                     variant,
                     carry_over,
@@ -126,7 +152,10 @@ fn steps_do_not_allocate_with(model: &Arc<ModalModel>, seed: u64) {
         }
     }
     // The transfer table (appended last: the other configurations see the same random input).
-    for variant in [Variant::PerContact, Variant::PerNode] {
+    for variant in [Variant::PerContact, Variant::PerNode]
+        .into_iter()
+        .filter(|_| !parallel)
+    {
         for carry_over in [false, true] {
             configs.push(ResponseParams {
                 variant,

@@ -1,5 +1,7 @@
 //! Simplicial sparse LLᵀ on a pattern from faer's symbolic analysis: the numeric factors of two
-//! matrices with that pattern in one sweep, and the triangular solves.
+//! matrices with that pattern in one sweep, and the triangular solves, run per [`Part`] of a
+//! [`Layout`] (the elimination tree's two halves and the chain above them, when the order
+//! splits) so the halves can be solved on two threads.
 //!
 //! Hand-written rather than faer's `factorize_numeric_llt` / `LltRef::solve_in_place_with_conj`
 //! (which these replaced) because faer could not reach the heat-geodesic targets on ~5k-vertex
@@ -182,38 +184,296 @@ impl Pattern {
         Ok(())
     }
 
-    /// `x ← A⁻¹ x` for A = L Lᵀ (x in the factor's order; `inv_diag` = 1/L_kk).
-    ///
-    /// Supernode by supernode: the dense triangle of its diagonal block on contiguous x, then
-    /// its rows below in passes of up to [`MAX_RUN`] columns (one index load and one x access
-    /// per row and pass instead of per entry). The forward sweep skips supernodes whose entries
-    /// are still zero, so a right-hand side with a few non-zeros only walks their
-    /// elimination-tree ancestors. Results differ from faer's in the last bits (summation
-    /// order).
+    /// The elimination tree's split into two subtrees and the chain above them, for solves on
+    /// two threads: `Some((a, t0))` when columns [0, a) and [a, t0) are two unions of whole
+    /// subtrees (so no entry couples them), [t0, n) is the chain of single-child ancestors
+    /// above both, and each side holds at least a quarter of the entries. Nested dissection
+    /// gives this (each half's columns contiguous, the top separator last); an order that does
+    /// not (AMD, tiny or lopsided surfaces) gives `None`.
+    fn two_subtrees(&self) -> Option<(usize, usize)> {
+        let (n, cp, ri) = (self.n(), &self.col_ptr, &self.row_idx);
+        let parent = |k: usize| (cp[k + 1] - cp[k] > 1).then(|| ri[cp[k] as usize + 1] as usize);
+        let mut desc = vec![1usize; n];
+        let mut children = vec![0u32; n];
+        let mut roots = 0;
+        for k in 0..n {
+            match parent(k) {
+                Some(p) => {
+                    desc[p] += desc[k];
+                    children[p] += 1;
+                }
+                None => roots += 1,
+            }
+        }
+        // Down the single-child chain from the root; a forest splits at its roots.
+        let mut t0 = n;
+        if roots == 1 {
+            t0 = n - 1;
+            while children[t0] == 1 && t0 > 0 && parent(t0 - 1) == Some(t0) {
+                t0 -= 1;
+            }
+            if children[t0] < 2 {
+                return None;
+            }
+        }
+        // The subtrees hanging from [t0, n) must tile [0, t0), each contiguous (last child
+        // first); their boundaries are the candidate splits.
+        let mut bounds = Vec::new();
+        let mut end = t0;
+        while end > 0 {
+            let c = end - 1;
+            if parent(c).is_some_and(|p| p < t0) || desc[c] > end {
+                return None;
+            }
+            end -= desc[c];
+            bounds.push(end);
+        }
+        let below = cp[t0] as usize;
+        let a = bounds[..bounds.len() - 1]
+            .iter()
+            .copied()
+            .min_by_key(|&a| (cp[a] as usize).max(below - cp[a] as usize))?;
+        let smaller = (cp[a] as usize).min(below - cp[a] as usize);
+        (4 * smaller >= cp[n] as usize).then_some((a, t0))
+    }
+}
+
+/// A run of consecutive factor columns [c0, c1) with its own copy of the pattern in local
+/// numbering: own rows at i − c0, rows of the top block [t0, n) at (c1 − c0) + (i − t0).
+pub(super) struct Part {
+    cols: std::ops::Range<usize>,
+    vals: std::ops::Range<usize>,
+    col_ptr: Vec<u32>,
+    row_idx: Vec<u32>,
+    sn_ptr: Vec<u32>,
+}
+
+impl Part {
+    fn new(p: &Pattern, c0: usize, c1: usize, t0: usize) -> Self {
+        let (v0, v1) = (p.col_ptr[c0], p.col_ptr[c1]);
+        let col_ptr = p.col_ptr[c0..=c1].iter().map(|&q| q - v0).collect();
+        let row_idx = p.row_idx[v0 as usize..v1 as usize]
+            .iter()
+            .map(|&i| {
+                let i = i as usize;
+                let local = if i < c1 { i - c0 } else { c1 - c0 + (i - t0) };
+                local as u32
+            })
+            .collect();
+        // Global supernodes cut at the run's ends (any run of a supernode's columns is one).
+        let sn_ptr = std::iter::once(0)
+            .chain(
+                p.sn_ptr
+                    .iter()
+                    .map(|&k| k as usize)
+                    .filter(|&k| k > c0 && k < c1)
+                    .map(|k| (k - c0) as u32),
+            )
+            .chain(std::iter::once((c1 - c0) as u32))
+            .collect();
+        Part {
+            cols: c0..c1,
+            vals: v0 as usize..v1 as usize,
+            col_ptr,
+            row_idx,
+            sn_ptr,
+        }
+    }
+
+    /// Number of columns.
+    pub(super) fn len(&self) -> usize {
+        self.cols.len()
+    }
+
+    /// One sweep of the run on `x` (its local vector); `l`, `inv_diag`: the whole factor's.
+    pub(super) fn sweep(&self, dir: Direction, l: &[f64], inv_diag: &[f64], x: &mut [f64]) {
+        let sweep = Sweep {
+            col_ptr: &self.col_ptr,
+            row_idx: &self.row_idx,
+            sn_ptr: &self.sn_ptr,
+        };
+        sweep.run(dir, &l[self.vals.clone()], &inv_diag[self.cols.clone()], x);
+    }
+}
+
+/// How the solves lay out a vector: with a [`Pattern::two_subtrees`] split, the storage is
+/// `[half 0 | copy of top | half 1 | copy of top | top]`, so each half sweeps its own
+/// contiguous slice (own rows, then the top block's rows, which its forward sweep accumulates
+/// into and its backward sweep reads) and the two halves can run on two threads; the copies
+/// are merged into / refreshed from the top block in between, in a fixed order, so one and two
+/// threads give the same bits. Without a split, the storage is the factor order itself.
+pub(super) struct Layout {
+    pub(super) halves: Option<[Part; 2]>,
+    pub(super) top: Part,
+}
+
+impl Layout {
+    pub(super) fn new(p: &Pattern) -> Self {
+        let n = p.n();
+        match p.two_subtrees() {
+            Some((a, t0)) => Layout {
+                halves: Some([Part::new(p, 0, a, t0), Part::new(p, a, t0, t0)]),
+                top: Part::new(p, t0, n, t0),
+            },
+            None => Layout {
+                halves: None,
+                top: Part::new(p, 0, n, 0),
+            },
+        }
+    }
+
+    /// Storage length: n, plus two copies of the top block with a split.
+    pub(super) fn len(&self) -> usize {
+        let nt = self.top.len();
+        match &self.halves {
+            Some([h0, h1]) => h0.len() + h1.len() + 3 * nt,
+            None => nt,
+        }
+    }
+
+    /// Storage position of factor row k.
+    pub(super) fn position(&self, k: usize) -> usize {
+        let nt = self.top.len();
+        match &self.halves {
+            Some([h0, _]) if k < h0.cols.end => k,
+            Some([_, h1]) if k < h1.cols.end => nt + k,
+            Some(_) => 2 * nt + k,
+            None => k,
+        }
+    }
+
+    /// Storage position of factor row k as seen by the part that `group` names (0, 1: the
+    /// halves, 2: the top block), whose local vector starts at its own offset.
+    pub(super) fn local_position(&self, group: usize, k: usize) -> usize {
+        match (&self.halves, group) {
+            (Some(h), 0 | 1) => {
+                let part = &h[group];
+                if part.cols.contains(&k) {
+                    k - part.cols.start
+                } else {
+                    part.len() + (k - self.top.cols.start)
+                }
+            }
+            _ => k - self.top.cols.start,
+        }
+    }
+
+    /// The group (0, 1: halves; 2: top block) holding factor row k.
+    pub(super) fn group(&self, k: usize) -> usize {
+        match &self.halves {
+            Some([h0, _]) if k < h0.cols.end => 0,
+            Some([_, h1]) if k < h1.cols.end => 1,
+            _ => 2,
+        }
+    }
+
+    /// `x ← A⁻¹ x` for A = L Lᵀ, x in storage order (`l`, `inv_diag` = 1/L_kk: the whole
+    /// factor's): every step of a query's solve in one serial call, for tests.
+    #[cfg(test)]
     pub(super) fn solve(&self, l: &[f64], inv_diag: &[f64], x: &mut [f64]) {
+        let (halves, xt) = self.split_mut(x);
+        if let (Some(parts), Some([x0, x1])) = (&self.halves, halves) {
+            let (n0, n1) = (parts[0].len(), parts[1].len());
+            parts[0].sweep(Direction::Forward, l, inv_diag, x0);
+            parts[1].sweep(Direction::Forward, l, inv_diag, x1);
+            merge_top(xt, &x0[n0..], &x1[n1..]);
+            self.top.sweep(Direction::Forward, l, inv_diag, xt);
+            self.top.sweep(Direction::Backward, l, inv_diag, xt);
+            x0[n0..].copy_from_slice(xt);
+            x1[n1..].copy_from_slice(xt);
+            parts[0].sweep(Direction::Backward, l, inv_diag, x0);
+            parts[1].sweep(Direction::Backward, l, inv_diag, x1);
+        } else {
+            self.top.sweep(Direction::Forward, l, inv_diag, xt);
+            self.top.sweep(Direction::Backward, l, inv_diag, xt);
+        }
+    }
+
+    /// Whether the solves split into two halves.
+    pub(super) fn is_split(&self) -> bool {
+        self.halves.is_some()
+    }
+
+    /// Splits a storage vector into the halves' slices and the top block.
+    pub(super) fn split_mut<'a>(
+        &self,
+        x: &'a mut [f64],
+    ) -> (Option<[&'a mut [f64]; 2]>, &'a mut [f64]) {
+        let nt = self.top.len();
+        match &self.halves {
+            Some([h0, h1]) => {
+                let (x0, rest) = x.split_at_mut(h0.len() + nt);
+                let (x1, xt) = rest.split_at_mut(h1.len() + nt);
+                (Some([x0, x1]), xt)
+            }
+            None => (None, x),
+        }
+    }
+}
+
+/// `top[i] += c0[i] + c1[i]`: the halves' contributions to the top block (or, for the
+/// divergence, the halves' faces'), in a fixed order.
+pub(super) fn merge_top(top: &mut [f64], c0: &[f64], c1: &[f64]) {
+    for ((t, &a), &b) in top.iter_mut().zip(c0).zip(c1) {
+        *t += a + b;
+    }
+}
+
+/// Which triangular sweep: L y = b (forward) or Lᵀ z = y (backward).
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+pub(super) enum Direction {
+    Forward,
+    Backward,
+}
+
+/// A run of consecutive factor columns in local numbering: their column pointers from 0, row
+/// indices as positions in the vector the sweep works on, supernode boundaries.
+#[derive(Clone, Copy)]
+struct Sweep<'a> {
+    col_ptr: &'a [u32],
+    row_idx: &'a [u32],
+    sn_ptr: &'a [u32],
+}
+
+impl Sweep<'_> {
+    /// One sweep on `x` (`l`, `inv_diag` = 1/L_kk: this run's values), under `pulp` dispatch.
+    fn run(self, dir: Direction, l: &[f64], inv_diag: &[f64], x: &mut [f64]) {
         #[cfg(target_arch = "x86_64")]
         if let Some(simd) = pulp::x86::V3::try_new() {
             return pulp::Simd::vectorize(
                 simd,
-                SolveKernel {
-                    pattern: self,
+                SweepKernel {
+                    sweep: self,
+                    dir,
                     l,
                     inv_diag,
                     x,
                 },
             );
         }
-        self.solve_impl::<false>(l, inv_diag, x);
+        self.run_impl::<false>(dir, l, inv_diag, x);
     }
 
     #[inline(always)]
-    fn solve_impl<const FMA: bool>(&self, l: &[f64], inv_diag: &[f64], x: &mut [f64]) {
-        let (cp, ri) = (&self.col_ptr, &self.row_idx);
+    fn run_impl<const FMA: bool>(self, dir: Direction, l: &[f64], inv_diag: &[f64], x: &mut [f64]) {
+        match dir {
+            Direction::Forward => self.forward::<FMA>(l, inv_diag, x),
+            Direction::Backward => self.backward::<FMA>(l, inv_diag, x),
+        }
+    }
+
+    /// L y = b, supernode by supernode: the dense triangle of its diagonal block on contiguous
+    /// x, then its rows below in passes of up to [`MAX_RUN`] columns (one index load and one x
+    /// access per row and pass instead of per entry). Skips supernodes whose entries are still
+    /// zero, so a right-hand side with a few non-zeros only walks their elimination-tree
+    /// ancestors.
+    #[inline(always)]
+    fn forward<const FMA: bool>(self, l: &[f64], inv_diag: &[f64], x: &mut [f64]) {
+        let (cp, ri) = (self.col_ptr, self.row_idx);
         let ns = self.sn_ptr.len() - 1;
         // Column k of supernode [k0, k1]: L_kk, the block rows k+1..=k1, then the rows below.
         let block = |k: usize, k1: usize| cp[k] as usize + 1..cp[k] as usize + 1 + (k1 - k);
         let below_start = |k: usize, k1: usize| cp[k] as usize + 1 + (k1 - k);
-        // L y = b.
         for s in 0..ns {
             let (k0, k1) = (self.sn_ptr[s] as usize, self.sn_ptr[s + 1] as usize - 1);
             if k0 == k1 {
@@ -264,7 +524,16 @@ impl Pattern {
                 }
             }
         }
-        // Lᵀ z = y, last supernode first.
+    }
+
+    /// Lᵀ z = y, last supernode first: gathers (dot products) from the rows below, then the
+    /// diagonal block's triangle.
+    #[inline(always)]
+    fn backward<const FMA: bool>(self, l: &[f64], inv_diag: &[f64], x: &mut [f64]) {
+        let (cp, ri) = (self.col_ptr, self.row_idx);
+        let ns = self.sn_ptr.len() - 1;
+        let block = |k: usize, k1: usize| cp[k] as usize + 1..cp[k] as usize + 1 + (k1 - k);
+        let below_start = |k: usize, k1: usize| cp[k] as usize + 1 + (k1 - k);
         for s in (0..ns).rev() {
             let (k0, k1) = (self.sn_ptr[s] as usize, self.sn_ptr[s + 1] as usize - 1);
             let rows = &ri[below_start(k1, k1)..cp[k1 + 1] as usize];
@@ -421,19 +690,20 @@ impl pulp::WithSimd for FactorKernel<'_> {
     }
 }
 
-/// [`Pattern::solve`]'s arguments, run under `pulp` dispatch.
-struct SolveKernel<'a> {
-    pattern: &'a Pattern,
+/// [`Sweep::run`]'s arguments, run under `pulp` dispatch.
+struct SweepKernel<'a> {
+    sweep: Sweep<'a>,
+    dir: Direction,
     l: &'a [f64],
     inv_diag: &'a [f64],
     x: &'a mut [f64],
 }
 
-impl pulp::WithSimd for SolveKernel<'_> {
+impl pulp::WithSimd for SweepKernel<'_> {
     type Output = ();
     #[inline(always)]
     fn with_simd<S: pulp::Simd>(self, _simd: S) {
-        self.pattern
-            .solve_impl::<true>(self.l, self.inv_diag, self.x);
+        self.sweep
+            .run_impl::<true>(self.dir, self.l, self.inv_diag, self.x);
     }
 }

@@ -2,7 +2,7 @@
 
 use super::*;
 use crate::math::{dot, norm, sub};
-use crate::testing::{icosphere, plate_grid};
+use crate::testing::{bisection_order, icosphere, plate_grid};
 
 /// Flat plate: heat distances stay within one mean edge length of the Euclidean distance.
 #[test]
@@ -150,10 +150,18 @@ fn distance_cache_is_bounded_lru() {
 #[test]
 fn own_solve_matches_faer() {
     let (v, t) = crate::testing::box_surface(9, [1.2, 0.8, 0.6]);
-    let heat = HeatGeodesic::new(&v, &t).unwrap();
-    let n = v.len();
+    own_solve_matches_faer_on(&HeatGeodesic::new(&v, &t).unwrap(), v.len());
+    // A nested-dissection order: the solve runs in two halves and the top block.
+    let (nx, ny) = (40, 24);
+    let (v, t) = plate_grid(nx, ny, 2.0, 1.2);
+    let split = HeatGeodesic::with_ordering(&v, &t, Some(&bisection_order(v.len(), &t))).unwrap();
+    assert!(split.splits_in_two());
+    own_solve_matches_faer_on(&split, v.len());
+}
+
+fn own_solve_matches_faer_on(heat: &HeatGeodesic, n: usize) {
     let mut rng = crate::testing::SplitMix64(3);
-    let mut x = vec![0.0; n];
+    let mut x = Vec::new();
     for which in [0, 1] {
         for sparse in [false, true] {
             let b: Vec<f64> = (0..n)
@@ -234,11 +242,22 @@ fn heat_timing() {
         normal: [0.0; 3],
         distance: 0.0,
     };
-    let source = best(
-        &mut || heat.distances_from_point_with(&sp, &mut out, &mut ws),
-        5,
-        60,
-    );
+    // Serial and two-thread queries, interleaved batch by batch.
+    let mut ws_par = heat.workspace();
+    ws_par.set_parallel(true);
+    let (mut source, mut source_par) = (f64::INFINITY, f64::INFINITY);
+    for _ in 0..60 {
+        source = source.min(best(
+            &mut || heat.distances_from_point_with(&sp, &mut out, &mut ws),
+            5,
+            1,
+        ));
+        source_par = source_par.min(best(
+            &mut || heat.distances_from_point_with(&sp, &mut out, &mut ws_par),
+            5,
+            1,
+        ));
+    }
     let mut spread: Vec<f64> = (0..40)
         .map(|s| {
             let sp = crate::SurfacePoint {
@@ -255,7 +274,7 @@ fn heat_timing() {
     spread.sort_by(f64::total_cmp);
     let n = v.len();
     let mut rhs = vec![0.0; n];
-    let mut x = vec![0.0; n];
+    let mut x = Vec::new();
     let tri = t[7];
     let heat_src = |rhs: &mut [f64]| {
         rhs.iter_mut().for_each(|r| *r = 0.0);
@@ -285,13 +304,15 @@ fn heat_timing() {
         }
     }
     println!(
-        "stored order: nnz(L) {} setup {:.2} ms (AMD at load: {:.2} ms), source {:.3} ms (40 sources: min {:.3} median {:.3} max {:.3} \
-         ms); heat solve own {:.3} / faer {:.3} ms; \
+        "stored order: nnz(L) {} setup {:.2} ms (AMD at load: {:.2} ms), source {:.3} ms, on two threads {:.3} ms (split: {}) \
+         (40 sources: min {:.3} median {:.3} max {:.3} ms); heat solve own {:.3} / faer {:.3} ms; \
          poisson solve own {:.3} / faer {:.3} ms (best of interleaved batches)",
         heat.factor_len(),
         setup * 1e3,
         setup_amd * 1e3,
         source * 1e3,
+        source_par * 1e3,
+        heat.splits_in_two(),
         spread[0] * 1e3,
         spread[20] * 1e3,
         spread[39] * 1e3,
@@ -391,4 +412,66 @@ fn planned_ordering_is_deterministic_and_fills_less_than_amd() {
     let order = HeatGeodesic::plan_ordering(&v, &t).unwrap();
     let planned = HeatGeodesic::with_ordering(&v, &t, Some(&order)).unwrap();
     assert!(planned.factor_len() <= HeatGeodesic::new(&v, &t).unwrap().factor_len());
+}
+
+/// A split query (two halves, then the top block) equals an unsplit one under AMD to 1e-9 of
+/// the largest distance, for sources in either half, in the separator and inside a triangle;
+/// serial and two-thread queries give the same bits; an order whose elimination tree does not
+/// split (reversed numbering) is served unsplit.
+#[test]
+fn split_queries_match_unsplit_and_threads_agree() {
+    let (nx, ny) = (40, 24);
+    let (v, t) = plate_grid(nx, ny, 2.0, 1.2);
+    let n = v.len();
+    let order = bisection_order(n, &t);
+    let split = HeatGeodesic::with_ordering(&v, &t, Some(&order)).unwrap();
+    // Large enough that a parallel query forks.
+    assert!(split.splits_in_two() && split.factor_len() >= HeatGeodesic::PARALLEL_MIN_ENTRIES);
+    let amd = HeatGeodesic::new(&v, &t).unwrap();
+    let reversed: Vec<u32> = (0..n as u32).rev().collect();
+    assert!(!HeatGeodesic::with_ordering(&v, &t, Some(&reversed))
+        .unwrap()
+        .splits_in_two());
+    let (mut ws_seq, mut ws_par) = (split.workspace(), split.workspace());
+    ws_par.set_parallel(true);
+    let mut ws_amd = amd.workspace();
+    let (mut a, mut s, mut p) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+    // A vertex of the first half, of the second, of the separator ring (eliminated last); each
+    // as a vertex source and inside one of its triangles.
+    let point = |v: u32, inside: bool| {
+        let f = t.iter().position(|f| f.contains(&v)).unwrap();
+        let mut bary = [0.0; 3];
+        bary[t[f].iter().position(|&c| c == v).unwrap()] = 1.0;
+        crate::SurfacePoint {
+            triangle: f as u32,
+            bary: if inside { [0.5, 0.3, 0.2] } else { bary },
+            point: [0.0; 3],
+            normal: [0.0, 0.0, 1.0],
+            distance: 0.0,
+        }
+    };
+    let sources = [order[5], order[3 * n / 4], order[n - 1]];
+    let points = sources
+        .iter()
+        .flat_map(|&v| [point(v, false), point(v, true)]);
+    for sp in points {
+        amd.distances_from_point_with(&sp, &mut a, &mut ws_amd);
+        split.distances_from_point_with(&sp, &mut s, &mut ws_seq);
+        split.distances_from_point_with(&sp, &mut p, &mut ws_par);
+        let scale = a.iter().fold(0.0f64, |m, x| m.max(*x));
+        assert!(scale > 1.0, "distances span the plate");
+        for i in 0..n {
+            assert!(
+                (a[i] - s[i]).abs() <= 1e-9 * scale,
+                "vertex {i}: {} vs {}",
+                a[i],
+                s[i]
+            );
+            assert_eq!(
+                s[i].to_bits(),
+                p[i].to_bits(),
+                "vertex {i}: serial vs two threads"
+            );
+        }
+    }
 }

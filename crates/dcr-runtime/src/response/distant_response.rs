@@ -311,7 +311,9 @@ impl DistantResponse {
                 let heat = model
                     .heat_geodesic()
                     .map_err(|e| ParamsError::Geodesic(e.to_string()))?;
-                Some(heat.workspace())
+                let mut ws = heat.workspace();
+                ws.set_parallel(a.parallel_heat);
+                Some(ws)
             }
             DistanceKind::Euclidean => None,
         };

@@ -370,6 +370,7 @@ fn attenuation_follows_eq15_16() {
                 distance: DistanceKind::Euclidean,
                 amplitude: amplitude.clone(),
                 cache_capacity: 4,
+                parallel_heat: false,
             }),
             ..Default::default()
         };

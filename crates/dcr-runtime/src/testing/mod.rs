@@ -34,6 +34,43 @@ impl SplitMix64 {
     }
 }
 
+/// A nested-dissection-like vertex order of a connected surface, for tests of split solves: the
+/// vertices nearer (in breadth-first hops from vertex 0) than the median hop count, then those
+/// farther, then the ring at the median (a vertex separator between the two). Each side must be
+/// connected for the halves to be single subtrees (true for boxes, spheres and plates).
+pub fn bisection_order(n: usize, triangles: &[[u32; 3]]) -> Vec<u32> {
+    let mut adj = vec![Vec::new(); n];
+    for t in triangles {
+        for i in 0..3 {
+            let (a, b) = (t[i] as usize, t[(i + 1) % 3] as usize);
+            adj[a].push(b);
+            adj[b].push(a);
+        }
+    }
+    let mut hops = vec![usize::MAX; n];
+    let mut queue = std::collections::VecDeque::from([0usize]);
+    hops[0] = 0;
+    while let Some(v) = queue.pop_front() {
+        for &w in &adj[v] {
+            if hops[w] == usize::MAX {
+                hops[w] = hops[v] + 1;
+                queue.push_back(w);
+            }
+        }
+    }
+    let mut sorted = hops.clone();
+    sorted.sort_unstable();
+    let mid = sorted[n / 2];
+    let side = |f: fn(usize, usize) -> bool| {
+        let hops = &hops;
+        (0..n as u32).filter(move |&v| f(hops[v as usize], mid))
+    };
+    side(|h, m| h < m)
+        .chain(side(|h, m| h > m))
+        .chain(side(|h, m| h == m))
+        .collect()
+}
+
 /// A flat `lx × ly` (m) plate in the z = 0 plane with `nx × ny` cells, normals +z (open surface).
 pub fn plate_grid(nx: usize, ny: usize, lx: f64, ly: f64) -> Surface {
     let mut v = Vec::with_capacity((nx + 1) * (ny + 1));
