@@ -728,7 +728,8 @@ pub fn bake_file_with_transfer(
 }
 
 /// Whether `modes` is an up-to-date base of `mesh_path` baked with `params`: it exists, reads,
-/// and its stored geometry and parameter hashes equal those of this mesh and these parameters.
+/// its stored geometry and parameter hashes equal those of this mesh and these parameters, and
+/// it holds the heat-geodesic `surface_order` a bake would store.
 ///
 /// `Ok(false)` when the base is missing, unreadable or stale.
 ///
@@ -776,9 +777,15 @@ pub fn is_up_to_date_with_transfer(
                         && base.meta.bake_params.get("transfer") == Some(&transfer_meta(tp))
                 }
             };
+            // A base without the stored heat-geodesic order (baked before it existed, or
+            // written elsewhere) is stale when this tool would store one.
+            let order_matches = base.surface_order.is_some()
+                || HeatGeodesic::plan_ordering(&base.surface_vertices, &base.surface_triangles)
+                    .is_err();
             base.meta.source_hash == prepared.hash
                 && base.meta.params_hash == params.hash()
                 && table_matches
+                && order_matches
         }
         Err(_) => false,
     })

@@ -118,6 +118,17 @@ fn check_exit_codes_follow_staleness() {
             .code(),
         Some(0)
     );
+    // A base without the stored heat-geodesic order (an older bake) is stale.
+    let fresh = dcr_runtime::format::ModesFile::read(&out).unwrap();
+    let mut old = fresh.clone();
+    old.surface_order = None;
+    old.write_atomic(&out).unwrap();
+    assert_eq!(
+        run(&["check", m, o, "--modes", "6"]).status.code(),
+        Some(1),
+        "no surface_order → 1"
+    );
+    fresh.write_atomic(&out).unwrap();
     let bad = data("bad/truncated.msh");
     assert_eq!(
         run(&["check", bad.to_str().unwrap(), o]).status.code(),
