@@ -234,7 +234,12 @@ impl Pattern {
             .copied()
             .min_by_key(|&a| (cp[a] as usize).max(below - cp[a] as usize))?;
         let smaller = (cp[a] as usize).min(below - cp[a] as usize);
-        (4 * smaller >= cp[n] as usize).then_some((a, t0))
+        // What the split solves rely on, checked outright (the subtree sizes above assume a
+        // postorder): no column of [0, a) has a row in [a, t0).
+        let coupled = ri[..cp[a] as usize]
+            .iter()
+            .any(|&i| (a..t0).contains(&(i as usize)));
+        (4 * smaller >= cp[n] as usize && !coupled).then_some((a, t0))
     }
 }
 

@@ -417,7 +417,8 @@ fn planned_ordering_is_deterministic_and_fills_less_than_amd() {
 /// A split query (two halves, then the top block) equals an unsplit one under AMD to 1e-9 of
 /// the largest distance, for sources in either half, in the separator and inside a triangle;
 /// serial and two-thread queries give the same bits; an order whose elimination tree does not
-/// split (reversed numbering) is served unsplit.
+/// split (reversed numbering) is served unsplit, and a perturbed nested dissection (two
+/// vertices swapped between the halves) still gives the same distances.
 #[test]
 fn split_queries_match_unsplit_and_threads_agree() {
     let (nx, ny) = (40, 24);
@@ -432,8 +433,6 @@ fn split_queries_match_unsplit_and_threads_agree() {
     assert!(!HeatGeodesic::with_ordering(&v, &t, Some(&reversed))
         .unwrap()
         .splits_in_two());
-    let (mut ws_seq, mut ws_par) = (split.workspace(), split.workspace());
-    ws_par.set_parallel(true);
     let mut ws_amd = amd.workspace();
     let (mut a, mut s, mut p) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
     // A vertex of the first half, of the second, of the separator ring (eliminated last); each
@@ -451,27 +450,38 @@ fn split_queries_match_unsplit_and_threads_agree() {
         }
     };
     let sources = [order[5], order[3 * n / 4], order[n - 1]];
-    let points = sources
-        .iter()
-        .flat_map(|&v| [point(v, false), point(v, true)]);
-    for sp in points {
-        amd.distances_from_point_with(&sp, &mut a, &mut ws_amd);
-        split.distances_from_point_with(&sp, &mut s, &mut ws_seq);
-        split.distances_from_point_with(&sp, &mut p, &mut ws_par);
-        let scale = a.iter().fold(0.0f64, |m, x| m.max(*x));
-        assert!(scale > 1.0, "distances span the plate");
-        for i in 0..n {
-            assert!(
-                (a[i] - s[i]).abs() <= 1e-9 * scale,
-                "vertex {i}: {} vs {}",
-                a[i],
-                s[i]
-            );
-            assert_eq!(
-                s[i].to_bits(),
-                p[i].to_bits(),
-                "vertex {i}: serial vs two threads"
-            );
+    // Also the order with a vertex of each half swapped: whatever the split analysis makes of
+    // it, the distances must not change.
+    let mut swapped = order.clone();
+    swapped.swap(5, 3 * n / 4);
+    for geo in [
+        split,
+        HeatGeodesic::with_ordering(&v, &t, Some(&swapped)).unwrap(),
+    ] {
+        let (mut ws_seq, mut ws_par) = (geo.workspace(), geo.workspace());
+        ws_par.set_parallel(true);
+        for sp in sources
+            .iter()
+            .flat_map(|&v| [point(v, false), point(v, true)])
+        {
+            amd.distances_from_point_with(&sp, &mut a, &mut ws_amd);
+            geo.distances_from_point_with(&sp, &mut s, &mut ws_seq);
+            geo.distances_from_point_with(&sp, &mut p, &mut ws_par);
+            let scale = a.iter().fold(0.0f64, |m, x| m.max(*x));
+            assert!(scale > 1.0, "distances span the plate");
+            for i in 0..n {
+                assert!(
+                    (a[i] - s[i]).abs() <= 1e-9 * scale,
+                    "vertex {i}: {} vs {}",
+                    a[i],
+                    s[i]
+                );
+                assert_eq!(
+                    s[i].to_bits(),
+                    p[i].to_bits(),
+                    "vertex {i}: serial vs two threads"
+                );
+            }
         }
     }
 }
