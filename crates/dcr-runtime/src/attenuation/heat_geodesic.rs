@@ -218,23 +218,32 @@ impl HeatGeodesic {
             .collect();
         // Faces grouped by owner (a face never has vertices in both halves: no entry couples
         // them), in their original order within a group.
-        let owner = |t: &[u32; 3]| {
-            t.iter()
-                .map(|&v| layout.group(iperm[v as usize] as usize))
-                .min()
-                .expect("three corners")
-        };
-        let mut order: Vec<usize> = (0..triangles.len()).collect();
-        order.sort_by_key(|&f| owner(&triangles[f]));
-        let mut face_ptr = [0, 0, 0, triangles.len()];
-        for g in 0..2 {
-            face_ptr[g + 1] =
-                face_ptr[g] + order.iter().filter(|&&f| owner(&triangles[f]) == g).count();
+        let owner: Vec<usize> = triangles
+            .iter()
+            .map(|t| {
+                t.iter()
+                    .map(|&v| layout.group(iperm[v as usize] as usize))
+                    .min()
+                    .expect("three corners")
+            })
+            .collect();
+        let mut face_ptr = [0usize; 4];
+        for &g in &owner {
+            face_ptr[g + 1] += 1;
+        }
+        for g in 0..3 {
+            face_ptr[g + 1] += face_ptr[g];
+        }
+        let mut next = face_ptr;
+        let mut order = vec![0usize; triangles.len()];
+        for (f, &g) in owner.iter().enumerate() {
+            order[next[g]] = f;
+            next[g] += 1;
         }
         let faces = order
             .iter()
             .map(|&f| {
-                let g = owner(&triangles[f]);
+                let g = owner[f];
                 triangles[f].map(|v| layout.local_position(g, iperm[v as usize] as usize) as u32)
             })
             .collect();
