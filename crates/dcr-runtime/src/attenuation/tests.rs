@@ -510,3 +510,50 @@ fn long_strip_distances_survive_heat_underflow() {
         }
     }
 }
+
+/// Timing probe (not a test of speed): per-query times of serial and two-thread queries on the
+/// 5k-vertex box, interleaved in blocks of 50, as percentiles. This VM runs in phases whose
+/// speed differs by up to 1.7× (the best-of figures of [`heat_timing`] catch the fast phase,
+/// medians mix both): `cargo test --release -p dcr-runtime --features metis --lib
+/// heat_query_percentiles -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn heat_query_percentiles() {
+    let (v, t) = crate::testing::box_surface(29, [1.2, 0.8, 0.6]);
+    #[cfg(feature = "metis")]
+    let order = HeatGeodesic::plan_ordering(&v, &t).unwrap();
+    #[cfg(not(feature = "metis"))]
+    let order = bisection_order(v.len(), &t);
+    let heat = HeatGeodesic::with_ordering(&v, &t, Some(&order)).unwrap();
+    let mut out = vec![0.0; v.len()];
+    let mut ws = [heat.workspace(), heat.workspace()];
+    ws[1].set_parallel(true);
+    let sp = crate::SurfacePoint {
+        triangle: 7,
+        bary: [0.2, 0.3, 0.5],
+        point: [0.0; 3],
+        normal: [0.0; 3],
+        distance: 0.0,
+    };
+    let mut times = [Vec::new(), Vec::new()];
+    for _ in 0..40 {
+        for (w, times) in ws.iter_mut().zip(&mut times) {
+            for _ in 0..50 {
+                let t0 = std::time::Instant::now();
+                heat.distances_from_point_with(&sp, &mut out, w);
+                times.push(t0.elapsed().as_secs_f64() * 1e3);
+            }
+        }
+    }
+    for (name, mut x) in ["serial", "two threads"].into_iter().zip(times) {
+        x.sort_by(f64::total_cmp);
+        let p = |q: f64| x[((x.len() - 1) as f64 * q) as usize];
+        println!(
+            "{name}: min {:.3} p10 {:.3} p50 {:.3} p90 {:.3} ms",
+            p(0.0),
+            p(0.1),
+            p(0.5),
+            p(0.9)
+        );
+    }
+}
