@@ -2,7 +2,8 @@
 //! structured beams of ~3k, ~15k and ≥100k free dofs (slender and stout). Writes medians to
 //! `target/bench/bake.json` and prints a table.
 //!
-//! Run: `cargo bench -p modal-bake --bench bake` (add `-- --quick` for one run per size).
+//! Run: `cargo bench -p modal-bake --bench bake` (add `-- --quick` for one run per size, and
+//! `-- --only 3k,15k` for some sizes only).
 
 use std::path::Path;
 use std::time::Instant;
@@ -22,7 +23,14 @@ fn median(mut v: Vec<f64>) -> f64 {
 }
 
 fn main() {
-    let quick = std::env::args().any(|a| a == "--quick");
+    let args: Vec<String> = std::env::args().collect();
+    let quick = args.iter().any(|a| a == "--quick");
+    // `--only NAMES`: comma-separated size names (e.g. `3k,15k`) to bake, the rest skipped.
+    let only: Option<Vec<String>> = args
+        .iter()
+        .position(|a| a == "--only")
+        .and_then(|i| args.get(i + 1))
+        .map(|list| list.split(',').map(str::to_string).collect());
     let dir = tempfile::tempdir().unwrap();
     // Clamped beams (cells are cubes). The factorization of a beam costs about
     // n·(cross-section dofs)², so the ≥100k row is reported twice: a slender, finely meshed
@@ -39,6 +47,9 @@ fn main() {
     };
     let mut rows = Vec::new();
     for (name, n, l, runs) in sizes {
+        if only.as_ref().is_some_and(|o| !o.iter().any(|s| s == name)) {
+            continue;
+        }
         let mesh = TetMesh::structured_box(n, l);
         let src = dir.path().join(format!("{name}.json"));
         write_json(&mesh, &src);

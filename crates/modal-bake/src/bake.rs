@@ -374,13 +374,74 @@ fn spans_a_plane(mesh: &TetMesh, set: &[usize]) -> bool {
     })
 }
 
+/// The boundary surface of a mesh as the bake stores it.
+struct Surface {
+    /// Sorted volume-node indices of the surface vertices.
+    nodes: Vec<usize>,
+    /// Their positions (m).
+    positions: Vec<[f64; 3]>,
+    /// Outward triangles in surface-vertex indices.
+    triangles: Vec<[u32; 3]>,
+    /// The heat geodesic's elimination order, so loading skips AMD and factors less fill.
+    /// A surface the heat method cannot factor (degenerate triangles) simply stores none; the
+    /// runtime reports the problem if the heat method is used.
+    order: Option<Vec<u32>>,
+}
+
+impl Surface {
+    fn of(mesh: &TetMesh) -> Surface {
+        let (nodes, tris) = extract_surface(mesh);
+        let mut local = vec![u32::MAX; mesh.nodes.len()];
+        for (i, &v) in nodes.iter().enumerate() {
+            local[v] = i as u32;
+        }
+        let triangles: Vec<[u32; 3]> = tris.iter().map(|t| t.map(|v| local[v])).collect();
+        let positions: Vec<[f64; 3]> = nodes.iter().map(|&v| mesh.nodes[v]).collect();
+        let order = HeatGeodesic::plan_ordering(&positions, &triangles).ok();
+        Surface {
+            nodes,
+            positions,
+            triangles,
+            order,
+        }
+    }
+}
+
+/// Bits per node index in the packed face keys of [`extract_surface`] (3 × 21 ≤ 64).
+const PACK_BITS: u32 = 21;
+
 /// Boundary faces of a tetrahedral mesh, oriented outward, as (sorted surface-vertex list of
 /// volume nodes, triangles in volume-node indices). Deterministic: faces are sorted.
 pub fn extract_surface(mesh: &TetMesh) -> (Vec<usize>, Vec<[usize; 3]>) {
-    // For a positively oriented tet (a, b, c, d), these faces have outward normals.
-    let mut faces: Vec<([usize; 3], [usize; 3])> = Vec::with_capacity(mesh.tets.len() * 4);
-    for &[a, b, c, d] in &mesh.tets {
-        for f in [[a, c, b], [a, b, d], [a, d, c], [b, c, d]] {
+    let packable = mesh.nodes.len() <= 1 << PACK_BITS && mesh.tets.len() < 1 << 30;
+    let tris = if packable {
+        boundary_faces_packed(&mesh.tets)
+    } else {
+        boundary_faces(&mesh.tets)
+    };
+    let mut verts: Vec<usize> = tris.iter().flatten().copied().collect();
+    verts.sort_unstable();
+    verts.dedup();
+    (verts, tris)
+}
+
+/// The faces of a positively oriented tet (a, b, c, d), with outward normals.
+fn tet_faces([a, b, c, d]: [usize; 4]) -> [[usize; 3]; 4] {
+    [[a, c, b], [a, b, d], [a, d, c], [b, c, d]]
+}
+
+/// A face rotated so its smallest index comes first (canonical, orientation kept).
+fn canonical_face(f: [usize; 3]) -> [usize; 3] {
+    let r = (0..3).min_by_key(|&k| f[k]).unwrap_or(0);
+    [f[r], f[(r + 1) % 3], f[(r + 2) % 3]]
+}
+
+/// The faces that belong to exactly one tet, canonical, in the order of their sorted node
+/// triples.
+fn boundary_faces(tets: &[[usize; 4]]) -> Vec<[usize; 3]> {
+    let mut faces: Vec<([usize; 3], [usize; 3])> = Vec::with_capacity(tets.len() * 4);
+    for &tet in tets {
+        for f in tet_faces(tet) {
             let mut key = f;
             key.sort_unstable();
             faces.push((key, f));
@@ -395,17 +456,39 @@ pub fn extract_surface(mesh: &TetMesh) -> (Vec<usize>, Vec<[usize; 3]>) {
             j += 1;
         }
         if j - i == 1 {
-            // Rotate so the smallest index comes first (canonical, orientation kept).
-            let f = faces[i].1;
-            let r = (0..3).min_by_key(|&k| f[k]).unwrap_or(0);
-            tris.push([f[r], f[(r + 1) % 3], f[(r + 2) % 3]]);
+            tris.push(canonical_face(faces[i].1));
         }
         i = j;
     }
-    let mut verts: Vec<usize> = tris.iter().flatten().copied().collect();
-    verts.sort_unstable();
-    verts.dedup();
-    (verts, tris)
+    tris
+}
+
+/// [`boundary_faces`] for node indices below 2^[`PACK_BITS`] and fewer than 2^30 tets: the
+/// sorted node triple packed into one u64 (same order as the triples) beside the face's
+/// number: 16-byte elements sort about twice as fast as the 48-byte (triple, face)
+/// pairs (measured on the bake bench beams: 3k 1.1–1.9 vs 2.0–3.0 ms, 15k 4.9–7.4 vs
+/// 8.9–17.8 ms for the whole surface extraction). Same result.
+fn boundary_faces_packed(tets: &[[usize; 4]]) -> Vec<[usize; 3]> {
+    let mut faces: Vec<(u64, u32)> = Vec::with_capacity(tets.len() * 4);
+    for (t, &tet) in tets.iter().enumerate() {
+        for (k, mut key) in tet_faces(tet).into_iter().enumerate() {
+            key.sort_unstable();
+            let packed = ((key[0] as u64) << (2 * PACK_BITS))
+                | ((key[1] as u64) << PACK_BITS)
+                | key[2] as u64;
+            faces.push((packed, (4 * t + k) as u32));
+        }
+    }
+    faces.sort_unstable();
+    let same = |j: usize, key: u64| faces.get(j).is_some_and(|&(other, _)| other == key);
+    let mut tris = Vec::new();
+    for (i, &(key, id)) in faces.iter().enumerate() {
+        if !same(i + 1, key) && (i == 0 || !same(i - 1, key)) {
+            let id = id as usize;
+            tris.push(canonical_face(tet_faces(tets[id / 4])[id % 4]));
+        }
+    }
+    tris
 }
 
 /// Bakes the modal base of an in-memory mesh. `file` names the source in messages.
@@ -478,10 +561,20 @@ pub fn bake_mesh(
         tol: MAX_RESIDUAL,
         ..Default::default()
     };
-    let res = eigen::solve_lowest(&kf, &mf, &eparams, &mut |p| {
-        progress(BakeStage::Eigensolve(p))
-    })
-    .map_err(|error| BakeError::Eigen {
+    // The surface and its heat-geodesic ordering depend on the mesh only: they are computed
+    // on a second thread during the factorization and eigensolve (the bake bench's 3k / 15k
+    // beams: ≈ 5 / 17 ms, otherwise after it).
+    let (res, surface) = std::thread::scope(|scope| {
+        let surface = scope.spawn(|| Surface::of(&mesh));
+        let res = eigen::solve_lowest(&kf, &mf, &eparams, &mut |p| {
+            progress(BakeStage::Eigensolve(p))
+        });
+        (
+            res,
+            surface.join().expect("the surface thread does not panic"),
+        )
+    });
+    let res = res.map_err(|error| BakeError::Eigen {
         file: file.to_string(),
         error,
     })?;
@@ -543,11 +636,12 @@ pub fn bake_mesh(
 
     // Surface rows of U.
     let full = map.expand(res.vectors.as_ref());
-    let (surf, tris) = extract_surface(&mesh);
-    let mut local = vec![u32::MAX; mesh.nodes.len()];
-    for (i, &v) in surf.iter().enumerate() {
-        local[v] = i as u32;
-    }
+    let Surface {
+        nodes: surf,
+        positions,
+        triangles,
+        order,
+    } = surface;
     let nm = elastic.len();
     let mut modes = Vec::with_capacity(surf.len() * 3 * nm);
     for &v in &surf {
@@ -559,10 +653,10 @@ pub fn bake_mesh(
     }
     let eigenvalues: Vec<f64> = elastic.iter().map(|&j| res.eigenvalues[j]).collect();
     let residuals: Vec<f64> = elastic.iter().map(|&j| res.residuals[j]).collect();
-    let mut base = ModesFile {
+    let base = ModesFile {
         eigenvalues,
-        surface_vertices: surf.iter().map(|&v| mesh.nodes[v]).collect(),
-        surface_triangles: tris.iter().map(|t| t.map(|v| local[v])).collect(),
+        surface_vertices: positions,
+        surface_triangles: triangles,
         surface_to_volume: surf.iter().map(|&v| v as u32).collect(),
         modes,
         material: params.material,
@@ -583,13 +677,8 @@ pub fn bake_mesh(
         },
         precision: params.precision,
         transfer: None,
-        surface_order: None,
+        surface_order: order,
     };
-    // The heat geodesic's elimination order, so loading skips AMD and factors less fill.
-    // A surface the heat method cannot factor (degenerate triangles) simply stores none; the
-    // runtime reports the problem if the heat method is used.
-    base.surface_order =
-        HeatGeodesic::plan_ordering(&base.surface_vertices, &base.surface_triangles).ok();
     report.modes = nm;
     report.frequencies_hz = base.frequencies_hz();
     report.residuals = base.residuals.clone();
@@ -789,4 +878,23 @@ pub fn is_up_to_date_with_transfer(
         }
         Err(_) => false,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The packed-key boundary faces equal the general ones (same faces, same order), on a
+    /// structured box and on the same box with its tets listed in reverse.
+    #[test]
+    fn packed_boundary_faces_equal_the_general_ones() {
+        let mesh = TetMesh::structured_box([7, 3, 4], [1.0, 0.5, 0.5]);
+        let mut tets = mesh.tets.clone();
+        let general = boundary_faces(&tets);
+        assert_eq!(general.len(), 2 * 2 * (7 * 3 + 7 * 4 + 3 * 4));
+        assert_eq!(boundary_faces_packed(&tets), general);
+        tets.reverse();
+        assert_eq!(boundary_faces_packed(&tets), boundary_faces(&tets));
+        assert_eq!(boundary_faces(&tets), general);
+    }
 }
