@@ -92,7 +92,8 @@ pub struct HeatWorkspace {
 impl HeatWorkspace {
     /// Lets queries run the two halves of the factor's elimination tree on two threads
     /// (`rayon::join` in the caller's rayon pool, else rayon's global pool): on a 5k-vertex
-    /// surface a query takes about 0.6× the serial time when a second core is free. The
+    /// surface a query takes down to 0.6× the serial time when a second core is free (less
+    /// gain where the two threads share a physical core or wait to be woken). The
     /// distances are bit-identical either way. Serial by default. Called from a thread outside
     /// any rayon pool, rayon's job injection may allocate now and then; called from inside a
     /// pool (or serial) a query does not allocate. No effect where the elimination order does
