@@ -1,6 +1,6 @@
 //! `dcr-runtime`: distant collision response for rigid-body engines (paper §4.2–4.5).
 //!
-//! Load a baked `.modes` base once ([`format`], [`ModalModel`]), share it between instances, and
+//! Load a baked `.modes` base once ([`mod@format`], [`ModalModel`]), share it between instances, and
 //! per simulation step answer: "these impacts happened; which impulses go to which resting
 //! contacts?" ([`DistantResponse`]).
 //!

@@ -155,7 +155,7 @@ impl ModalModel {
     }
 
     /// A per-vertex field (one value per surface vertex, any unit) read at a surface point:
-    /// linear in its triangle, Σ bary_i · field[v_i].
+    /// linear in its triangle, Σ bary_i · field\[v_i\].
     pub fn interpolate(&self, field: &[f64], sp: &SurfacePoint) -> f64 {
         let vs = self.triangle(sp.triangle);
         (0..3).map(|i| sp.bary[i] * field[vs[i]]).sum()

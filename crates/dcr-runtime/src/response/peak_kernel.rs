@@ -48,11 +48,11 @@ fn abs_max4(acc: &[f64; LANES], pk: &mut [f64; LANES]) {
 
 /// `peaks[c] = max_k |Σ_j b[j·nb + c] · v[j·stride + k]|` for `c < nb`: the largest normal
 /// displacement magnitude (m) of channel c over the step's samples. `v` holds the modal samples
-/// mode-major (`m × stride`, `stride` a multiple of [`LANES`], unused samples zero); `b` holds
+/// mode-major (`m × stride`, `stride` a multiple of `LANES` (4), unused samples zero); `b` holds
 /// the channel weights mode-major too (`m × nb`, one column per channel). Does not allocate.
 ///
 /// # Panics
-/// If `stride` is not a multiple of [`LANES`] or a slice is too short.
+/// If `stride` is not a multiple of `LANES` (4) or a slice is too short.
 pub fn peak_abs_rows(v: &[f64], stride: usize, m: usize, b: &[f64], nb: usize, peaks: &mut [f64]) {
     assert!(
         stride.is_multiple_of(LANES),

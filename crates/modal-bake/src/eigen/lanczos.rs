@@ -42,7 +42,7 @@ const SMALL_EXTRA_BLOCKS: usize = 8;
 const RR_SKIP_FRACTION: f64 = 0.3;
 
 /// A pair whose relative residual is within this factor of its rounding floor counts as
-/// converged even above `tol` (see [`Residual`]).
+/// converged even above `tol` (see `Residual`).
 pub const FLOOR_FACTOR: f64 = 8.0;
 
 pub(crate) fn solve(

@@ -11,7 +11,7 @@
 //! and stored, as f32, in the base ([`dcr_runtime::format::TransferTable`]). The runtime looks
 //! it up with `dcr_runtime::Method::Transfer`.
 //!
-//! The mode set is any base-shaped [`ModesFile`] holding many modes (surface rows of U): from the
+//! The mode set is any base-shaped [`ModesFile`](dcr_runtime::format::ModesFile) holding many modes (surface rows of U): from the
 //! dense all-mode eigensolve ([`mode_set_dense`], small meshes) or a Lanczos bake with many modes
 //! ([`mode_set_lanczos`]).
 

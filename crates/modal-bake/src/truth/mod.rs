@@ -6,9 +6,9 @@
 //! D = α0 M + α1 K, every dof of the mesh):
 //!
 //! - [`newmark_peaks`]: implicit Newmark average acceleration (β = ¼, γ = ½) with a small step,
-//!   one sparse Cholesky of K_eff, one back-solve per step ([`newmark`]).
+//!   one sparse Cholesky of K_eff, one back-solve per step (`newmark`).
 //! - [`ModalAll`]: dense generalized eigensolve of every mode and the exact damped impulse
-//!   response of each (ξ < 1, = 1, > 1) — small meshes only ([`modal_all`]).
+//!   response of each (ξ < 1, = 1, > 1) — small meshes only (`modal_all`).
 //!
 //! Conventions (identical to `modal-bake probe` and `dcr_runtime::ModalModel`):
 //! - points are mapped to the closest triangle of the extracted boundary surface (brute force,
