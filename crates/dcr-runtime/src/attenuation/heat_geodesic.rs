@@ -425,9 +425,10 @@ impl HeatGeodesic {
     /// all in storage order until the final gather to `out`. The heat u falls by about e⁻⁰·⁸
     /// per mean edge length away from the source (t = h²), so the source is scaled up (by a
     /// power of two: the normalised gradient keeps its bits) to put the peak near 1e140, and
-    /// [`divergence`] rescales faces whose u is below ≈ 1e-145: directions stay exact until u
-    /// leaves the double range, about 1,300 edge lengths from the source (unscaled and
-    /// unrescaled they failed beyond ≈ 450, where |∇u|² underflowed). With a [`Layout`] split, the
+    /// [`divergence`] rescales faces whose |A∇u|² leaves [1e-290, 1e290]: directions hold until
+    /// u nears the bottom of the double range, 1,050–1,250 edge lengths from the source on a
+    /// 1 cm strip (unscaled and unrescaled they failed beyond ≈ 450, where |A∇u|² underflowed).
+    /// With a [`Layout`] split, the
     /// halves' sweeps and face loops run as two independent tasks (on two threads when the
     /// workspace allows) between the top block's sweeps.
     fn distances_with(&self, source: &[(usize, f64)], out: &mut [f64], ws: &mut HeatWorkspace) {
