@@ -193,6 +193,29 @@ fn own_solve_matches_faer_on(heat: &HeatGeodesic, n: usize) {
     }
 }
 
+/// The timing probes' surface, the 5,048-vertex box, with the order a bake stores for it
+/// (METIS; without the `metis` feature, AMD's order handed in, which only skips the ordering).
+fn probe_surface() -> (Vec<[f64; 3]>, Vec<[u32; 3]>, Vec<u32>) {
+    let (v, t) = crate::testing::box_surface(29, [1.2, 0.8, 0.6]);
+    #[cfg(feature = "metis")]
+    let order = HeatGeodesic::plan_ordering(&v, &t).unwrap();
+    #[cfg(not(feature = "metis"))]
+    let order = HeatGeodesic::new(&v, &t)
+        .unwrap()
+        .elimination_order()
+        .to_vec();
+    (v, t, order)
+}
+
+/// The timing probes' source: inside triangle 7.
+const PROBE_SOURCE: crate::SurfacePoint = crate::SurfacePoint {
+    triangle: 7,
+    bary: [0.2, 0.3, 0.5],
+    point: [0.0; 3],
+    normal: [0.0; 3],
+    distance: 0.0,
+};
+
 /// Timing probe (not a test of speed): `cargo test --release -p dcr-runtime heat_timing -- --ignored --nocapture`.
 /// Interleaved best-of batches (robust to a loaded machine): set-up, one source (triangle 7),
 /// the spread over 40 sources across the surface (the forward heat sweep walks only the
@@ -201,7 +224,7 @@ fn own_solve_matches_faer_on(heat: &HeatGeodesic, n: usize) {
 #[test]
 #[ignore]
 fn heat_timing() {
-    let (v, t) = crate::testing::box_surface(29, [1.2, 0.8, 0.6]);
+    let (v, t, order) = probe_surface();
     let best = |f: &mut dyn FnMut(), reps: usize, batches: usize| {
         let mut b = f64::INFINITY;
         for _ in 0..batches {
@@ -220,15 +243,7 @@ fn heat_timing() {
         1,
         30,
     );
-    // As a base baked with its `surface_order` loads (METIS; without the feature, AMD's
-    // order handed in, which only skips the ordering).
-    #[cfg(feature = "metis")]
-    let order = HeatGeodesic::plan_ordering(&v, &t).unwrap();
-    #[cfg(not(feature = "metis"))]
-    let order = HeatGeodesic::new(&v, &t)
-        .unwrap()
-        .elimination_order()
-        .to_vec();
+    // As a base baked with its `surface_order` loads.
     let setup = best(
         &mut || {
             std::hint::black_box(HeatGeodesic::with_ordering(&v, &t, Some(&order)).unwrap());
@@ -239,13 +254,7 @@ fn heat_timing() {
     let heat = HeatGeodesic::with_ordering(&v, &t, Some(&order)).unwrap();
     let mut out = vec![0.0; v.len()];
     let mut ws = heat.workspace();
-    let sp = crate::SurfacePoint {
-        triangle: 7,
-        bary: [0.2, 0.3, 0.5],
-        point: [0.0; 3],
-        normal: [0.0; 3],
-        distance: 0.0,
-    };
+    let sp = PROBE_SOURCE;
     // Serial and two-thread queries, interleaved batch by batch.
     let mut ws_par = heat.workspace();
     ws_par.set_parallel(true);
@@ -517,22 +526,12 @@ fn long_strip_distances_survive_heat_underflow() {
 #[test]
 #[ignore]
 fn heat_query_percentiles() {
-    let (v, t) = crate::testing::box_surface(29, [1.2, 0.8, 0.6]);
-    #[cfg(feature = "metis")]
-    let order = HeatGeodesic::plan_ordering(&v, &t).unwrap();
-    #[cfg(not(feature = "metis"))]
-    let order = bisection_order(v.len(), &t);
+    let (v, t, order) = probe_surface();
     let heat = HeatGeodesic::with_ordering(&v, &t, Some(&order)).unwrap();
     let mut out = vec![0.0; v.len()];
     let mut ws = [heat.workspace(), heat.workspace()];
     ws[1].set_parallel(true);
-    let sp = crate::SurfacePoint {
-        triangle: 7,
-        bary: [0.2, 0.3, 0.5],
-        point: [0.0; 3],
-        normal: [0.0; 3],
-        distance: 0.0,
-    };
+    let sp = PROBE_SOURCE;
     let mut times = [Vec::new(), Vec::new()];
     let mut run = || {
         for _ in 0..40 {
