@@ -172,6 +172,9 @@ pub struct EigenInfo {
     /// Explicit residual checks (each costs one purification solve of the wanted vectors whose
     /// estimate is near the tolerance).
     pub residual_checks: usize,
+    /// Ritz vectors purified by an extra solve before the residual checks (summed over the
+    /// checks; see the module docs).
+    pub purified: usize,
     /// Largest Krylov basis size used.
     pub krylov_dim: usize,
     /// Stored entries of the Cholesky factor (0 for the dense path).
