@@ -491,3 +491,61 @@ mod tests {
         }
     }
 }
+
+/// Timing probe (ignored; speed is measured, never asserted): on the bake bench's 3k and 15k
+/// beams, the factorization of K − σM and one block solve of 8 right-hand sides, best and
+/// median of 20, and their sum for the block solves a 20-mode bake takes there (17 and 15):
+/// the floor of a shift-invert Lanczos bake before any orthogonalisation.
+/// `cargo test --release -p modal-bake --lib factor_and_solve_floor -- --ignored --nocapture`
+#[cfg(test)]
+mod timing {
+    use super::*;
+    use crate::fem::{assemble_clamped, Material};
+    use crate::mesh::TetMesh;
+
+    #[test]
+    #[ignore = "timing probe"]
+    fn factor_and_solve_floor() {
+        let beams = [
+            ("bench3k", [24, 6, 6], [1.0, 0.25, 0.25], 17),
+            ("bench15k", [45, 9, 9], [2.0, 0.4, 0.4], 15),
+        ];
+        for (name, cells, size, solves) in beams {
+            let mesh = TetMesh::structured_box(cells, size);
+            let mat = Material::new(2e11, 0.3, 7800.0).unwrap();
+            let (_, k, m) = assemble_clamped(&mesh, &mat, false, &mesh.groups["xmin"]).unwrap();
+            let a = shifted(&k, &m, 0.0);
+            let mut factor = Vec::new();
+            let mut fac = None;
+            for _ in 0..5 {
+                let t = std::time::Instant::now();
+                fac = Some(ShiftInvert::new(&a, Par::Seq).unwrap());
+                factor.push(t.elapsed().as_secs_f64());
+            }
+            let fac = fac.unwrap();
+            let n = a.nrows();
+            let b = faer::Mat::<f64>::from_fn(n, 8, |i, j| ((i * 7 + j * 13) % 11) as f64 - 5.0);
+            let mut buf = fac.solve_buffer(8);
+            let mut solve = Vec::new();
+            for _ in 0..20 {
+                let mut x = b.clone();
+                let t = std::time::Instant::now();
+                fac.solve_in_place(x.as_mut(), &mut buf);
+                solve.push(t.elapsed().as_secs_f64());
+            }
+            factor.sort_by(f64::total_cmp);
+            solve.sort_by(f64::total_cmp);
+            let (f, s) = (factor[0], solve[0]);
+            println!(
+                "{name}: {n} dofs, {} factor entries; factor best {:.1} ms (median {:.1}); \
+                 8-column solve best {:.2} ms (median {:.2}); factor + {solves} solves {:.0} ms",
+                fac.factor_nnz(),
+                f * 1e3,
+                factor[2] * 1e3,
+                s * 1e3,
+                solve[10] * 1e3,
+                (f + solves as f64 * s) * 1e3
+            );
+        }
+    }
+}
