@@ -96,36 +96,27 @@ thread_local! {
 /// One panel of [`spmm_impl`]: `out[i] = Σ_p a_ip · xr[row_p]` (and the absolute sums), each
 /// output row a sequential sum in index order.
 fn spmm_panel(a: &SparseColMat<usize, f64>, xr: &[f64], out: &mut [f64], with_abs: bool) {
-    const W: usize = SPMM_COLS;
-    let (ptr, rows, vals) = (a.symbolic().col_ptr(), a.symbolic().row_idx(), a.val());
-    let (xrows, _) = xr.as_chunks::<W>();
-    let stride = if with_abs { 2 * W } else { W };
+    let (xrows, _) = xr.as_chunks::<SPMM_COLS>();
+    let stride = if with_abs { 2 * SPMM_COLS } else { SPMM_COLS };
     let task = |(t, chunk): (usize, &mut [f64])| {
-        let r0 = t * SPMM_ROWS_PER_TASK;
-        for (ri, o) in chunk.chunks_exact_mut(stride).enumerate() {
-            let i = r0 + ri;
-            let (p0, p1) = (ptr[i], ptr[i + 1]);
-            let mut acc = [0.0f64; W];
-            if with_abs {
-                let mut acc_abs = [0.0f64; W];
-                for (&r, &v) in rows[p0..p1].iter().zip(&vals[p0..p1]) {
-                    let xv = &xrows[r];
-                    for c in 0..W {
-                        let t = v * xv[c];
-                        acc[c] += t;
-                        acc_abs[c] += t.abs();
-                    }
-                }
-                o[W..].copy_from_slice(&acc_abs);
+        let rows = PanelRows {
+            a,
+            xrows,
+            first: t * SPMM_ROWS_PER_TASK,
+            out: chunk,
+        };
+        #[cfg(target_arch = "x86_64")]
+        if let Some(simd) = pulp::x86::V3::try_new() {
+            return if with_abs {
+                pulp::Simd::vectorize(simd, AbsKernel::<true>(rows))
             } else {
-                for (&r, &v) in rows[p0..p1].iter().zip(&vals[p0..p1]) {
-                    let xv = &xrows[r];
-                    for c in 0..W {
-                        acc[c] += v * xv[c];
-                    }
-                }
-            }
-            o[..W].copy_from_slice(&acc);
+                pulp::Simd::vectorize(simd, AbsKernel::<false>(rows))
+            };
+        }
+        if with_abs {
+            rows.run::<true>()
+        } else {
+            rows.run::<false>()
         }
     };
     // Same fixed chunks either way (identical results); small products run on this thread,
@@ -137,6 +128,64 @@ fn spmm_panel(a: &SparseColMat<usize, f64>, xr: &[f64], out: &mut [f64], with_ab
         out.par_chunks_mut(SPMM_ROWS_PER_TASK * stride)
             .enumerate()
             .for_each(task);
+    }
+}
+
+/// One chunk of output rows of [`spmm_panel`], starting at row `first`.
+struct PanelRows<'a> {
+    a: &'a SparseColMat<usize, f64>,
+    xrows: &'a [[f64; SPMM_COLS]],
+    first: usize,
+    out: &'a mut [f64],
+}
+
+/// [`PanelRows::run`] under `pulp` dispatch: AVX2 lanes, with the same operations per lane
+/// and no fused products, so the same bits as the portable (SSE2) path. Measured in-process,
+/// interleaved (best of 30 each): 3.5k dofs, M × 8 columns 0.187 vs 0.232 ms, K × 20 columns
+/// with |K||x| 2.05 vs 2.56 ms; at 13.5k dofs, where the panels leave L2, 1.10 vs 1.17 ms and
+/// 8.6–11.4 vs 11.9–12.5 ms.
+struct AbsKernel<'a, const ABS: bool>(PanelRows<'a>);
+
+impl PanelRows<'_> {
+    /// `out[i] = Σ_p a_ip · xr[row_p]` (and, with `ABS`, the absolute sums) for each row of
+    /// the chunk, each a sequential sum in index order.
+    #[inline(always)]
+    fn run<const ABS: bool>(self) {
+        const W: usize = SPMM_COLS;
+        let (ptr, rows, vals) = (
+            self.a.symbolic().col_ptr(),
+            self.a.symbolic().row_idx(),
+            self.a.val(),
+        );
+        let stride = if ABS { 2 * W } else { W };
+        for (ri, o) in self.out.chunks_exact_mut(stride).enumerate() {
+            let i = self.first + ri;
+            let (p0, p1) = (ptr[i], ptr[i + 1]);
+            let mut acc = [0.0f64; W];
+            let mut acc_abs = [0.0f64; W];
+            for (&r, &v) in rows[p0..p1].iter().zip(&vals[p0..p1]) {
+                let xv = &self.xrows[r];
+                for c in 0..W {
+                    let t = v * xv[c];
+                    acc[c] += t;
+                    if ABS {
+                        acc_abs[c] += t.abs();
+                    }
+                }
+            }
+            o[..W].copy_from_slice(&acc);
+            if ABS {
+                o[W..].copy_from_slice(&acc_abs);
+            }
+        }
+    }
+}
+
+impl<const ABS: bool> pulp::WithSimd for AbsKernel<'_, ABS> {
+    type Output = ();
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, _simd: S) {
+        self.0.run::<ABS>()
     }
 }
 
@@ -244,5 +293,48 @@ impl SplitMix64 {
     /// Uniform in [−1, 1).
     pub fn next_sym(&mut self) -> f64 {
         ((self.next_u64() >> 11) as f64) * (2.0 / (1u64 << 53) as f64) - 1.0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fem::{assemble_clamped, Material};
+    use crate::mesh::TetMesh;
+
+    /// The products (whichever SIMD path runs) give, bit for bit, each output entry as the
+    /// sequential sum over its row's stored entries in index order, and the absolute sums
+    /// likewise: the order the determinism of the bake relies on. Widths around the panel
+    /// width of 8 columns.
+    #[test]
+    fn sym_spmm_sums_each_row_in_index_order() {
+        let mesh = TetMesh::structured_box([4, 3, 2], [1.0, 0.6, 0.4]);
+        let mat = Material::new(2e11, 0.3, 7800.0).unwrap();
+        let (_, k, m) = assemble_clamped(&mesh, &mat, false, &mesh.groups["xmin"]).unwrap();
+        for a in [&k, &m] {
+            let n = a.nrows();
+            let (ptr, rows, vals) = (a.symbolic().col_ptr(), a.symbolic().row_idx(), a.val());
+            for w in [1, 5, 8, 9, 20] {
+                let x =
+                    Mat::<f64>::from_fn(n, w, |i, j| ((i * 31 + j * 17) % 13) as f64 / 7.0 - 0.9);
+                let (mut y, mut ya, mut y1) =
+                    (Mat::zeros(n, w), Mat::zeros(n, w), Mat::zeros(n, w));
+                sym_spmm_with_abs(a, x.as_ref(), y.as_mut(), ya.as_mut());
+                sym_spmm(a, x.as_ref(), y1.as_mut());
+                for c in 0..w {
+                    for i in 0..n {
+                        let (mut s, mut sa) = (0.0f64, 0.0f64);
+                        for p in ptr[i]..ptr[i + 1] {
+                            let t = vals[p] * x[(rows[p], c)];
+                            s += t;
+                            sa += t.abs();
+                        }
+                        assert_eq!(y[(i, c)].to_bits(), s.to_bits(), "w {w}, ({i}, {c})");
+                        assert_eq!(y1[(i, c)].to_bits(), s.to_bits(), "w {w}, ({i}, {c})");
+                        assert_eq!(ya[(i, c)].to_bits(), sa.to_bits(), "w {w}, |.| ({i}, {c})");
+                    }
+                }
+            }
+        }
     }
 }
