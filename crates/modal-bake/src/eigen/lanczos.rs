@@ -469,6 +469,7 @@ fn lanczos_chunk(
         if ready || out_of_steps {
             info.residual_checks += 1;
             let sel = select_cols(s_asc.as_ref(), &order[..wanted.min(kk)]);
+            // Written as "not ≤" so that a NaN estimate is purified.
             let purify: Vec<bool> = est
                 .iter()
                 .take(wanted.min(kk))
