@@ -493,8 +493,9 @@ mod tests {
 }
 
 /// Timing probe (ignored; speed is measured, never asserted): on the bake bench's 3k and 15k
-/// beams, the factorization of K − σM and one block solve of 8 right-hand sides, best and
-/// median of 20, and their sum for the block solves a 20-mode bake takes there (17 and 15):
+/// beams (`benches/bake.rs`), the factorization of K − σM (best and median of 5) and one
+/// block solve of 8 right-hand sides (best and median of 20), and the best factorization plus
+/// as many best solves as a 20-mode bake takes there (17 and 15, `EigenInfo::block_solves`):
 /// the floor of a shift-invert Lanczos bake before any orthogonalisation.
 /// `cargo test --release -p modal-bake --lib factor_and_solve_floor -- --ignored --nocapture`
 #[cfg(test)]
