@@ -27,7 +27,7 @@ use std::path::{Path, PathBuf};
 use dcr_runtime::format::ModesFile;
 
 pub use contact_sheet::{render_contact_sheet, write_modes_png, SheetParams};
-pub use gltf_builder::{GltfBuilder, GLTF_GENERATOR};
+pub use gltf_builder::{extras_of, GltfBuilder, GLTF_GENERATOR};
 pub use mode_gltf::{write_modes_glb, ModeGltfParams};
 pub use mode_vtu::write_modes_vtu;
 
