@@ -51,14 +51,21 @@ function clearModel() {
 
 function sideOf(label) { return state.sides.find((s) => s.label === label) || state.sides[0]; }
 
+// Frames the elastic and moving bodies under `obj` (static scenery such as a large ground
+// plane is left out), or all of `obj` when it has none.
 function frame(obj, offset) {
-  const box = new Box3().setFromObject(obj);
+  const box = new Box3();
+  obj.traverse((o) => {
+    if (o.userData && (o.userData.elastic || o.userData.dynamic)) box.expandByObject(o);
+  });
+  if (box.isEmpty()) box.setFromObject(obj);
   const size = box.getSize(new Vector3());
   const center = box.getCenter(new Vector3());
   if (offset) center.sub(offset);
   const dim = Math.max(size.x, size.y * 1.4, size.z, 1e-3);
-  const dist = (0.5 * dim) / Math.tan((camera.fov * Math.PI) / 360);
-  const dir = new Vector3(0, 0.42, 1).normalize();
+  const dist = (0.44 * dim) / Math.tan((camera.fov * Math.PI) / 360);
+  const az = (Number(params.get('az') || 0) * Math.PI) / 180; // camera azimuth about +y (deg)
+  const dir = new Vector3(Math.sin(az), 0.42, Math.cos(az)).normalize();
   camera.position.copy(center).addScaledVector(dir, dist);
   camera.near = dist / 100;
   camera.far = dist * 100;
