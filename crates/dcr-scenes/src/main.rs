@@ -189,8 +189,14 @@ fn real_main() -> Result<()> {
             let refs: Vec<&RunReport> = reports.iter().collect();
             if !desc.outcomes.is_empty() {
                 let svg = out_dir.join("outcomes.svg");
+                let t = std::time::Instant::now();
                 write_outcomes_svg(&desc, &refs, &svg)?;
-                println!("  outcomes over time: {}", svg.display());
+                println!(
+                    "  outcomes over time: {} ({:.1} KiB, {:.3} s)",
+                    svg.display(),
+                    std::fs::metadata(&svg).map_or(0, |m| m.len()) as f64 / 1024.0,
+                    t.elapsed().as_secs_f64()
+                );
             }
             if let Some(path) = gltf {
                 let sides: Vec<Side> = reports
@@ -200,15 +206,17 @@ fn real_main() -> Result<()> {
                         report: r,
                     })
                     .collect();
+                let t = std::time::Instant::now();
                 let info = write_scene_glb(&desc, &root, &bases_dir, &sides, &path)
                     .with_context(|| format!("writing {}", path.display()))?;
                 println!(
-                    "  glTF: {} ({:.1} KiB, {} body nodes, {} keyframes, {} response events)",
+                    "  glTF: {} ({:.1} KiB, {} body nodes, {} keyframes, {} response events, {:.3} s)",
                     path.display(),
                     info.bytes as f64 / 1024.0,
                     info.body_nodes,
                     info.keyframes,
-                    info.events
+                    info.events,
+                    t.elapsed().as_secs_f64()
                 );
             }
         }
