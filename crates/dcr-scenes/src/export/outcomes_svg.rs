@@ -87,6 +87,9 @@ pub fn write_outcomes_svg(desc: &SceneDesc, runs: &[&RunReport], path: &Path) ->
                 .y_desc(unit)
                 .draw()
                 .map_err(|e| anyhow::anyhow!("{e}"))?;
+            // Off first, so the on curve is drawn on top where they coincide.
+            let mut series = series;
+            series.sort_by_key(|(dcr, _)| *dcr);
             for (dcr, pts) in series {
                 let (colour, label) = if dcr {
                     (RGBColor(200, 60, 40), "dcr on")
