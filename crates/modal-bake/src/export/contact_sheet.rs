@@ -14,10 +14,7 @@ use dcr_runtime::format::ModesFile;
 use tiny_skia::{Color, Paint, Pixmap, Rect, Transform};
 
 use super::raster::{glyph, viridis, Raster};
-use super::{
-    bounding_box, diagonal, linear_triangles, mode_max_norm, mode_vec, write_file_atomic,
-    ExportError,
-};
+use super::{bounding_box, diagonal, write_file_atomic, ExportError, ExportSurface};
 
 /// Settings of [`render_contact_sheet`].
 #[derive(Clone, Debug)]
@@ -120,13 +117,14 @@ pub fn render_contact_sheet(base: &ModesFile, p: &SheetParams) -> Result<Pixmap,
     pix.fill(Color::WHITE);
 
     // Camera from the undeformed bounding box.
-    let (lo, hi) = bounding_box(&base.surface_vertices);
+    let surf = ExportSurface::of(base);
+    let (lo, hi) = bounding_box(&surf.positions);
     let centre = [
         0.5 * (lo[0] + hi[0]),
         0.5 * (lo[1] + hi[1]),
         0.5 * (lo[2] + hi[2]),
     ];
-    let diag = diagonal(&base.surface_vertices);
+    let diag = diagonal(&surf.positions);
     let (az, el) = (p.azimuth_deg.to_radians(), p.elevation_deg.to_radians());
     let eye = [el.cos() * az.sin(), el.sin(), el.cos() * az.cos()];
     let right = normalize(cross([0.0, 1.0, 0.0], eye));
@@ -138,7 +136,7 @@ pub fn render_contact_sheet(base: &ModesFile, p: &SheetParams) -> Result<Pixmap,
         f64::INFINITY,
         f64::NEG_INFINITY,
     );
-    for q in &base.surface_vertices {
+    for q in &surf.positions {
         let d = sub(*q, centre);
         let (x, y) = (dot(d, right), dot(d, up));
         x0s = x0s.min(x);
@@ -155,13 +153,13 @@ pub fn render_contact_sheet(base: &ModesFile, p: &SheetParams) -> Result<Pixmap,
     } else {
         1.0
     };
-    let tris = linear_triangles(base);
+    let tris = &surf.triangles;
     let freqs = base.frequencies_hz();
-    let ns = base.num_surface_vertices();
+    let ns = surf.len();
 
     for j in 0..p.modes {
         let (col, row) = (j % cols, j / cols);
-        let peak = mode_max_norm(base, j);
+        let peak = surf.mode_max_norm(j);
         let a = if peak > 0.0 {
             p.scale * diag / peak
         } else {
@@ -171,8 +169,8 @@ pub fn render_contact_sheet(base: &ModesFile, p: &SheetParams) -> Result<Pixmap,
         let mut pos = Vec::with_capacity(ns);
         let mut col_v = Vec::with_capacity(ns);
         for v in 0..ns {
-            let u = mode_vec(base, v, j);
-            let x = base.surface_vertices[v];
+            let u = surf.mode_vec(v, j);
+            let x = surf.positions[v];
             pos.push([x[0] + a * u[0], x[1] + a * u[1], x[2] + a * u[2]]);
             let mag = dot(u, u).sqrt();
             col_v.push(viridis(if peak > 0.0 { mag / peak } else { 0.0 }));
@@ -188,7 +186,7 @@ pub fn render_contact_sheet(base: &ModesFile, p: &SheetParams) -> Result<Pixmap,
                 (-dot(d, eye)) as f32,
             ]
         };
-        for t in &tris {
+        for t in tris {
             let q = [pos[t[0] as usize], pos[t[1] as usize], pos[t[2] as usize]];
             let n = normalize(cross(sub(q[1], q[0]), sub(q[2], q[0])));
             let shade = (0.35 + 0.65 * dot(n, eye).abs()) as f32;

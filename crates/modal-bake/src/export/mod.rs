@@ -14,7 +14,8 @@
 //! `U[v, :, j] · q_j` for a modal coordinate q_j (kg^½·m). Exports show each mode with q_j
 //! chosen so that its largest vertex displacement is a stated length (see each writer).
 //!
-//! Surfaces are the base's linear triangles (`surface_triangles`, outward).
+//! Every writer draws the same surface (`ExportSurface`): the base's vertices and outward linear
+//! triangles.
 
 mod contact_sheet;
 mod gltf_builder;
@@ -104,30 +105,59 @@ pub fn select_modes(base: &ModesFile, n: Option<usize>) -> Result<usize, ExportE
     }
 }
 
-/// Linear surface triangles of the base (outward, counter-clockwise from outside).
-pub(crate) fn linear_triangles(base: &ModesFile) -> Vec<[u32; 3]> {
-    base.surface_triangles.clone()
+/// The surface an export shows: vertices, linear triangles and per-vertex mode rows.
+///
+/// Built once per export by [`ExportSurface::of`]. A second-order base's 6-node triangles are
+/// to be split here into four linear triangles through their mid-edge nodes (positions at the
+/// edge midpoints, mode rows from the base's mid-edge rows), so every writer sees plain
+/// triangles; today's bases are linear and pass through unchanged.
+pub(crate) struct ExportSurface {
+    /// Vertex positions (m, object frame).
+    pub positions: Vec<[f64; 3]>,
+    /// Outward triangles (indices into `positions`).
+    pub triangles: Vec<[u32; 3]>,
+    /// Volume-mesh node of each vertex.
+    pub volume_node: Vec<u32>,
+    /// Mode rows (v, 3, m) row-major, m·kg^-½.
+    modes: Vec<f64>,
+    m: usize,
 }
 
-/// Mode j's displacement of vertex v (m per unit modal coordinate, object frame).
-pub(crate) fn mode_vec(base: &ModesFile, v: usize, j: usize) -> [f64; 3] {
-    let m = base.num_modes();
-    let r = v * 3 * m;
-    [
-        base.modes[r + j],
-        base.modes[r + m + j],
-        base.modes[r + 2 * m + j],
-    ]
-}
+impl ExportSurface {
+    pub fn of(base: &ModesFile) -> ExportSurface {
+        ExportSurface {
+            positions: base.surface_vertices.clone(),
+            triangles: base.surface_triangles.clone(),
+            volume_node: base.surface_to_volume.clone(),
+            modes: base.modes.clone(),
+            m: base.num_modes(),
+        }
+    }
 
-/// Largest vertex displacement norm of mode j (m per unit modal coordinate).
-pub(crate) fn mode_max_norm(base: &ModesFile, j: usize) -> f64 {
-    (0..base.num_surface_vertices())
-        .map(|v| {
-            let u = mode_vec(base, v, j);
-            (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt()
-        })
-        .fold(0.0, f64::max)
+    /// Number of vertices.
+    pub fn len(&self) -> usize {
+        self.positions.len()
+    }
+
+    /// Mode j's displacement of vertex v (m per unit modal coordinate, object frame).
+    pub fn mode_vec(&self, v: usize, j: usize) -> [f64; 3] {
+        let (m, r) = (self.m, v * 3 * self.m);
+        [
+            self.modes[r + j],
+            self.modes[r + m + j],
+            self.modes[r + 2 * m + j],
+        ]
+    }
+
+    /// Largest vertex displacement norm of mode j (m per unit modal coordinate).
+    pub fn mode_max_norm(&self, j: usize) -> f64 {
+        (0..self.len())
+            .map(|v| {
+                let u = self.mode_vec(v, j);
+                (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt()
+            })
+            .fold(0.0, f64::max)
+    }
 }
 
 /// Axis-aligned bounding box (min, max) of the surface (m, object frame).
@@ -149,8 +179,8 @@ pub(crate) fn diagonal(points: &[[f64; 3]]) -> f64 {
     ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2) + (hi[2] - lo[2]).powi(2)).sqrt()
 }
 
-/// Writes `bytes` to `path` through a temporary file beside it and a rename: on failure
-/// nothing is left behind and an existing `path` is untouched.
+/// Writes `bytes` to `path` through a temporary file beside it (`tempfile`) and a rename: on
+/// failure nothing is left behind and an existing `path` is untouched.
 ///
 /// # Errors
 /// I/O errors, naming `path`.
@@ -164,20 +194,17 @@ pub fn write_file_atomic(path: &Path, bytes: &[u8]) -> Result<(), ExportError> {
         .parent()
         .filter(|d| !d.as_os_str().is_empty())
         .unwrap_or(Path::new("."));
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let tmp = dir.join(format!(".{name}.tmp-{}", std::process::id()));
-    let result = (|| {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
-        f.sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    if let Err(e) = result {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(io(e));
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(".export-");
+    // Readable like any file the user creates (tempfile's default is owner-only).
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        builder.permissions(std::fs::Permissions::from_mode(0o644));
     }
+    let mut tmp = builder.tempfile_in(dir).map_err(io)?;
+    tmp.write_all(bytes).map_err(io)?;
+    tmp.as_file().sync_all().map_err(io)?;
+    tmp.persist(path).map_err(|e| io(e.error))?;
     Ok(())
 }

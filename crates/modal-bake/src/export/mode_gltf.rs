@@ -7,10 +7,7 @@ use dcr_runtime::format::ModesFile;
 use gltf::json::{self, animation::Property, validation::Checked, Index};
 
 use super::gltf_builder::extras_of;
-use super::{
-    diagonal, linear_triangles, mode_label, mode_max_norm, mode_vec, write_file_atomic,
-    ExportError, GltfBuilder,
-};
+use super::{diagonal, mode_label, write_file_atomic, ExportError, ExportSurface, GltfBuilder};
 
 /// Settings of [`write_modes_glb`].
 #[derive(Clone, Debug)]
@@ -88,18 +85,19 @@ fn modes_glb_bytes(base: &ModesFile, params: &ModeGltfParams) -> Result<Vec<u8>,
             "animation period must be positive with at least 4 keyframes".into(),
         ));
     }
-    let ns = base.num_surface_vertices();
+    let surf = ExportSurface::of(base);
+    let ns = surf.len();
     let freqs = base.frequencies_hz();
-    let diag = diagonal(&base.surface_vertices);
-    let positions: Vec<[f32; 3]> = base
-        .surface_vertices
+    let diag = diagonal(&surf.positions);
+    let positions: Vec<[f32; 3]> = surf
+        .positions
         .iter()
         .map(|p| [p[0] as f32, p[1] as f32, p[2] as f32])
         .collect();
     let mut targets = Vec::with_capacity(n);
     let mut info = Vec::with_capacity(n);
     for j in 0..n {
-        let peak = mode_max_norm(base, j);
+        let peak = surf.mode_max_norm(j);
         if !(peak > 0.0) {
             return Err(ExportError::Invalid(format!(
                 "mode {} is zero on the surface",
@@ -109,7 +107,7 @@ fn modes_glb_bytes(base: &ModesFile, params: &ModeGltfParams) -> Result<Vec<u8>,
         let a = params.scale * diag / peak;
         let d: Vec<[f32; 3]> = (0..ns)
             .map(|v| {
-                let u = mode_vec(base, v, j);
+                let u = surf.mode_vec(v, j);
                 [(a * u[0]) as f32, (a * u[1]) as f32, (a * u[2]) as f32]
             })
             .collect();
@@ -127,8 +125,7 @@ fn modes_glb_bytes(base: &ModesFile, params: &ModeGltfParams) -> Result<Vec<u8>,
 
     let mut b = GltfBuilder::new();
     let material = b.material("surface", [0.75, 0.72, 0.68, 1.0], 0.6, false);
-    let tris = linear_triangles(base);
-    let mesh = b.triangle_mesh("surface", &positions, &tris, material, &targets)?;
+    let mesh = b.triangle_mesh("surface", &positions, &surf.triangles, material, &targets)?;
     let node = b.root.push(json::Node {
         mesh: Some(mesh),
         name: Some("surface".into()),

@@ -12,7 +12,7 @@ use vtkio::model::{
     UnstructuredGridPiece, Version, VertexNumbers, Vtk,
 };
 
-use super::{linear_triangles, mode_label, mode_vec, write_file_atomic, ExportError};
+use super::{mode_label, write_file_atomic, ExportError, ExportSurface};
 
 /// Writes the surface of `base` with the lowest `modes` mode shapes to `path` (VTK XML
 /// UnstructuredGrid, `.vtu`).
@@ -41,15 +41,16 @@ pub fn write_modes_vtu(base: &ModesFile, modes: usize, path: &Path) -> Result<()
             "cannot export {modes} modes from a base with {m}"
         )));
     }
-    let ns = base.num_surface_vertices();
+    let surf = ExportSurface::of(base);
+    let ns = surf.len();
     let freqs = base.frequencies_hz();
-    let tris = linear_triangles(base);
-    let points: Vec<f64> = base.surface_vertices.iter().flatten().copied().collect();
+    let tris = &surf.triangles;
+    let points: Vec<f64> = surf.positions.iter().flatten().copied().collect();
     let connectivity: Vec<u64> = tris.iter().flatten().map(|&i| i as u64).collect();
     let offsets: Vec<u64> = (1..=tris.len() as u64).map(|k| 3 * k).collect();
     let mut point = Vec::with_capacity(modes + 1);
     for (j, &hz) in freqs.iter().enumerate().take(modes) {
-        let data: Vec<f64> = (0..ns).flat_map(|v| mode_vec(base, v, j)).collect();
+        let data: Vec<f64> = (0..ns).flat_map(|v| surf.mode_vec(v, j)).collect();
         point.push(Attribute::DataArray(DataArray {
             name: mode_label(j, hz),
             elem: ElementType::Vectors,
@@ -62,7 +63,7 @@ pub fn write_modes_vtu(base: &ModesFile, modes: usize, path: &Path) -> Result<()
             num_comp: 1,
             lookup_table: None,
         },
-        data: IOBuffer::I64(base.surface_to_volume.iter().map(|&i| i as i64).collect()),
+        data: IOBuffer::I64(surf.volume_node.iter().map(|&i| i as i64).collect()),
     }));
     let vtk = Vtk {
         version: Version::new(),
