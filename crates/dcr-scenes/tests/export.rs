@@ -275,3 +275,41 @@ fn cli_run_both_writes_both_runs_outcomes_svg_and_the_glb() {
     assert_eq!(on["dcr"], true);
     validate_gltf(&glb);
 }
+
+#[test]
+fn cli_table1_gltf_writes_one_on_off_file_per_scene() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_dcr-scenes"))
+        .args([
+            "table1",
+            "--scenes",
+            "dinner,roof",
+            "--seconds",
+            "0.3",
+            "--bases",
+        ])
+        .arg(bases())
+        .arg("--gltf")
+        .arg(dir.path())
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for s in ["dinner", "roof"] {
+        let path = dir.path().join(format!("{s}.glb"));
+        validate_gltf(&path);
+        let ex = Glb::read(&path).extras();
+        let labels: Vec<_> = ex["dcr"]["sides"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|s| {
+                (
+                    s["label"].as_str().unwrap().to_string(),
+                    s["dcr"].as_bool().unwrap(),
+                )
+            })
+            .collect();
+        assert_eq!(labels, [("on".into(), true), ("off".into(), false)], "{s}");
+        assert_eq!(ex["dcr"]["scene"], s);
+    }
+}

@@ -235,6 +235,7 @@ fn png_sheet_has_one_distinct_panel_per_mode_and_exports_are_deterministic() {
     let a = outs("a");
     let b = outs("b");
     assert!(a == b, "two exports of the same base differ");
+    validate_gltf(&dir.path().join("a.glb"));
     let png = tiny_skia::Pixmap::decode_png(&a[2]).unwrap();
     // 6 modes in 4 columns: 2 rows of 320 × 240 panels.
     assert_eq!((png.width(), png.height()), (1280, 480));
