@@ -1,4 +1,5 @@
-//! `modal-bake export`: the VTU opens in meshio with every mode shape bit-exact, the GLB's morph
+//! `modal-bake export`: the VTU opens in meshio and in VTK's own reader (ParaView's) with every
+//! mode shape bit-exact, the GLB's morph
 //! targets are the scaled mode shapes and pass the Khronos glTF-Validator, the PNG sheet shows
 //! one distinct panel per mode, outputs are deterministic, and bad options fail with a clear
 //! message and no file written.
@@ -121,6 +122,76 @@ print(json.dumps({"points": m.points.tolist(), "types": [c.type for c in m.cells
     }
     let s2v = pd["surface_to_volume"].as_array().unwrap();
     assert_eq!(s2v[0].as_u64().unwrap(), base.surface_to_volume[0] as u64);
+}
+
+/// VTK's own XML reader (the one ParaView uses, from the PyPI `vtk` package) opens the file:
+/// every cell a triangle, every mode array with its values bit-exact.
+#[test]
+fn vtu_opened_by_vtks_own_reader_as_paraview_does() {
+    let dir = tempfile::tempdir().unwrap();
+    let base_path = beam_base(dir.path());
+    let vtu = dir.path().join("beam.vtu");
+    let o = run(&["export", s(&base_path), "--vtu", s(&vtu), "--modes", "3"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let script = r#"
+import json, sys
+try:
+    import vtk
+except ImportError:
+    print("NO_VTK"); sys.exit(0)
+r = vtk.vtkXMLUnstructuredGridReader()
+r.SetFileName(sys.argv[1])
+r.Update()
+g = r.GetOutput()
+pd = g.GetPointData()
+arrays = {pd.GetArrayName(i): [list(pd.GetArray(i).GetTuple(k)) for k in range(g.GetNumberOfPoints())]
+          for i in range(pd.GetNumberOfArrays())}
+print(json.dumps({"error": r.GetErrorCode(), "points": g.GetNumberOfPoints(),
+                  "types": sorted({g.GetCellType(c) for c in range(g.GetNumberOfCells())}),
+                  "cells": g.GetNumberOfCells(), "arrays": arrays}))
+"#;
+    let out = Command::new("python3")
+        .args(["-c", script, s(&vtu)])
+        .output()
+        .expect("python3 runs");
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "vtk failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    if text.trim() == "NO_VTK" {
+        assert!(
+            std::env::var_os("CI").is_none() || std::env::var_os("DCR_NO_VTK").is_some(),
+            "the vtk package is not installed under CI"
+        );
+        eprintln!("SKIPPED: vtk not installed (pip install vtk)");
+        return;
+    }
+    let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let base = ModesFile::read(&base_path).unwrap();
+    assert_eq!(v["error"], 0);
+    assert_eq!(
+        v["points"].as_u64().unwrap() as usize,
+        base.num_surface_vertices()
+    );
+    assert_eq!(
+        v["cells"].as_u64().unwrap() as usize,
+        base.surface_triangles.len()
+    );
+    assert_eq!(v["types"], serde_json::json!([5]), "VTK_TRIANGLE only");
+    let freqs = base.frequencies_hz();
+    let arrays = v["arrays"].as_object().unwrap();
+    assert_eq!(arrays.len(), 4, "{:?}", arrays.keys());
+    for j in 0..3 {
+        let rows = arrays[&mode_label(j, freqs[j])].as_array().unwrap();
+        for (vtx, row) in rows.iter().enumerate() {
+            let u = mode(&base, vtx, j);
+            for a in 0..3 {
+                assert_eq!(row[a].as_f64().unwrap(), u[a], "mode {j} vertex {vtx}");
+            }
+        }
+    }
 }
 
 #[test]
