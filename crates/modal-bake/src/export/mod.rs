@@ -107,10 +107,9 @@ pub fn select_modes(base: &ModesFile, n: Option<usize>) -> Result<usize, ExportE
 
 /// The surface an export shows: vertices, linear triangles and per-vertex mode rows.
 ///
-/// Built once per export by [`ExportSurface::of`]. A second-order base's 6-node triangles are
-/// to be split here into four linear triangles through their mid-edge nodes (positions at the
-/// edge midpoints, mode rows from the base's mid-edge rows), so every writer sees plain
-/// triangles; today's bases are linear and pass through unchanged.
+/// Built once per export by [`ExportSurface::of`] from the base's corner vertices and linear
+/// triangles (the one place to split second-order 6-node triangles into four linear ones
+/// through their mid-edge nodes; bases carrying mid-edge rows are shown by their corners).
 pub(crate) struct ExportSurface {
     /// Vertex positions (m, object frame).
     pub positions: Vec<[f64; 3]>,
