@@ -188,16 +188,21 @@ fn outcome_curves_end_at_the_reported_figures_and_the_svg_has_one_per_run() {
     let (on, off) = (run(&desc, true, 0.5), run(&desc, false, 0.5));
     for r in [&on, &off] {
         for o in &desc.outcomes {
-            let v = outcome_series(o, &r.trajectory);
+            let v = outcome_series(o, &r.trajectory, 1000);
             assert_eq!(v.len(), r.trajectory.rows());
-            assert_eq!(*v.last().unwrap(), r.outcomes[&o.name].0, "{}", o.name);
+            assert_eq!(v.last().unwrap().1, r.outcomes[&o.name].0, "{}", o.name);
             if o.kind.starts_with("max_") && o.kind != "max_slide" {
                 assert!(
-                    v.windows(2).all(|w| w[1] >= w[0]),
+                    v.windows(2).all(|w| w[1].1 >= w[0].1),
                     "{} not monotone",
                     o.name
                 );
             }
+            // Thinned to at most 10 points: first and last rows kept, same values there.
+            let few = outcome_series(o, &r.trajectory, 10);
+            assert!(few.len() <= 10, "{} points", few.len());
+            assert_eq!(few[0], v[0]);
+            assert_eq!(few.last(), v.last());
         }
     }
     let dir = tempfile::tempdir().unwrap();

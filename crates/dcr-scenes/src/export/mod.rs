@@ -7,6 +7,6 @@ mod outcomes_svg;
 mod scene_gltf;
 mod shape_mesh;
 
-pub use outcomes_svg::{outcome_series, write_outcomes_svg};
+pub use outcomes_svg::{outcome_series, write_outcomes_svg, SVG_CURVE_POINTS};
 pub use scene_gltf::{side_label, write_scene_glb, SceneGlbInfo, Side};
 pub use shape_mesh::{shape_triangles, ShapeMesh};

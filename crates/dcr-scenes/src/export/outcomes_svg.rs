@@ -10,20 +10,35 @@ use plotters::prelude::*;
 use crate::runner::{measure_outcome, unit_of, RunReport, Trajectory};
 use crate::scene::{OutcomeDesc, SceneDesc};
 
-/// The figure `o` as measured on rows 0..=k of `traj`, for every row k: the running value
-/// whose last entry is the run's reported figure (`max_*` kinds rise monotonically; slides
-/// and counts follow the current state). NaN where the figure is undefined (no body matches).
-pub fn outcome_series(o: &OutcomeDesc, traj: &Trajectory) -> Vec<f64> {
+/// Most points per curve in [`write_outcomes_svg`] (each point measures the trajectory up to
+/// it, so a curve costs points × rows).
+pub const SVG_CURVE_POINTS: usize = 500;
+
+/// The figure `o` as measured on rows 0..=k of `traj`, at up to `max_points` rows k evenly
+/// spread over the run (always the first and the last): `(t_k in s, value)`. The running
+/// value whose last entry is the run's reported figure (`max_*` kinds rise monotonically;
+/// slides and counts follow the current state). NaN where the figure is undefined (no body
+/// matches).
+pub fn outcome_series(o: &OutcomeDesc, traj: &Trajectory, max_points: usize) -> Vec<(f64, f64)> {
     let n = traj.rows();
+    if n == 0 {
+        return Vec::new();
+    }
     let nb = traj.names.len();
+    let stride = n.div_ceil(max_points.max(2) - 1).max(1);
+    let mut rows: Vec<usize> = (0..n).step_by(stride).collect();
+    if rows.last() != Some(&(n - 1)) {
+        rows.push(n - 1);
+    }
     let mut t = traj.clone();
-    let mut out = vec![f64::NAN; n];
-    for k in (0..n).rev() {
+    let mut out = Vec::with_capacity(rows.len());
+    for &k in rows.iter().rev() {
         t.time.truncate(k + 1);
         t.positions.truncate((k + 1) * nb * 3);
         t.rotations.truncate((k + 1) * nb * 4);
-        out[k] = measure_outcome(o, &t).unwrap_or(f64::NAN);
+        out.push((traj.time[k], measure_outcome(o, &t).unwrap_or(f64::NAN)));
     }
+    out.reverse();
     out
 }
 
@@ -51,14 +66,9 @@ pub fn write_outcomes_svg(desc: &SceneDesc, runs: &[&RunReport], path: &Path) ->
             let series: Vec<(bool, Vec<(f64, f64)>)> = runs
                 .iter()
                 .map(|r| {
-                    let v = outcome_series(o, &r.trajectory);
-                    let pts = r
-                        .trajectory
-                        .time
-                        .iter()
-                        .zip(v)
+                    let pts = outcome_series(o, &r.trajectory, SVG_CURVE_POINTS)
+                        .into_iter()
                         .filter(|(_, y)| y.is_finite())
-                        .map(|(&t, y)| (t, y))
                         .collect();
                     (r.dcr, pts)
                 })
