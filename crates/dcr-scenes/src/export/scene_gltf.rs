@@ -10,9 +10,9 @@
 //!
 //! `extras.dcr` of the document: `kind: "scene_run"`, `scene`, `h`, `rows`, and per side
 //! `{label, node, dcr, offset, outcomes {name: [value, unit]}, events [{row, time, body, node,
-//! point, impulse}]}` — every response impulse applied (trajectory row and time t = row · h,
-//! receiving body, point m and impulse N·s in the simulation's world frame, i.e. the side's
-//! local frame).
+//! model, point, impulse}]}` — every response impulse applied (trajectory row and time
+//! t = row · h, receiving body, the elastic object whose response it is, point m and impulse
+//! N·s in the simulation's world frame, i.e. the side's local frame).
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -312,6 +312,7 @@ pub fn write_scene_glb(
                     "time": e.row as f64 * r.h,
                     "body": body,
                     "node": format!("{}_{}", side.label, body),
+                    "model": desc.elastic.get(e.model).map(|m| m.name.as_str()),
                     "point": e.point,
                     "impulse": e.impulse,
                 })
