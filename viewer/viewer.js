@@ -2,7 +2,7 @@
 // events from extras.dcr) and `modal-bake export … --gltf` (one animation per mode).
 // Static page; three.js comes bundled in vendor/ (no network at run time).
 import {
-  AmbientLight, AnimationMixer, ArrowHelper, Box3, Color, DirectionalLight, HemisphereLight,
+  AmbientLight, AnimationMixer, ArrowHelper, Box3, BufferAttribute, Color, DirectionalLight, HemisphereLight,
   LoopRepeat, PerspectiveCamera, Scene, SRGBColorSpace, Vector3, WebGLRenderer,
   GLTFLoader, OrbitControls,
 } from 'three-bundle';
@@ -138,8 +138,33 @@ function setupModes(gltf, dcr) {
   $('info').textContent = `${dcr.modes.length} modes, largest displacement ${dcr.scale} × diagonal (${(dcr.scale * dcr.diagonal_m).toPrecision(3)} m)`;
 }
 
+// Viridis (as the PNG contact sheet): displacement magnitude of the selected mode as colour.
+const VIRIDIS = [[0.267, 0.005, 0.329], [0.283, 0.141, 0.458], [0.254, 0.265, 0.530], [0.207, 0.372, 0.553],
+  [0.164, 0.471, 0.558], [0.128, 0.567, 0.551], [0.135, 0.659, 0.518], [0.478, 0.821, 0.319], [0.993, 0.906, 0.144]];
+function viridis(t) {
+  const x = Math.min(Math.max(t, 0), 1) * (VIRIDIS.length - 1);
+  const i = Math.min(Math.floor(x), VIRIDIS.length - 2), f = x - i;
+  // sRGB table → linear vertex colours (the renderer converts back on output).
+  return VIRIDIS[i].map((a, k) => ((a + f * (VIRIDIS[i + 1][k] - a) + 0.055) / 1.055) ** 2.4);
+}
+function colourByMode(i) {
+  state.root.traverse((o) => {
+    const targets = o.isMesh && o.geometry.morphAttributes.position;
+    if (!targets || !targets[i]) return;
+    const d = targets[i];
+    const mag = new Float32Array(d.count);
+    let peak = 0;
+    for (let v = 0; v < d.count; v++) { mag[v] = Math.hypot(d.getX(v), d.getY(v), d.getZ(v)); peak = Math.max(peak, mag[v]); }
+    const rgb = new Float32Array(3 * d.count);
+    for (let v = 0; v < d.count; v++) rgb.set(viridis(peak > 0 ? mag[v] / peak : 0), 3 * v);
+    o.geometry.setAttribute('color', new BufferAttribute(rgb, 3));
+    if (!o.material.vertexColors) { o.material = o.material.clone(); o.material.vertexColors = true; o.material.color.set(0xffffff); }
+  });
+}
+
 function selectMode(i) {
   if (!state.modes[i]) return;
+  colourByMode(i);
   state.mixer.stopAllAction();
   state.action = state.mixer.clipAction(state.modes[i]);
   state.action.setLoop(LoopRepeat, Infinity).play();

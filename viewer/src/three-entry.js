@@ -5,6 +5,7 @@ export {
   AnimationMixer,
   ArrowHelper,
   Box3,
+  BufferAttribute,
   Color,
   DirectionalLight,
   HemisphereLight,
