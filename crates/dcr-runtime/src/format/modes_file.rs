@@ -30,6 +30,13 @@
 //! `transfer_samples` u32 (), and `transfer_edges` u32 (ne, 2) (absent in tables written
 //! before it: vertex points only). Readers that predate the table ignore these entries.
 //!
+//! Optional (version ≥ 2, all or none): the mid-edge rows of a second-order (P2) base
+//! ([`QuadraticSurface`]): `surface_edges` u32 (ne, 2), `edge_to_volume` u32 (ne,),
+//! `edge_modes` f64 or f32 (ne, 3, m). A file carries the lowest version that describes it
+//! ([`ModesFile::required_format_version`]): linear bases stay version 1, which every earlier
+//! reader opens; second-order bases are version 2, which version-1 readers refuse rather than
+//! interpolate them linearly.
+//!
 //! Files are written deterministically (fixed zip timestamps, fixed entry order, stored) and
 //! atomically (temporary file in the target directory, then rename).
 
@@ -42,10 +49,11 @@ use ndarray_npy::npy::header::Header;
 use ndarray_npy::{NpzWriter, ReadNpyExt, ReadableElement};
 use serde::{Deserialize, Serialize};
 
+use super::quadratic_surface::{QuadraticSurface, QUADRATIC_ENTRIES, QUADRATIC_FORMAT_VERSION};
 use super::transfer_table::{TransferTable, TRANSFER_EDGES_ENTRY, TRANSFER_ENTRIES};
 
-/// Current `.modes` schema version.
-pub const FORMAT_VERSION: u32 = 1;
+/// Newest `.modes` schema version this build reads and writes (it reads every version from 1).
+pub const FORMAT_VERSION: u32 = 2;
 
 /// Largest `.npy` entry accepted when reading (bytes); guards against hostile headers.
 const MAX_ENTRY_BYTES: u64 = 8 << 30;
@@ -78,7 +86,8 @@ pub struct MaterialSi {
 /// Free-form bake metadata stored as JSON in the `meta` entry.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ModesMeta {
-    /// Schema version (same as the `format_version` entry).
+    /// Schema version (same as the `format_version` entry): 1 to [`FORMAT_VERSION`], at least
+    /// [`ModesFile::required_format_version`].
     pub format_version: u32,
     /// Tool that wrote the file, e.g. `modal-bake 0.1.0`.
     pub tool_version: String,
@@ -132,6 +141,9 @@ pub struct ModesFile {
     /// factor (`order[k]` = the vertex eliminated k-th; a permutation of 0..ns). `None`: the
     /// runtime computes AMD when it first needs the factor.
     pub surface_order: Option<Vec<u32>>,
+    /// Second-order bases: the mid-edge nodes of the 6-node surface triangles and their mode
+    /// rows (`None`: a linear base, modes interpolated linearly in each triangle).
+    pub quadratic: Option<QuadraticSurface>,
 }
 
 /// What went wrong reading or writing a `.modes` file.
@@ -173,7 +185,7 @@ pub enum FormatError {
         detail: String,
     },
     /// The file was written by an incompatible schema version.
-    #[error("{path}: format version {found} is not supported (this build reads version {FORMAT_VERSION})")]
+    #[error("{path}: format version {found} is not supported (this build reads versions 1 to {FORMAT_VERSION})")]
     Version {
         /// File concerned.
         path: PathBuf,
@@ -201,6 +213,16 @@ impl ModesFile {
         self.surface_vertices.len()
     }
 
+    /// The lowest format version that can hold this base: [`QUADRATIC_FORMAT_VERSION`] with a
+    /// second-order surface, else 1.
+    pub fn required_format_version(&self) -> u32 {
+        if self.quadratic.is_some() {
+            QUADRATIC_FORMAT_VERSION
+        } else {
+            1
+        }
+    }
+
     /// Frequencies f_j = √λ_j / 2π (Hz).
     pub fn frequencies_hz(&self) -> Vec<f64> {
         self.eigenvalues
@@ -218,11 +240,17 @@ impl ModesFile {
             path: path.to_path_buf(),
             detail,
         };
-        if self.meta.format_version != FORMAT_VERSION {
+        if !(1..=FORMAT_VERSION).contains(&self.meta.format_version) {
             return Err(FormatError::Version {
                 path: path.to_path_buf(),
                 found: self.meta.format_version,
             });
+        }
+        if self.meta.format_version < self.required_format_version() {
+            return Err(inv(format!(
+                "format version {} cannot hold a second-order surface (needs {QUADRATIC_FORMAT_VERSION})",
+                self.meta.format_version
+            )));
         }
         let m = self.num_modes();
         let ns = self.num_surface_vertices();
@@ -303,6 +331,14 @@ impl ModesFile {
         if let Some(t) = &self.transfer {
             t.check(ns).map_err(inv)?;
         }
+        if let Some(q) = &self.quadratic {
+            q.check(ns, m, &self.surface_triangles).map_err(inv)?;
+            if self.transfer.is_some() {
+                return Err(inv(
+                    "a peak-transfer table on a second-order base is not supported (the table interpolates P1 midpoint rows)".into(),
+                ));
+            }
+        }
         if let Some(order) = &self.surface_order {
             if order.len() != ns {
                 return Err(inv(format!(
@@ -373,8 +409,11 @@ impl ModesFile {
         let tri: Vec<u32> = self.surface_triangles.iter().flatten().copied().collect();
         let pos: Vec<f64> = self.surface_vertices.iter().flatten().copied().collect();
         let meta = serde_json::to_vec(&self.meta).map_err(|err| err.to_string())?;
-        npz.add_array("format_version", &Array0::from_elem((), FORMAT_VERSION))
-            .map_err(e)?;
+        npz.add_array(
+            "format_version",
+            &Array0::from_elem((), self.meta.format_version),
+        )
+        .map_err(e)?;
         npz.add_array("eigenvalues", &Array1::from(self.eigenvalues.clone()))
             .map_err(e)?;
         npz.add_array("frequencies_hz", &Array1::from(self.frequencies_hz()))
@@ -424,6 +463,30 @@ impl ModesFile {
         if let Some(order) = &self.surface_order {
             npz.add_array("surface_order", &Array1::from(order.clone()))
                 .map_err(e)?;
+        }
+        if let Some(q) = &self.quadratic {
+            let ne = q.edges.len();
+            let edges: Vec<u32> = q.edges.iter().flatten().copied().collect();
+            npz.add_array(
+                QUADRATIC_ENTRIES[0],
+                &Array2::from_shape_vec((ne, 2), edges).map_err(|x| x.to_string())?,
+            )
+            .map_err(e)?;
+            npz.add_array(QUADRATIC_ENTRIES[1], &Array1::from(q.edge_to_volume.clone()))
+                .map_err(e)?;
+            match self.precision {
+                ModesPrecision::F64 => npz.add_array(
+                    QUADRATIC_ENTRIES[2],
+                    &Array3::from_shape_vec((ne, 3, m), q.modes.clone())
+                        .map_err(|x| x.to_string())?,
+                ),
+                ModesPrecision::F32 => npz.add_array(
+                    QUADRATIC_ENTRIES[2],
+                    &Array3::from_shape_vec((ne, 3, m), q.modes.iter().map(|&x| x as f32).collect())
+                        .map_err(|x| x.to_string())?,
+                ),
+            }
+            .map_err(e)?;
         }
         if let Some(t) = &self.transfer {
             npz.add_array("transfer_vertices", &Array1::from(t.vertices.clone()))
@@ -476,7 +539,7 @@ impl ModesFile {
             path,
         };
         let version: u32 = rd.scalar("format_version")?;
-        if version != FORMAT_VERSION {
+        if !(1..=FORMAT_VERSION).contains(&version) {
             return Err(FormatError::Version {
                 path: path.to_path_buf(),
                 found: version,
@@ -516,6 +579,7 @@ impl ModesFile {
         } else {
             None
         };
+        let quadratic = rd.quadratic(precision)?;
 
         let inv = |detail: String| FormatError::Invalid {
             path: path.to_path_buf(),
@@ -533,6 +597,15 @@ impl ModesFile {
                 "modes shape {modes_shape:?} does not match (ns, 3, m) = ({ns}, 3, {m})"
             )));
         }
+        if let Some((q, shape)) = &quadratic {
+            let ne = q.edges.len();
+            if shape != &[ne, 3, m] {
+                return Err(inv(format!(
+                    "edge_modes shape {shape:?} does not match (ne, 3, m) = ({ne}, 3, {m})"
+                )));
+            }
+        }
+        let quadratic = quadratic.map(|(q, _)| q);
         if frequencies.len() != m {
             return Err(inv(format!(
                 "frequencies_hz has {} entries for {m} eigenvalues",
@@ -560,7 +633,14 @@ impl ModesFile {
             precision,
             transfer,
             surface_order,
+            quadratic,
         };
+        if out.meta.format_version != version {
+            return Err(inv(format!(
+                "the format_version entry ({version}) and meta.format_version ({}) disagree",
+                out.meta.format_version
+            )));
+        }
         out.validate(path)?;
         for (j, (&f, g)) in frequencies.iter().zip(out.frequencies_hz()).enumerate() {
             if !((f - g).abs() <= 1e-9 * g.abs()) {
@@ -762,6 +842,55 @@ impl<R: Read + Seek> EntryReader<'_, R> {
             edges,
             peaks,
         }))
+    }
+
+    /// The optional second-order surface with the shape of its `edge_modes`: `None` when none
+    /// of its entries is present, an error naming the missing one when only some are.
+    #[allow(clippy::type_complexity)]
+    fn quadratic(
+        &mut self,
+        precision: ModesPrecision,
+    ) -> Result<Option<(QuadraticSurface, Vec<usize>)>, FormatError> {
+        let present = QUADRATIC_ENTRIES
+            .iter()
+            .filter(|e| self.zip.index_for_name(&format!("{e}.npy")).is_some())
+            .count();
+        if present == 0 {
+            return Ok(None);
+        }
+        if let Some(missing) = QUADRATIC_ENTRIES
+            .iter()
+            .find(|e| self.zip.index_for_name(&format!("{e}.npy")).is_none())
+        {
+            return Err(FormatError::Missing {
+                path: self.path.to_path_buf(),
+                entry: missing,
+            });
+        }
+        let (flat, shape) = self.array::<u32>(QUADRATIC_ENTRIES[0], 2)?;
+        if shape[1] != 2 {
+            return Err(self.err(
+                QUADRATIC_ENTRIES[0],
+                format!("expected shape (ne, 2), found {shape:?}"),
+            ));
+        }
+        let edges = flat.chunks_exact(2).map(|c| [c[0], c[1]]).collect();
+        let edge_to_volume: Vec<u32> = self.vector(QUADRATIC_ENTRIES[1], MAX_ENTRY_BYTES)?;
+        let (modes, shape) = match precision {
+            ModesPrecision::F64 => self.array::<f64>(QUADRATIC_ENTRIES[2], 3)?,
+            ModesPrecision::F32 => {
+                let (v, s) = self.array::<f32>(QUADRATIC_ENTRIES[2], 3)?;
+                (v.into_iter().map(f64::from).collect(), s)
+            }
+        };
+        Ok(Some((
+            QuadraticSurface {
+                edges,
+                edge_to_volume,
+                modes,
+            },
+            shape,
+        )))
     }
 
     fn scalar<A: ReadableElement + Copy>(&mut self, entry: &'static str) -> Result<A, FormatError> {

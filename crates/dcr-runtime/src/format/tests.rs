@@ -43,6 +43,7 @@ pub(crate) fn tiny_base() -> ModesFile {
         precision: ModesPrecision::F64,
         transfer: None,
         surface_order: None,
+        quadratic: None,
     }
 }
 

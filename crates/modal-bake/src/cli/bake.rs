@@ -7,7 +7,7 @@ use anyhow::Context;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use modal_bake::bake::{
-    self, BakeParams, BakeReport, BakeStage, MaterialSi, ModeRequest, ModesPrecision,
+    self, BakeParams, BakeReport, BakeStage, FixedBelow, MaterialSi, ModeRequest, ModesPrecision,
 };
 use modal_bake::transfer::{TransferModes, TransferParams};
 
@@ -63,6 +63,14 @@ pub struct BakeOptions {
     /// Store the surface mode shapes as 32-bit floats (half the file size).
     #[arg(long)]
     pub f32: bool,
+    /// Fix every node at or below a coordinate, e.g. `y=0.01` (m, object frame; repeatable;
+    /// combines with --fixed and --fixed-box). A selector that fixes no node is an error.
+    #[arg(long, value_name = "AXIS=VALUE", value_parser = parse::axis_value, allow_hyphen_values = true)]
+    pub fixed_below: Vec<FixedBelow>,
+    /// Fix every node inside a box X0,Y0,Z0,X1,Y1,Z1 (m, object frame, bounds included;
+    /// repeatable; combines with --fixed and --fixed-below).
+    #[arg(long, value_name = "X0,Y0,Z0,X1,Y1,Z1", value_parser = parse::aabb, allow_hyphen_values = true)]
+    pub fixed_box: Vec<[f64; 6]>,
 }
 
 impl BakeOptions {
@@ -74,6 +82,8 @@ impl BakeOptions {
                 None => ModeRequest::Count(self.modes.unwrap_or(20)),
             },
             fixed: self.model.fixed.clone(),
+            fixed_below: self.fixed_below.clone(),
+            fixed_boxes: self.fixed_box.clone(),
             rayleigh: self.model.rayleigh,
             lumped: self.model.lumped,
             precision: if self.f32 {
@@ -256,9 +266,10 @@ pub fn run(args: &BakeArgs) -> anyhow::Result<()> {
 fn print_report(out: &std::path::Path, r: &BakeReport) {
     outln!("wrote {}", out.display());
     outln!(
-        "  mesh: {} nodes, {} tets, {} free dofs, mass {:.6} kg",
+        "  mesh: {} nodes, {} {}-node tets, {} free dofs, mass {:.6} kg",
         r.nodes,
         r.tets,
+        if r.order == 2 { 10 } else { 4 },
         r.free_dofs,
         r.mass_kg
     );
@@ -278,12 +289,24 @@ fn print_report(out: &std::path::Path, r: &BakeReport) {
         );
     } else {
         outln!("  fixed nodes: {}", r.fixed_nodes);
+        for (what, n) in &r.fixed_by {
+            outln!("    {what}: {n} nodes");
+        }
     }
-    outln!(
-        "  surface: {} vertices, {} triangles",
-        r.surface_vertices,
-        r.surface_triangles
-    );
+    if r.surface_edge_nodes > 0 {
+        outln!(
+            "  surface: {} vertices + {} mid-edge nodes, {} 6-node triangles",
+            r.surface_vertices,
+            r.surface_edge_nodes,
+            r.surface_triangles
+        );
+    } else {
+        outln!(
+            "  surface: {} vertices, {} triangles",
+            r.surface_vertices,
+            r.surface_triangles
+        );
+    }
     let worst = r.residuals.iter().fold(0.0f64, |a, &b| a.max(b));
     outln!(
         "  {} modes, {:.3} Hz … {:.3} Hz, worst relative residual {:.1e}",

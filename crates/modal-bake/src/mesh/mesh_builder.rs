@@ -177,6 +177,7 @@ impl MeshBuilder {
             triangles,
             groups,
             notes,
+            mid_edges: Vec::new(),
         })
     }
 }

@@ -139,6 +139,29 @@ pub enum MeshErrorKind {
         /// The threshold it fell below (m³).
         threshold: f64,
     },
+    /// A second-order tetrahedron with a mid-edge node off its edge's midpoint.
+    #[error(
+        "curved 10-node tetrahedron {element}: a mid-edge node is {offset:e} m off its edge's \
+         midpoint (edge length {edge_length:e} m); only straight-sided second-order elements are \
+         supported: mesh with gmsh's `Mesh.SecondOrderLinear = 1` (what `modal-bake mesh \
+         --order 2` does) or bake the linear mesh"
+    )]
+    CurvedTet {
+        /// The element id (see [`crate::mesh::TetMesh::tet_ids`]).
+        element: u64,
+        /// Distance of the mid-edge node from the midpoint (m).
+        offset: f64,
+        /// Length of the edge (m).
+        edge_length: f64,
+    },
+    /// Second-order tetrahedra that disagree on their shared edges' mid-edge nodes.
+    #[error("non-conforming 10-node tetrahedron {element}: {detail}")]
+    NonConforming {
+        /// The element id (see [`crate::mesh::TetMesh::tet_ids`]).
+        element: u64,
+        /// What disagrees.
+        detail: String,
+    },
     /// A group name the mesh does not have.
     #[error(
         "no node group named {name:?}; available groups: {}",

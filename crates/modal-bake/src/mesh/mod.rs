@@ -23,8 +23,8 @@ mod validate;
 use std::path::Path;
 
 pub use mesh_error::{Location, MeshError, MeshErrorKind};
-pub use tet_mesh::{signed_volume, TetMesh};
-pub use validate::DEFAULT_DEGENERATE_REL_TOL;
+pub use tet_mesh::{signed_volume, TetMesh, TET10_EDGES};
+pub use validate::{DEFAULT_DEGENERATE_REL_TOL, DEFAULT_STRAIGHT_REL_TOL};
 
 fn read_file(path: &Path) -> Result<(Vec<u8>, String), MeshError> {
     let name = path.display().to_string();
