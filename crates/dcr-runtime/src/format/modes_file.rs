@@ -472,8 +472,11 @@ impl ModesFile {
                 &Array2::from_shape_vec((ne, 2), edges).map_err(|x| x.to_string())?,
             )
             .map_err(e)?;
-            npz.add_array(QUADRATIC_ENTRIES[1], &Array1::from(q.edge_to_volume.clone()))
-                .map_err(e)?;
+            npz.add_array(
+                QUADRATIC_ENTRIES[1],
+                &Array1::from(q.edge_to_volume.clone()),
+            )
+            .map_err(e)?;
             match self.precision {
                 ModesPrecision::F64 => npz.add_array(
                     QUADRATIC_ENTRIES[2],
@@ -482,8 +485,11 @@ impl ModesFile {
                 ),
                 ModesPrecision::F32 => npz.add_array(
                     QUADRATIC_ENTRIES[2],
-                    &Array3::from_shape_vec((ne, 3, m), q.modes.iter().map(|&x| x as f32).collect())
-                        .map_err(|x| x.to_string())?,
+                    &Array3::from_shape_vec(
+                        (ne, 3, m),
+                        q.modes.iter().map(|&x| x as f32).collect(),
+                    )
+                    .map_err(|x| x.to_string())?,
                 ),
             }
             .map_err(e)?;

@@ -49,7 +49,9 @@ pub fn axis_value(s: &str) -> Result<modal_bake::bake::FixedBelow, String> {
     };
     match value.trim().parse::<f64>() {
         Ok(value) if value.is_finite() => Ok(modal_bake::bake::FixedBelow { axis, value }),
-        _ => Err(format!("`{value}` is not a finite number of metres (in `{s}`)")),
+        _ => Err(format!(
+            "`{value}` is not a finite number of metres (in `{s}`)"
+        )),
     }
 }
 

@@ -109,11 +109,9 @@ impl TetMesh {
             for (k, &[a, b]) in super::tet_mesh::TET10_EDGES.iter().enumerate() {
                 let (x, y, m) = (self.nodes[c[a]], self.nodes[c[b]], self.nodes[e[k]]);
                 let mid = [0, 1, 2].map(|i| 0.5 * (x[i] + y[i]));
-                let len = super::tet_mesh::dot(
-                    super::tet_mesh::sub(y, x),
-                    super::tet_mesh::sub(y, x),
-                )
-                .sqrt();
+                let len =
+                    super::tet_mesh::dot(super::tet_mesh::sub(y, x), super::tet_mesh::sub(y, x))
+                        .sqrt();
                 let off = super::tet_mesh::sub(m, mid);
                 let off = super::tet_mesh::dot(off, off).sqrt();
                 if !(off <= rel_tol * len) {
@@ -176,7 +174,10 @@ impl TetMesh {
                     if mid != w.1 {
                         return Err(err(
                             w.2,
-                            format!("edge of nodes {:?} has two mid-edge nodes, {mid} and {}", edge, w.1),
+                            format!(
+                                "edge of nodes {:?} has two mid-edge nodes, {mid} and {}",
+                                edge, w.1
+                            ),
                         ));
                     }
                 }
@@ -186,17 +187,12 @@ impl TetMesh {
         let mut mids: Vec<(usize, usize)> = out.iter().enumerate().map(|(i, e)| (e.1, i)).collect();
         mids.sort_unstable();
         if let Some(w) = mids.windows(2).find(|w| w[0].0 == w[1].0) {
-            let t = all
-                .iter()
-                .find(|x| x.0 == out[w[1].1].0)
-                .map_or(0, |x| x.2);
+            let t = all.iter().find(|x| x.0 == out[w[1].1].0).map_or(0, |x| x.2);
             return Err(err(
                 t,
                 format!(
                     "mid-edge node {} sits on two edges, {:?} and {:?}",
-                    w[0].0,
-                    out[w[0].1].0,
-                    out[w[1].1].0
+                    w[0].0, out[w[0].1].0, out[w[1].1].0
                 ),
             ));
         }
