@@ -249,8 +249,14 @@ fn bad_msh_files_give_located_errors() {
 
     let e = read_err("bad/no_tets.msh");
     assert_eq!(e.kind, MeshErrorKind::NoTets);
-    let e = read_err("bad/second_order_only.msh");
-    assert_eq!(e.kind, MeshErrorKind::NoTets);
+    // A 10-node tet reads as second-order; its mid-edge nodes are off the edges (curved).
+    let m = read_ok("bad/second_order_only.msh");
+    assert!(m.is_quadratic() && m.tets.len() == 1 && m.nodes.len() == 10);
+    let e = m.check_straight(1e-6).unwrap_err();
+    assert!(
+        matches!(e.kind, MeshErrorKind::CurvedTet { element: 1, .. }),
+        "{e}"
+    );
 
     let e = read_err("bad/huge_count.msh");
     assert_eq!(

@@ -2,7 +2,8 @@
 //!
 //! Layout (meshio's JSON-compatible form): `points` (n×3 numbers, m), `cells` a list of
 //! `{"type", "data"}` blocks with 0-based point indices (`tetra` for 4-node tetrahedra,
-//! `triangle`; other types skipped with a note), and optional named groups as meshio
+//! `tetra10` for 10-node ones in meshio's (VTK's) node order, `triangle` / `triangle6`; other
+//! types skipped with a note), and optional named groups as meshio
 //! `cell_sets` (`{name: [per-block lists of cell indices]}`) or gmsh-style
 //! `cell_data["gmsh:physical"]` (per-block tag lists) with `field_data` (`{name: [tag, dim]}`).
 
@@ -375,7 +376,13 @@ pub(crate) fn parse_json_dom(data: &[u8], file: &str) -> Result<TetMesh, MeshErr
                     builder.push_tet(tet_id, [row[0], row[1], row[2], row[3]]);
                 }
             }
-            "triangle" => {
+            "tetra10" => {
+                for row in &block.rows {
+                    tet_id += 1;
+                    builder.push_tet10(tet_id, tetra10_to_gmsh(row));
+                }
+            }
+            "triangle" | "triangle6" => {
                 for row in &block.rows {
                     builder.push_triangle([row[0], row[1], row[2]]);
                 }
@@ -395,6 +402,14 @@ pub(crate) fn parse_json_dom(data: &[u8], file: &str) -> Result<TetMesh, MeshErr
     r.cell_sets(&root, &blocks, &mut builder)?;
     r.gmsh_physical(&root, &blocks, &mut builder)?;
     builder.finish(file)
+}
+
+/// A meshio `tetra10` row (VTK order: corners, then edges (0,1), (1,2), (0,2), (0,3), (1,3),
+/// (2,3)) in gmsh's type-11 order (its last two mid-edge nodes swapped: (2,3) then (1,3)).
+fn tetra10_to_gmsh(row: &[usize]) -> [usize; 10] {
+    [
+        row[0], row[1], row[2], row[3], row[4], row[5], row[6], row[7], row[9], row[8],
+    ]
 }
 
 /// The typed reader: serde visitors that write points and cell rows straight into flat
@@ -785,7 +800,13 @@ mod fast {
                         builder.push_tet(tet_id, [row[0], row[1], row[2], row[3]]);
                     }
                 }
-                "triangle" => {
+                "tetra10" => {
+                    for row in block.rows() {
+                        tet_id += 1;
+                        builder.push_tet10(tet_id, super::tetra10_to_gmsh(row));
+                    }
+                }
+                "triangle" | "triangle6" => {
                     for row in block.rows() {
                         builder.push_triangle([row[0], row[1], row[2]]);
                     }

@@ -15,6 +15,8 @@ pub(crate) struct MeshBuilder {
     /// `Some(first)` when the sorted tags are exactly `first, first+1, ...`.
     dense_first: Option<u64>,
     tets: Vec<(u64, [usize; 4])>,
+    /// 10-node tetrahedra: 4 corners, then the mid-edge nodes in `TET10_EDGES` order.
+    tets10: Vec<(u64, [usize; 10])>,
     triangles: Vec<[usize; 3]>,
     groups: BTreeMap<String, Vec<usize>>,
     skipped: Vec<(String, u64)>,
@@ -59,6 +61,12 @@ impl MeshBuilder {
         self.tets.push((id, nodes));
     }
 
+    /// Adds a 10-node tetrahedron with element id `id` (node table indices, gmsh order: 4
+    /// corners, then the mid-edge nodes of edges (0,1), (1,2), (2,0), (3,0), (3,2), (3,1)).
+    pub fn push_tet10(&mut self, id: u64, nodes: [usize; 10]) {
+        self.tets10.push((id, nodes));
+    }
+
     /// Adds a triangle (node table indices).
     pub fn push_triangle(&mut self, nodes: [usize; 3]) {
         self.triangles.push(nodes);
@@ -92,9 +100,20 @@ impl MeshBuilder {
     /// # Errors
     /// [`MeshErrorKind::NoTets`] when there is no tetrahedron.
     pub fn finish(mut self, file: &str) -> Result<TetMesh, MeshError> {
-        if self.tets.is_empty() {
+        if self.tets.is_empty() && self.tets10.is_empty() {
             return Err(MeshError::new(file, Location::None, MeshErrorKind::NoTets));
         }
+        if !self.tets.is_empty() && !self.tets10.is_empty() {
+            return Err(MeshError::new(
+                file,
+                Location::None,
+                MeshErrorKind::MixedOrder {
+                    linear: self.tets.len(),
+                    quadratic: self.tets10.len(),
+                },
+            ));
+        }
+        let quadratic = !self.tets10.is_empty();
         let mut notes = Vec::new();
         for (what, n) in &self.skipped {
             notes.push(format!("skipped {n} {what}"));
@@ -102,12 +121,14 @@ impl MeshBuilder {
         // Canonical element order: by node indices (which follow node tags), so the order in
         // which a file lists its elements does not matter; ties by element id.
         self.tets.sort_unstable_by_key(|&(id, t)| (t, id));
-        let before = self.tets.len();
+        self.tets10.sort_unstable_by_key(|&(id, t)| (t, id));
+        let before = self.tets.len() + self.tets10.len();
         self.tets.dedup_by_key(|t| t.1);
-        if self.tets.len() < before {
+        self.tets10.dedup_by_key(|t| t.1);
+        if self.tets.len() + self.tets10.len() < before {
             notes.push(format!(
                 "removed {} duplicated tetrahedra (same nodes in the same order)",
-                before - self.tets.len()
+                before - self.tets.len() - self.tets10.len()
             ));
         }
         self.triangles.sort_unstable();
@@ -116,6 +137,11 @@ impl MeshBuilder {
         const UNUSED: usize = usize::MAX;
         let mut new_index = vec![UNUSED; self.tags.len()];
         for (_, t) in &self.tets {
+            for &v in t {
+                new_index[v] = 0;
+            }
+        }
+        for (_, t) in &self.tets10 {
             for &v in t {
                 new_index[v] = 0;
             }
@@ -133,12 +159,24 @@ impl MeshBuilder {
                 "dropped {dropped} nodes not referenced by any tetrahedron"
             ));
         }
-        let tets = self
-            .tets
-            .iter()
-            .map(|(_, t)| t.map(|v| new_index[v]))
-            .collect();
-        let tet_ids = self.tets.iter().map(|(id, _)| *id).collect();
+        let (tets, tet_ids, mid_edges) = if quadratic {
+            let corner = |t: &[usize; 10]| [t[0], t[1], t[2], t[3]].map(|v| new_index[v]);
+            let mid = |t: &[usize; 10]| [t[4], t[5], t[6], t[7], t[8], t[9]].map(|v| new_index[v]);
+            (
+                self.tets10.iter().map(|(_, t)| corner(t)).collect(),
+                self.tets10.iter().map(|(id, _)| *id).collect(),
+                self.tets10.iter().map(|(_, t)| mid(t)).collect(),
+            )
+        } else {
+            (
+                self.tets
+                    .iter()
+                    .map(|(_, t)| t.map(|v| new_index[v]))
+                    .collect(),
+                self.tets.iter().map(|(id, _)| *id).collect(),
+                Vec::new(),
+            )
+        };
 
         let mut triangles = Vec::with_capacity(self.triangles.len());
         for tri in &self.triangles {
@@ -177,7 +215,7 @@ impl MeshBuilder {
             triangles,
             groups,
             notes,
-            mid_edges: Vec::new(),
+            mid_edges,
         })
     }
 }

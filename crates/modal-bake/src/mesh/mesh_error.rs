@@ -114,9 +114,19 @@ pub enum MeshErrorKind {
     /// A required section is absent (or out of order).
     #[error("missing section {0}")]
     MissingSection(&'static str),
-    /// The file holds no 4-node tetrahedra.
-    #[error("no 4-node tetrahedra in the mesh (tet4 only; second-order elements are skipped)")]
+    /// The file holds no 4-node or 10-node tetrahedra.
+    #[error("no 4-node or 10-node tetrahedra in the mesh (other element types are skipped)")]
     NoTets,
+    /// The file mixes 4-node and 10-node tetrahedra.
+    #[error(
+        "the mesh mixes {linear} 4-node and {quadratic} 10-node tetrahedra; use one element order"
+    )]
+    MixedOrder {
+        /// 4-node tetrahedra found.
+        linear: usize,
+        /// 10-node tetrahedra found.
+        quadratic: usize,
+    },
     /// The JSON text does not parse.
     #[error("invalid JSON: {0}")]
     Json(String),

@@ -1,10 +1,11 @@
 //! gmsh MSH reader: versions 2.2 and 4.1, ASCII and binary.
 //!
 //! Format reference: gmsh manual §10 "Gmsh file formats" (MSH 4.1) and the legacy MSH 2.2
-//! description. Only 4-node tetrahedra (type 4) make the volume mesh; triangles (type 2) are
-//! kept for information; every element of a physical group (any dimension) contributes its
-//! nodes to that group. Other element types, including second-order ones, are skipped with a
-//! note.
+//! description. 4-node (type 4) or 10-node (type 11, gmsh node order: corners, then the
+//! mid-edge nodes of edges (0,1), (1,2), (2,0), (3,0), (3,2), (3,1)) tetrahedra make the volume
+//! mesh; triangles (types 2 and 9, corners only) are kept for information; every element of a
+//! physical group (any dimension) contributes all its nodes to that group. Other element types
+//! are skipped with a note.
 
 use std::collections::BTreeMap;
 
@@ -495,7 +496,11 @@ impl MshReader<'_> {
         let v = &self.scratch;
         match ty {
             4 => self.builder.push_tet(tag, [v[0], v[1], v[2], v[3]]),
-            2 => self.builder.push_triangle([v[0], v[1], v[2]]),
+            11 => self.builder.push_tet10(
+                tag,
+                [v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7], v[8], v[9]],
+            ),
+            2 | 9 => self.builder.push_triangle([v[0], v[1], v[2]]),
             _ => self.count_skipped(ty, 1),
         }
         if let Some(key) = group {
