@@ -1045,7 +1045,35 @@ pub fn is_up_to_date_with_transfer(
         })?;
     }
     let mesh = crate::mesh::read_mesh(mesh_path)?;
-    let prepared = prepare(mesh, params, &mesh_path.display().to_string())?;
+    is_mesh_up_to_date(
+        mesh,
+        &mesh_path.display().to_string(),
+        params,
+        transfer,
+        modes,
+    )
+}
+
+/// As [`is_up_to_date_with_transfer`] for a mesh already in memory (e.g. one gmsh made from a
+/// surface asset); `file` names it in messages.
+///
+/// # Errors
+/// As [`is_up_to_date`].
+pub fn is_mesh_up_to_date(
+    mesh: TetMesh,
+    file: &str,
+    params: &BakeParams,
+    transfer: Option<&crate::transfer::TransferParams>,
+    modes: &Path,
+) -> Result<bool, BakeError> {
+    params.check()?;
+    if let Some(tp) = transfer {
+        tp.check().map_err(|error| BakeError::Transfer {
+            file: file.to_string(),
+            error: Box::new(error),
+        })?;
+    }
+    let prepared = prepare(mesh, params, file)?;
     if !modes.exists() {
         return Ok(false);
     }

@@ -11,7 +11,9 @@ use modal_bake::bake::{
 };
 use modal_bake::transfer::{TransferModes, TransferParams};
 
+use super::mesh::AssetOptions;
 use super::parse;
+use modal_bake::mesh::surface::is_surface_asset;
 
 /// The object's material, boundary conditions and damping (shared by `bake`, `check`,
 /// `truth` and `fit-attenuation`).
@@ -97,7 +99,9 @@ impl BakeOptions {
 
 #[derive(Args)]
 pub struct BakeArgs {
-    /// Tetrahedral mesh: gmsh .msh (2.2 or 4.1, ASCII or binary) or meshio-style .json.
+    /// Tetrahedral mesh: gmsh .msh (2.2 or 4.1, ASCII or binary, 4- or 10-node tetrahedra) or
+    /// meshio-style .json; or a closed surface asset .obj / .stl / .ply (in metres), meshed
+    /// with gmsh first (--size, --order, --gmsh).
     pub mesh: PathBuf,
     /// Output base (written atomically: nothing is left behind on failure).
     #[arg(short = 'o', long = "out", value_name = "OUT.modes")]
@@ -112,6 +116,29 @@ pub struct BakeArgs {
     pub json: bool,
     #[command(flatten)]
     pub transfer: TransferOptions,
+    #[command(flatten)]
+    pub asset: AssetOptions,
+}
+
+/// The tetrahedral mesh of `path`: read, or (a surface asset) meshed with gmsh; with the
+/// seconds it took. Meshing options given with a volume mesh are an error.
+pub fn load_mesh(
+    path: &std::path::Path,
+    asset: &AssetOptions,
+) -> anyhow::Result<(modal_bake::mesh::TetMesh, f64)> {
+    let t = std::time::Instant::now();
+    if is_surface_asset(path) {
+        let (out, _) = super::mesh::mesh_asset(path, 1.0, asset)?;
+        return Ok((out.mesh, t.elapsed().as_secs_f64()));
+    }
+    if asset.any_set() {
+        anyhow::bail!(
+            "--size, --order, --gmsh and --keep-surface apply to surface assets (.obj, .stl, .ply), not to the volume mesh {}",
+            path.display()
+        );
+    }
+    let mesh = modal_bake::mesh::read_mesh(path).map_err(anyhow::Error::new)?;
+    Ok((mesh, t.elapsed().as_secs_f64()))
 }
 
 /// The optional bake-time peak-transfer table (`dcr_runtime::Method::Transfer`).
@@ -226,13 +253,31 @@ pub fn run(args: &BakeArgs) -> anyhow::Result<()> {
     let params = args.options.params();
     let mut progress = Progress::new();
     let transfer = args.transfer.params();
-    let report = bake::bake_file_with_transfer(
-        &args.mesh,
-        &params,
-        transfer.as_ref(),
-        &args.out,
-        &mut |s| progress.update(s),
-    );
+    let report = if is_surface_asset(&args.mesh) || args.asset.any_set() {
+        progress.bar.finish_and_clear();
+        let (mesh, read_s) = load_mesh(&args.mesh, &args.asset)?;
+        progress = Progress::new();
+        let file = args.mesh.display().to_string();
+        bake::bake_mesh_with_transfer(mesh, &params, transfer.as_ref(), &file, &mut |s| {
+            progress.update(s)
+        })
+        .and_then(|(base, mut report)| {
+            report.read_s = read_s;
+            progress.update(BakeStage::Write);
+            let t = std::time::Instant::now();
+            base.write_atomic(&args.out)?;
+            report.write_s = t.elapsed().as_secs_f64();
+            Ok(report)
+        })
+    } else {
+        bake::bake_file_with_transfer(
+            &args.mesh,
+            &params,
+            transfer.as_ref(),
+            &args.out,
+            &mut |s| progress.update(s),
+        )
+    };
     progress.bar.finish_and_clear();
     let report = report
         .with_context(|| format!("baking {} failed; nothing was written", args.mesh.display()))?;

@@ -13,6 +13,7 @@ mod check;
 mod fit_attenuation;
 mod geodesic;
 mod info;
+mod mesh;
 mod parse;
 mod probe;
 mod truth;
@@ -33,9 +34,12 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Bake MESH (gmsh MSH 2.2/4.1 ASCII or binary, or meshio JSON) into OUT.modes.
+    /// Bake MESH (gmsh MSH 2.2/4.1 ASCII or binary, meshio JSON, or a surface asset .obj /
+    /// .stl / .ply meshed with gmsh) into OUT.modes.
     #[command(allow_negative_numbers = true)]
     Bake(bake::BakeArgs),
+    /// Tetrahedralize a surface asset (OBJ, STL, PLY) with gmsh into a .msh mesh.
+    Mesh(mesh::MeshArgs),
     /// Print a readable summary of a .modes file (or one JSON object with --json).
     Info(info::InfoArgs),
     /// Exit 0 if OUT.modes is up to date for MESH and the options, 1 if stale or missing,
@@ -65,6 +69,7 @@ pub fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Bake(a) => bake::run(&a).map(|()| ExitCode::SUCCESS),
+        Command::Mesh(a) => mesh::run(&a).map(|()| ExitCode::SUCCESS),
         Command::Info(a) => info::run(&a).map(|()| ExitCode::SUCCESS),
         Command::Probe(a) => probe::run(&a).map(|()| ExitCode::SUCCESS),
         Command::Geodesic(a) => geodesic::run(&a).map(|()| ExitCode::SUCCESS),

@@ -12,16 +12,20 @@
 //! element type, including second-order tetrahedra, which are skipped with a note in
 //! [`TetMesh::notes`]; MSH versions other than 2.2 and 4.1.
 
+mod asset;
 mod cursor;
+pub mod gmsh;
 mod json;
 mod mesh_builder;
 mod mesh_error;
 mod msh;
+pub mod surface;
 mod tet_mesh;
 mod validate;
 
 use std::path::Path;
 
+pub use asset::{mesh_asset, AssetError};
 pub use mesh_error::{Location, MeshError, MeshErrorKind};
 pub use tet_mesh::{signed_volume, TetMesh, TET10_EDGES};
 pub use validate::{DEFAULT_DEGENERATE_REL_TOL, DEFAULT_STRAIGHT_REL_TOL};
