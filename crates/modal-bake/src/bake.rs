@@ -83,7 +83,7 @@ use sha2::{Digest, Sha256};
 
 use crate::eigen::{self, EigenError, EigenParams, EigenProgress};
 use crate::fem::{self, Material, MaterialError};
-use crate::mesh::{MeshError, DEFAULT_DEGENERATE_REL_TOL, DEFAULT_STRAIGHT_REL_TOL};
+use crate::mesh::{tet_faces, MeshError, DEFAULT_DEGENERATE_REL_TOL, DEFAULT_STRAIGHT_REL_TOL};
 use dcr_runtime::format::{FormatError, ModesMeta, QuadraticSurface};
 use dcr_runtime::HeatGeodesic;
 
@@ -314,15 +314,24 @@ impl BakeParams {
     }
 }
 
-/// `sha256:<hex>` of the canonical geometry: node positions (f64 bits), tetrahedra (after
-/// orientation) and the sorted fixed-node set. Independent of the file's format and bytes.
+/// `sha256:<hex>` of the canonical geometry: node positions rounded to 16 significant
+/// digits, tetrahedra (after orientation) and the sorted fixed-node set. Independent of the
+/// file's format and bytes.
+///
+/// Why 16 digits: gmsh prints ASCII MSH coordinates with `%.16g`, which does not round-trip
+/// every `f64`, so its ASCII and binary files of one mesh can differ by an ulp per coordinate.
+/// Rounding is idempotent on what gmsh prints (x and the double nearest its 16-digit decimal
+/// round alike), so every form gmsh writes of one mesh — MSH 2.2 or 4.1, ASCII or binary —
+/// and a meshio JSON of it hash alike. Two meshes whose coordinates differ only beyond the
+/// 16th significant digit (relative change below ~5e-16) share a hash; their bases differ by
+/// rounding only.
 pub fn geometry_hash(mesh: &TetMesh, fixed: &[usize]) -> String {
     let mut h = Sha256::new();
-    h.update(b"dcr-geometry-v1");
+    h.update(b"dcr-geometry-v2");
     h.update((mesh.nodes.len() as u64).to_le_bytes());
     for p in &mesh.nodes {
-        for x in p {
-            h.update(x.to_bits().to_le_bytes());
+        for &x in p {
+            h.update(round_16_digits(x).to_bits().to_le_bytes());
         }
     }
     h.update((mesh.tets.len() as u64).to_le_bytes());
@@ -345,6 +354,24 @@ pub fn geometry_hash(mesh: &TetMesh, fixed: &[usize]) -> String {
         }
     }
     format!("sha256:{:x}", h.finalize())
+}
+
+/// `x` rounded to 16 significant decimal digits (the double nearest `%.16g` of `x`); non-finite
+/// values unchanged.
+pub fn round_16_digits(x: f64) -> f64 {
+    use std::io::Write;
+    if !x.is_finite() {
+        return x;
+    }
+    // "-d.ddddddddddddddde-308" is 23 bytes.
+    let mut buf = [0u8; 32];
+    let mut w = &mut buf[..];
+    let _ = write!(w, "{x:.15e}");
+    let n = 32 - w.len();
+    std::str::from_utf8(&buf[..n])
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(x)
 }
 
 /// A mesh prepared for baking: oriented, checked, with its fixed-node set and hash.
@@ -447,6 +474,7 @@ fn prepare(mut mesh: TetMesh, params: &BakeParams, file: &str) -> Result<Prepare
     mesh.check_straight(DEFAULT_STRAIGHT_REL_TOL)
         .map_err(name_file)?;
     let mid_table = mesh.edge_mid_nodes().map_err(name_file)?;
+    mesh.check_overlaps().map_err(name_file)?;
     let pieces = mesh.connected_components();
     if pieces != 1 {
         return Err(BakeError::Disconnected {
@@ -587,11 +615,6 @@ pub fn extract_surface(mesh: &TetMesh) -> (Vec<usize>, Vec<[usize; 3]>) {
     verts.sort_unstable();
     verts.dedup();
     (verts, tris)
-}
-
-/// The faces of a positively oriented tet (a, b, c, d), with outward normals.
-fn tet_faces([a, b, c, d]: [usize; 4]) -> [[usize; 3]; 4] {
-    [[a, c, b], [a, b, d], [a, d, c], [b, c, d]]
 }
 
 /// A face rotated so its smallest index comes first (canonical, orientation kept).
@@ -1103,6 +1126,35 @@ pub fn is_mesh_up_to_date(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Rounding to 16 digits is idempotent (the geometry hash relies on it: a coordinate and
+    /// its `%.16g` print round alike), exact where 16 digits suffice, and moves a value by at
+    /// most half a unit of its 16th digit (plus the parse's half ulp). Random bit patterns over
+    /// the whole finite range.
+    #[test]
+    fn rounding_to_16_digits_is_idempotent() {
+        let mut state = 0x9E37_79B9_7F4A_7C15u64;
+        let mut checked = 0;
+        for _ in 0..200_000 {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            let x = f64::from_bits(state);
+            if !x.is_finite() {
+                continue;
+            }
+            let r = round_16_digits(x);
+            let printed: f64 = format!("{x:.15e}").parse().unwrap();
+            assert_eq!(r.to_bits(), printed.to_bits(), "{x:e}");
+            assert_eq!(round_16_digits(r).to_bits(), r.to_bits(), "{x:e}");
+            assert!((r - x).abs() <= 6.2e-16 * x.abs(), "{x:e} → {r:e}");
+            checked += 1;
+        }
+        assert!(checked > 190_000);
+        for x in [0.0, -0.0, 1.0, 0.1, 0.3, -2.5e-7, 1e300, 5e-324] {
+            assert_eq!(round_16_digits(x).to_bits(), x.to_bits(), "{x:e}");
+        }
+    }
 
     /// The packed-key boundary faces equal the general ones (same faces, same order), on a
     /// structured box and on the same box with its tets listed in reverse.

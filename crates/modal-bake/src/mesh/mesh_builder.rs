@@ -98,7 +98,9 @@ impl MeshBuilder {
     /// deduplicated. Element order in the file therefore does not matter.
     ///
     /// # Errors
-    /// [`MeshErrorKind::NoTets`] when there is no tetrahedron.
+    /// [`MeshErrorKind::NoTets`] when there is no tetrahedron;
+    /// [`MeshErrorKind::DuplicateTet`] (at the later element) when two tetrahedra have the
+    /// same nodes in different orders: one would count twice.
     pub fn finish(mut self, file: &str) -> Result<TetMesh, MeshError> {
         if self.tets.is_empty() && self.tets10.is_empty() {
             return Err(MeshError::new(file, Location::None, MeshErrorKind::NoTets));
@@ -114,6 +116,23 @@ impl MeshBuilder {
             ));
         }
         let quadratic = !self.tets10.is_empty();
+        let corners: Vec<(u64, [usize; 4])> = self
+            .tets10
+            .iter()
+            .map(|&(id, t)| (id, [t[0], t[1], t[2], t[3]]))
+            .collect();
+        let dup = if quadratic {
+            same_nodes_reordered(&corners)
+        } else {
+            same_nodes_reordered(&self.tets)
+        };
+        if let Some((first, second)) = dup {
+            return Err(MeshError::new(
+                file,
+                Location::Element(second),
+                MeshErrorKind::DuplicateTet { first, second },
+            ));
+        }
         let mut notes = Vec::new();
         for (what, n) in &self.skipped {
             notes.push(format!("skipped {n} {what}"));
@@ -218,4 +237,35 @@ impl MeshBuilder {
             mid_edges,
         })
     }
+}
+
+/// The ids (smaller first) of two tetrahedra with the same node set in different orders, if
+/// any (exact repeats are the same element listed twice and are not reported). Sorted node
+/// sets are packed into one `u128` (node indices < 2^32, as any mesh that fits in memory has)
+/// to sort fast.
+fn same_nodes_reordered(tets: &[(u64, [usize; 4])]) -> Option<(u64, u64)> {
+    let mut keys: Vec<(u128, usize)> = tets
+        .iter()
+        .enumerate()
+        .map(|(i, (_, t))| {
+            let mut k = *t;
+            k.sort_unstable();
+            let packed = k
+                .iter()
+                .fold(0u128, |acc, &v| (acc << 32) | (v as u32 as u128));
+            (packed, i)
+        })
+        .collect();
+    keys.sort_unstable();
+    keys.windows(2).find_map(|w| {
+        let (a, b) = (&tets[w[0].1], &tets[w[1].1]);
+        // Equal packed keys are equal sets when every index fits in 32 bits.
+        let same_set = w[0].0 == w[1].0 && {
+            let (mut x, mut y) = (a.1, b.1);
+            x.sort_unstable();
+            y.sort_unstable();
+            x == y
+        };
+        (same_set && a.1 != b.1).then(|| (a.0.min(b.0), a.0.max(b.0)))
+    })
 }

@@ -39,6 +39,10 @@ pub enum MeshErrorKind {
     /// The file could not be read.
     #[error("cannot read file: {0}")]
     Io(String),
+    /// The path is not a regular file (a directory, device, FIFO or socket): meshes are read
+    /// from regular files only, whose size bounds the read.
+    #[error("not a regular file ({0}); give the path of a mesh file")]
+    NotARegularFile(&'static str),
     /// Neither `$MeshFormat` nor a JSON object, and no known extension.
     #[error("unrecognised mesh format (expected gmsh .msh or meshio-style .json)")]
     UnknownFormat,
@@ -114,6 +118,59 @@ pub enum MeshErrorKind {
     /// A required section is absent (or out of order).
     #[error("missing section {0}")]
     MissingSection(&'static str),
+    /// A section a file holds once appears again.
+    #[error("section ${section} appears a second time (the first is at line {first}); a mesh file holds it once")]
+    DuplicateSection {
+        /// The section name without `$`.
+        section: &'static str,
+        /// 1-based line of its first header.
+        first: usize,
+    },
+    /// A section that must come after another one comes before it.
+    #[error("section ${section} comes before ${before}, which it depends on")]
+    SectionOrder {
+        /// The section found too early.
+        section: &'static str,
+        /// The section that must precede it.
+        before: &'static str,
+    },
+    /// A node or element tag that is zero or negative (gmsh tags start at 1).
+    #[error("{what} {found} is not a positive tag (gmsh tags start at 1)")]
+    InvalidTag {
+        /// What the tag names ("node tag", "element tag", "element node tag").
+        what: &'static str,
+        /// The value found.
+        found: String,
+    },
+    /// An ASCII record with more values than its layout has.
+    #[error("extra value {found:?} at the end of {record} (expected the end of the line)")]
+    ExtraValue {
+        /// The record ("an element line", "the $Nodes header", ...).
+        record: &'static str,
+        /// The first extra token (shortened).
+        found: String,
+    },
+    /// An ASCII record that ends (line break) before all its values.
+    #[error("the line ends before its {0}")]
+    ShortLine(&'static str),
+    /// Two elements with the same four nodes in another order (one would count twice).
+    #[error("elements {first} and {second} have the same four nodes (overlapping tetrahedra); remove one")]
+    DuplicateTet {
+        /// The first element's id (MSH tag, JSON 1-based position).
+        first: u64,
+        /// The second element's id.
+        second: u64,
+    },
+    /// Two positively oriented tetrahedra share a face and lie on the same side of it.
+    #[error(
+        "elements {first} and {second} overlap: they share a face and lie on the same side of it"
+    )]
+    OverlappingTets {
+        /// One element id.
+        first: u64,
+        /// The other element id.
+        second: u64,
+    },
     /// The file holds no 4-node or 10-node tetrahedra.
     #[error("no 4-node or 10-node tetrahedra in the mesh (other element types are skipped)")]
     NoTets,

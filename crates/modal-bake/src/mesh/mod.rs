@@ -5,12 +5,21 @@
 //! positions) and elements give equal meshes, whatever their format or element order.
 //!
 //! Caveat: gmsh writes ASCII MSH coordinates with `%.16g`, which does not round-trip every
-//! `f64`; an ASCII and a binary file of one gmsh mesh can differ by 1 ulp per coordinate.
+//! `f64`; an ASCII and a binary file of one gmsh mesh can differ by 1 ulp per coordinate
+//! (the geometry hash, [`crate::bake::geometry_hash`], rounds to 16 digits and sees them as one).
 //!
 //! Supported: 4-node tetrahedra (volume), 3-node triangles (informational) and physical
 //! groups of any dimension (as node sets, for boundary conditions). Unsupported: every other
 //! element type, including second-order tetrahedra, which are skipped with a note in
-//! [`TetMesh::notes`]; MSH versions other than 2.2 and 4.1.
+//! [`TetMesh::notes`]; MSH versions other than 2.2 and 4.1. How an element type is dispatched
+//! is in the `msh` and `json` module docs: one table of node counts per format, one function
+//! that files each element by type.
+//!
+//! Hostile input: files are read only when they are regular files (a device or FIFO is refused
+//! before it is opened), and no more than their size; declared counts are checked against the
+//! bytes left before allocating; repeated or misplaced sections, non-positive tags, short or
+//! long ASCII records and tetrahedra listed twice in different node orders are refused with
+//! their line, byte offset or element ids. Every error is a [`MeshError`] naming the file.
 
 mod asset;
 mod cursor;
@@ -27,18 +36,60 @@ use std::path::Path;
 
 pub use asset::{mesh_asset, AssetError};
 pub use mesh_error::{Location, MeshError, MeshErrorKind};
+pub(crate) use tet_mesh::tet_faces;
 pub use tet_mesh::{signed_volume, TetMesh, TET10_EDGES};
 pub use validate::{DEFAULT_DEGENERATE_REL_TOL, DEFAULT_STRAIGHT_REL_TOL};
 
+/// Reads a whole regular file, at most as many bytes as its size when opened. A directory,
+/// device, FIFO or socket is refused before it is opened for reading (a FIFO would block, a
+/// device like `/dev/zero` never ends).
 fn read_file(path: &Path) -> Result<(Vec<u8>, String), MeshError> {
+    use std::io::Read;
     let name = path.display().to_string();
-    match std::fs::read(path) {
-        Ok(data) => Ok((data, name)),
-        Err(e) => Err(MeshError::new(
-            name,
+    let io =
+        |e: std::io::Error| MeshError::new(&name, Location::None, MeshErrorKind::Io(e.to_string()));
+    let not_regular = |t: std::fs::FileType| {
+        MeshError::new(
+            &name,
             Location::None,
-            MeshErrorKind::Io(e.to_string()),
-        )),
+            MeshErrorKind::NotARegularFile(file_type_name(t)),
+        )
+    };
+    let meta = std::fs::metadata(path).map_err(io)?;
+    if !meta.is_file() {
+        return Err(not_regular(meta.file_type()));
+    }
+    let file = std::fs::File::open(path).map_err(io)?;
+    // The path may have been replaced between the two looks: check what was opened.
+    let meta = file.metadata().map_err(io)?;
+    if !meta.is_file() {
+        return Err(not_regular(meta.file_type()));
+    }
+    let len = meta.len();
+    let mut data = Vec::with_capacity(usize::try_from(len).unwrap_or(0));
+    file.take(len).read_to_end(&mut data).map_err(io)?;
+    Ok((data, name))
+}
+
+/// What kind of file system object `t` is, for messages.
+fn file_type_name(t: std::fs::FileType) -> &'static str {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if t.is_char_device() {
+            return "a character device";
+        } else if t.is_block_device() {
+            return "a block device";
+        } else if t.is_fifo() {
+            return "a FIFO";
+        } else if t.is_socket() {
+            return "a socket";
+        }
+    }
+    if t.is_dir() {
+        "a directory"
+    } else {
+        "a special file"
     }
 }
 

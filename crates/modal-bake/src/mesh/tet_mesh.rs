@@ -50,6 +50,12 @@ pub fn signed_volume(a: [f64; 3], b: [f64; 3], c: [f64; 3], d: [f64; 3]) -> f64 
     dot(cross(u, v), w) / 6.0
 }
 
+/// The faces of a positively oriented tetrahedron (a, b, c, d), each ordered so that its
+/// right-hand normal points out of the tetrahedron.
+pub(crate) fn tet_faces([a, b, c, d]: [usize; 4]) -> [[usize; 3]; 4] {
+    [[a, c, b], [a, b, d], [a, d, c], [b, c, d]]
+}
+
 pub(crate) fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }

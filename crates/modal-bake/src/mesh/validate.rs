@@ -2,7 +2,7 @@
 //! and group look-up.
 
 use super::mesh_error::{Location, MeshError, MeshErrorKind};
-use super::tet_mesh::{signed_volume, TetMesh};
+use super::tet_mesh::{signed_volume, tet_faces, TetMesh};
 
 /// Default relative volume tolerance for [`TetMesh::orient_tets`]: a tetrahedron whose
 /// |volume| is below this fraction of the mean tetrahedron volume is degenerate.
@@ -206,6 +206,74 @@ impl TetMesh {
     /// As [`TetMesh::edge_mid_nodes`].
     pub fn check_conforming(&self) -> Result<(), MeshError> {
         self.edge_mid_nodes().map(|_| ())
+    }
+
+    /// Checks that no two tetrahedra overlap across a face: in a conforming mesh every
+    /// interior face is shared by exactly two tetrahedra, one on each side, so with every
+    /// tetrahedron positively oriented (call [`TetMesh::orient_tets`] first) no oriented face
+    /// occurs twice. A face occurring twice with one orientation means two tetrahedra on the
+    /// same side of it (an overlap, a tetrahedron listed twice, or a face shared by three).
+    /// One sort of the 4 faces per tetrahedron.
+    ///
+    /// # Errors
+    /// [`MeshErrorKind::OverlappingTets`] naming both element ids ([`TetMesh::tet_ids`]),
+    /// located at the larger.
+    ///
+    /// ```
+    /// use modal_bake::mesh::TetMesh;
+    /// let mut m = TetMesh::structured_box([1, 1, 1], [1.0, 1.0, 1.0]);
+    /// m.check_overlaps().unwrap();
+    /// let first = m.tets[0];
+    /// m.tets.push(first);
+    /// m.tet_ids.push(7);
+    /// assert!(m.check_overlaps().is_err());
+    /// ```
+    pub fn check_overlaps(&self) -> Result<(), MeshError> {
+        // Key: sorted node triple and the orientation's parity against it.
+        let parity = |f: [usize; 3]| ((f[0] > f[1]) ^ (f[0] > f[2]) ^ (f[1] > f[2])) as u64;
+        let pair = if self.nodes.len() <= 1 << 21 && self.tets.len() < 1 << 30 {
+            let mut faces: Vec<(u64, u32)> = Vec::with_capacity(4 * self.tets.len());
+            for (t, &tet) in self.tets.iter().enumerate() {
+                for f in tet_faces(tet) {
+                    let mut k = f;
+                    k.sort_unstable();
+                    let key = (parity(f) << 63)
+                        | ((k[0] as u64) << 42)
+                        | ((k[1] as u64) << 21)
+                        | k[2] as u64;
+                    faces.push((key, t as u32));
+                }
+            }
+            faces.sort_unstable();
+            faces
+                .windows(2)
+                .find(|w| w[0].0 == w[1].0)
+                .map(|w| (w[0].1 as usize, w[1].1 as usize))
+        } else {
+            let mut faces: Vec<([usize; 3], u64, usize)> = Vec::with_capacity(4 * self.tets.len());
+            for (t, &tet) in self.tets.iter().enumerate() {
+                for f in tet_faces(tet) {
+                    let mut k = f;
+                    k.sort_unstable();
+                    faces.push((k, parity(f), t));
+                }
+            }
+            faces.sort_unstable();
+            faces
+                .windows(2)
+                .find(|w| (w[0].0, w[0].1) == (w[1].0, w[1].1))
+                .map(|w| (w[0].2, w[1].2))
+        };
+        let Some((a, b)) = pair else {
+            return Ok(());
+        };
+        let id = |i: usize| self.tet_ids.get(i).copied().unwrap_or(i as u64 + 1);
+        let (first, second) = (id(a).min(id(b)), id(a).max(id(b)));
+        Err(MeshError::new(
+            "",
+            Location::Element(second),
+            MeshErrorKind::OverlappingTets { first, second },
+        ))
     }
 
     /// Number of connected components of the tetrahedra (two tetrahedra are connected when
