@@ -275,20 +275,27 @@ fn have_gmsh(test: &str) -> bool {
 }
 
 /// gmsh's tutorial STL (a real asset from the PyPI `gmsh` package, coordinates in mm),
-/// found beside the Python installation that has the `gmsh` module.
-fn t13_asset() -> PathBuf {
-    let out = Command::new("python3")
+/// found beside the Python installation that has the `gmsh` module; `None` (skip) when it is
+/// missing, unless `DCR_REQUIRE_GMSH=1`.
+fn t13_asset(test: &str) -> Option<PathBuf> {
+    let prefix = Command::new("python3")
         .args(["-c", "import sys, gmsh; print(sys.prefix)"])
         .output()
-        .expect("python3 runs");
-    let prefix = String::from_utf8_lossy(&out.stdout).trim().to_string();
-    let p = Path::new(&prefix).join("share/doc/gmsh/tutorials/t13_data.stl");
-    assert!(
-        p.is_file(),
-        "the PyPI gmsh package's t13_data.stl is not at {}",
-        p.display()
-    );
-    p
+        .ok()
+        .filter(|o| o.status.success())
+        .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string());
+    let p = prefix.map(|d| Path::new(&d).join("share/doc/gmsh/tutorials/t13_data.stl"));
+    match p {
+        Some(p) if p.is_file() => Some(p),
+        _ => {
+            let msg = "the PyPI gmsh package (python3 -m pip install gmsh) and its tutorials/t13_data.stl are missing";
+            if std::env::var("DCR_REQUIRE_GMSH").as_deref() == Ok("1") {
+                panic!("{test}: DCR_REQUIRE_GMSH=1 but {msg}");
+            }
+            eprintln!("SKIPPED {test}: {msg}");
+            None
+        }
+    }
 }
 
 fn bin() -> Command {
@@ -303,7 +310,9 @@ fn real_asset_mesh_bake_probe_and_a_holed_copy() {
     if !have_gmsh("real_asset_mesh_bake_probe_and_a_holed_copy") {
         return;
     }
-    let asset = t13_asset();
+    let Some(asset) = t13_asset("real_asset_mesh_bake_probe_and_a_holed_copy") else {
+        return;
+    };
     let dir = tempfile::tempdir().unwrap();
     let msh = dir.path().join("t13.msh");
     let run = |c: &mut Command| {
@@ -318,7 +327,7 @@ fn real_asset_mesh_bake_probe_and_a_holed_copy() {
     let mesh_args = |out: &Path| {
         let mut c = bin();
         c.arg("mesh").arg(&asset).arg("-o").arg(out);
-        c.args(["--units", "mm", "--size", "0.01", "--order", "2"]);
+        c.args(["--units", "mm", "--size", "0.006", "--order", "2"]);
         c
     };
     run(&mut mesh_args(&msh));
