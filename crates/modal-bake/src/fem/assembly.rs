@@ -4,7 +4,7 @@
 //! P2 element matrices are integrated exactly: the stiffness integrand (products of linear
 //! shape-function gradients, degree 2) with the symmetric 4-point rule (degree 2), the
 //! consistent mass (products of quadratic shape functions, degree 4) in closed form from
-//! ∫ L₀^a L₁^b L₂^c L₃^d dV = 6V a! b! c! d! / (a+b+c+d+3)! ([`p2_mass_ref`]). The lumped P2
+//! ∫ L₀^a L₁^b L₂^c L₃^d dV = 6V a! b! c! d! / (a+b+c+d+3)! (`p2_mass_ref`). The lumped P2
 //! mass is the HRZ diagonal (the consistent diagonal scaled to the element mass: corners
 //! 6/216, mid-edge nodes 32/216 of ρV), because row-sum lumping gives corners negative mass.
 //!
@@ -443,7 +443,9 @@ fn stiffness(
 ///
 /// P1, `lumped == false`: consistent mass, ρV/20·(1+δ_ab) between nodes a, b of a
 /// tetrahedron, per axis (no coupling between axes). `lumped == true`: diagonal, ρV/4 per node
-/// and axis. P2: consistent ρV/420·[`p2_mass_ref`] (exact), or its HRZ diagonal when lumped.
+/// and axis. P2: consistent ρV/420 × (6, 1; −4, −6; 32, 16, 8) between corners, corner and
+/// mid-edge node, and mid-edge nodes (exact; see the module docs), or its HRZ diagonal when
+/// lumped.
 /// Either way 1ᵀ M_axis 1 = ρ·(total volume). Deterministic like [`assemble_stiffness`].
 ///
 /// ```

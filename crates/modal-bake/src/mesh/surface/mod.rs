@@ -117,7 +117,6 @@ fn read_obj(data: &[u8], name: &str) -> Result<Soup, SurfaceError> {
         single_index: false,
         ignore_points: true,
         ignore_lines: true,
-        ..Default::default()
     };
     let (models, _) = tobj::load_obj_buf(&mut BufReader::new(Cursor::new(data)), &opts, |_| {
         Ok(Default::default())
