@@ -256,6 +256,10 @@ fn surface_defects_are_refused_with_positions() {
         err.to_string().contains("declares 4294967295 triangles"),
         "{err}"
     );
+    let huge = b"ply\nformat binary_little_endian 1.0\nelement vertex 1000000000000\n\
+                 property float x\nproperty float y\nproperty float z\nend_header\n\0\0\0\0";
+    let err = read_surface_bytes(huge, "huge.ply").unwrap_err();
+    assert!(err.to_string().contains("huge.ply"), "{err}");
     let err = read_surface_bytes(b"v 0 0 0\nf 1 2 3\n", "bad.obj").unwrap_err();
     assert!(err.to_string().contains("bad.obj"), "{err}");
 }

@@ -393,3 +393,135 @@ fn p2_nafems_fv32_within_half_a_percent() {
         );
     }
 }
+
+/// `--fixed-below` / `--fixed-box` / `--fixed` combine by union with a count per selector; a
+/// selector that fixes nothing is an error naming the mesh's extent; the selectors are bake
+/// parameters (part of the hash), so `check` sees a change; the P1 parameter hash without them
+/// is unchanged by their existence.
+#[test]
+fn fixed_selectors_count_union_refuse_empty_and_hash() {
+    use modal_bake::bake::is_mesh_up_to_date;
+    let mesh = TetMesh::structured_box([4, 2, 2], [0.4, 0.2, 0.2]);
+    let base_params = BakeParams {
+        modes: ModeRequest::Count(3),
+        ..Default::default()
+    };
+    let params = BakeParams {
+        fixed: vec!["xmin".into()],
+        fixed_below: vec![FixedBelow {
+            axis: 0,
+            value: 0.1,
+        }],
+        fixed_boxes: vec![[0.35, -1.0, -1.0, 0.5, 1.0, 1.0]],
+        ..base_params.clone()
+    };
+    let (_, report) = bake_mesh(mesh.clone(), &params, "box", &mut |_| {}).unwrap();
+    assert_eq!(
+        report.fixed_by,
+        vec![
+            ("group xmin".to_string(), 9),
+            ("below x=0.1".to_string(), 18),
+            ("box 0.35,-1,-1,0.5,1,1".to_string(), 9),
+        ]
+    );
+    assert_eq!(report.fixed_nodes, 27);
+
+    for (bad, what) in [
+        (
+            BakeParams {
+                fixed_below: vec![FixedBelow {
+                    axis: 2,
+                    value: -0.01,
+                }],
+                ..base_params.clone()
+            },
+            "--fixed-below z=-0.01 fixes no node",
+        ),
+        (
+            BakeParams {
+                fixed_boxes: vec![[1.0, 1.0, 1.0, 2.0, 2.0, 2.0]],
+                ..base_params.clone()
+            },
+            "--fixed-box 1,1,1,2,2,2 fixes no node",
+        ),
+    ] {
+        let err = bake_mesh(mesh.clone(), &bad, "box", &mut |_| {})
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains(what) && err.contains("the mesh spans x 0.000000…0.400000"),
+            "{err}"
+        );
+    }
+    let inverted = BakeParams {
+        fixed_boxes: vec![[1.0, 0.0, 0.0, 0.0, 1.0, 1.0]],
+        ..base_params.clone()
+    };
+    assert!(bake_mesh(mesh.clone(), &inverted, "box", &mut |_| {}).is_err());
+
+    // Part of the hash: a base baked with one selector is stale for another.
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("b.modes");
+    let below = BakeParams {
+        fixed_below: vec![FixedBelow {
+            axis: 0,
+            value: 0.0,
+        }],
+        ..base_params.clone()
+    };
+    let (b, _) = bake_mesh(mesh.clone(), &below, "box", &mut |_| {}).unwrap();
+    b.write_atomic(&out).unwrap();
+    assert!(is_mesh_up_to_date(mesh.clone(), "box", &below, None, &out).unwrap());
+    let other = BakeParams {
+        fixed_below: vec![FixedBelow {
+            axis: 0,
+            value: 0.05,
+        }],
+        ..base_params.clone()
+    };
+    assert!(!is_mesh_up_to_date(mesh.clone(), "box", &other, None, &out).unwrap());
+    let group = BakeParams {
+        fixed: vec!["xmin".into()],
+        ..base_params.clone()
+    };
+    assert_ne!(below.hash(), group.hash());
+    // Absent selectors serialise as before: the JSON has no selector keys.
+    let json = serde_json::to_string(&group).unwrap();
+    assert!(
+        !json.contains("fixed_below") && !json.contains("fixed_boxes"),
+        "{json}"
+    );
+}
+
+/// A meshio JSON `tetra10` block (VTK node order: its last two mid-edge nodes are (1,3), (2,3))
+/// reads into the same second-order mesh as the one written, straight-sided.
+#[test]
+fn meshio_tetra10_reads_in_vtk_order() {
+    let p2 = TetMesh::structured_box([2, 1, 1], [0.2, 0.1, 0.1]).to_quadratic();
+    let rows: Vec<[usize; 10]> = (0..p2.tets.len())
+        .map(|t| {
+            let (c, e) = (p2.tets[t], p2.mid_edges[t]);
+            // TET10_EDGES: (0,1) (1,2) (0,2) (0,3) (2,3) (1,3) → VTK: ... (0,3) (1,3) (2,3).
+            [c[0], c[1], c[2], c[3], e[0], e[1], e[2], e[3], e[5], e[4]]
+        })
+        .collect();
+    let json = serde_json::json!({
+        "points": p2.nodes,
+        "cells": [{"type": "tetra10", "data": rows}],
+    });
+    let back = modal_bake::mesh::read_json_bytes(json.to_string().as_bytes(), "p2.json").unwrap();
+    assert!(back.is_quadratic());
+    back.check_straight(1e-12).unwrap();
+    let key = |m: &TetMesh| {
+        let mut v: Vec<([usize; 4], [usize; 6])> = m
+            .tets
+            .iter()
+            .copied()
+            .zip(m.mid_edges.iter().copied())
+            .collect();
+        v.sort_unstable();
+        v
+    };
+    assert_eq!(key(&back), key(&p2));
+    assert_eq!(back.nodes, p2.nodes);
+}
