@@ -1060,13 +1060,7 @@ pub fn is_up_to_date_with_transfer(
     transfer: Option<&crate::transfer::TransferParams>,
     modes: &Path,
 ) -> Result<bool, BakeError> {
-    params.check()?;
-    if let Some(tp) = transfer {
-        tp.check().map_err(|error| BakeError::Transfer {
-            file: mesh_path.display().to_string(),
-            error: Box::new(error),
-        })?;
-    }
+    check_options(params, transfer, &mesh_path.display().to_string())?;
     let mesh = crate::mesh::read_mesh(mesh_path)?;
     is_mesh_up_to_date(
         mesh,
@@ -1075,6 +1069,22 @@ pub fn is_up_to_date_with_transfer(
         transfer,
         modes,
     )
+}
+
+/// Checks the bake and transfer-table parameters (what `check` exits 2 on before any mesh work).
+fn check_options(
+    params: &BakeParams,
+    transfer: Option<&crate::transfer::TransferParams>,
+    file: &str,
+) -> Result<(), BakeError> {
+    params.check()?;
+    if let Some(tp) = transfer {
+        tp.check().map_err(|error| BakeError::Transfer {
+            file: file.to_string(),
+            error: Box::new(error),
+        })?;
+    }
+    Ok(())
 }
 
 /// As [`is_up_to_date_with_transfer`] for a mesh already in memory (e.g. one gmsh made from a
@@ -1089,13 +1099,7 @@ pub fn is_mesh_up_to_date(
     transfer: Option<&crate::transfer::TransferParams>,
     modes: &Path,
 ) -> Result<bool, BakeError> {
-    params.check()?;
-    if let Some(tp) = transfer {
-        tp.check().map_err(|error| BakeError::Transfer {
-            file: file.to_string(),
-            error: Box::new(error),
-        })?;
-    }
+    check_options(params, transfer, file)?;
     let prepared = prepare(mesh, params, file)?;
     if !modes.exists() {
         return Ok(false);

@@ -525,3 +525,31 @@ fn meshio_tetra10_reads_in_vtk_order() {
     assert_eq!(key(&back), key(&p2));
     assert_eq!(back.nodes, p2.nodes);
 }
+
+/// The P1-only consumers refuse a second-order mesh instead of treating its mid-edge nodes as
+/// loose nodes: the full-order truth, and a transfer table.
+#[test]
+fn p1_only_paths_refuse_second_order() {
+    let p2 = TetMesh::structured_box([2, 1, 1], [0.2, 0.1, 0.1]).to_quadratic();
+    let Err(err) = modal_bake::truth::TruthSystem::new(
+        p2.clone(),
+        &modal_bake::truth::TruthParams::default(),
+        "p2.msh",
+    ) else {
+        panic!("the truth accepted a second-order mesh")
+    };
+    let err = err.to_string();
+    assert!(err.contains("4-node tetrahedra only"), "{err}");
+    let params = BakeParams {
+        modes: ModeRequest::Count(2),
+        ..Default::default()
+    };
+    let tp = modal_bake::transfer::TransferParams::default();
+    let Err(err) =
+        modal_bake::bake::bake_mesh_with_transfer(p2, &params, Some(&tp), "p2.msh", &mut |_| {})
+    else {
+        panic!("a transfer table was built on a second-order mesh")
+    };
+    let err = err.to_string();
+    assert!(err.contains("not supported for second-order"), "{err}");
+}
