@@ -1,11 +1,14 @@
 //! The `.modes` base format (read and write), defined once here; `modal-bake` writes through it.
 
 mod modes_file;
+mod regular_file;
 mod transfer_table;
 
 pub use modes_file::{
     FormatError, MaterialSi, ModesFile, ModesMeta, ModesPrecision, FORMAT_VERSION,
+    MAX_COORDINATE_M, MIN_EXTENT_M,
 };
+pub use regular_file::{describe_file_type, open_regular_file, same_file, OpenError};
 pub use transfer_table::{TransferTable, MAX_TRANSFER_POINTS};
 
 #[cfg(test)]

@@ -105,7 +105,7 @@ fn nan_and_mismatch_are_rejected() {
     base.modes[5] = f64::NAN;
     let err = base.write_atomic(&p).unwrap_err().to_string();
     assert!(
-        err.contains("non-finite mode value at vertex 0, axis 2, mode 1"),
+        err.contains("modes[0][2][1] = NaN (must be finite)"),
         "{err}"
     );
     assert!(!p.exists(), "nothing is written for invalid content");
@@ -124,7 +124,7 @@ fn nan_and_mismatch_are_rejected() {
         .write_atomic(&p)
         .unwrap_err()
         .to_string()
-        .contains("triangle 1"));
+        .contains("surface_triangles[1][2] = 9 (must be < 4 surface vertices)"));
 
     let mut base = tiny_base();
     base.meta.format_version = 99;
@@ -340,5 +340,130 @@ fn surface_order_round_trips_and_a_bad_one_is_named() {
     ] {
         b.surface_order = Some(order);
         assert_refused(&b, needle);
+    }
+}
+
+/// `bytes` (a valid archive) with entry `name.npy` replaced by `npy`.
+fn with_entry(bytes: &[u8], name: &str, npy: &[u8]) -> Vec<u8> {
+    let mut zin = zip::ZipArchive::new(Cursor::new(bytes)).unwrap();
+    let opts =
+        zip::write::SimpleFileOptions::default().compression_method(zip::CompressionMethod::Stored);
+    let mut w = zip::ZipWriter::new(Cursor::new(Vec::new()));
+    for i in 0..zin.len() {
+        let mut f = zin.by_index(i).unwrap();
+        let entry = f.name().to_string();
+        w.start_file(entry.as_str(), opts).unwrap();
+        if entry == format!("{name}.npy") {
+            std::io::Write::write_all(&mut w, npy).unwrap();
+        } else {
+            std::io::copy(&mut f, &mut w).unwrap();
+        }
+    }
+    w.finish().unwrap().into_inner()
+}
+
+// Regression: a version-2 `.npy` header declaring a 0xFFFFFFF0-byte header made every reader
+// (info, probe, geodesic, check, ModalModel::load) allocate 4 GiB before failing. The header
+// length is checked against the entry's real size (and numpy's 10,000-byte limit) first.
+#[test]
+fn npy_header_length_is_bounded_by_the_entry() {
+    let good = tiny_base().to_bytes().unwrap();
+    for (version, len) in [(2u8, 0xFFFF_FFF0u32), (3, 0x7FFF_0000), (2, 20_000)] {
+        let mut npy = b"\x93NUMPY".to_vec();
+        npy.extend_from_slice(&[version, 0]);
+        npy.extend_from_slice(&len.to_le_bytes());
+        npy.extend_from_slice(&[b' '; 64]);
+        let bytes = with_entry(&good, "residuals", &npy);
+        let err = ModesFile::read_from(Cursor::new(bytes), Path::new("h.modes")).unwrap_err();
+        let msg = err.to_string();
+        assert!(
+            matches!(
+                err,
+                FormatError::Entry {
+                    entry: "residuals",
+                    ..
+                }
+            ) && msg.contains(&format!("header of {len} bytes")),
+            "{msg}"
+        );
+    }
+    // Deeply nested header text is refused before it reaches the recursive parser.
+    let mut npy = b"\x93NUMPY\x01\x00".to_vec();
+    let h = format!("{}\n", "(".repeat(3000));
+    npy.extend_from_slice(&(h.len() as u16).to_le_bytes());
+    npy.extend_from_slice(h.as_bytes());
+    let bytes = with_entry(&good, "residuals", &npy);
+    let err = ModesFile::read_from(Cursor::new(bytes), Path::new("n.modes")).unwrap_err();
+    assert!(err.to_string().contains("nest"), "{err}");
+}
+
+// Regression: NaN, infinite and negative residuals were accepted although the format says
+// values are validated on read; so were indices past the volume mesh, coordinates far outside
+// any object (a surface scaled by 1e150 made geodesic distances all zero) and meta values
+// that cannot be. Each is refused naming the entry, the index and the range that holds.
+#[test]
+fn content_out_of_range_is_refused_naming_entry_index_and_range() {
+    type Corrupt = fn(&mut ModesFile);
+    let cases: [(Corrupt, &str); 12] = [
+        (|b| b.residuals[1] = f64::NAN, "residuals[1] = NaN"),
+        (|b| b.residuals[0] = f64::INFINITY, "residuals[0] = inf"),
+        (
+            |b| b.residuals[1] = -1e-12,
+            "residuals[1] = -1e-12 (must be finite and ≥ 0)",
+        ),
+        (|b| b.eigenvalues[0] = -1.0, "eigenvalues[0] = -1"),
+        (|b| b.surface_to_volume[2] = 4, "surface_to_volume[2] = 4"),
+        (|b| b.fixed_nodes = vec![1, 7], "fixed_nodes[1] = 7"),
+        (
+            |b| {
+                for p in &mut b.surface_vertices {
+                    *p = p.map(|x| x * 1e150);
+                }
+            },
+            "surface_vertices[1][0] = 1e150 (must be within ±1e6 m)",
+        ),
+        (
+            |b| {
+                for p in &mut b.surface_vertices {
+                    *p = p.map(|x| x * 1e-9);
+                }
+            },
+            "surface extent 1.73e-9 m (bounding-box diagonal) is below the supported 1e-6 m",
+        ),
+        (
+            |b| b.meta.mass_kg = -1.0,
+            "meta.mass_kg = -1 (must be finite and > 0)",
+        ),
+        (|b| b.meta.volume_nodes = 3, "volume_nodes"),
+        (|b| b.meta.rigid_modes_excluded = 5, "rigid_modes_excluded"),
+        (|b| b.modes[5] = f64::NAN, "modes[0][2][1] = NaN"),
+    ];
+    for (corrupt, needle) in cases {
+        let mut b = tiny_base();
+        corrupt(&mut b);
+        assert_refused(&b, needle);
+    }
+    // The ends of the supported coordinate range load.
+    for scale in [1e-5, 3e5] {
+        let mut b = tiny_base();
+        for p in &mut b.surface_vertices {
+            *p = p.map(|x| x * scale);
+        }
+        let bytes = b.to_bytes().unwrap();
+        ModesFile::read_from(Cursor::new(bytes), Path::new("s.modes")).unwrap();
+    }
+}
+
+// Regression: reading a `.modes` path that is a device, FIFO or directory opened it (a FIFO
+// blocks, `/dev/zero` never ends); it is refused by name before opening.
+#[test]
+fn only_regular_files_are_read() {
+    let dir = tempfile::tempdir().unwrap();
+    for path in [Path::new("/dev/zero"), dir.path()] {
+        let err = ModesFile::read(path).unwrap_err().to_string();
+        assert!(
+            err.starts_with(&path.display().to_string()) && err.contains("not a regular file"),
+            "{err}"
+        );
     }
 }

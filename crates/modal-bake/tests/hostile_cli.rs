@@ -1,0 +1,162 @@
+//! Hostile and abusive uses of the `modal-bake` binary, each a regression test of a defect
+//! class: values that overflow silently, writes that fail silently or clobber what they should
+//! not, signals that leave temporaries behind. Each asserts a clean refusal (exit code, a
+//! message naming the file or option and the range that works) or the right result.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_modal-bake"))
+}
+
+fn data(rel: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../data")
+        .join(rel)
+}
+
+fn run(args: &[&str]) -> Output {
+    bin().args(args).output().expect("modal-bake runs")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// Bakes the cube (free-free, 6 modes) into `dir/cube.modes`.
+fn cube_base(dir: &Path) -> PathBuf {
+    let out = dir.join("cube.modes");
+    let o = run(&[
+        "bake",
+        data("meshes/cube_v41.msh").to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--modes",
+        "6",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    out
+}
+
+/// Copies the `.modes` archive `src` to `dst` with every surface-vertex coordinate scaled by
+/// `scale` (bypassing validation, as a foreign or broken writer would).
+fn scaled_copy(src: &Path, dst: &Path, scale: f64) {
+    use ndarray_npy::{NpzReader, NpzWriter};
+    let mut r = NpzReader::new(std::fs::File::open(src).unwrap()).unwrap();
+    let mut w = NpzWriter::new(std::fs::File::create(dst).unwrap());
+    for name in r.names().unwrap() {
+        let key = name.trim_end_matches(".npy").to_string();
+        match key.as_str() {
+            "surface_vertices" | "eigenvalues" | "frequencies_hz" | "modes" | "material"
+            | "rayleigh" | "residuals" => {
+                let mut a: ndarray::ArrayD<f64> = r.by_name(&name).unwrap();
+                if key == "surface_vertices" {
+                    a.mapv_inplace(|x| x * scale);
+                }
+                w.add_array(key, &a).unwrap();
+            }
+            "meta" => {
+                let a: ndarray::ArrayD<u8> = r.by_name(&name).unwrap();
+                w.add_array(key, &a).unwrap();
+            }
+            "format_version" => {
+                let a: ndarray::ArrayD<u32> = r.by_name(&name).unwrap();
+                w.add_array(key, &a).unwrap();
+            }
+            _ => {
+                let a: ndarray::ArrayD<u32> = r.by_name(&name).unwrap();
+                w.add_array(key, &a).unwrap();
+            }
+        }
+    }
+    w.finish().unwrap();
+}
+
+// Regression: `probe --direction 1e308,1e308,1e308` normalised an infinite length and applied
+// no impulse (all peaks 0, exit 0). Any finite non-zero direction is a direction: it gives the
+// response of (1, 1, 1)/√3. A zero direction is refused.
+#[test]
+fn probe_direction_of_any_finite_length_works() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = cube_base(dir.path());
+    let probe = |direction: &str| {
+        run(&[
+            "probe",
+            base.to_str().unwrap(),
+            "--impact",
+            "0.5,0.5,1",
+            "--impulse",
+            "1",
+            "--contact",
+            "0.2,0.3,1",
+            "--direction",
+            direction,
+            "--json",
+        ])
+    };
+    let unit = probe("1,1,1");
+    assert!(unit.status.success(), "{}", stderr(&unit));
+    let huge = probe("1e308,1e308,1e308");
+    assert!(huge.status.success(), "{}", stderr(&huge));
+    let tiny = probe("1e-320,1e-320,1e-320");
+    assert!(tiny.status.success(), "{}", stderr(&tiny));
+    let v: serde_json::Value = serde_json::from_slice(&unit.stdout).unwrap();
+    let peak = v["contacts"][0]["peak_displacement_m"].as_f64().unwrap();
+    assert!(peak > 0.0, "{v}");
+    assert_eq!(huge.stdout, unit.stdout);
+    assert_eq!(tiny.stdout, unit.stdout);
+    let zero = probe("0,0,0");
+    assert_eq!(zero.status.code(), Some(1));
+    assert!(stderr(&zero).contains("--direction"), "{}", stderr(&zero));
+}
+
+// Regression: `geodesic` on a base whose surface was scaled by 1e150 returned all zeros (exit
+// 0): squared lengths overflow. The base is refused on load, naming the entry and the range.
+#[test]
+fn geodesic_refuses_a_surface_outside_the_coordinate_range() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = cube_base(dir.path());
+    let far = dir.path().join("far.modes");
+    scaled_copy(&base, &far, 1e150);
+    for sub in [
+        &["geodesic", far.to_str().unwrap(), "--from-vertex", "0"][..],
+        &["info", far.to_str().unwrap()][..],
+    ] {
+        let o = run(sub);
+        assert_eq!(o.status.code(), Some(1), "{sub:?}");
+        let err = stderr(&o);
+        assert!(
+            err.contains("far.modes")
+                && err.contains("surface_vertices[")
+                && err.contains("±1e6 m"),
+            "{err}"
+        );
+    }
+    // Within the range, distances scale with the surface.
+    let near = dir.path().join("near.modes");
+    scaled_copy(&base, &near, 1e5);
+    let d = |p: &Path| -> Vec<f64> {
+        let o = run(&[
+            "geodesic",
+            p.to_str().unwrap(),
+            "--from-vertex",
+            "0",
+            "--json",
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        v["distances_m"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_f64().unwrap())
+            .collect()
+    };
+    let (a, b) = (d(&base), d(&near));
+    let max = a.iter().fold(0.0f64, |m, x| m.max(*x));
+    assert!(max > 0.5);
+    for (x, y) in a.iter().zip(&b) {
+        assert!((x * 1e5 - y).abs() <= 1e-9 * max * 1e5, "{x} vs {y}");
+    }
+}
