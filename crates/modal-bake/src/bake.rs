@@ -195,6 +195,8 @@ pub struct BakeReport {
     pub transfer_samples: usize,
     /// Transfer table: where its modes came from (`base`, `dense`, `lanczos`).
     pub transfer_mode_source: String,
+    /// The output's folder, when the bake had to create it ([`bake_file`]).
+    pub created_folder: Option<String>,
 }
 
 /// Progress of a bake, for a CLI bar.
@@ -796,7 +798,8 @@ fn transfer_meta(tp: &crate::transfer::TransferParams) -> serde_json::Value {
     })
 }
 
-/// Reads `mesh_path`, bakes it and writes `out` atomically (nothing is left on failure).
+/// Reads `mesh_path`, bakes it and writes `out` atomically (nothing is left on failure),
+/// creating `out`'s folder if it is missing ([`BakeReport::created_folder`]).
 ///
 /// # Errors
 /// A [`BakeError`] naming the file and what failed.
@@ -834,6 +837,15 @@ pub fn bake_file_with_transfer(
     report.read_s = read_s;
     progress(BakeStage::Write);
     let t = Instant::now();
+    if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
+        if !dir.exists() {
+            std::fs::create_dir_all(dir).map_err(|source| FormatError::Io {
+                path: dir.to_path_buf(),
+                source,
+            })?;
+            report.created_folder = Some(dir.display().to_string());
+        }
+    }
     base.write_atomic(out)?;
     report.write_s = t.elapsed().as_secs_f64();
     Ok(report)

@@ -160,3 +160,172 @@ fn geodesic_refuses_a_surface_outside_the_coordinate_range() {
         assert!((x * 1e5 - y).abs() <= 1e-9 * max * 1e5, "{x} vs {y}");
     }
 }
+
+fn bake_to(out: &Path, mesh: &Path) -> Output {
+    run(&[
+        "bake",
+        mesh.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--modes",
+        "4",
+    ])
+}
+
+// Regression: `-o` equal to the input mesh overwrote the mesh with the base; `-o` onto a device
+// replaced the device node. Both are refused before baking, naming `-o`, and nothing changes.
+#[test]
+fn output_onto_an_input_or_a_non_file_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = dir.path().join("m.msh");
+    std::fs::copy(data("meshes/cube_v41.msh"), &mesh).unwrap();
+    let before = std::fs::read(&mesh).unwrap();
+    let link = dir.path().join("link.msh");
+    std::fs::hard_link(&mesh, &link).unwrap();
+    let dotted = dir.path().join(".").join("m.msh");
+    for out in [&mesh, &link, &dotted] {
+        let o = bake_to(out, &mesh);
+        assert_eq!(o.status.code(), Some(1), "{}", out.display());
+        let err = stderr(&o);
+        assert!(err.contains("-o") && err.contains("is the input"), "{err}");
+    }
+    assert_eq!(
+        std::fs::read(&mesh).unwrap(),
+        before,
+        "the mesh is untouched"
+    );
+    let fifo = dir.path().join("pipe.modes");
+    assert!(Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .unwrap()
+        .success());
+    let folder = dir.path().join("folder.modes");
+    std::fs::create_dir(&folder).unwrap();
+    for (out, what) in [(&fifo, "a FIFO"), (&folder, "a directory")] {
+        let o = bake_to(out, &mesh);
+        assert_eq!(o.status.code(), Some(1));
+        assert!(stderr(&o).contains(what), "{}", stderr(&o));
+    }
+    use std::os::unix::fs::FileTypeExt;
+    assert!(std::fs::metadata(&fifo).unwrap().file_type().is_fifo());
+    let o = run(&[
+        "geodesic",
+        data("meshes/cube_v41.msh").to_str().unwrap(),
+        "--from-vertex",
+        "0",
+        "--npy",
+        folder.to_str().unwrap(),
+    ]);
+    assert!(stderr(&o).contains("--npy"), "{}", stderr(&o));
+    // Only the mesh, its link, the FIFO and the folder: no temporary anywhere.
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 4);
+    assert_eq!(std::fs::read_dir(&folder).unwrap().count(), 0);
+}
+
+// Regression: the README's first bake (`-o out/beam.modes` on a fresh clone) failed because
+// `out/` did not exist, printing the cause twice. The folder is created, and said so.
+#[test]
+fn a_missing_output_folder_is_created_and_reported() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out/nested/beam.modes");
+    let o = bake_to(&out, &data("meshes/beam.msh"));
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(out.exists());
+    assert!(
+        stderr(&o).contains(&format!(
+            "created folder {}",
+            out.parent().unwrap().display()
+        )),
+        "{}",
+        stderr(&o)
+    );
+    // A folder that cannot be made (its parent is a file): one clear line, the cause once.
+    let file = dir.path().join("plain");
+    std::fs::write(&file, b"x").unwrap();
+    let o = bake_to(&file.join("sub/x.modes"), &data("meshes/beam.msh"));
+    assert_eq!(o.status.code(), Some(1));
+    let err = stderr(&o);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.contains("plain") && err.contains("not a folder"),
+        "{err}"
+    );
+}
+
+/// Runs `args` with stdout on `/dev/full` (every write fails: no space left on device).
+fn run_full(args: &[&str]) -> Output {
+    let full = std::fs::OpenOptions::new()
+        .write(true)
+        .open("/dev/full")
+        .unwrap();
+    bin()
+        .args(args)
+        .stdout(full)
+        .output()
+        .expect("modal-bake runs")
+}
+
+// Regression: `info`, `geodesic` and `probe --json` redirected to a full device exited 0. A
+// failed write of stdout is an error (exit 1; 2 for `check`), for every subcommand that prints;
+// a closed pipe (`| head`) is not.
+#[test]
+fn a_failed_stdout_write_is_an_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = cube_base(dir.path());
+    let b = base.to_str().unwrap();
+    let mesh = data("meshes/cube_v41.msh");
+    let m = mesh.to_str().unwrap();
+    let out2 = dir.path().join("again.modes");
+    let probe = [
+        "probe",
+        b,
+        "--impact",
+        "0.5,0.5,1",
+        "--impulse",
+        "1",
+        "--contact",
+        "0.2,0.3,1",
+    ];
+    let cases: Vec<(Vec<&str>, i32)> = vec![
+        (vec!["info", b], 1),
+        (vec!["info", b, "--json"], 1),
+        (vec!["geodesic", b, "--from-vertex", "0"], 1),
+        (vec!["geodesic", b, "--from-vertex", "0", "--json"], 1),
+        (probe.to_vec(), 1),
+        ([&probe[..], &["--json"]].concat(), 1),
+        (vec!["check", m, b, "--modes", "6"], 2),
+        (
+            vec![
+                "bake",
+                m,
+                "-o",
+                out2.to_str().unwrap(),
+                "--modes",
+                "6",
+                "--json",
+            ],
+            1,
+        ),
+    ];
+    for (args, code) in cases {
+        let o = run_full(&args);
+        assert_eq!(o.status.code(), Some(code), "{args:?}: {}", stderr(&o));
+        assert!(
+            stderr(&o).contains("cannot write to standard output"),
+            "{args:?}: {}",
+            stderr(&o)
+        );
+        // A closed pipe ends output quietly.
+        let mut child = bin()
+            .args(&args)
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        drop(child.stdout.take());
+        let o = child.wait_with_output().unwrap();
+        assert_eq!(o.status.code(), Some(0), "{args:?}: {}", stderr(&o));
+        assert!(!stderr(&o).contains("error"), "{args:?}: {}", stderr(&o));
+    }
+}

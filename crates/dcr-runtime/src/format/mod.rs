@@ -1,9 +1,11 @@
 //! The `.modes` base format (read and write), defined once here; `modal-bake` writes through it.
 
+mod atomic_file;
 mod modes_file;
 mod regular_file;
 mod transfer_table;
 
+pub use atomic_file::{remove_pending_temporaries, write_atomic, AtomicFile, STALE_AFTER};
 pub use modes_file::{
     FormatError, MaterialSi, ModesFile, ModesMeta, ModesPrecision, FORMAT_VERSION,
     MAX_COORDINATE_M, MIN_EXTENT_M,

@@ -38,8 +38,7 @@
 //! the entry's bytes and each shape against the data present before anything is allocated;
 //! the content is then validated ([`ModesFile::validate`], one table of rules per kind of value).
 
-use std::fs::File;
-use std::io::{Cursor, Read, Seek, Write};
+use std::io::{Cursor, Read, Seek};
 use std::path::{Path, PathBuf};
 
 use ndarray::{Array0, Array1, Array2, Array3, ArrayD};
@@ -184,6 +183,14 @@ pub enum FormatError {
         /// Path concerned.
         path: PathBuf,
         /// What it is instead ("a directory", "a FIFO", ...).
+        what: &'static str,
+    },
+    /// A write would replace something that is not a regular file.
+    #[error("{path}: is {what}; refusing to replace it with a file (give the path of a file)")]
+    Clobber {
+        /// Path concerned.
+        path: PathBuf,
+        /// What it is ("a directory", "a character device", ...).
         what: &'static str,
     },
     /// The file was written by an incompatible schema version.
@@ -370,41 +377,20 @@ impl ModesFile {
 
     /// Writes the base to `path` atomically and deterministically (same content → same bytes).
     ///
-    /// The data is written to a temporary file beside `path`, synced, then renamed over it; on
-    /// any error the temporary file is removed and `path` is left untouched.
+    /// The data is written to a temporary file beside `path`, synced, then renamed over it
+    /// ([`super::AtomicFile`]: unique temporary names, stale temporaries of dead writers
+    /// removed); on any error the temporary file is removed and `path` is left untouched.
     ///
     /// # Errors
-    /// [`FormatError::Invalid`] if the content fails [`ModesFile::validate`]; I/O errors.
+    /// [`FormatError::Invalid`] if the content fails [`ModesFile::validate`];
+    /// [`FormatError::Clobber`] if `path` is a directory, device, FIFO or socket; I/O errors.
     pub fn write_atomic(&self, path: &Path) -> Result<(), FormatError> {
         self.validate(path)?;
-        let io = |source| FormatError::Io {
-            path: path.to_path_buf(),
-            source,
-        };
         let bytes = self.to_bytes().map_err(|detail| FormatError::Archive {
             path: path.to_path_buf(),
             detail,
         })?;
-        let dir = path
-            .parent()
-            .filter(|d| !d.as_os_str().is_empty())
-            .unwrap_or(Path::new("."));
-        let name = path
-            .file_name()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_default();
-        let tmp = dir.join(format!(".{name}.tmp-{}", std::process::id()));
-        let result = (|| {
-            let mut f = File::create(&tmp)?;
-            f.write_all(&bytes)?;
-            f.sync_all()?;
-            std::fs::rename(&tmp, path)
-        })();
-        if let Err(e) = result {
-            let _ = std::fs::remove_file(&tmp);
-            return Err(io(e));
-        }
-        Ok(())
+        super::atomic_file::write_atomic(path, &bytes)
     }
 
     /// Serialises the archive to bytes (deterministic).

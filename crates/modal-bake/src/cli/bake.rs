@@ -213,6 +213,7 @@ impl Progress {
 }
 
 pub fn run(args: &BakeArgs) -> anyhow::Result<()> {
+    super::check_output(&args.out, "-o", &[&args.mesh])?;
     let params = args.options.params();
     let mut progress = Progress::new();
     let transfer = args.transfer.params();
@@ -226,6 +227,9 @@ pub fn run(args: &BakeArgs) -> anyhow::Result<()> {
     progress.bar.finish_and_clear();
     let report = report
         .with_context(|| format!("baking {} failed; nothing was written", args.mesh.display()))?;
+    if let Some(dir) = &report.created_folder {
+        eprintln!("note: created folder {dir}");
+    }
     if args.json {
         outln!("{}", serde_json::to_string_pretty(&report)?);
     } else {
