@@ -510,6 +510,10 @@ impl ModesFile {
             source,
         };
         let archive_len = reader.seek(std::io::SeekFrom::End(0)).map_err(io)?;
+        check_zip_directory(&mut reader, archive_len).map_err(|detail| FormatError::Archive {
+            path: path.to_path_buf(),
+            detail,
+        })?;
         reader.seek(std::io::SeekFrom::Start(0)).map_err(io)?;
         let mut zip = zip::ZipArchive::new(reader).map_err(|err| FormatError::Archive {
             path: path.to_path_buf(),
@@ -768,6 +772,52 @@ struct EntryReader<'a, R: Read + Seek> {
     path: &'a Path,
     /// Bytes in the whole archive: no entry holds more.
     archive_len: u64,
+}
+
+/// Most entries a `.modes` archive may declare (it has about 20): the zip reader reserves
+/// memory per declared entry, ~200 bytes each, before reading any.
+const MAX_ARCHIVE_ENTRIES: u64 = 256;
+
+/// Checks the entry counts a zip archive declares (end-of-central-directory record, and its
+/// zip64 form if present) against [`MAX_ARCHIVE_ENTRIES`] and the archive's length before the
+/// zip reader trusts them. Archives without the record are left to the zip reader to refuse.
+fn check_zip_directory<R: Read + Seek>(reader: &mut R, len: u64) -> Result<(), String> {
+    let io = |e: std::io::Error| format!("unreadable: {e}");
+    let tail_len = len.min(22 + 65_535 + 20 + 56);
+    reader
+        .seek(std::io::SeekFrom::Start(len - tail_len))
+        .map_err(io)?;
+    let mut tail = vec![0u8; tail_len as usize];
+    reader.read_exact(&mut tail).map_err(io)?;
+    let Some(eocd) = (0..tail.len().saturating_sub(21))
+        .rev()
+        .find(|&i| &tail[i..i + 4] == b"PK\x05\x06")
+    else {
+        return Ok(());
+    };
+    let u16_at = |i: usize| u64::from(u16::from_le_bytes([tail[i], tail[i + 1]]));
+    let mut counts = vec![u16_at(eocd + 8), u16_at(eocd + 10)];
+    // zip64: the locator just before the record points at the zip64 record with u64 counts.
+    if counts.contains(&0xFFFF) && eocd >= 20 && &tail[eocd - 20..eocd - 16] == b"PK\x06\x07" {
+        let at = u64::from_le_bytes(tail[eocd - 12..eocd - 4].try_into().unwrap_or([0; 8]));
+        let mut rec = [0u8; 56];
+        if at.checked_add(56).is_some_and(|end| end <= len) {
+            reader.seek(std::io::SeekFrom::Start(at)).map_err(io)?;
+            reader.read_exact(&mut rec).map_err(io)?;
+            if &rec[..4] == b"PK\x06\x06" {
+                counts = vec![
+                    u64::from_le_bytes(rec[24..32].try_into().unwrap_or([0; 8])),
+                    u64::from_le_bytes(rec[32..40].try_into().unwrap_or([0; 8])),
+                ];
+            }
+        }
+    }
+    match counts.iter().max() {
+        Some(&n) if n > MAX_ARCHIVE_ENTRIES || n.saturating_mul(46) > len => Err(format!(
+            "the zip directory declares {n} entries (a .modes archive has about 20; at most {MAX_ARCHIVE_ENTRIES}, 46 bytes each, are accepted)"
+        )),
+        _ => Ok(()),
+    }
 }
 
 /// Largest `.npy` header accepted (bytes): numpy's own default (`max_header_size`).

@@ -557,3 +557,19 @@ fn writes_never_replace_what_is_not_a_regular_file() {
     // Only the FIFO, the folder and nothing else: no temporary left behind.
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 2);
 }
+
+// Regression (found by the fuzz harness): an end-of-central-directory record declaring 65,535
+// entries made the zip reader reserve ~7 MB for a 58 kB archive (~200 bytes per declared
+// entry). Declared counts are checked first.
+#[test]
+fn zip_entry_counts_are_bounded_before_the_zip_reader_trusts_them() {
+    let mut bytes = tiny_base().to_bytes().unwrap();
+    let eocd = bytes.len() - 22;
+    assert_eq!(&bytes[eocd..eocd + 4], b"PK\x05\x06");
+    bytes[eocd + 8..eocd + 12].copy_from_slice(&[0xFF; 4]);
+    let err = ModesFile::read_from(Cursor::new(bytes), Path::new("z.modes")).unwrap_err();
+    assert!(
+        matches!(err, FormatError::Archive { .. }) && err.to_string().contains("65535 entries"),
+        "{err}"
+    );
+}
