@@ -117,7 +117,11 @@ fn real_main() -> Result<()> {
                 }
             }
             let out_dir = out.unwrap_or_else(|| {
-                let on = if matches!(dcr, OnOff::On) { "on" } else { "off" };
+                let on = if matches!(dcr, OnOff::On) {
+                    "on"
+                } else {
+                    "off"
+                };
                 root.join("out").join(format!("{}-{on}", desc.name))
             });
             let report = run_scene(

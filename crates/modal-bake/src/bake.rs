@@ -195,6 +195,8 @@ pub struct BakeReport {
     pub transfer_samples: usize,
     /// Transfer table: where its modes came from (`base`, `dense`, `lanczos`).
     pub transfer_mode_source: String,
+    /// Bounding-box diagonal of the mesh (m).
+    pub extent_m: f64,
     /// The output's folder, when the bake had to create it ([`bake_file`]).
     pub created_folder: Option<String>,
 }
@@ -335,6 +337,7 @@ fn prepare(mut mesh: TetMesh, params: &BakeParams, file: &str) -> Result<Prepare
             "{file}: the mesh has no tetrahedra"
         )));
     }
+    mesh.check_extent().map_err(name_file)?;
     let reoriented = mesh
         .orient_tets(DEFAULT_DEGENERATE_REL_TOL)
         .map_err(name_file)?;
@@ -544,6 +547,7 @@ pub fn bake_mesh(
     } = prepare(mesh, params, file)?;
     report.nodes = mesh.nodes.len();
     report.tets = mesh.tets.len();
+    report.extent_m = mesh.extent();
     report.reoriented_tets = reoriented;
     report.fixed_nodes = fixed.len();
     report.source_hash = hash.clone();

@@ -329,3 +329,147 @@ fn a_failed_stdout_write_is_an_error() {
         assert!(!stderr(&o).contains("error"), "{args:?}: {}", stderr(&o));
     }
 }
+
+/// Writes the cube mesh with every coordinate multiplied by `scale` (and node 1 moved to
+/// `outlier`, if given) as MSH 2.2 ASCII at `path`.
+fn scaled_cube(path: &Path, scale: f64, outlier: Option<f64>) {
+    let m = modal_bake::mesh::read_mesh(&data("meshes/cube_v41.msh")).unwrap();
+    let mut text = format!(
+        "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n{}\n",
+        m.nodes.len()
+    );
+    for (i, p) in m.nodes.iter().enumerate() {
+        let mut q = p.map(|x| x * scale);
+        if i == 0 {
+            if let Some(o) = outlier {
+                q[0] = o;
+            }
+        }
+        text += &format!("{} {:e} {:e} {:e}\n", i + 1, q[0], q[1], q[2]);
+    }
+    text += &format!("$EndNodes\n$Elements\n{}\n", m.tets.len());
+    for (k, t) in m.tets.iter().enumerate() {
+        text += &format!(
+            "{} 4 0 {} {} {} {}\n",
+            k + 1,
+            t[0] + 1,
+            t[1] + 1,
+            t[2] + 1,
+            t[3] + 1
+        );
+    }
+    text += "$EndElements\n";
+    std::fs::write(path, text).unwrap();
+}
+
+// Regression: numerical internals instead of causes — a mesh scaled by 1e100 or 1e150 ("Ritz
+// vectors not M-independent", "|volume| inf m³ below NaN m³"), a coordinate of 2147483648
+// ("NonPositivePivot"), an outlier node at 1e12 m (a healthy tet blamed), E = 1e300 or 1e308,
+// ρ = 1e-300 ("NoConvergence"). Each names the input out of range and the range that works.
+#[test]
+fn out_of_range_inputs_are_named_with_the_range_that_works() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("x.modes");
+    let bake = |mesh: &Path, extra: &[&str]| {
+        let mut a = vec![
+            "bake",
+            mesh.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "--modes",
+            "4",
+        ];
+        a.extend_from_slice(extra);
+        run(&a)
+    };
+    let cube = data("meshes/cube_v41.msh");
+    for (scale, outlier) in [
+        (1e100, None),
+        (1e150, None),
+        (1.0, Some(2147483648.0)),
+        (1.0, Some(1e12)),
+    ] {
+        let mesh = dir.path().join("scaled.msh");
+        scaled_cube(&mesh, scale, outlier);
+        let o = bake(&mesh, &[]);
+        assert_eq!(o.status.code(), Some(1));
+        let err = stderr(&o);
+        assert!(
+            err.contains("scaled.msh") && err.contains("node") && err.contains("±1e6 m"),
+            "{scale} {outlier:?}: {err}"
+        );
+    }
+    for (option, value, range) in [
+        ("--youngs", "1e300", "1e14"),
+        ("--youngs", "1e308", "1e14"),
+        ("--density", "1e-300", "0.01"),
+        ("--density", "1e300", "1e6"),
+    ] {
+        let o = bake(&cube, &[option, value]);
+        assert_eq!(o.status.code(), Some(1), "{option} {value}");
+        let err = stderr(&o);
+        assert!(
+            err.contains(option) && err.contains(range),
+            "{option} {value}: {err}"
+        );
+    }
+    // The ends of the ranges bake.
+    for extra in [
+        &["--youngs", "1"][..],
+        &["--youngs", "1e14"],
+        &["--density", "0.01"],
+        &["--density", "1e6"],
+    ] {
+        let o = bake(&cube, extra);
+        assert!(o.status.success(), "{extra:?}: {}", stderr(&o));
+    }
+    for scale in [1e-4, 1e5] {
+        let mesh = dir.path().join("ok.msh");
+        scaled_cube(&mesh, scale, None);
+        let o = bake(&mesh, &[]);
+        assert!(o.status.success(), "scale {scale}: {}", stderr(&o));
+    }
+}
+
+// Regression: wrong units were accepted silently — `--youngs 11` (GPa meant) baked 0.003 Hz
+// modes, `--density 0.77` (g/cm³ meant) a 19 g bench, a mesh in millimetres a 1.9e10 kg
+// bench. Each bakes (the values are legal) with a warning naming the likely mistake.
+#[test]
+fn likely_unit_mistakes_are_warned_about() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("x.modes");
+    let cube = data("meshes/cube_v41.msh");
+    let mm = dir.path().join("mm.msh");
+    scaled_cube(&mm, 1000.0, None);
+    for (mesh, extra, needle) in [
+        (&cube, &["--youngs", "11"][..], "GPa"),
+        (&cube, &["--density", "0.77"], "g/cm³"),
+        (&mm, &[], "millimetres"),
+    ] {
+        let mut a = vec![
+            "bake",
+            mesh.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "--modes",
+            "4",
+        ];
+        a.extend_from_slice(extra);
+        let o = run(&a);
+        assert!(o.status.success(), "{extra:?}: {}", stderr(&o));
+        let err = stderr(&o);
+        assert!(
+            err.contains("warning") && err.contains(needle),
+            "{extra:?}: {err}"
+        );
+    }
+    let o = run(&[
+        "bake",
+        cube.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--modes",
+        "4",
+    ]);
+    assert!(!stderr(&o).contains("warning"), "{}", stderr(&o));
+}
