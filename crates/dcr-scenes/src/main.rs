@@ -12,6 +12,7 @@ use dcr_scenes::{repo_root, SCENES};
 #[derive(Parser)]
 #[command(
     name = "dcr-scenes",
+    version,
     about = "The paper's Table 1 scenes, headless on rapier3d-f64"
 )]
 struct Cli {
@@ -49,7 +50,8 @@ enum Cmd {
         /// Attenuation exponent β (implies --method attenuation).
         #[arg(long)]
         beta: Option<f64>,
-        /// Output directory (default out/SCENE).
+        /// Output directory (default out/SCENE-on or out/SCENE-off, by --dcr, so the two runs
+        /// of a comparison never overwrite each other).
         #[arg(long)]
         out: Option<PathBuf>,
         /// Bases directory (default out/bases).
@@ -114,7 +116,14 @@ fn real_main() -> Result<()> {
                     bail!("--seconds must be positive, got {s}");
                 }
             }
-            let out_dir = out.unwrap_or_else(|| root.join("out").join(&desc.name));
+            let out_dir = out.unwrap_or_else(|| {
+                let on = if matches!(dcr, OnOff::On) {
+                    "on"
+                } else {
+                    "off"
+                };
+                root.join("out").join(format!("{}-{on}", desc.name))
+            });
             let report = run_scene(
                 &desc,
                 &RunParams {

@@ -232,6 +232,10 @@ pub struct BakeReport {
     pub transfer_samples: usize,
     /// Transfer table: where its modes came from (`base`, `dense`, `lanczos`).
     pub transfer_mode_source: String,
+    /// Bounding-box diagonal of the mesh (m).
+    pub extent_m: f64,
+    /// The output's folder, when the bake had to create it ([`bake_file`]).
+    pub created_folder: Option<String>,
 }
 
 /// Progress of a bake, for a CLI bar.
@@ -468,6 +472,7 @@ fn prepare(mut mesh: TetMesh, params: &BakeParams, file: &str) -> Result<Prepare
             "{file}: the mesh has no tetrahedra"
         )));
     }
+    mesh.check_extent().map_err(name_file)?;
     let reoriented = mesh
         .orient_tets(DEFAULT_DEGENERATE_REL_TOL)
         .map_err(name_file)?;
@@ -710,6 +715,7 @@ pub fn bake_mesh(
     report.fixed_by = fixed_by;
     report.nodes = mesh.nodes.len();
     report.tets = mesh.tets.len();
+    report.extent_m = mesh.extent();
     report.reoriented_tets = reoriented;
     report.fixed_nodes = fixed.len();
     report.source_hash = hash.clone();
@@ -988,7 +994,8 @@ fn transfer_meta(tp: &crate::transfer::TransferParams) -> serde_json::Value {
     })
 }
 
-/// Reads `mesh_path`, bakes it and writes `out` atomically (nothing is left on failure).
+/// Reads `mesh_path`, bakes it and writes `out` atomically (nothing is left on failure),
+/// creating `out`'s folder if it is missing ([`BakeReport::created_folder`]).
 ///
 /// # Errors
 /// A [`BakeError`] naming the file and what failed.
@@ -1026,6 +1033,15 @@ pub fn bake_file_with_transfer(
     report.read_s = read_s;
     progress(BakeStage::Write);
     let t = Instant::now();
+    if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
+        if !dir.exists() {
+            std::fs::create_dir_all(dir).map_err(|source| FormatError::Io {
+                path: dir.to_path_buf(),
+                source,
+            })?;
+            report.created_folder = Some(dir.display().to_string());
+        }
+    }
     base.write_atomic(out)?;
     report.write_s = t.elapsed().as_secs_f64();
     Ok(report)

@@ -11,5 +11,6 @@ pub mod bake;
 pub mod eigen;
 pub mod fem;
 pub mod mesh;
+pub mod signals;
 pub mod transfer;
 pub mod truth;

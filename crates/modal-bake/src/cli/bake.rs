@@ -41,6 +41,50 @@ pub struct ModelOptions {
 }
 
 impl ModelOptions {
+    /// Refuses a Young's modulus or density outside the supported ranges, naming the option,
+    /// and warns (stderr) about values that look like a unit mistake.
+    ///
+    /// # Errors
+    /// A one-line message naming `--youngs` or `--density` and the range that works.
+    pub fn check_ranges(&self) -> anyhow::Result<()> {
+        use modal_bake::fem::Material;
+        let [elo, ehi] = Material::YOUNGS_RANGE;
+        if !(self.youngs >= elo && self.youngs <= ehi) {
+            anyhow::bail!(
+                "--youngs {:e} Pa is outside the supported {elo:e} … {ehi:e} Pa (foams ~1e5, polymers ~1e9, steel 2e11)",
+                self.youngs
+            );
+        }
+        let [dlo, dhi] = Material::DENSITY_RANGE;
+        if !(self.density >= dlo && self.density <= dhi) {
+            anyhow::bail!(
+                "--density {:e} kg/m³ is outside the supported {dlo} … {dhi:e} kg/m³ (aerogel ~2, wood ~700, steel 7850)",
+                self.density
+            );
+        }
+        if self.youngs < 1e5 {
+            eprintln!(
+                "warning: --youngs {} Pa is softer than any solid object (plausible: 1e5 Pa foam … 1.2e12 Pa diamond); \
+                 the unit is Pa: did you mean {} GPa = {:e} Pa or {} MPa = {:e} Pa?",
+                self.youngs,
+                self.youngs,
+                self.youngs * 1e9,
+                self.youngs,
+                self.youngs * 1e6
+            );
+        }
+        if self.density < 100.0 {
+            eprintln!(
+                "warning: --density {} kg/m³ is lighter than solids other than foams and aerogels (plausible: 100 … 22600 kg/m³); \
+                 the unit is kg/m³: did you mean {} g/cm³ = {} kg/m³?",
+                self.density,
+                self.density,
+                self.density * 1000.0
+            );
+        }
+        Ok(())
+    }
+
     /// The material in SI units.
     pub fn material(&self) -> MaterialSi {
         MaterialSi {
@@ -250,6 +294,8 @@ impl Progress {
 }
 
 pub fn run(args: &BakeArgs) -> anyhow::Result<()> {
+    super::check_output(&args.out, "-o", &[&args.mesh])?;
+    args.options.model.check_ranges()?;
     let params = args.options.params();
     let mut progress = Progress::new();
     let transfer = args.transfer.params();
@@ -281,6 +327,18 @@ pub fn run(args: &BakeArgs) -> anyhow::Result<()> {
     progress.bar.finish_and_clear();
     let report = report
         .with_context(|| format!("baking {} failed; nothing was written", args.mesh.display()))?;
+    if let Some(dir) = &report.created_folder {
+        eprintln!("note: created folder {dir}");
+    }
+    if report.extent_m > 100.0 {
+        eprintln!(
+            "warning: {} is {:.4e} m across and weighs {:.4e} kg (plausible objects: 0.01 … 100 m); \
+             bake expects metres: if the mesh is in millimetres, coordinates are 1000× too large",
+            args.mesh.display(),
+            report.extent_m,
+            report.mass_kg
+        );
+    }
     if args.json {
         outln!("{}", serde_json::to_string_pretty(&report)?);
     } else {

@@ -3,7 +3,6 @@
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
-use anyhow::Context;
 use clap::Args;
 use dcr_runtime::format::ModesFile;
 
@@ -17,8 +16,8 @@ pub struct InfoArgs {
 }
 
 pub fn run(args: &InfoArgs) -> anyhow::Result<()> {
-    let base = ModesFile::read(&args.file)
-        .with_context(|| format!("cannot read {}", args.file.display()))?;
+    // FormatError messages name the file and the entry at fault.
+    let base = ModesFile::read(&args.file)?;
     let freqs = base.frequencies_hz();
     if args.json {
         let v = serde_json::json!({

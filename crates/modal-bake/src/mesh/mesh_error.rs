@@ -16,6 +16,8 @@ pub enum Location {
     Element(u64),
     /// A path into a JSON document, e.g. `cells[1].data[3]`.
     Path(String),
+    /// A 1-based node in canonical order (ascending file tag), for checks on positions.
+    Node(u64),
 }
 
 /// A mesh that could not be read or fails a check, with the file name and a location.
@@ -193,6 +195,24 @@ pub enum MeshErrorKind {
     /// A negative node index in JSON cells.
     #[error("negative node index {0}")]
     NegativeIndex(i64),
+    /// A node coordinate outside ±[`dcr_runtime::format::MAX_COORDINATE_M`].
+    #[error(
+        "coordinate {value:e} m is outside the supported ±{max:e} m (bake expects metres: is the mesh in other units, or is this node misplaced?)"
+    )]
+    CoordinateOutOfRange {
+        /// The coordinate (m).
+        value: f64,
+        /// The limit (m).
+        max: f64,
+    },
+    /// A mesh smaller than [`dcr_runtime::format::MIN_EXTENT_M`].
+    #[error("the mesh is {extent:e} m across (bounding-box diagonal); at least {min:e} m is supported (bake expects metres)")]
+    TooSmall {
+        /// Bounding-box diagonal (m).
+        extent: f64,
+        /// The limit (m).
+        min: f64,
+    },
     /// A tetrahedron of (near-)zero or NaN volume.
     #[error(
         "degenerate tetrahedron {element}: |volume| {volume:e} m³ below {threshold:e} m³ \
@@ -282,6 +302,7 @@ impl fmt::Display for MeshError {
             Location::Byte(offset) => write!(f, "{sep}byte {offset}")?,
             Location::Element(id) => write!(f, "{sep}element {id}")?,
             Location::Path(path) => write!(f, "{sep}{path}")?,
+            Location::Node(n) => write!(f, "{sep}node {n}")?,
         }
         if self.file.is_empty() && self.location == Location::None {
             write!(f, "{}", self.kind)

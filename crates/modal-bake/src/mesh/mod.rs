@@ -44,53 +44,19 @@ pub use validate::{DEFAULT_DEGENERATE_REL_TOL, DEFAULT_STRAIGHT_REL_TOL};
 /// device, FIFO or socket is refused before it is opened for reading (a FIFO would block, a
 /// device like `/dev/zero` never ends).
 fn read_file(path: &Path) -> Result<(Vec<u8>, String), MeshError> {
+    use dcr_runtime::format::{open_regular_file, OpenError};
     use std::io::Read;
     let name = path.display().to_string();
-    let io =
-        |e: std::io::Error| MeshError::new(&name, Location::None, MeshErrorKind::Io(e.to_string()));
-    let not_regular = |t: std::fs::FileType| {
-        MeshError::new(
-            &name,
-            Location::None,
-            MeshErrorKind::NotARegularFile(file_type_name(t)),
-        )
-    };
-    let meta = std::fs::metadata(path).map_err(io)?;
-    if !meta.is_file() {
-        return Err(not_regular(meta.file_type()));
-    }
-    let file = std::fs::File::open(path).map_err(io)?;
-    // The path may have been replaced between the two looks: check what was opened.
-    let meta = file.metadata().map_err(io)?;
-    if !meta.is_file() {
-        return Err(not_regular(meta.file_type()));
-    }
-    let len = meta.len();
+    let error = |kind| MeshError::new(&name, Location::None, kind);
+    let (file, len) = open_regular_file(path).map_err(|e| match e {
+        OpenError::NotRegular(what) => error(MeshErrorKind::NotARegularFile(what)),
+        OpenError::Io(e) => error(MeshErrorKind::Io(e.to_string())),
+    })?;
     let mut data = Vec::with_capacity(usize::try_from(len).unwrap_or(0));
-    file.take(len).read_to_end(&mut data).map_err(io)?;
+    file.take(len)
+        .read_to_end(&mut data)
+        .map_err(|e| error(MeshErrorKind::Io(e.to_string())))?;
     Ok((data, name))
-}
-
-/// What kind of file system object `t` is, for messages.
-fn file_type_name(t: std::fs::FileType) -> &'static str {
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::FileTypeExt;
-        if t.is_char_device() {
-            return "a character device";
-        } else if t.is_block_device() {
-            return "a block device";
-        } else if t.is_fifo() {
-            return "a FIFO";
-        } else if t.is_socket() {
-            return "a socket";
-        }
-    }
-    if t.is_dir() {
-        "a directory"
-    } else {
-        "a special file"
-    }
 }
 
 /// Reads a mesh file (positions in m), choosing the format from its content (`$MeshFormat`

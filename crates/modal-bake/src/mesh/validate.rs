@@ -208,6 +208,59 @@ impl TetMesh {
         self.edge_mid_nodes().map(|_| ())
     }
 
+    /// Checks node positions are within the range the bake and the runtime work in: every
+    /// coordinate within ±[`dcr_runtime::format::MAX_COORDINATE_M`] (1e6 m) and a bounding-box
+    /// diagonal of at least [`dcr_runtime::format::MIN_EXTENT_M`] (1e-6 m). Outside, volumes,
+    /// stiffness and eigenvalues over- or underflow and the failure would surface as a
+    /// numerical one far from its cause.
+    ///
+    /// # Errors
+    /// [`MeshErrorKind::CoordinateOutOfRange`] at the first node outside (1-based, canonical
+    /// order), [`MeshErrorKind::TooSmall`].
+    pub fn check_extent(&self) -> Result<(), MeshError> {
+        use dcr_runtime::format::{MAX_COORDINATE_M, MIN_EXTENT_M};
+        for (i, p) in self.nodes.iter().enumerate() {
+            if let Some(&value) = p.iter().find(|x| !(x.abs() <= MAX_COORDINATE_M)) {
+                return Err(MeshError::new(
+                    "",
+                    Location::Node(i as u64 + 1),
+                    MeshErrorKind::CoordinateOutOfRange {
+                        value,
+                        max: MAX_COORDINATE_M,
+                    },
+                ));
+            }
+        }
+        let extent = self.extent();
+        if !(extent >= MIN_EXTENT_M) && !self.nodes.is_empty() {
+            return Err(MeshError::new(
+                "",
+                Location::None,
+                MeshErrorKind::TooSmall {
+                    extent,
+                    min: MIN_EXTENT_M,
+                },
+            ));
+        }
+        Ok(())
+    }
+
+    /// Bounding-box diagonal of the nodes (m); 0 for an empty mesh.
+    pub fn extent(&self) -> f64 {
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        for p in &self.nodes {
+            for k in 0..3 {
+                lo[k] = lo[k].min(p[k]);
+                hi[k] = hi[k].max(p[k]);
+            }
+        }
+        if self.nodes.is_empty() {
+            return 0.0;
+        }
+        (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt()
+    }
+
     /// Checks that no two tetrahedra overlap across a face: in a conforming mesh every
     /// interior face is shared by exactly two tetrahedra, one on each side, so with every
     /// tetrahedron positively oriented (call [`TetMesh::orient_tets`] first) no oriented face
