@@ -110,6 +110,7 @@ pub fn mesh_asset(
 }
 
 pub fn run(args: &MeshArgs) -> anyhow::Result<()> {
+    super::check_output(&args.out, "-o", &[&args.asset])?;
     let (out, surface) = mesh_asset(&args.asset, args.units.to_metres(), &args.asset_options)?;
     write_atomic(&args.out, &out.msh).with_context(|| format!("writing {}", args.out.display()))?;
     let m = &out.mesh;
