@@ -27,7 +27,7 @@ pub use attenuation::{
     HeatWorkspace,
 };
 pub use filter::{damping_ratio, samples_per_step, ModalBank, ModeFilter, Sampling};
-pub use model::{LoadError, ModalModel, SurfacePoint};
+pub use model::{quadratic_triangle_weights, LoadError, ModalModel, SurfacePoint};
 pub use response::{
     effective_mass, peak_abs_projection, peak_abs_rows, response_impulse, ContactResponse,
     DistantResponse, ForceInput, Impact, Method, ParamsError, ResponseParams, RestingContact,
