@@ -53,6 +53,12 @@ impl ModelOptions {
                 self.youngs
             );
         }
+        if !(self.poisson > -1.0 && self.poisson < 0.5) {
+            anyhow::bail!(
+                "--poisson {} must satisfy −1 < ν < 0.5 (rubber ~0.49, metals ~0.3, cork ~0)",
+                self.poisson
+            );
+        }
         let [dlo, dhi] = Material::DENSITY_RANGE;
         if !(self.density >= dlo && self.density <= dhi) {
             anyhow::bail!(
