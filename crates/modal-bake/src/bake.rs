@@ -208,7 +208,9 @@ pub enum BakeStage {
     Read,
     /// Assembling K and M.
     Assemble,
-    /// Factoring and iterating; carries the eigensolver's progress.
+    /// Factoring K − σM (before the first Lanczos step).
+    Factor,
+    /// Iterating; carries the eigensolver's progress.
     Eigensolve(EigenProgress),
     /// Solving for the transfer table's modes (dense or Lanczos).
     TransferModes,
@@ -593,6 +595,7 @@ pub fn bake_mesh(
     // The surface and its heat-geodesic ordering depend on the mesh only: they are computed
     // on a second thread during the factorization and eigensolve (the bake bench's 3k / 15k
     // beams: ≈ 5 / 17 ms, otherwise after it).
+    progress(BakeStage::Factor);
     let (res, surface) = std::thread::scope(|scope| {
         let surface = scope.spawn(|| Surface::of(&mesh));
         let res = eigen::solve_lowest(&kf, &mf, &eparams, &mut |p| {

@@ -473,3 +473,41 @@ fn likely_unit_mistakes_are_warned_about() {
     ]);
     assert!(!stderr(&o).contains("warning"), "{}", stderr(&o));
 }
+
+// Regression: without a terminal (CI logs) a bake was silent however long it ran, and the bar
+// said "(assembling K and M)" while factoring. Plain lines name each long stage and its
+// progress (`MODAL_BAKE_PROGRESS_EVERY` = 0 reports every stage here; the default is 5 s).
+#[test]
+fn progress_without_a_terminal_is_plain_lines() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("b.modes");
+    let o = bin()
+        .args([
+            "bake",
+            data("meshes/beam.msh").to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "--fixed",
+            "clamp",
+            "--modes",
+            "6",
+        ])
+        .env("MODAL_BAKE_PROGRESS_EVERY", "0")
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let err = stderr(&o);
+    for needle in [
+        "reading mesh: done",
+        "assembling K and M: done",
+        "factoring K − σM: done",
+        "modes converged",
+        "writing: done",
+    ] {
+        assert!(err.contains(needle), "{needle}: {err}");
+    }
+    // By default a short bake prints no progress at all.
+    let o = bake_to(&out, &data("meshes/beam.msh"));
+    assert!(o.status.success());
+    assert!(!stderr(&o).contains("bake ["), "{}", stderr(&o));
+}
