@@ -61,6 +61,13 @@ use crate::mesh::{tet_faces, MeshError, DEFAULT_DEGENERATE_REL_TOL};
 use dcr_runtime::format::{FormatError, ModesMeta, FORMAT_VERSION};
 use dcr_runtime::HeatGeodesic;
 
+/// Version of what `modal-bake` writes for given inputs, stored in every base
+/// (`meta.bake_params.output_version`). Bumped by any change of the tool that changes a base's
+/// content for the same mesh and options (assembly, eigensolver, surface extraction, hashing),
+/// and only then — not by the crate version — so `check` calls bases of an older output stale
+/// and an upgrade that changes nothing keeps them fresh.
+pub const OUTPUT_VERSION: u32 = 1;
+
 /// `modal-bake <version>`, stored in every base.
 pub const TOOL_VERSION: &str = concat!("modal-bake ", env!("CARGO_PKG_VERSION"));
 
@@ -700,7 +707,13 @@ pub fn bake_mesh(
             tool_version: TOOL_VERSION.to_string(),
             source_hash: hash,
             params_hash: params.hash(),
-            bake_params: serde_json::to_value(params).expect("params serialise"),
+            bake_params: {
+                let mut v = serde_json::to_value(params).expect("params serialise");
+                if let Some(obj) = v.as_object_mut() {
+                    obj.insert("output_version".into(), OUTPUT_VERSION.into());
+                }
+                v
+            },
             volume_nodes: mesh.nodes.len(),
             volume_tets: mesh.tets.len(),
             rigid_modes_excluded: first,
@@ -887,6 +900,59 @@ pub fn is_up_to_date_with_transfer(
     transfer: Option<&crate::transfer::TransferParams>,
     modes: &Path,
 ) -> Result<bool, BakeError> {
+    Ok(base_status(mesh_path, params, transfer, modes)? == BaseStatus::UpToDate)
+}
+
+/// Whether a base is up to date, and if not why (what `modal-bake check --json` reports).
+#[derive(Clone, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum BaseStatus {
+    /// The base holds what a bake of this mesh with these options would write.
+    UpToDate,
+    /// No file at the base's path.
+    Missing,
+    /// The file does not read as a valid base (the reader's message).
+    Unreadable(String),
+    /// Written by a `modal-bake` whose output differs ([`OUTPUT_VERSION`]), or without what
+    /// this one stores (the heat-geodesic order).
+    ToolChanged,
+    /// The mesh's geometry or fixed set differs ([`geometry_hash`]).
+    GeometryChanged,
+    /// The bake parameters differ ([`BakeParams::hash`]).
+    ParametersChanged,
+    /// The peak-transfer table is missing, unwanted or built with other parameters.
+    TransferTableChanged,
+}
+
+impl BaseStatus {
+    /// The reason as one word (`up_to_date`, `missing`, `unreadable`, `tool_changed`,
+    /// `geometry_changed`, `parameters_changed`, `transfer_table_changed`).
+    pub fn reason(&self) -> &'static str {
+        match self {
+            BaseStatus::UpToDate => "up_to_date",
+            BaseStatus::Missing => "missing",
+            BaseStatus::Unreadable(_) => "unreadable",
+            BaseStatus::ToolChanged => "tool_changed",
+            BaseStatus::GeometryChanged => "geometry_changed",
+            BaseStatus::ParametersChanged => "parameters_changed",
+            BaseStatus::TransferTableChanged => "transfer_table_changed",
+        }
+    }
+}
+
+/// Compares the base at `modes` with what a bake of `mesh_path` with `params` (and `transfer`)
+/// would write: by content hashes of the parsed geometry and of the parameters, and the
+/// [`OUTPUT_VERSION`] of the tool that wrote it — never by file times.
+///
+/// # Errors
+/// A [`BakeError`] when the mesh itself cannot be read or prepared, or the parameters are
+/// invalid (what `check` exits 2 on).
+pub fn base_status(
+    mesh_path: &Path,
+    params: &BakeParams,
+    transfer: Option<&crate::transfer::TransferParams>,
+    modes: &Path,
+) -> Result<BaseStatus, BakeError> {
     params.check()?;
     if let Some(tp) = transfer {
         tp.check().map_err(|error| BakeError::Transfer {
@@ -896,30 +962,38 @@ pub fn is_up_to_date_with_transfer(
     }
     let mesh = crate::mesh::read_mesh(mesh_path)?;
     let prepared = prepare(mesh, params, &mesh_path.display().to_string())?;
-    if !modes.exists() {
-        return Ok(false);
+    if std::fs::symlink_metadata(modes).is_err() {
+        return Ok(BaseStatus::Missing);
     }
-    Ok(match ModesFile::read(modes) {
-        Ok(base) => {
-            let table_matches = match transfer {
-                None => base.transfer.is_none(),
-                Some(tp) => {
-                    base.transfer.is_some()
-                        && base.meta.bake_params.get("transfer") == Some(&transfer_meta(tp))
-                }
-            };
-            // A base without the stored heat-geodesic order (baked before it existed, or
-            // written elsewhere) is stale when this tool would store one.
-            let order_matches = base.surface_order.is_some()
-                || HeatGeodesic::plan_ordering(&base.surface_vertices, &base.surface_triangles)
-                    .is_err();
-            base.meta.source_hash == prepared.hash
-                && base.meta.params_hash == params.hash()
-                && table_matches
-                && order_matches
+    let base = match ModesFile::read(modes) {
+        Ok(base) => base,
+        Err(e) => return Ok(BaseStatus::Unreadable(e.to_string())),
+    };
+    let output_version = base.meta.bake_params.get("output_version");
+    // A base without the stored heat-geodesic order (baked before it existed, or written
+    // elsewhere) is stale when this tool would store one.
+    let order_matches = base.surface_order.is_some()
+        || HeatGeodesic::plan_ordering(&base.surface_vertices, &base.surface_triangles).is_err();
+    if output_version != Some(&serde_json::json!(OUTPUT_VERSION)) || !order_matches {
+        return Ok(BaseStatus::ToolChanged);
+    }
+    if base.meta.source_hash != prepared.hash {
+        return Ok(BaseStatus::GeometryChanged);
+    }
+    if base.meta.params_hash != params.hash() {
+        return Ok(BaseStatus::ParametersChanged);
+    }
+    let table_matches = match transfer {
+        None => base.transfer.is_none(),
+        Some(tp) => {
+            base.transfer.is_some()
+                && base.meta.bake_params.get("transfer") == Some(&transfer_meta(tp))
         }
-        Err(_) => false,
-    })
+    };
+    if !table_matches {
+        return Ok(BaseStatus::TransferTableChanged);
+    }
+    Ok(BaseStatus::UpToDate)
 }
 
 #[cfg(test)]

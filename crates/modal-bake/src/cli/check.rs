@@ -4,7 +4,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::Args;
-use modal_bake::bake;
+use modal_bake::bake::{self, BaseStatus};
 
 use super::bake::{BakeOptions, TransferOptions};
 
@@ -20,25 +20,65 @@ pub struct CheckArgs {
     /// table when none is asked for, is stale).
     #[command(flatten)]
     pub transfer: TransferOptions,
+    /// Print one JSON object: {"base", "mesh", "up_to_date", "reason" (up_to_date, missing,
+    /// unreadable, tool_changed, geometry_changed, parameters_changed, transfer_table_changed),
+    /// "detail"} (or {"error"} with exit 2).
+    #[arg(long)]
+    pub json: bool,
 }
 
 pub fn run(args: &CheckArgs) -> ExitCode {
     let transfer = args.transfer.params();
-    match bake::is_up_to_date_with_transfer(
+    let status = bake::base_status(
         &args.mesh,
         &args.options.params(),
         transfer.as_ref(),
         &args.out,
-    ) {
-        Ok(true) => {
-            outln!("{}: up to date", args.out.display());
-            ExitCode::SUCCESS
-        }
-        Ok(false) => {
-            outln!("{}: stale or missing", args.out.display());
-            ExitCode::from(1)
+    );
+    match status {
+        Ok(status) => {
+            let fresh = status == BaseStatus::UpToDate;
+            if args.json {
+                let detail = match &status {
+                    BaseStatus::Unreadable(d) => Some(d.clone()),
+                    _ => None,
+                };
+                outln!(
+                    "{}",
+                    serde_json::json!({
+                        "base": args.out.display().to_string(),
+                        "mesh": args.mesh.display().to_string(),
+                        "up_to_date": fresh,
+                        "reason": status.reason(),
+                        "detail": detail,
+                    })
+                );
+            } else if fresh {
+                outln!("{}: up to date", args.out.display());
+            } else {
+                outln!(
+                    "{}: stale ({})",
+                    args.out.display(),
+                    status.reason().replace('_', " ")
+                );
+            }
+            if fresh {
+                ExitCode::SUCCESS
+            } else {
+                ExitCode::from(1)
+            }
         }
         Err(e) => {
+            if args.json {
+                outln!(
+                    "{}",
+                    serde_json::json!({
+                        "base": args.out.display().to_string(),
+                        "mesh": args.mesh.display().to_string(),
+                        "error": e.to_string(),
+                    })
+                );
+            }
             eprintln!("error: {e}");
             ExitCode::from(2)
         }
