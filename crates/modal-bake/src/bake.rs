@@ -574,9 +574,13 @@ pub fn bake_mesh(
     let wanted = params.min_modes() + rigid;
     if wanted > map.n_free() {
         return Err(BakeError::Params(format!(
-            "{file}: {} modes requested but the mesh has only {} free degrees of freedom",
+            "{file}: --modes {}: at most {} modes for this mesh (3 × {} nodes − {} fixed dofs{} = {})",
             params.min_modes(),
-            map.n_free()
+            map.n_free().saturating_sub(rigid),
+            mesh.nodes.len(),
+            3 * mesh.nodes.len() - map.n_free(),
+            if rigid > 0 { " − 6 rigid" } else { "" },
+            map.n_free().saturating_sub(rigid)
         )));
     }
     let eparams = EigenParams {

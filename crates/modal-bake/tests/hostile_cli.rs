@@ -556,3 +556,28 @@ fn check_json_gives_the_reason() {
         "{v}"
     );
 }
+
+// Regression: a request beyond the mesh's modes said "N modes requested but only M free
+// dofs" (the dofs, not the modes, and without the rigid modes). It names the exact limit.
+#[test]
+fn a_request_beyond_the_mesh_names_the_exact_limit() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("m.modes");
+    let cube = data("meshes/cube_v41.msh");
+    let nodes = modal_bake::mesh::read_mesh(&cube).unwrap().nodes.len();
+    let limit = 3 * nodes - 6;
+    let o = run(&[
+        "bake",
+        cube.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--modes",
+        &(limit + 1).to_string(),
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(
+        stderr(&o).contains(&format!("at most {limit} modes for this mesh")),
+        "{}",
+        stderr(&o)
+    );
+}
