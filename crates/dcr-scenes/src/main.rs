@@ -53,9 +53,9 @@ enum Cmd {
         /// Attenuation exponent β (implies --method attenuation).
         #[arg(long)]
         beta: Option<f64>,
-        /// Output directory (default out/SCENE, each run in its own `on/` or `off/` folder so
-        /// the two runs of a comparison never overwrite each other; with --out DIR a single
-        /// run writes into DIR, `--dcr both` into DIR/on and DIR/off).
+        /// Output directory (default out/SCENE). Without --out the runs go to out/SCENE/on
+        /// and out/SCENE/off (as with --dcr both), so an on and an off run never overwrite
+        /// each other; with --out a single run writes there.
         #[arg(long)]
         out: Option<PathBuf>,
         /// Bases directory (default out/bases).
@@ -161,9 +161,7 @@ fn real_main() -> Result<()> {
                     bail!("--seconds must be positive, got {s}");
                 }
             }
-            // Default: out/SCENE/on and out/SCENE/off, so an `off` run never overwrites an `on`
-            // run; an explicit --out takes a single run directly (both: OUT/on and OUT/off).
-            let explicit_out = out.is_some();
+            let split = out.is_none() || matches!(dcr, OnOff::Both);
             let out_dir = out.unwrap_or_else(|| root.join("out").join(&desc.name));
             let bases_dir = bases.unwrap_or_else(|| root.join("out").join("bases"));
             let runs: &[bool] = match dcr {
@@ -173,9 +171,10 @@ fn real_main() -> Result<()> {
             };
             let mut reports = Vec::new();
             for &on in runs {
-                let dir = match dcr {
-                    OnOff::On | OnOff::Off if explicit_out => out_dir.clone(),
-                    _ => out_dir.join(if on { "on" } else { "off" }),
+                let dir = if split {
+                    out_dir.join(if on { "on" } else { "off" })
+                } else {
+                    out_dir.clone()
                 };
                 let report = run_scene(
                     &desc,

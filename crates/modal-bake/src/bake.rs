@@ -87,6 +87,13 @@ use crate::mesh::{tet_faces, MeshError, DEFAULT_DEGENERATE_REL_TOL, DEFAULT_STRA
 use dcr_runtime::format::{FormatError, ModesMeta, QuadraticSurface};
 use dcr_runtime::HeatGeodesic;
 
+/// Version of what `modal-bake` writes for given inputs, stored in every base
+/// (`meta.bake_params.output_version`). Bumped by any change of the tool that changes a base's
+/// content for the same mesh and options (assembly, eigensolver, surface extraction, hashing),
+/// and only then — not by the crate version — so `check` calls bases of an older output stale
+/// and an upgrade that changes nothing keeps them fresh.
+pub const OUTPUT_VERSION: u32 = 1;
+
 /// `modal-bake <version>`, stored in every base.
 pub const TOOL_VERSION: &str = concat!("modal-bake ", env!("CARGO_PKG_VERSION"));
 
@@ -245,7 +252,9 @@ pub enum BakeStage {
     Read,
     /// Assembling K and M.
     Assemble,
-    /// Factoring and iterating; carries the eigensolver's progress.
+    /// Factoring K − σM (before the first Lanczos step).
+    Factor,
+    /// Iterating; carries the eigensolver's progress.
     Eigensolve(EigenProgress),
     /// Solving for the transfer table's modes (dense or Lanczos).
     TransferModes,
@@ -733,9 +742,13 @@ pub fn bake_mesh(
     let wanted = params.min_modes() + rigid;
     if wanted > map.n_free() {
         return Err(BakeError::Params(format!(
-            "{file}: {} modes requested but the mesh has only {} free degrees of freedom",
+            "{file}: --modes {}: at most {} modes for this mesh (3 × {} nodes − {} fixed dofs{} = {})",
             params.min_modes(),
-            map.n_free()
+            map.n_free().saturating_sub(rigid),
+            mesh.nodes.len(),
+            3 * mesh.nodes.len() - map.n_free(),
+            if rigid > 0 { " − 6 rigid" } else { "" },
+            map.n_free().saturating_sub(rigid)
         )));
     }
     let eparams = EigenParams {
@@ -761,6 +774,7 @@ pub fn bake_mesh(
     // The surface and its heat-geodesic ordering depend on the mesh only: they are computed
     // on a second thread during the factorization and eigensolve (the bake bench's 3k / 15k
     // beams: ≈ 5 / 17 ms, otherwise after it).
+    progress(BakeStage::Factor);
     let (res, surface) = std::thread::scope(|scope| {
         let surface = scope.spawn(|| Surface::of(&mesh, &mid_table));
         let res = eigen::solve_lowest(&kf, &mf, &eparams, &mut |p| {
@@ -880,7 +894,13 @@ pub fn bake_mesh(
             tool_version: TOOL_VERSION.to_string(),
             source_hash: hash,
             params_hash: params.hash(),
-            bake_params: serde_json::to_value(params).expect("params serialise"),
+            bake_params: {
+                let mut v = serde_json::to_value(params).expect("params serialise");
+                if let Some(obj) = v.as_object_mut() {
+                    obj.insert("output_version".into(), OUTPUT_VERSION.into());
+                }
+                v
+            },
             volume_nodes: mesh.nodes.len(),
             volume_tets: mesh.tets.len(),
             rigid_modes_excluded: first,
@@ -1076,15 +1096,63 @@ pub fn is_up_to_date_with_transfer(
     transfer: Option<&crate::transfer::TransferParams>,
     modes: &Path,
 ) -> Result<bool, BakeError> {
-    check_options(params, transfer, &mesh_path.display().to_string())?;
+    Ok(base_status(mesh_path, params, transfer, modes)? == BaseStatus::UpToDate)
+}
+
+/// Whether a base is up to date, and if not why (what `modal-bake check --json` reports).
+#[derive(Clone, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum BaseStatus {
+    /// The base holds what a bake of this mesh with these options would write.
+    UpToDate,
+    /// No file at the base's path.
+    Missing,
+    /// The file does not read as a valid base (the reader's message).
+    Unreadable(String),
+    /// Written by a `modal-bake` whose output differs ([`OUTPUT_VERSION`]), or without what
+    /// this one stores (the heat-geodesic order).
+    ToolChanged,
+    /// The mesh's geometry or fixed set differs ([`geometry_hash`]).
+    GeometryChanged,
+    /// The bake parameters differ ([`BakeParams::hash`]).
+    ParametersChanged,
+    /// The peak-transfer table is missing, unwanted or built with other parameters.
+    TransferTableChanged,
+}
+
+impl BaseStatus {
+    /// The reason as one word (`up_to_date`, `missing`, `unreadable`, `tool_changed`,
+    /// `geometry_changed`, `parameters_changed`, `transfer_table_changed`).
+    pub fn reason(&self) -> &'static str {
+        match self {
+            BaseStatus::UpToDate => "up_to_date",
+            BaseStatus::Missing => "missing",
+            BaseStatus::Unreadable(_) => "unreadable",
+            BaseStatus::ToolChanged => "tool_changed",
+            BaseStatus::GeometryChanged => "geometry_changed",
+            BaseStatus::ParametersChanged => "parameters_changed",
+            BaseStatus::TransferTableChanged => "transfer_table_changed",
+        }
+    }
+}
+
+/// Compares the base at `modes` with what a bake of `mesh_path` with `params` (and `transfer`)
+/// would write: by content hashes of the parsed geometry and of the parameters, and the
+/// [`OUTPUT_VERSION`] of the tool that wrote it — never by file times.
+///
+/// # Errors
+/// A [`BakeError`] when the mesh itself cannot be read or prepared, or the parameters are
+/// invalid (what `check` exits 2 on).
+pub fn base_status(
+    mesh_path: &Path,
+    params: &BakeParams,
+    transfer: Option<&crate::transfer::TransferParams>,
+    modes: &Path,
+) -> Result<BaseStatus, BakeError> {
+    let file = mesh_path.display().to_string();
+    check_options(params, transfer, &file)?;
     let mesh = crate::mesh::read_mesh(mesh_path)?;
-    is_mesh_up_to_date(
-        mesh,
-        &mesh_path.display().to_string(),
-        params,
-        transfer,
-        modes,
-    )
+    mesh_base_status(mesh, &file, params, transfer, modes)
 }
 
 /// Checks the bake and transfer-table parameters (what `check` exits 2 on before any mesh work).
@@ -1115,32 +1183,54 @@ pub fn is_mesh_up_to_date(
     transfer: Option<&crate::transfer::TransferParams>,
     modes: &Path,
 ) -> Result<bool, BakeError> {
+    Ok(mesh_base_status(mesh, file, params, transfer, modes)? == BaseStatus::UpToDate)
+}
+
+/// As [`base_status`] for a mesh already in memory; `file` names it in messages.
+///
+/// # Errors
+/// As [`base_status`].
+pub fn mesh_base_status(
+    mesh: TetMesh,
+    file: &str,
+    params: &BakeParams,
+    transfer: Option<&crate::transfer::TransferParams>,
+    modes: &Path,
+) -> Result<BaseStatus, BakeError> {
     check_options(params, transfer, file)?;
     let prepared = prepare(mesh, params, file)?;
-    if !modes.exists() {
-        return Ok(false);
+    if std::fs::symlink_metadata(modes).is_err() {
+        return Ok(BaseStatus::Missing);
     }
-    Ok(match ModesFile::read(modes) {
-        Ok(base) => {
-            let table_matches = match transfer {
-                None => base.transfer.is_none(),
-                Some(tp) => {
-                    base.transfer.is_some()
-                        && base.meta.bake_params.get("transfer") == Some(&transfer_meta(tp))
-                }
-            };
-            // A base without the stored heat-geodesic order (baked before it existed, or
-            // written elsewhere) is stale when this tool would store one.
-            let order_matches = base.surface_order.is_some()
-                || HeatGeodesic::plan_ordering(&base.surface_vertices, &base.surface_triangles)
-                    .is_err();
-            base.meta.source_hash == prepared.hash
-                && base.meta.params_hash == params.hash()
-                && table_matches
-                && order_matches
+    let base = match ModesFile::read(modes) {
+        Ok(base) => base,
+        Err(e) => return Ok(BaseStatus::Unreadable(e.to_string())),
+    };
+    let output_version = base.meta.bake_params.get("output_version");
+    // A base without the stored heat-geodesic order (baked before it existed, or written
+    // elsewhere) is stale when this tool would store one.
+    let order_matches = base.surface_order.is_some()
+        || HeatGeodesic::plan_ordering(&base.surface_vertices, &base.surface_triangles).is_err();
+    if output_version != Some(&serde_json::json!(OUTPUT_VERSION)) || !order_matches {
+        return Ok(BaseStatus::ToolChanged);
+    }
+    if base.meta.source_hash != prepared.hash {
+        return Ok(BaseStatus::GeometryChanged);
+    }
+    if base.meta.params_hash != params.hash() {
+        return Ok(BaseStatus::ParametersChanged);
+    }
+    let table_matches = match transfer {
+        None => base.transfer.is_none(),
+        Some(tp) => {
+            base.transfer.is_some()
+                && base.meta.bake_params.get("transfer") == Some(&transfer_meta(tp))
         }
-        Err(_) => false,
-    })
+    };
+    if !table_matches {
+        return Ok(BaseStatus::TransferTableChanged);
+    }
+    Ok(BaseStatus::UpToDate)
 }
 
 #[cfg(test)]

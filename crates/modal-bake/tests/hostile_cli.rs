@@ -473,3 +473,111 @@ fn likely_unit_mistakes_are_warned_about() {
     ]);
     assert!(!stderr(&o).contains("warning"), "{}", stderr(&o));
 }
+
+// Regression: without a terminal (CI logs) a bake was silent however long it ran, and the bar
+// said "(assembling K and M)" while factoring. Plain lines name each long stage and its
+// progress (`MODAL_BAKE_PROGRESS_EVERY` = 0 reports every stage here; the default is 5 s).
+#[test]
+fn progress_without_a_terminal_is_plain_lines() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("b.modes");
+    let o = bin()
+        .args([
+            "bake",
+            data("meshes/beam.msh").to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "--fixed",
+            "clamp",
+            "--modes",
+            "6",
+        ])
+        .env("MODAL_BAKE_PROGRESS_EVERY", "0")
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let err = stderr(&o);
+    for needle in [
+        "reading mesh: done",
+        "assembling K and M: done",
+        "factoring K − σM: done",
+        "modes converged",
+        "writing: done",
+    ] {
+        assert!(err.contains(needle), "{needle}: {err}");
+    }
+    // By default a short bake prints no progress at all.
+    let o = bake_to(&out, &data("meshes/beam.msh"));
+    assert!(o.status.success());
+    assert!(!stderr(&o).contains("bake ["), "{}", stderr(&o));
+}
+
+// Expectation: `check --json` says why a base is stale — missing, unreadable, geometry changed,
+// parameters changed, tool changed (a base written by a modal-bake whose output differs:
+// `meta.bake_params.output_version`) — with the exit codes of the plain check (0, 1, 2).
+#[test]
+fn check_json_gives_the_reason() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = dir.path().join("c.modes");
+    let b = base.to_str().unwrap();
+    let cube = data("meshes/cube_v41.msh");
+    let check = |mesh: &Path, extra: &[&str]| {
+        let mut a = vec!["check", mesh.to_str().unwrap(), b, "--modes", "4", "--json"];
+        a.extend_from_slice(extra);
+        let o = run(&a);
+        let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        (
+            o.status.code(),
+            v["reason"].as_str().unwrap_or("").to_string(),
+            v,
+        )
+    };
+    assert_eq!(check(&cube, &[]).1, "missing");
+    assert!(bake_to(&base, &cube).status.success());
+    let (code, reason, v) = check(&cube, &[]);
+    assert_eq!((code, reason.as_str()), (Some(0), "up_to_date"), "{v}");
+    assert_eq!(check(&cube, &["--density", "800"]).1, "parameters_changed");
+    let other = dir.path().join("other.msh");
+    scaled_cube(&other, 2.0, None);
+    assert_eq!(check(&other, &[]).1, "geometry_changed");
+    let mut old = dcr_runtime::format::ModesFile::read(&base).unwrap();
+    old.meta.bake_params["output_version"] = serde_json::json!(0);
+    old.write_atomic(&base).unwrap();
+    let (code, reason, _) = check(&cube, &[]);
+    assert_eq!((code, reason.as_str()), (Some(1), "tool_changed"));
+    std::fs::write(&base, b"not a base").unwrap();
+    let (code, reason, v) = check(&cube, &[]);
+    assert_eq!((code, reason.as_str()), (Some(1), "unreadable"));
+    assert!(v["detail"].as_str().unwrap().contains("c.modes"), "{v}");
+    let (code, _, v) = check(&data("bad/truncated.msh"), &[]);
+    assert_eq!(code, Some(2));
+    assert!(
+        v["error"].as_str().unwrap().contains("truncated.msh"),
+        "{v}"
+    );
+}
+
+// Regression: a request beyond the mesh's modes said "N modes requested but only M free
+// dofs" (the dofs, not the modes, and without the rigid modes). It names the exact limit.
+#[test]
+fn a_request_beyond_the_mesh_names_the_exact_limit() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("m.modes");
+    let cube = data("meshes/cube_v41.msh");
+    let nodes = modal_bake::mesh::read_mesh(&cube).unwrap().nodes.len();
+    let limit = 3 * nodes - 6;
+    let o = run(&[
+        "bake",
+        cube.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--modes",
+        &(limit + 1).to_string(),
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(
+        stderr(&o).contains(&format!("at most {limit} modes for this mesh")),
+        "{}",
+        stderr(&o)
+    );
+}

@@ -55,6 +55,12 @@ impl ModelOptions {
                 self.youngs
             );
         }
+        if !(self.poisson > -1.0 && self.poisson < 0.5) {
+            anyhow::bail!(
+                "--poisson {} must satisfy −1 < ν < 0.5 (rubber ~0.49, metals ~0.3, cork ~0)",
+                self.poisson
+            );
+        }
         let [dlo, dhi] = Material::DENSITY_RANGE;
         if !(self.density >= dlo && self.density <= dhi) {
             anyhow::bail!(
@@ -236,22 +242,118 @@ impl TransferOptions {
     }
 }
 
-/// A spinner per stage, a bar for the eigensolve; hidden when stderr is not a terminal.
+/// Progress of a bake on stderr: on a terminal a spinner per stage and a bar for the
+/// eigensolve and the transfer table; otherwise (CI logs, redirected stderr) plain lines for the
+/// stages longer than [`PLAIN_EVERY`]: one every `PLAIN_EVERY` while a stage that reports
+/// progress runs, and one with its duration when it ends. Short bakes print nothing.
 struct Progress {
     bar: ProgressBar,
+    plain: Option<Plain>,
+}
+
+/// Interval between plain progress lines, and the shortest stage that gets one (seconds;
+/// `MODAL_BAKE_PROGRESS_EVERY` overrides it, e.g. 0 for every event).
+const PLAIN_EVERY: Duration = Duration::from_secs(5);
+
+/// State of the plain-line progress.
+struct Plain {
+    every: Duration,
+    start: std::time::Instant,
+    stage: &'static str,
+    label: String,
+    stage_start: std::time::Instant,
+    last: std::time::Instant,
+}
+
+impl Plain {
+    fn line(&self, text: &str) {
+        eprintln!("bake [{:7.1} s] {text}", self.start.elapsed().as_secs_f64());
+    }
+
+    /// Ends the current stage (a line with its duration if it was long).
+    fn end_stage(&mut self) {
+        let took = self.stage_start.elapsed();
+        if !self.stage.is_empty() && took >= self.every {
+            self.line(&format!(
+                "{}: done in {:.1} s",
+                self.label,
+                took.as_secs_f64()
+            ));
+        }
+    }
+
+    /// Records progress of `stage` described by `label`.
+    fn report(&mut self, stage: &'static str, label: impl FnOnce() -> String) {
+        let now = std::time::Instant::now();
+        if stage != self.stage {
+            self.end_stage();
+            self.stage = stage;
+            self.label = label();
+            self.stage_start = now;
+            self.last = now;
+        } else if now.duration_since(self.last) >= self.every {
+            self.label = label();
+            self.line(&self.label);
+            self.last = now;
+        }
+    }
 }
 
 impl Progress {
     fn new() -> Progress {
-        let bar = ProgressBar::new_spinner();
-        bar.enable_steady_tick(Duration::from_millis(120));
-        Progress { bar }
+        use std::io::IsTerminal;
+        if std::io::stderr().is_terminal() {
+            let bar = ProgressBar::new_spinner();
+            bar.enable_steady_tick(Duration::from_millis(120));
+            Progress { bar, plain: None }
+        } else {
+            let now = std::time::Instant::now();
+            Progress {
+                bar: ProgressBar::hidden(),
+                plain: Some(Plain {
+                    every: std::env::var("MODAL_BAKE_PROGRESS_EVERY")
+                        .ok()
+                        .and_then(|s| s.parse::<f64>().ok())
+                        .filter(|s| s.is_finite() && *s >= 0.0)
+                        .map_or(PLAIN_EVERY, Duration::from_secs_f64),
+                    start: now,
+                    stage: "",
+                    label: String::new(),
+                    stage_start: now,
+                    last: now,
+                }),
+            }
+        }
     }
 
     fn update(&mut self, stage: BakeStage) {
+        if let Some(plain) = &mut self.plain {
+            match stage {
+                BakeStage::Read => plain.report("read", || "reading mesh".into()),
+                BakeStage::Assemble => plain.report("assemble", || "assembling K and M".into()),
+                BakeStage::Factor => plain.report("factor", || "factoring K − σM".into()),
+                BakeStage::Eigensolve(p) => plain.report("eigensolve", || {
+                    format!(
+                        "eigensolve: {}/{} modes converged, Lanczos step {}",
+                        p.converged.min(p.requested),
+                        p.requested,
+                        p.iteration
+                    )
+                }),
+                BakeStage::TransferModes => plain.report("transfer modes", || {
+                    "solving for the transfer table's modes".into()
+                }),
+                BakeStage::Transfer(p) => plain.report("transfer", || {
+                    format!("transfer table: {}/{} rows", p.done, p.total)
+                }),
+                BakeStage::Write => plain.report("write", || "writing".into()),
+            }
+            return;
+        }
         match stage {
             BakeStage::Read => self.bar.set_message("reading mesh"),
             BakeStage::Assemble => self.bar.set_message("assembling K and M"),
+            BakeStage::Factor => self.bar.set_message("factoring K − σM"),
             BakeStage::Eigensolve(p) => {
                 if self.bar.length().is_none() {
                     self.bar.set_style(
@@ -263,6 +365,7 @@ impl Progress {
                     );
                     self.bar.set_length(p.requested as u64);
                 }
+                self.bar.set_length(p.requested as u64);
                 self.bar.set_position(p.converged.min(p.requested) as u64);
                 self.bar
                     .set_message(format!("Lanczos step {}", p.iteration));
@@ -325,6 +428,9 @@ pub fn run(args: &BakeArgs) -> anyhow::Result<()> {
         )
     };
     progress.bar.finish_and_clear();
+    if let Some(plain) = &mut progress.plain {
+        plain.end_stage();
+    }
     let report = report
         .with_context(|| format!("baking {} failed; nothing was written", args.mesh.display()))?;
     if let Some(dir) = &report.created_folder {
