@@ -21,6 +21,7 @@ mod math;
 pub mod model;
 pub mod response;
 pub mod testing;
+pub mod world;
 
 pub use attenuation::{
     AmplitudeKind, AttenuationLaw, AttenuationParams, DistanceKind, GeodesicError, HeatGeodesic,
@@ -31,5 +32,9 @@ pub use model::{LoadError, ModalModel, SurfacePoint};
 pub use response::{
     effective_mass, peak_abs_projection, peak_abs_rows, response_impulse, ContactResponse,
     DistantResponse, ForceInput, Impact, Method, ParamsError, ResponseParams, RestingContact,
-    ServedBy, StepInfo, Variant,
+    ServedBy, StepInfo, TableFallback, TablePolicy, TableStatus, Variant,
+};
+pub use world::{
+    BodyState, ClassifyParams, ContactReport, DcrWorld, ElasticHandle, ElasticObjectDesc,
+    EnergyInfo, ImpulseEvent, ObjectStepInfo, Pose, WorldError, WorldParams, WorldStepInfo,
 };

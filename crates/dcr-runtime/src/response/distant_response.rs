@@ -16,7 +16,7 @@ mod transfer;
 use super::peak_kernel::{peak_abs_rows, LANES};
 use super::{
     ContactResponse, ForceInput, Impact, Method, ParamsError, ResponseParams, RestingContact,
-    ServedBy, StepInfo, Variant,
+    ServedBy, StepInfo, TablePolicy, TableStatus, Variant,
 };
 use crate::attenuation::{
     AmplitudeKind, AttenuationParams, DistanceCache, DistanceKind, HeatWorkspace,
@@ -116,6 +116,7 @@ pub struct DistantResponse {
     att: Option<AttenuationState>,
     /// Transfer-table method state (`None`: not requested or the base's table does not apply).
     transfer: Option<transfer::TransferState>,
+    table_status: TableStatus,
 }
 
 fn invalid(field: &'static str, detail: impl Into<String>) -> ParamsError {
@@ -207,9 +208,19 @@ impl DistantResponse {
             Method::Modal | Method::Transfer => None,
             Method::Attenuation(a) => Some(Self::attenuation_setup(&model, a, &g_table, samples)?),
         };
-        let transfer = match p.method {
-            Method::Transfer => transfer::TransferState::new(&model, p.h, rayleigh, p.carry_over),
-            _ => None,
+        let (transfer, table_status) = match p.method {
+            Method::Transfer => {
+                match transfer::TransferState::new(&model, p.h, rayleigh, p.carry_over) {
+                    Ok(t) => (Some(t), TableStatus::Active),
+                    Err(status) => {
+                        if p.table_policy == TablePolicy::Refuse {
+                            return Err(ParamsError::TableRefused { status });
+                        }
+                        (None, status)
+                    }
+                }
+            }
+            _ => (None, TableStatus::NotRequested),
         };
         let remap_tolerance = 0.01 * model.mean_edge_length();
         Ok(DistantResponse {
@@ -244,6 +255,7 @@ impl DistantResponse {
             info: StepInfo::default(),
             att,
             transfer,
+            table_status,
             model,
             params,
         })
@@ -367,6 +379,25 @@ impl DistantResponse {
     /// Counters of the last step.
     pub fn last_step_info(&self) -> StepInfo {
         self.info
+    }
+
+    /// Whether the transfer table serves this response, and if not, why (set-up time; see
+    /// [`TablePolicy`]).
+    pub fn table_status(&self) -> TableStatus {
+        self.table_status
+    }
+
+    /// Counts `n` rigid-body steps that passed without a call: cache eviction
+    /// ([`ResponseParams::evict_after_steps`]) is counted in steps, not calls. A caller that
+    /// queries only on steps with impacts reports the steps in between here.
+    pub fn skip_steps(&mut self, n: u64) {
+        self.step_index += n;
+    }
+
+    /// Whether the response must run this step even without impacts: carry-over filters that
+    /// still ring (not asleep). `false` for the default restart-every-step mode.
+    pub fn needs_step(&self) -> bool {
+        self.params.carry_over && !self.asleep
     }
 
     /// Number of resting contacts currently cached.
@@ -804,6 +835,7 @@ fn mapped_response(
         normal: sp.normal,
         peak_displacement: d,
         delta_v: d / h,
+        lateral_delta_v: [0.0; 3],
         mapped: true,
         served_by,
     }
@@ -816,6 +848,7 @@ fn unmapped_response(rc: &RestingContact) -> ContactResponse {
         normal: [0.0; 3],
         peak_displacement: 0.0,
         delta_v: 0.0,
+        lateral_delta_v: [0.0; 3],
         mapped: false,
         served_by: ServedBy::Unmapped,
     }

@@ -18,9 +18,9 @@ pub use effective_mass::{effective_mass, response_impulse};
 pub use force_input::ForceInput;
 pub use impact::Impact;
 pub use peak_kernel::{peak_abs_projection, peak_abs_rows};
-pub use response_params::{Method, ParamsError, ResponseParams, Variant};
+pub use response_params::{Method, ParamsError, ResponseParams, TablePolicy, TableStatus, Variant};
 pub use resting_contact::RestingContact;
-pub use step_info::StepInfo;
+pub use step_info::{StepInfo, TableFallback};
 
 #[cfg(test)]
 mod tests;
