@@ -281,7 +281,7 @@ fn world_steps_do_not_allocate(model: &Arc<ModalModel>) {
             // The fridge rests on the floor; bodies rest on the floor or the fridge.
             contacts.push(floor_contact(1, FRIDGE, [0.5, 0.3, 0.4], 0.5));
             for k in 0..30u64 {
-                if (k + step as u64) % 7 == 0 {
+                if (k + step as u64).is_multiple_of(7) {
                     continue; // comes and goes
                 }
                 let other = 3 + k % 11;
@@ -329,6 +329,7 @@ fn floor_contact(id: u64, other: u64, p: [f64; 3], impulse: f64) -> ContactRepor
         point2: p,
         normal: [0.0, 0.0, 1.0],
         impulse,
+        is_new: false,
     }
 }
 
@@ -342,5 +343,6 @@ fn fridge_contact(pose: &Pose, id: u64, other: u64, p: [f64; 3], impulse: f64) -
         point2: p,
         normal: [r[0][2], r[1][2], r[2][2]],
         impulse,
+        is_new: false,
     }
 }
