@@ -121,6 +121,12 @@ struct Touched {
 /// `g Δv ≤ a`. A plate on four contacts that all ask for Δv thus gets Δv, not four times it —
 /// one Gauss–Seidel pass, in contact-report order.
 ///
+/// # Lateral kick
+/// With [`crate::ResponseParams::lateral_kick`] on an object, its responses also carry the
+/// tangential velocity change of §5.4 ([`crate::ContactResponse::lateral_delta_v`], rotated to
+/// the world); after the normal part the world adds `m_eff,t (g |Δv_t| − a_t) t̂` along its
+/// direction t̂ by the same Gauss–Seidel rule, so the event's impulse gets a tangential part.
+///
 /// # Chains through dynamic elastic objects
 /// An impulse issued to the body of a dynamic elastic object becomes an impact on that object
 /// in the same step (point and direction in its frame, magnitude |j|), so a hit floor pushes a
