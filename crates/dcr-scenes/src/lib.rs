@@ -5,10 +5,13 @@
 //! - [`adapter`]: rapier contacts → impacts / resting contacts → [`dcr_runtime::DistantResponse`]
 //!   → impulses at the resting contacts (Eq. 17–19).
 //! - [`runner`]: a headless run (trajectories, timings, outcome figures) and the Table 1 report.
+//! - [`export`]: runs as animated glTF (side by side, response events in `extras`) and the
+//!   outcome figures over time as SVG.
 //!
 //! See docs/scenes.md.
 
 pub mod adapter;
+pub mod export;
 pub mod runner;
 pub mod scene;
 

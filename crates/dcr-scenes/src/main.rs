@@ -5,7 +5,8 @@ use std::process::ExitCode;
 
 use anyhow::{bail, Context, Result};
 use clap::{Parser, Subcommand, ValueEnum};
-use dcr_scenes::runner::{run_scene, table1, MethodChoice, RunParams, Table1Params};
+use dcr_scenes::export::{side_label, write_outcomes_svg, write_scene_glb, Side};
+use dcr_scenes::runner::{run_scene, table1, MethodChoice, RunParams, RunReport, Table1Params};
 use dcr_scenes::scene::SceneDesc;
 use dcr_scenes::{repo_root, SCENES};
 
@@ -23,6 +24,8 @@ struct Cli {
 enum OnOff {
     On,
     Off,
+    /// Both runs: files in OUT/on and OUT/off, outcomes.svg and --gltf with both.
+    Both,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -55,6 +58,10 @@ enum Cmd {
         /// Bases directory (default out/bases).
         #[arg(long)]
         bases: Option<PathBuf>,
+        /// Also write the run(s) as animated glTF here (side by side with --dcr both; the
+        /// response events in the file's extras). Open it with scripts/view.sh.
+        #[arg(long, value_name = "OUT.glb")]
+        gltf: Option<PathBuf>,
     },
     /// Bake missing/stale bases, run every scene on and off, print Table 1.
     Table1 {
@@ -70,6 +77,9 @@ enum Cmd {
         /// Bases directory (default out/bases).
         #[arg(long)]
         bases: Option<PathBuf>,
+        /// Also write every scene's on and off runs side by side as DIR/SCENE.glb.
+        #[arg(long, value_name = "DIR")]
+        gltf: Option<PathBuf>,
     },
 }
 
@@ -79,6 +89,39 @@ fn scene_path(root: &std::path::Path, s: &str) -> PathBuf {
     } else {
         root.join("scenes").join(format!("{s}.json"))
     }
+}
+
+fn print_report(report: &RunReport, out_dir: &std::path::Path) {
+    println!(
+        "{} dcr {} ({} steps): {}",
+        report.scene,
+        if report.dcr { "on" } else { "off" },
+        report.steps,
+        out_dir.display()
+    );
+    for (k, (v, u)) in &report.outcomes {
+        println!("  {k:28} {v:10.3} {u}");
+    }
+    for m in &report.models {
+        println!(
+            "  model {:8} impacts {:4} queries {:4} distant contacts (max) {:3} query µs median {} p99 {}",
+            m.model,
+            m.stats.impacts,
+            m.queries,
+            m.distant_contacts,
+            m.query_us_median.map_or("-".into(), |v| format!("{v:.1}")),
+            m.query_us_p99.map_or("-".into(), |v| format!("{v:.1}"))
+        );
+    }
+    println!(
+        "  rapier {:.1} ms, adapter {:.1} ms ({:.2}% of step); energy injected {:.4e} J, dissipated {:.4e} J",
+        report.rapier_ms,
+        report.adapter_ms,
+        100.0 * report.dcr_share_of_step,
+        report.injected_ke,
+        report.dissipated
+    );
+    println!("  trajectory {}", report.trajectory_hash);
 }
 
 fn real_main() -> Result<()> {
@@ -93,6 +136,7 @@ fn real_main() -> Result<()> {
             beta,
             out,
             bases,
+            gltf,
         } => {
             let path = scene_path(&root, &scene);
             if !path.exists() {
@@ -115,54 +159,73 @@ fn real_main() -> Result<()> {
                 }
             }
             let out_dir = out.unwrap_or_else(|| root.join("out").join(&desc.name));
-            let report = run_scene(
-                &desc,
-                &RunParams {
-                    seconds,
-                    dcr: matches!(dcr, OnOff::On),
-                    method,
-                    root: root.clone(),
-                    bases_dir: bases.unwrap_or_else(|| root.join("out").join("bases")),
-                    out_dir: Some(out_dir.clone()),
-                    progress: true,
-                },
-            )?;
-            println!(
-                "{} dcr {} ({} steps): {}",
-                report.scene,
-                if report.dcr { "on" } else { "off" },
-                report.steps,
-                out_dir.display()
-            );
-            for (k, (v, u)) in &report.outcomes {
-                println!("  {k:28} {v:10.3} {u}");
+            let bases_dir = bases.unwrap_or_else(|| root.join("out").join("bases"));
+            let runs: &[bool] = match dcr {
+                OnOff::On => &[true],
+                OnOff::Off => &[false],
+                OnOff::Both => &[true, false],
+            };
+            let mut reports = Vec::new();
+            for &on in runs {
+                let dir = match dcr {
+                    OnOff::Both => out_dir.join(if on { "on" } else { "off" }),
+                    _ => out_dir.clone(),
+                };
+                let report = run_scene(
+                    &desc,
+                    &RunParams {
+                        seconds,
+                        dcr: on,
+                        method: method.clone(),
+                        root: root.clone(),
+                        bases_dir: bases_dir.clone(),
+                        out_dir: Some(dir.clone()),
+                        progress: true,
+                    },
+                )?;
+                print_report(&report, &dir);
+                reports.push(report);
             }
-            for m in &report.models {
+            let refs: Vec<&RunReport> = reports.iter().collect();
+            if !desc.outcomes.is_empty() {
+                let svg = out_dir.join("outcomes.svg");
+                let t = std::time::Instant::now();
+                write_outcomes_svg(&desc, &refs, &svg)?;
                 println!(
-                    "  model {:8} impacts {:4} queries {:4} distant contacts (max) {:3} query µs median {} p99 {}",
-                    m.model,
-                    m.stats.impacts,
-                    m.queries,
-                    m.distant_contacts,
-                    m.query_us_median.map_or("-".into(), |v| format!("{v:.1}")),
-                    m.query_us_p99.map_or("-".into(), |v| format!("{v:.1}"))
+                    "  outcomes over time: {} ({:.1} KiB, {:.3} s)",
+                    svg.display(),
+                    std::fs::metadata(&svg).map_or(0, |m| m.len()) as f64 / 1024.0,
+                    t.elapsed().as_secs_f64()
                 );
             }
-            println!(
-                "  rapier {:.1} ms, adapter {:.1} ms ({:.2}% of step); energy injected {:.4e} J, dissipated {:.4e} J",
-                report.rapier_ms,
-                report.adapter_ms,
-                100.0 * report.dcr_share_of_step,
-                report.injected_ke,
-                report.dissipated
-            );
-            println!("  trajectory {}", report.trajectory_hash);
+            if let Some(path) = gltf {
+                let sides: Vec<Side> = reports
+                    .iter()
+                    .map(|r| Side {
+                        label: side_label(r),
+                        report: r,
+                    })
+                    .collect();
+                let t = std::time::Instant::now();
+                let info = write_scene_glb(&desc, &root, &bases_dir, &sides, &path)
+                    .with_context(|| format!("writing {}", path.display()))?;
+                println!(
+                    "  glTF: {} ({:.1} KiB, {} body nodes, {} keyframes, {} response events, {:.3} s)",
+                    path.display(),
+                    info.bytes as f64 / 1024.0,
+                    info.body_nodes,
+                    info.keyframes,
+                    info.events,
+                    t.elapsed().as_secs_f64()
+                );
+            }
         }
         Cmd::Table1 {
             json,
             seconds,
             scenes,
             bases,
+            gltf,
         } => {
             let scenes = scenes.unwrap_or_else(|| SCENES.iter().map(|s| s.to_string()).collect());
             for s in &scenes {
@@ -176,6 +239,7 @@ fn real_main() -> Result<()> {
                 root: root.clone(),
                 bases_dir: bases.unwrap_or_else(|| root.join("out").join("bases")),
                 scaffold_betas: vec![0.5, 1.0, 2.0],
+                gltf_dir: gltf,
             })
             .context("table1")?;
             if json {

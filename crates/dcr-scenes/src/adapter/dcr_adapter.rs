@@ -65,6 +65,22 @@ pub struct ModelStats {
     pub dissipated: f64,
 }
 
+/// One response impulse applied to a resting body (what a viewer marks).
+#[derive(Clone, Copy, Debug, serde::Serialize)]
+pub struct ResponseEvent {
+    /// Trajectory row at whose time the impulse was applied: it is applied right after step
+    /// `row − 1`'s solve, i.e. at t = row · h (s).
+    pub row: usize,
+    /// Elastic object (slot, scene order) whose response it is.
+    pub model: usize,
+    /// Receiving body (index into `BuiltWorld::bodies`).
+    pub body: usize,
+    /// Point of application (m, world frame).
+    pub point: [f64; 3],
+    /// Impulse (N·s, world frame).
+    pub impulse: [f64; 3],
+}
+
 /// Per-step timing of the adapter.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct StepStats {
@@ -119,6 +135,7 @@ pub struct DcrAdapter {
     slots: Vec<Slot>,
     step: u64,
     pre: Vec<Kin>,
+    events: Vec<ResponseEvent>,
 }
 
 fn body_kin(rb: &RigidBody) -> Kin {
@@ -188,6 +205,7 @@ impl DcrAdapter {
             slots,
             step: 0,
             pre: vec![Kin::default(); world.bodies.len()],
+            events: Vec::new(),
         }
     }
 
@@ -196,6 +214,11 @@ impl DcrAdapter {
         for (i, b) in built.bodies.iter().enumerate() {
             self.pre[i] = body_kin(&built.world.bodies[b.handle]);
         }
+    }
+
+    /// Every response impulse applied so far, in application order (empty when off).
+    pub fn events(&self) -> &[ResponseEvent] {
+        &self.events
     }
 
     /// The per-model statistics so far.
@@ -306,6 +329,13 @@ impl DcrAdapter {
             let m_eff = effective_mass(inv_mass, inv_i, arr(r), arr(n));
             let j = vecf(response_impulse(m_eff, need, arr(n)));
             rb.apply_impulse_at_point(j, src.world_point, true);
+            self.events.push(ResponseEvent {
+                row: self.step as usize + 1,
+                model: si,
+                body: src.body,
+                point: arr(src.world_point),
+                impulse: arr(j),
+            });
             // A body with its own base receives this impulse as an impact on its model.
             if let Some(ts) = self.slots.iter().position(|s| s.body == src.body) {
                 if ts != si {

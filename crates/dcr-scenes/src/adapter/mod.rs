@@ -11,4 +11,4 @@ mod dcr_adapter;
 pub mod engine;
 
 pub use contact_key::contact_key;
-pub use dcr_adapter::{AdapterParams, DcrAdapter, ModelStats, StepStats};
+pub use dcr_adapter::{AdapterParams, DcrAdapter, ModelStats, ResponseEvent, StepStats};

@@ -15,7 +15,7 @@ use ndarray_npy::NpzWriter;
 use rapier3d_f64::math::Vector;
 use serde::Serialize;
 
-use crate::adapter::{AdapterParams, DcrAdapter, ModelStats};
+use crate::adapter::{AdapterParams, DcrAdapter, ModelStats, ResponseEvent};
 use crate::runner::bases::ensure_base;
 use crate::runner::outcomes::{measure_outcome, unit_of};
 use crate::runner::Trajectory;
@@ -117,6 +117,13 @@ pub struct RunReport {
     /// The run's trajectory (not serialised; written as NPZ).
     #[serde(skip)]
     pub trajectory: Trajectory,
+    /// Response impulses applied, with `body` an index into `bodies_all` (not serialised;
+    /// exported with `--gltf`).
+    #[serde(skip)]
+    pub events: Vec<ResponseEvent>,
+    /// Names of every body of the built world (events' `body` indexes this).
+    #[serde(skip)]
+    pub bodies_all: Vec<String>,
 }
 
 fn percentile(v: &[f64], p: f64) -> Option<f64> {
@@ -392,6 +399,8 @@ pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
             0.0
         },
         trajectory: traj,
+        events: adapter.events().to_vec(),
+        bodies_all: built.bodies.iter().map(|b| b.name.clone()).collect(),
     };
 
     if let Some(dir) = &params.out_dir {

@@ -69,6 +69,8 @@ pub struct Table1Params {
     pub bases_dir: PathBuf,
     /// Also run the scaffold with attenuation at these β.
     pub scaffold_betas: Vec<f64>,
+    /// If set, write each scene's on and off runs side by side as `DIR/SCENE.glb`.
+    pub gltf_dir: Option<PathBuf>,
 }
 
 fn fmt_opt(x: Option<f64>, scale: f64, prec: usize) -> String {
@@ -132,6 +134,19 @@ pub fn table1(p: &Table1Params) -> Result<(String, Value)> {
         };
         let on = run(true, MethodChoice::Scene)?;
         let off = run(false, MethodChoice::Scene)?;
+        if let Some(dir) = &p.gltf_dir {
+            std::fs::create_dir_all(dir)?;
+            let path = dir.join(format!("{name}.glb"));
+            let sides = [&on, &off].map(|r| crate::export::Side {
+                label: crate::export::side_label(r),
+                report: r,
+            });
+            crate::export::write_scene_glb(&desc, &p.root, &p.bases_dir, &sides, &path)?;
+            eprintln!(
+                "[dcr-scenes] table1: {name} on/off glTF: {}",
+                path.display()
+            );
+        }
         let mut outcomes = serde_json::Map::new();
         for (k, (v, unit)) in &on.outcomes {
             let off_v = off.outcomes.get(k).map(|x| x.0);
