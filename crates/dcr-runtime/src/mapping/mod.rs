@@ -6,4 +6,4 @@ mod contact_cache;
 mod id_hasher;
 
 pub use contact_cache::{CachedContact, ContactCache};
-pub use id_hasher::IdHasher;
+pub(crate) use id_hasher::BuildIdHasher;

@@ -8,7 +8,7 @@ use parry3d_f64::query::PointQueryWithLocation;
 use parry3d_f64::shape::TriMesh;
 
 use super::{quadratic_triangle_weights, LoadError, SurfacePoint};
-use crate::attenuation::{GeodesicError, HeatGeodesic};
+use crate::attenuation::{GeodesicError, GeodesicTable, HeatGeodesic};
 use crate::format::ModesFile;
 use crate::math::{add, cross, norm, normalize, scale, sub};
 
@@ -29,6 +29,7 @@ pub struct ModalModel {
     /// `base.quadratic`) of its edges (v₀,v₁), (v₁,v₂), (v₂,v₀). Empty for a linear base.
     tri_edges: Vec<[u32; 3]>,
     heat: OnceLock<Result<HeatGeodesic, GeodesicError>>,
+    geodesic_table: OnceLock<GeodesicTable>,
 }
 
 impl ModalModel {
@@ -112,6 +113,7 @@ impl ModalModel {
             mean_edge_length,
             tri_edges,
             heat: OnceLock::new(),
+            geodesic_table: OnceLock::new(),
         })
     }
 
@@ -287,5 +289,18 @@ impl ModalModel {
                 )
             })
             .as_ref()
+    }
+
+    /// All-pairs heat-method distances over the surface's vertices, computed on first use
+    /// (ns solves) and shared by every instance using the model.
+    ///
+    /// # Errors
+    /// As [`ModalModel::heat_geodesic`]; a surface of more than
+    /// [`GeodesicTable::MAX_VERTICES`] vertices is refused by the caller before this.
+    pub fn geodesic_table(&self) -> Result<&GeodesicTable, &GeodesicError> {
+        let heat = self.heat_geodesic()?;
+        Ok(self
+            .geodesic_table
+            .get_or_init(|| GeodesicTable::build(heat)))
     }
 }
