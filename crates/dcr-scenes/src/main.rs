@@ -5,6 +5,7 @@ use std::process::ExitCode;
 
 use anyhow::{bail, Context, Result};
 use clap::{Parser, Subcommand, ValueEnum};
+use dcr_rapier::f64::ApplyMode;
 use dcr_scenes::runner::{run_scene, table1, MethodChoice, RunParams, Table1Params};
 use dcr_scenes::scene::SceneDesc;
 use dcr_scenes::{repo_root, SCENES};
@@ -12,7 +13,7 @@ use dcr_scenes::{repo_root, SCENES};
 #[derive(Parser)]
 #[command(
     name = "dcr-scenes",
-    about = "The paper's Table 1 scenes, headless on rapier3d-f64"
+    about = "The paper's Table 1 scenes, headless on rapier3d-f64 with dcr-rapier"
 )]
 struct Cli {
     #[command(subcommand)]
@@ -29,6 +30,63 @@ enum OnOff {
 enum MethodArg {
     Modal,
     Attenuation,
+}
+
+/// How the responses reach the bodies.
+#[derive(Clone, Copy, ValueEnum)]
+enum ApplyArg {
+    /// Explicit impulses right after the step (Eq. 17–18).
+    AfterStep,
+    /// Replayed through the next step's contact solver (restitution pass; rapier hooks).
+    InSolver,
+}
+
+impl From<ApplyArg> for ApplyMode {
+    fn from(a: ApplyArg) -> ApplyMode {
+        match a {
+            ApplyArg::AfterStep => ApplyMode::AfterStep,
+            ApplyArg::InSolver => ApplyMode::InSolver,
+        }
+    }
+}
+
+/// Options shared by `run` and `table1`: how the response is applied and bounded.
+#[derive(clap::Args, Clone)]
+struct ResponseArgs {
+    /// Energy bound η in [0, 1] (per object and step, the responses inject at most η × what
+    /// the step's impacts dissipated), or `off` for no bound. Default: the world's (1).
+    #[arg(long, value_name = "ETA|off", value_parser = parse_eta)]
+    energy_eta: Option<Eta>,
+    /// How the responses reach the bodies.
+    #[arg(long, value_enum, default_value = "after-step")]
+    apply: ApplyArg,
+    /// Lateral kick (paper §5.4): the tangential peak displacement also pushes sideways.
+    #[arg(long)]
+    lateral_kick: bool,
+}
+
+/// A parsed `--energy-eta`.
+#[derive(Clone, Copy)]
+struct Eta(Option<f64>);
+
+fn parse_eta(s: &str) -> Result<Eta, String> {
+    if s.eq_ignore_ascii_case("off") || s.eq_ignore_ascii_case("none") {
+        return Ok(Eta(None));
+    }
+    let v: f64 = s
+        .parse()
+        .map_err(|_| format!("{s:?} is not a number in [0, 1] or `off`"))?;
+    if !(0.0..=1.0).contains(&v) {
+        return Err(format!("{v} is outside [0, 1]"));
+    }
+    Ok(Eta(Some(v)))
+}
+
+impl ResponseArgs {
+    fn eta(&self) -> Option<f64> {
+        self.energy_eta
+            .map_or(dcr_rapier::WorldParams::default().energy_eta, |e| e.0)
+    }
 }
 
 #[derive(Subcommand)]
@@ -55,6 +113,8 @@ enum Cmd {
         /// Bases directory (default out/bases).
         #[arg(long)]
         bases: Option<PathBuf>,
+        #[command(flatten)]
+        response: ResponseArgs,
     },
     /// Bake missing/stale bases, run every scene on and off, print Table 1.
     Table1 {
@@ -70,6 +130,12 @@ enum Cmd {
         /// Bases directory (default out/bases).
         #[arg(long)]
         bases: Option<PathBuf>,
+        #[command(flatten)]
+        response: ResponseArgs,
+        /// Energy-bound sweep: also run each scene unbounded and at each η (comma separated,
+        /// e.g. 1,0.5,0.1) and report which outcomes move by more than 5 %.
+        #[arg(long, value_delimiter = ',', value_name = "ETAS")]
+        energy_sweep: Vec<f64>,
     },
 }
 
@@ -93,6 +159,7 @@ fn real_main() -> Result<()> {
             beta,
             out,
             bases,
+            response,
         } => {
             let path = scene_path(&root, &scene);
             if !path.exists() {
@@ -119,12 +186,14 @@ fn real_main() -> Result<()> {
                 &desc,
                 &RunParams {
                     seconds,
-                    dcr: matches!(dcr, OnOff::On),
                     method,
-                    root: root.clone(),
                     bases_dir: bases.unwrap_or_else(|| root.join("out").join("bases")),
                     out_dir: Some(out_dir.clone()),
                     progress: true,
+                    apply: response.apply.into(),
+                    energy_eta: response.eta(),
+                    lateral_kick: response.lateral_kick,
+                    ..RunParams::new(root.clone(), matches!(dcr, OnOff::On))
                 },
             )?;
             println!(
@@ -149,7 +218,7 @@ fn real_main() -> Result<()> {
                 );
             }
             println!(
-                "  rapier {:.1} ms, adapter {:.1} ms ({:.2}% of step); energy injected {:.4e} J, dissipated {:.4e} J",
+                "  rapier {:.1} ms, dcr {:.1} ms ({:.2}% of step); energy injected {:.4e} J, dissipated {:.4e} J",
                 report.rapier_ms,
                 report.adapter_ms,
                 100.0 * report.dcr_share_of_step,
@@ -163,7 +232,14 @@ fn real_main() -> Result<()> {
             seconds,
             scenes,
             bases,
+            response,
+            energy_sweep,
         } => {
+            for &e in &energy_sweep {
+                if !(0.0..=1.0).contains(&e) {
+                    bail!("--energy-sweep: {e} is outside [0, 1]");
+                }
+            }
             let scenes = scenes.unwrap_or_else(|| SCENES.iter().map(|s| s.to_string()).collect());
             for s in &scenes {
                 if !SCENES.contains(&s.as_str()) {
@@ -176,6 +252,10 @@ fn real_main() -> Result<()> {
                 root: root.clone(),
                 bases_dir: bases.unwrap_or_else(|| root.join("out").join("bases")),
                 scaffold_betas: vec![0.5, 1.0, 2.0],
+                apply: response.apply.into(),
+                energy_eta: response.eta(),
+                lateral_kick: response.lateral_kick,
+                eta_sweep: energy_sweep,
             })
             .context("table1")?;
             if json {

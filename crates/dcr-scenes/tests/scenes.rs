@@ -38,12 +38,9 @@ fn run(desc: &SceneDesc, dcr: bool, method: MethodChoice) -> RunReport {
         desc,
         &RunParams {
             seconds: desc.test_seconds,
-            dcr,
             method,
-            root: repo_root(),
             bases_dir: bases().clone(),
-            out_dir: None,
-            progress: false,
+            ..RunParams::new(repo_root(), dcr)
         },
     )
     .expect("scene runs")

@@ -9,6 +9,8 @@ mod trajectory;
 
 pub use bases::{bake_params, base_path, ensure_base};
 pub use outcomes::{measure_outcome, unit_of};
-pub use run::{run_scene, MethodChoice, ModelReport, RunParams, RunReport};
+pub use run::{
+    run_scene, AppliedEvent, MethodChoice, ModelReport, ModelStats, RunParams, RunReport,
+};
 pub use table1::{paper_rows, table1, PaperRow, Table1Params};
 pub use trajectory::Trajectory;
