@@ -534,23 +534,43 @@ impl DcrWorld {
         let out = obj.response.step(&obj.impacts, &obj.resting);
         self.touched.clear();
         for (resp, src) in out.iter().zip(&obj.sources) {
-            if !resp.mapped || !(resp.delta_v > 0.0) {
+            let lateral = resp.lateral_delta_v != [0.0; 3];
+            if !resp.mapped || !(resp.delta_v > 0.0 || lateral) {
                 continue;
             }
             let b = &bodies[src.body as usize];
             let n = rotate(&obj.rot, resp.normal);
             let r = sub(src.point, b.center_of_mass);
             let t = &mut self.tracked[src.body as usize];
+            // Normal part: the Δv not yet produced at this point (one Gauss–Seidel pass).
+            let mut j = [0.0; 3];
+            let mut need = 0.0;
             let achieved = dot(add(t.dlin, cross(t.dang, r)), n);
-            let need = obj.gain * resp.delta_v - achieved;
-            if !(need > 0.0) {
+            let want = obj.gain * resp.delta_v - achieved;
+            if want > 0.0 {
+                let m_eff = effective_mass(b.inv_mass, b.inv_inertia, r, n);
+                if m_eff > 0.0 {
+                    need = want;
+                    j = scale(n, m_eff * want);
+                }
+            }
+            // Tangential part (lateral kick), after the normal part, the same way.
+            if lateral {
+                let tw = rotate(&obj.rot, resp.lateral_delta_v);
+                let mag = norm(tw);
+                let dir = scale(tw, 1.0 / mag);
+                let jv = scale(j, b.inv_mass);
+                let jw = mat_vec(&b.inv_inertia, cross(r, j));
+                let achieved = dot(add(add(t.dlin, jv), cross(add(t.dang, jw), r)), dir);
+                let want = obj.gain * mag - achieved;
+                let m_eff = effective_mass(b.inv_mass, b.inv_inertia, r, dir);
+                if want > 0.0 && m_eff > 0.0 {
+                    j = add(j, scale(dir, m_eff * want));
+                }
+            }
+            if j == [0.0; 3] {
                 continue;
             }
-            let m_eff = effective_mass(b.inv_mass, b.inv_inertia, r, n);
-            if !(m_eff > 0.0) {
-                continue;
-            }
-            let j = scale(n, m_eff * need);
             if t.touch == u32::MAX {
                 t.touch = self.touched.len() as u32;
                 self.touched.push(Touched {
