@@ -123,7 +123,13 @@ pub fn run(model: &Arc<ModalModel>, on: bool) -> Result<RunOutcome, Box<dyn std:
         h: H,
         ..WorldParams::default()
     })?;
-    let mut dcr = DcrRapier::new(dcr_world, AdapterParams { apply });
+    let mut dcr = DcrRapier::new(
+        dcr_world,
+        AdapterParams {
+            apply,
+            ..AdapterParams::default()
+        },
+    );
     let mut desc = ElasticObjectDesc::new(model.clone(), 0);
     desc.response = ResponseParams {
         impact_threshold: 0.5,

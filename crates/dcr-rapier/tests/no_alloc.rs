@@ -62,6 +62,7 @@ macro_rules! run_backend {
             DcrWorld::new(WorldParams::default()).expect("world"),
             AdapterParams {
                 apply: ApplyMode::$apply,
+                ..AdapterParams::default()
             },
         );
         dcr.add_object(

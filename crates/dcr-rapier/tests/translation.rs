@@ -64,7 +64,10 @@ macro_rules! backend_tests {
                 };
                 let mut dcr = DcrRapier::new(
                     DcrWorld::new(params).expect("world"),
-                    AdapterParams { apply },
+                    AdapterParams {
+                        apply,
+                        ..AdapterParams::default()
+                    },
                 );
                 dcr.add_object(
                     &world.bodies,

@@ -63,6 +63,10 @@ struct ResponseArgs {
     /// Lateral kick (paper §5.4): the tangential peak displacement also pushes sideways.
     #[arg(long)]
     lateral_kick: bool,
+    /// Turn rapier's contact recycling off on the elastic objects (as the in-solver path
+    /// must), to compare the two paths under the same contact generation.
+    #[arg(long)]
+    no_contact_recycling: bool,
 }
 
 /// A parsed `--energy-eta`.
@@ -193,6 +197,7 @@ fn real_main() -> Result<()> {
                     apply: response.apply.into(),
                     energy_eta: response.eta(),
                     lateral_kick: response.lateral_kick,
+                    contact_recycling: !response.no_contact_recycling,
                     ..RunParams::new(root.clone(), matches!(dcr, OnOff::On))
                 },
             )?;
@@ -255,6 +260,7 @@ fn real_main() -> Result<()> {
                 apply: response.apply.into(),
                 energy_eta: response.eta(),
                 lateral_kick: response.lateral_kick,
+                contact_recycling: !response.no_contact_recycling,
                 eta_sweep: energy_sweep,
             })
             .context("table1")?;

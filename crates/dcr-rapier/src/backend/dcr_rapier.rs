@@ -19,10 +19,25 @@ use super::solver_hooks::{DcrSolverHooks, PairMark};
 use super::{arr, to_f64, vector, ApplyMode};
 
 /// Settings of a [`DcrRapier`].
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct AdapterParams {
     /// How the responses reach the bodies. Default [`ApplyMode::AfterStep`].
     pub apply: ApplyMode,
+    /// Leave rapier's contact recycling on for the elastic objects' colliders (rapier skips
+    /// contact generation for a pair whose bodies barely moved and reuses its contacts).
+    /// `false` sets `ActiveHooks::MODIFY_SOLVER_CONTACTS` on them, which rapier treats as "never
+    /// recycle" (`geometry/narrow_phase/pair_update.rs`); [`ApplyMode::InSolver`] always does, as
+    /// its hook must see every step. Default `true`.
+    pub contact_recycling: bool,
+}
+
+impl Default for AdapterParams {
+    fn default() -> Self {
+        AdapterParams {
+            apply: ApplyMode::AfterStep,
+            contact_recycling: true,
+        }
+    }
 }
 
 /// What the last [`DcrRapier::after_step`] did.
@@ -221,7 +236,7 @@ impl DcrRapier {
         });
         for &c in rb.colliders() {
             self.colliders.push((c, obj));
-            if self.params.apply == ApplyMode::InSolver {
+            if self.params.apply == ApplyMode::InSolver || !self.params.contact_recycling {
                 if let Some(co) = colliders.get_mut(c) {
                     co.set_active_hooks(co.active_hooks() | ActiveHooks::MODIFY_SOLVER_CONTACTS);
                 }

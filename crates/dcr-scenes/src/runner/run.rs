@@ -59,6 +59,9 @@ pub struct RunParams {
     pub energy_eta: Option<f64>,
     /// The lateral kick (paper §5.4) on every elastic object.
     pub lateral_kick: bool,
+    /// rapier's contact recycling on the elastic objects' colliders
+    /// ([`AdapterParams::contact_recycling`]; always off in the solver path).
+    pub contact_recycling: bool,
 }
 
 impl RunParams {
@@ -77,6 +80,7 @@ impl RunParams {
             apply: ApplyMode::AfterStep,
             energy_eta: WorldParams::default().energy_eta,
             lateral_kick: false,
+            contact_recycling: true,
         }
     }
 }
@@ -191,6 +195,8 @@ pub struct RunReport {
     pub apply: String,
     /// Whether the lateral kick was on.
     pub lateral_kick: bool,
+    /// Whether rapier's contact recycling was on for the elastic objects' colliders.
+    pub contact_recycling: bool,
     /// The run's trajectory (not serialised; written as NPZ).
     #[serde(skip)]
     pub trajectory: Trajectory,
@@ -273,7 +279,13 @@ pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
         ..WorldParams::default()
     })
     .map_err(|err| anyhow::anyhow!("scene {}: {err}", desc.name))?;
-    let mut dcr = DcrRapier::new(world, AdapterParams { apply });
+    let mut dcr = DcrRapier::new(
+        world,
+        AdapterParams {
+            apply,
+            contact_recycling: params.contact_recycling,
+        },
+    );
     let mut infos = Vec::new();
     let mut handles: Vec<ElasticHandle> = Vec::new();
     for (i, e) in desc.elastic.iter().enumerate() {
@@ -540,6 +552,7 @@ pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
         }
         .to_string(),
         lateral_kick: params.lateral_kick,
+        contact_recycling: params.contact_recycling && apply != ApplyMode::InSolver,
         trajectory: traj,
         events,
     };

@@ -77,6 +77,8 @@ pub struct Table1Params {
     pub energy_eta: Option<f64>,
     /// Lateral kick in the "on" runs.
     pub lateral_kick: bool,
+    /// rapier's contact recycling on the elastic objects' colliders.
+    pub contact_recycling: bool,
     /// Energy-bound sweep: also run every scene unbounded and at each of these η, and report
     /// which outcomes move by more than 5 % from the unbounded run.
     pub eta_sweep: Vec<f64>,
@@ -152,6 +154,7 @@ pub fn table1(p: &Table1Params) -> Result<(String, Value)> {
                     apply: p.apply,
                     energy_eta: eta,
                     lateral_kick: p.lateral_kick,
+                    contact_recycling: p.contact_recycling,
                     ..RunParams::new(p.root.clone(), dcr)
                 },
             )
@@ -298,6 +301,7 @@ pub fn table1(p: &Table1Params) -> Result<(String, Value)> {
                 "energy_eta": on.energy_eta,
                 "apply": on.apply,
                 "lateral_kick": on.lateral_kick,
+                "contact_recycling": on.contact_recycling,
                 "energy_sweep": sweep,
                 "attenuation_runs": extra,
                 "trajectory_hash_on": on.trajectory_hash,
