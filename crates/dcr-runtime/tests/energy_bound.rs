@@ -180,6 +180,7 @@ fn injected_energy_is_bounded_by_eta_times_dissipated() {
                         } else {
                             rng.range(0.0, 5e-4) // below the threshold: never an impact
                         },
+                        is_new: false,
                     };
                     if impact {
                         impacts.push(c);

@@ -60,6 +60,7 @@ fn on_plate(pose: &Pose, id: u64, other: u64, p: [f64; 3], impulse: f64) -> Cont
         point2: wp,
         normal: [r[0][2], r[1][2], r[2][2]],
         impulse,
+        is_new: false,
     }
 }
 
@@ -104,18 +105,73 @@ fn classification_follows_the_documented_rules() {
     assert_eq!(impacts_at(&mut w, &[c(4, 9, 2.0)]).0, 1);
     // Present without a gap it does not fire again.
     assert_eq!(impacts_at(&mut w, &[c(4, 9, 2.0)]).0, 0);
-    // Stale: E waits with zero impulse longer than fresh_steps = 2; its late impulse is not an
-    // impact (it is a resting contact of the dynamic body 9).
+    // A zero-impulse contact stays fresh however long it waits (a body lifted within the
+    // prediction distance): E fires when it lands; after firing, one step at zero impulse makes
+    // it new again (it lands a second time).
     for _ in 0..3 {
         impacts_at(&mut w, &[c(5, 9, 0.0)]);
     }
+    assert_eq!(impacts_at(&mut w, &[c(5, 9, 2.0)]), (1, 0));
     assert_eq!(impacts_at(&mut w, &[c(5, 9, 2.0)]), (0, 1));
+    impacts_at(&mut w, &[c(5, 9, 0.0)]);
+    assert_eq!(impacts_at(&mut w, &[c(5, 9, 2.0)]), (1, 0));
+    // Stale: F touches with an impulse below the threshold for longer than fresh_steps = 2;
+    // its late big impulse is not an impact (it is a resting contact of the dynamic body 9).
+    for _ in 0..3 {
+        impacts_at(&mut w, &[c(10, 9, 1e-4)]);
+    }
+    assert_eq!(impacts_at(&mut w, &[c(10, 9, 2.0)]), (0, 1));
     // Below the object's threshold (1e-3 N·s): not an impact; a body without state (static)
     // is never resting.
     assert_eq!(impacts_at(&mut w, &[c(6, 9, 1e-4)]), (0, 1));
     assert_eq!(impacts_at(&mut w, &[c(7, 99, 2.0)]).0, 1);
     assert_eq!(impacts_at(&mut w, &[c(8, 99, 0.5)]), (1, 0));
     assert_eq!(impacts_at(&mut w, &[c(8, 99, 0.5)]), (0, 0));
+}
+
+/// The engine's newness rule with quiet steps passed by `advance`: impacts are the reports
+/// flagged new with impulse ≥ threshold after the settle window (counted in engine steps), and
+/// cache eviction counts the advanced steps.
+#[test]
+fn engine_newness_and_advance() {
+    let mut wp = world_params(None);
+    wp.classify.engine_newness = true;
+    let mut w = DcrWorld::new(wp).unwrap();
+    let mut desc = ElasticObjectDesc::new(model(), PLATE);
+    desc.response.evict_after_steps = 5;
+    let plate = w.add_object(desc).unwrap();
+    let id = Pose::IDENTITY;
+    let bodies = [body(7, 1.0, [0.5, 0.3, 0.1]), body(9, 2.0, [0.2, 0.2, 0.1])];
+    let c = |cid: u64, lambda: f64, is_new: bool| ContactReport {
+        is_new,
+        ..on_plate(&id, cid, 9, [0.2, 0.2, 0.0], lambda)
+    };
+    let rest = on_plate(&id, 70, 7, [0.8, 0.4, 0.0], 0.1);
+    // Steps 0 and 1: the settle window.
+    w.step(&[c(1, 2.0, true), rest], &bodies);
+    assert_eq!(w.step_info().impacts, 0);
+    w.advance(1);
+    assert!(!w.needs_step());
+    w.step(&[c(2, 2.0, true)], &bodies); // step 2
+    assert_eq!(w.step_info().impacts, 0);
+    // Step 3 on: new and strong → impact (the resting contact is mapped at this query); not
+    // new, weak or zero → not.
+    let events = w.step(&[c(3, 2.0, true), rest], &bodies).len();
+    assert_eq!(
+        (w.step_info().step, w.step_info().impacts, events),
+        (3, 1, 1)
+    );
+    assert_eq!(w.response(plate).cached_contacts(), 1);
+    for (lambda, is_new) in [(2.0, false), (0.0, true), (1e-4, true)] {
+        w.step(&[c(3, lambda, is_new)], &bodies);
+        assert_eq!(w.step_info().impacts, 0, "λ {lambda} new {is_new}");
+    }
+    // Twenty quiet steps: the resting contact, unseen, is evicted at the next query.
+    w.advance(20);
+    assert_eq!(w.events().len(), 0);
+    w.step(&[c(4, 2.0, true)], &bodies);
+    assert_eq!((w.step_info().step, w.step_info().impacts), (27, 1));
+    assert_eq!(w.response(plate).cached_contacts(), 0);
 }
 
 /// A non-trivial world inverse inertia (symmetric positive definite), 1/(kg·m²).
@@ -316,6 +372,7 @@ fn an_impulse_on_the_fridge_reaches_the_plant_in_the_same_step() {
         point2: [0.55, 0.3, 0.0],
         normal: [0.0, 0.0, 1.0],
         impulse: 0.5,
+        is_new: false,
     };
     let plant_contact = on_fridge(&fridge_pose, 23, PLANT, [0.3, 0.35, 0.0]);
     let hit = ContactReport {
@@ -326,6 +383,7 @@ fn an_impulse_on_the_fridge_reaches_the_plant_in_the_same_step() {
         point2: [0.2, 0.2, 0.0],
         normal: [0.0, 0.0, 1.0],
         impulse: 3.0,
+        is_new: false,
     };
     for fridge_first in [false, true] {
         let mut w = DcrWorld::new(world_params(Some(1.0))).unwrap();
@@ -386,6 +444,7 @@ fn an_impulse_on_the_fridge_reaches_the_plant_in_the_same_step() {
         point2: p,
         normal: [0.0, 0.0, 1.0],
         impulse: lambda,
+        is_new: false,
     };
     let bodies = [fridge_body, plant_body, ball];
     let rest = on_lower(33, PLANT, [0.6, 0.4, 0.0], 0.2);
@@ -412,6 +471,7 @@ fn on_fridge(pose: &Pose, id: u64, other: u64, p: [f64; 3]) -> ContactReport {
         point2: wp,
         normal: [r[0][2], r[1][2], r[2][2]],
         impulse: 0.1,
+        is_new: false,
     }
 }
 

@@ -11,15 +11,22 @@ pub(crate) struct ContactSet {
     cache: ContactCache,
     /// Cache slot of each resting contact of the step, in call order.
     slots: Vec<u32>,
+    /// Mapping distance (m).
+    max_map: f64,
+    /// Contacts unseen for more than this many steps are evicted.
+    evict_after: u32,
 }
 
 impl ContactSet {
-    /// An empty set for an m-mode model; contacts moved farther than `remap_tolerance` (m) are
-    /// mapped again.
-    pub fn new(m: usize, remap_tolerance: f64) -> ContactSet {
+    /// An empty set for an m-mode model; contacts farther than `max_map` (m) from the surface
+    /// are not mapped, contacts moved farther than `remap_tolerance` (m) are mapped again, and
+    /// contacts unseen for more than `evict_after` steps are evicted.
+    pub fn new(m: usize, remap_tolerance: f64, max_map: f64, evict_after: u32) -> ContactSet {
         ContactSet {
             cache: ContactCache::new(m, remap_tolerance),
             slots: Vec::new(),
+            max_map,
+            evict_after,
         }
     }
 
@@ -32,12 +39,12 @@ impl ContactSet {
         model: &ModalModel,
         resting: &[RestingContact],
         step: u64,
-        max_map: f64,
-        evict_after: u32,
         info: &mut StepInfo,
         mut changed: impl FnMut(u32),
     ) {
-        self.cache.evict_unseen(step, evict_after, &mut changed);
+        let max_map = self.max_map;
+        self.cache
+            .evict_unseen(step, self.evict_after, &mut changed);
         // Last step's slot at the same list position is tried first (contact lists repeat).
         self.slots.resize(resting.len(), u32::MAX);
         for (i, rc) in resting.iter().enumerate() {

@@ -171,7 +171,7 @@ impl DistantResponse {
             samples,
             period,
             max_map,
-            contacts: ContactSet::new(m, remap_tolerance),
+            contacts: ContactSet::new(m, remap_tolerance, max_map, p.evict_after_steps),
             method,
             lateral,
             table_status,
@@ -305,19 +305,12 @@ impl DistantResponse {
         self.info = StepInfo::default();
         let step = self.step_index;
         let method = &mut self.method;
-        self.contacts.map(
-            &self.model,
-            resting,
-            step,
-            self.max_map,
-            self.params.evict_after_steps,
-            &mut self.info,
-            |s| {
+        self.contacts
+            .map(&self.model, resting, step, &mut self.info, |s| {
                 if let MethodResponse::Attenuation(a) = method {
                     a.invalidate(s);
                 }
-            },
-        );
+            });
         let mut ctx = StepCtx {
             model: &self.model,
             params: &self.params,
