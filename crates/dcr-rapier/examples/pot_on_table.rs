@@ -14,8 +14,8 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use dcr_rapier::f32::rapier::prelude::*;
-use dcr_rapier::f32::{body_id, AdapterParams, ApplyMode, DcrRapier};
-use dcr_rapier::{DcrWorld, ElasticObjectDesc, ModalModel, ResponseParams, WorldParams};
+use dcr_rapier::f32::{body_id, AdapterParams, ApplyMode, DcrRapier, StepGate};
+use dcr_rapier::{ElasticObjectDesc, ModalModel, ResponseParams, WorldParams};
 use modal_bake::bake::{bake_file, is_up_to_date, BakeParams, MaterialSi, ModeRequest};
 
 /// Rigid-body step (s).
@@ -119,17 +119,17 @@ pub fn run(model: &Arc<ModalModel>, on: bool) -> Result<RunOutcome, Box<dyn std:
     } else {
         ApplyMode::MeasureOnly
     };
-    let dcr_world = DcrWorld::new(WorldParams {
-        h: H,
-        ..WorldParams::default()
-    })?;
     let mut dcr = DcrRapier::new(
-        dcr_world,
+        WorldParams {
+            h: H,
+            ..WorldParams::default()
+        },
         AdapterParams {
             apply,
+            gate: StepGate::ImpactSteps,
             ..AdapterParams::default()
         },
-    );
+    )?;
     let mut desc = ElasticObjectDesc::new(model.clone(), 0);
     desc.response = ResponseParams {
         impact_threshold: 0.5,

@@ -3,7 +3,8 @@
 //! Expectation: on a rapier world with ten boxes resting on an elastic plate and a heavy ball
 //! kicked up every 0.5 s (an impact on every landing, responses to every box), once every
 //! buffer has seen the largest counts, the adapter's per-step calls allocate nothing — after the
-//! step and in the solver (seeds, pair marks, hook), f64 and f32. rapier's own `step` is not
+//! step and in the solver (seeds, pair marks, hook), reading every step or gated by force
+//! events (flagged pairs, load memory, quiet steps), f64 and f32. rapier's own `step` is not
 //! counted, nor is rapier's list of modified bodies: `RigidBodySet` hands that list to the
 //! step by value (`mem::take`) and rebuilds it from empty, so the first `get_mut` of a body
 //! after every step allocates whoever calls it; the test touches every dynamic body right after
@@ -17,7 +18,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Arc;
 
 use dcr_rapier::dcr_runtime::testing::plate_base;
-use dcr_rapier::{DcrWorld, ElasticObjectDesc, ModalModel, WorldParams};
+use dcr_rapier::{ElasticObjectDesc, ModalModel, WorldParams};
 
 struct Counting;
 
@@ -45,9 +46,9 @@ unsafe impl GlobalAlloc for Counting {
 static GLOBAL: Counting = Counting;
 
 macro_rules! run_backend {
-    ($m:ident, $apply:ident) => {{
+    ($m:ident, $apply:ident, $gate:ident) => {{
         use dcr_rapier::$m::rapier::prelude::*;
-        use dcr_rapier::$m::{AdapterParams, ApplyMode, DcrRapier};
+        use dcr_rapier::$m::{AdapterParams, ApplyMode, DcrRapier, StepGate};
 
         let mut world = PhysicsWorld::default();
         world.integration_parameters.dt = 0.01;
@@ -59,12 +60,14 @@ macro_rules! run_backend {
         );
         let model = Arc::new(ModalModel::from_base(plate_base()).expect("base"));
         let mut dcr = DcrRapier::new(
-            DcrWorld::new(WorldParams::default()).expect("world"),
+            WorldParams::default(),
             AdapterParams {
                 apply: ApplyMode::$apply,
+                gate: StepGate::$gate,
                 ..AdapterParams::default()
             },
-        );
+        )
+        .expect("adapter");
         dcr.add_object(
             &world.bodies,
             &mut world.colliders,
@@ -97,11 +100,7 @@ macro_rules! run_backend {
             let before = ALLOCS.load(Ordering::Relaxed);
             dcr.before_step(&mut world.bodies);
             let mid = ALLOCS.load(Ordering::Relaxed);
-            if dcr.params().apply == ApplyMode::InSolver {
-                world.step_with_events(dcr.hooks(), &());
-            } else {
-                world.step();
-            }
+            world.step_with_events(dcr.hooks(), &());
             for &h in &dynamic {
                 let _ = world.bodies.get_mut(h);
             }
@@ -121,10 +120,21 @@ macro_rules! run_backend {
 #[test]
 fn adapter_steps_do_not_allocate_after_warm_up() {
     let runs = [
-        ("f64 after step", run_backend!(f64, AfterStep)),
-        ("f64 in solver", run_backend!(f64, InSolver)),
-        ("f32 after step", run_backend!(f32, AfterStep)),
-        ("f32 in solver", run_backend!(f32, InSolver)),
+        ("f64 after step", run_backend!(f64, AfterStep, EveryStep)),
+        ("f64 in solver", run_backend!(f64, InSolver, EveryStep)),
+        (
+            "f64 after step, gated",
+            run_backend!(f64, AfterStep, ImpactSteps),
+        ),
+        (
+            "f64 in solver, gated",
+            run_backend!(f64, InSolver, ImpactSteps),
+        ),
+        ("f32 after step", run_backend!(f32, AfterStep, EveryStep)),
+        (
+            "f32 in solver, gated",
+            run_backend!(f32, InSolver, ImpactSteps),
+        ),
     ];
     for (name, (allocs, events)) in runs {
         assert!(

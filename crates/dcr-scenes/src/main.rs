@@ -5,7 +5,7 @@ use std::process::ExitCode;
 
 use anyhow::{bail, Context, Result};
 use clap::{Parser, Subcommand, ValueEnum};
-use dcr_rapier::f64::ApplyMode;
+use dcr_rapier::f64::{ApplyMode, StepGate};
 use dcr_scenes::runner::{run_scene, table1, MethodChoice, RunParams, Table1Params};
 use dcr_scenes::scene::SceneDesc;
 use dcr_scenes::{repo_root, SCENES};
@@ -67,6 +67,29 @@ struct ResponseArgs {
     /// must), to compare the two paths under the same contact generation.
     #[arg(long)]
     no_contact_recycling: bool,
+    /// On which steps the contacts are read in full and the world stepped: only the steps
+    /// with an impact (default), or every step.
+    #[arg(long, value_enum, default_value = "impact-steps")]
+    gate: GateArg,
+}
+
+/// On which steps the adapter reads the contacts.
+#[derive(Clone, Copy, ValueEnum)]
+enum GateArg {
+    /// Steps with an impact, found by a light pass over the contacts' impulses
+    /// (engine-newness classification).
+    ImpactSteps,
+    /// Every step (the world's age-based classification).
+    EveryStep,
+}
+
+impl From<GateArg> for StepGate {
+    fn from(g: GateArg) -> StepGate {
+        match g {
+            GateArg::ImpactSteps => StepGate::ImpactSteps,
+            GateArg::EveryStep => StepGate::EveryStep,
+        }
+    }
 }
 
 /// A parsed `--energy-eta`.
@@ -198,6 +221,7 @@ fn real_main() -> Result<()> {
                     energy_eta: response.eta(),
                     lateral_kick: response.lateral_kick,
                     contact_recycling: !response.no_contact_recycling,
+                    gate: response.gate.into(),
                     ..RunParams::new(root.clone(), matches!(dcr, OnOff::On))
                 },
             )?;
@@ -230,6 +254,10 @@ fn real_main() -> Result<()> {
                 report.injected_ke,
                 report.dissipated
             );
+            println!(
+                "  world stepped on {} of {} steps ({})",
+                report.world_steps, report.steps, report.gate
+            );
             println!("  trajectory {}", report.trajectory_hash);
         }
         Cmd::Table1 {
@@ -261,6 +289,7 @@ fn real_main() -> Result<()> {
                 energy_eta: response.eta(),
                 lateral_kick: response.lateral_kick,
                 contact_recycling: !response.no_contact_recycling,
+                gate: response.gate.into(),
                 eta_sweep: energy_sweep,
             })
             .context("table1")?;

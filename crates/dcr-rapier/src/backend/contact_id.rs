@@ -46,12 +46,15 @@ pub fn body_handle(id: u64) -> RigidBodyHandle {
     RigidBodyHandle::from_raw_parts(id as u32, (id >> 32) as u32)
 }
 
-/// An id of the unordered collider pair `{a, b}` (the same for `(a, b)` and `(b, a)`).
+/// An id of the unordered collider pair `{a, b}` (the same for `(a, b)` and `(b, a)`): the two
+/// handles' bits folded and multiplied once (Fibonacci hashing), well mixed in the high bits
+/// as hash tables want them. Cheap: it is computed for every pair on every step.
 #[inline]
 pub fn collider_pair_key(a: ColliderHandle, b: ColliderHandle) -> u64 {
     let (x, y) = (collider_bits(a), collider_bits(b));
     let (lo, hi) = if x <= y { (x, y) } else { (y, x) };
-    mix(mix(0x1319_8A2E_0370_7344, lo), hi)
+    let h = (lo ^ hi.rotate_left(29)).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+    h ^ (h >> 32)
 }
 
 /// The stable id of one rapier contact point: a hash of the ordered collider pair of the

@@ -4,19 +4,19 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use dcr_runtime::{
     BodyState, ContactReport, DcrWorld, ElasticHandle, ElasticObjectDesc, ImpulseEvent, Pose,
-    WorldError,
+    WorldError, WorldParams,
 };
 
 use super::body_reader::body_state;
 use super::contact_id::{body_handle, body_id, collider_pair_key, NO_BODY};
-use super::contact_reader::{read_pair, ReportSource};
+use super::contact_reader::{read_pair, scan_pair, LoadMemory, ReportSource};
 use super::rapier::math::Vector;
 use super::rapier::prelude::{
     ActiveHooks, ColliderHandle, ColliderSet, NarrowPhase, PhysicsWorld, RigidBodyHandle,
     RigidBodySet,
 };
 use super::solver_hooks::{DcrSolverHooks, PairMark};
-use super::{arr, to_f64, vector, ApplyMode};
+use super::{arr, to_f64, vector, ApplyMode, StepGate};
 
 /// Settings of a [`DcrRapier`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -29,6 +29,9 @@ pub struct AdapterParams {
     /// recycle" (`geometry/narrow_phase/pair_update.rs`); [`ApplyMode::InSolver`] always does, as
     /// its hook must see every step. Default `true`.
     pub contact_recycling: bool,
+    /// On which steps the contacts are read in full and the world stepped. Default
+    /// [`StepGate::ImpactSteps`].
+    pub gate: StepGate,
 }
 
 impl Default for AdapterParams {
@@ -36,6 +39,7 @@ impl Default for AdapterParams {
         AdapterParams {
             apply: ApplyMode::AfterStep,
             contact_recycling: true,
+            gate: StepGate::ImpactSteps,
         }
     }
 }
@@ -49,6 +53,9 @@ pub struct AdapterStepInfo {
     pub reports: u32,
     /// Body states passed to the world (dynamic bodies touching an elastic object).
     pub bodies: u32,
+    /// Whether the contacts were read in full and the world stepped (always under
+    /// [`StepGate::EveryStep`]; see [`StepGate::ImpactSteps`]).
+    pub world_stepped: bool,
     /// Impulse events the world returned.
     pub events: u32,
     /// [`ApplyMode::InSolver`]: collider pairs whose contacts replay responses in the next step.
@@ -90,6 +97,8 @@ struct ObjectSlot {
     handle: ElasticHandle,
     body: RigidBodyHandle,
     dynamic: bool,
+    /// Impact threshold (N·s).
+    threshold: f64,
 }
 
 /// A response replayed through the solver ([`ApplyMode::InSolver`]).
@@ -107,8 +116,8 @@ struct Seed {
 /// The distant collision response of a rapier world (paper §4.2–4.5): rapier's contacts in, the
 /// world API's impulse events applied to rapier's bodies.
 ///
-/// Set up once: [`DcrRapier::new`] with a [`DcrWorld`] (its [`dcr_runtime::WorldParams`]`::h`
-/// must be rapier's `integration_parameters.dt`), then [`DcrRapier::add_object`] for each rigid
+/// Set up once: [`DcrRapier::new`] with the world's [`WorldParams`] (`h` must be rapier's
+/// `integration_parameters.dt`) and [`AdapterParams`], then [`DcrRapier::add_object`] for each rigid
 /// body that carries a baked base (the base's object frame is the body's local frame). Per
 /// rapier step, once, in this order:
 ///
@@ -125,7 +134,7 @@ struct Seed {
 /// ```
 /// use dcr_rapier::dcr_runtime::testing;
 /// use dcr_rapier::f64::{rapier::prelude::*, AdapterParams, DcrRapier};
-/// use dcr_rapier::{DcrWorld, ElasticObjectDesc, ModalModel, WorldParams};
+/// use dcr_rapier::{ElasticObjectDesc, ModalModel, WorldParams};
 ///
 /// let mut world = PhysicsWorld::default();
 /// world.integration_parameters.dt = 0.01;
@@ -134,7 +143,7 @@ struct Seed {
 /// let plate = world.insert_body(RigidBodyBuilder::fixed());
 /// let slab = ColliderBuilder::cuboid(0.5, 0.3, 0.05).translation(Vector::new(0.5, 0.3, -0.05));
 /// world.insert_collider(slab, Some(plate));
-/// let mut dcr = DcrRapier::new(DcrWorld::new(WorldParams::default())?, AdapterParams::default());
+/// let mut dcr = DcrRapier::new(WorldParams::default(), AdapterParams::default())?;
 /// let model = std::sync::Arc::new(ModalModel::from_base(testing::plate_base())?);
 /// dcr.add_object(&world.bodies, &mut world.colliders, plate, ElasticObjectDesc::new(model, 0))?;
 /// // A small box resting on it, and a heavy ball dropped next to it.
@@ -158,6 +167,8 @@ pub struct DcrRapier {
     objects: Vec<ObjectSlot>,
     /// Every elastic object's colliders with the object's index, sorted by handle.
     colliders: Vec<(ColliderHandle, u32)>,
+    /// Per collider arena index: its position in `colliders`, or `u32::MAX`.
+    collider_rank: Vec<u32>,
     reports: Vec<ContactReport>,
     sources: Vec<ReportSource>,
     states: Vec<BodyState>,
@@ -165,6 +176,9 @@ pub struct DcrRapier {
     stamps: Vec<u32>,
     stamp: u32,
     hooks: DcrSolverHooks,
+    /// The points that carried an impulse at the previous step and at this one
+    /// ([`StepGate::ImpactSteps`]).
+    memory: LoadMemory,
     /// In-solver: seeds for the coming step (filled after a step, applied before the next).
     seeds: Vec<Seed>,
     /// Whether `seeds` were applied by `before_step` (and await the hook's verdict).
@@ -178,26 +192,36 @@ pub struct DcrRapier {
 }
 
 impl DcrRapier {
-    /// An adapter around `world` (with no elastic object yet).
-    pub fn new(world: DcrWorld, params: AdapterParams) -> DcrRapier {
-        DcrRapier {
-            world,
-            params,
+    /// An adapter with an empty world of parameters `params` (`h` must be rapier's
+    /// `integration_parameters.dt`). Under [`StepGate::ImpactSteps`] the world classifies with
+    /// engine newness (`params.classify.engine_newness` is set).
+    ///
+    /// # Errors
+    /// [`AdapterError::World`] for invalid world parameters ([`DcrWorld::new`]).
+    pub fn new(mut params: WorldParams, adapter: AdapterParams) -> Result<DcrRapier, AdapterError> {
+        if adapter.gate == StepGate::ImpactSteps {
+            params.classify.engine_newness = true;
+        }
+        Ok(DcrRapier {
+            world: DcrWorld::new(params)?,
+            params: adapter,
             objects: Vec::new(),
             colliders: Vec::new(),
+            collider_rank: Vec::new(),
             reports: Vec::new(),
             sources: Vec::new(),
             states: Vec::new(),
             stamps: Vec::new(),
             stamp: 0,
             hooks: DcrSolverHooks::default(),
+            memory: LoadMemory::default(),
             seeds: Vec::new(),
             seeded: false,
             by_id: Vec::new(),
             replays: Vec::new(),
             info: AdapterStepInfo::default(),
             step: 0,
-        }
+        })
     }
 
     /// Adds the elastic object carried by rapier body `body`: `desc.body` is set to
@@ -227,22 +251,33 @@ impl DcrRapier {
         desc.body = body_id(body);
         desc.dynamic = rb.is_dynamic();
         desc.pose = pose_of(rb.position());
+        let threshold = desc.response.impact_threshold;
         let handle = self.world.add_object(desc)?;
         let obj = self.objects.len() as u32;
         self.objects.push(ObjectSlot {
             handle,
             body,
             dynamic: rb.is_dynamic(),
+            threshold,
         });
         for &c in rb.colliders() {
             self.colliders.push((c, obj));
+            let Some(co) = colliders.get_mut(c) else {
+                continue;
+            };
             if self.params.apply == ApplyMode::InSolver || !self.params.contact_recycling {
-                if let Some(co) = colliders.get_mut(c) {
-                    co.set_active_hooks(co.active_hooks() | ActiveHooks::MODIFY_SOLVER_CONTACTS);
-                }
+                co.set_active_hooks(co.active_hooks() | ActiveHooks::MODIFY_SOLVER_CONTACTS);
             }
         }
         self.colliders.sort_by_key(|(c, _)| c.into_raw_parts());
+        self.collider_rank.clear();
+        for (k, &(c, _)) in self.colliders.iter().enumerate() {
+            let i = c.into_raw_parts().0 as usize;
+            if i >= self.collider_rank.len() {
+                self.collider_rank.resize(i + 1, u32::MAX);
+            }
+            self.collider_rank[i] = k as u32;
+        }
         Ok(handle)
     }
 
@@ -320,6 +355,14 @@ impl DcrRapier {
         if self.params.apply == ApplyMode::InSolver {
             self.settle_replays(bodies);
         }
+        if self.params.gate == StepGate::ImpactSteps {
+            let hot = self.scan(narrow_phase);
+            if !hot && !self.must_step() {
+                self.world.advance(1);
+                return &[];
+            }
+        }
+        self.info.world_stepped = true;
         for o in &self.objects {
             if o.dynamic {
                 if let Some(rb) = bodies.get(o.body) {
@@ -346,16 +389,55 @@ impl DcrRapier {
         self.world.events()
     }
 
-    /// One full step of `world`: [`DcrRapier::before_step`], `step_with_events` (with
-    /// [`DcrRapier::hooks`] under [`ApplyMode::InSolver`]), [`DcrRapier::after_step`].
+    /// One full step of `world`: [`DcrRapier::before_step`], `step_with_events` with
+    /// [`DcrRapier::hooks`], [`DcrRapier::after_step`].
     pub fn step(&mut self, world: &mut PhysicsWorld) -> &[ImpulseEvent] {
         self.before_step(&mut world.bodies);
-        if self.params.apply == ApplyMode::InSolver {
-            world.step_with_events(&self.hooks, &());
-        } else {
-            world.step();
-        }
+        world.step_with_events(&self.hooks, &());
         self.after_step(&mut world.bodies, &world.colliders, &world.narrow_phase)
+    }
+
+    /// Whether the world must be stepped with contacts whatever the light pass says: while a
+    /// response rings. (Its settle window needs no reports under engine newness: no impact can
+    /// fire there, and the light pass already remembers which points were loaded.)
+    fn must_step(&self) -> bool {
+        self.world.needs_step()
+    }
+
+    /// Position of elastic collider `c` in `colliders`.
+    #[inline]
+    fn rank_of(&self, c: ColliderHandle) -> Option<usize> {
+        let r = *self.collider_rank.get(c.into_raw_parts().0 as usize)?;
+        (r != u32::MAX && self.colliders[r as usize].0 == c).then_some(r as usize)
+    }
+
+    /// The light pass of [`StepGate::ImpactSteps`]: records this step's loaded points in
+    /// `loaded_now`; whether one is an impact candidate (new and at or above its object's
+    /// threshold; a pair of two elastic objects uses the lower threshold).
+    fn scan(&mut self, np: &NarrowPhase) -> bool {
+        self.memory.begin_step(self.step);
+        let mut hot = false;
+        for k in 0..self.colliders.len() {
+            let (ec, obj) = self.colliders[k];
+            let own = self.objects[obj as usize].threshold;
+            for pair in np.contact_pairs_with(ec) {
+                let mut threshold = own;
+                let other = if pair.collider1 == ec {
+                    pair.collider2
+                } else {
+                    pair.collider1
+                };
+                if let Some(j) = self.rank_of(other) {
+                    if j < k {
+                        continue;
+                    }
+                    threshold = threshold.min(self.objects[self.colliders[j].1 as usize].threshold);
+                }
+                let key = collider_pair_key(pair.collider1, pair.collider2);
+                hot |= scan_pair(pair, key, threshold, &mut self.memory);
+            }
+        }
+        hot
     }
 
     /// Fills `reports`, `sources` and `states` from the narrow phase.
@@ -377,13 +459,8 @@ impl DcrRapier {
                     pair.collider1
                 };
                 // A pair of two elastic colliders is read once, from the first in order.
-                if let Ok(j) = self
-                    .colliders
-                    .binary_search_by_key(&other.into_raw_parts(), |(c, _)| c.into_raw_parts())
-                {
-                    if j < k {
-                        continue;
-                    }
+                if self.rank_of(other).is_some_and(|j| j < k) {
+                    continue;
                 }
                 let (Some(co1), Some(co2)) =
                     (colliders.get(pair.collider1), colliders.get(pair.collider2))
@@ -403,6 +480,7 @@ impl DcrRapier {
                     [co1, co2],
                     [id1, id2],
                     key,
+                    &self.memory,
                     &mut self.reports,
                     &mut self.sources,
                 );

@@ -18,11 +18,13 @@ mod contact_id;
 mod contact_reader;
 mod dcr_rapier;
 mod solver_hooks;
+mod step_gate;
 
 pub use apply_mode::ApplyMode;
 pub use contact_id::{body_handle, body_id, collider_pair_key, contact_id, NO_BODY};
 pub use dcr_rapier::{AdapterError, AdapterParams, AdapterStepInfo, DcrRapier};
 pub use solver_hooks::DcrSolverHooks;
+pub use step_gate::StepGate;
 
 /// A rapier vector as the world API's `[f64; 3]`.
 #[inline]

@@ -5,8 +5,8 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
-use dcr_rapier::f64::{body_handle, AdapterParams, ApplyMode, DcrRapier};
-use dcr_rapier::{DcrWorld, ElasticHandle, ElasticObjectDesc, WorldParams};
+use dcr_rapier::f64::{body_handle, AdapterParams, ApplyMode, DcrRapier, StepGate};
+use dcr_rapier::{ElasticHandle, ElasticObjectDesc, WorldParams};
 use dcr_runtime::format::ModesFile;
 use dcr_runtime::{
     AmplitudeKind, AttenuationLaw, AttenuationParams, DistanceKind, Method, ModalModel,
@@ -62,6 +62,9 @@ pub struct RunParams {
     /// rapier's contact recycling on the elastic objects' colliders
     /// ([`AdapterParams::contact_recycling`]; always off in the solver path).
     pub contact_recycling: bool,
+    /// On which steps the contacts are read ([`AdapterParams::gate`]). Default
+    /// [`StepGate::ImpactSteps`].
+    pub gate: StepGate,
 }
 
 impl RunParams {
@@ -81,6 +84,7 @@ impl RunParams {
             energy_eta: WorldParams::default().energy_eta,
             lateral_kick: false,
             contact_recycling: true,
+            gate: StepGate::ImpactSteps,
         }
     }
 }
@@ -90,7 +94,8 @@ impl RunParams {
 pub struct ModelStats {
     /// Model (elastic object) name.
     pub name: String,
-    /// Wall time (µs) of the adapter step of each step on which the object's response ran.
+    /// Wall time (µs) of the object's response call on each step it ran (the world's
+    /// `ObjectStepInfo::response_time_ns`).
     #[serde(skip)]
     pub query_us: Vec<f64>,
     /// Resting contacts at each of those steps.
@@ -197,6 +202,10 @@ pub struct RunReport {
     pub lateral_kick: bool,
     /// Whether rapier's contact recycling was on for the elastic objects' colliders.
     pub contact_recycling: bool,
+    /// On which steps the contacts were read (`every_step`, `impact_steps`).
+    pub gate: String,
+    /// Steps on which the contacts were read and the world stepped.
+    pub world_steps: usize,
     /// The run's trajectory (not serialised; written as NPZ).
     #[serde(skip)]
     pub trajectory: Trajectory,
@@ -273,19 +282,19 @@ pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
     } else {
         ApplyMode::MeasureOnly
     };
-    let world = DcrWorld::new(WorldParams {
-        h: desc.h,
-        energy_eta: params.energy_eta,
-        ..WorldParams::default()
-    })
-    .map_err(|err| anyhow::anyhow!("scene {}: {err}", desc.name))?;
     let mut dcr = DcrRapier::new(
-        world,
+        WorldParams {
+            h: desc.h,
+            energy_eta: params.energy_eta,
+            ..WorldParams::default()
+        },
         AdapterParams {
             apply,
             contact_recycling: params.contact_recycling,
+            gate: params.gate,
         },
-    );
+    )
+    .map_err(|err| anyhow::anyhow!("scene {}: {err}", desc.name))?;
     let mut infos = Vec::new();
     let mut handles: Vec<ElasticHandle> = Vec::new();
     for (i, e) in desc.elastic.iter().enumerate() {
@@ -402,6 +411,7 @@ pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
     let mut rapier_us = Vec::with_capacity(steps);
     let mut adapter_us = Vec::with_capacity(steps);
     let mut events = Vec::new();
+    let mut world_steps = 0;
     let wall = Instant::now();
     let mut last_progress = Instant::now();
     for k in 0..steps {
@@ -436,11 +446,7 @@ pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
         dcr.before_step(&mut built.world.bodies);
         let before_us = ta.elapsed().as_secs_f64() * 1e6;
         let ts = Instant::now();
-        if apply == ApplyMode::InSolver {
-            built.world.step_with_events(dcr.hooks(), &());
-        } else {
-            built.world.step();
-        }
+        built.world.step_with_events(dcr.hooks(), &());
         rapier_us.push(ts.elapsed().as_secs_f64() * 1e6);
         let ta = Instant::now();
         dcr.after_step(
@@ -450,7 +456,10 @@ pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
         );
         let us = before_us + ta.elapsed().as_secs_f64() * 1e6;
         adapter_us.push(us);
-        for (i, &h) in handles.iter().enumerate() {
+        world_steps += usize::from(dcr.step_info().world_stepped);
+        // The world's counters describe its last `step`: read them only when it stepped.
+        let stepped = dcr.step_info().world_stepped;
+        for (i, &h) in handles.iter().enumerate().filter(|_| stepped) {
             let info = dcr.world().object_info(h);
             let s = &mut stats[i];
             s.impacts += info.impacts as usize;
@@ -464,7 +473,7 @@ pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
             s.received = info.energy.total_received;
             s.energy_limited_steps += usize::from(info.energy.scale < 1.0);
             if info.queried {
-                s.query_us.push(us);
+                s.query_us.push(info.response_time_ns as f64 / 1e3);
                 s.query_resting.push(info.resting as usize);
             }
         }
@@ -553,6 +562,12 @@ pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
         .to_string(),
         lateral_kick: params.lateral_kick,
         contact_recycling: params.contact_recycling && apply != ApplyMode::InSolver,
+        gate: match params.gate {
+            StepGate::EveryStep => "every_step",
+            _ => "impact_steps",
+        }
+        .to_string(),
+        world_steps,
         trajectory: traj,
         events,
     };

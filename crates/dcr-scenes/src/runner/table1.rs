@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use anyhow::Result;
 use serde_json::{json, Value};
 
-use dcr_rapier::f64::ApplyMode;
+use dcr_rapier::f64::{ApplyMode, StepGate};
 
 use crate::runner::{run_scene, MethodChoice, RunParams, RunReport};
 use crate::scene::SceneDesc;
@@ -79,6 +79,8 @@ pub struct Table1Params {
     pub lateral_kick: bool,
     /// rapier's contact recycling on the elastic objects' colliders.
     pub contact_recycling: bool,
+    /// On which steps the contacts are read.
+    pub gate: StepGate,
     /// Energy-bound sweep: also run every scene unbounded and at each of these η, and report
     /// which outcomes move by more than 5 % from the unbounded run.
     pub eta_sweep: Vec<f64>,
@@ -155,6 +157,7 @@ pub fn table1(p: &Table1Params) -> Result<(String, Value)> {
                     energy_eta: eta,
                     lateral_kick: p.lateral_kick,
                     contact_recycling: p.contact_recycling,
+                    gate: p.gate,
                     ..RunParams::new(p.root.clone(), dcr)
                 },
             )
@@ -302,6 +305,9 @@ pub fn table1(p: &Table1Params) -> Result<(String, Value)> {
                 "apply": on.apply,
                 "lateral_kick": on.lateral_kick,
                 "contact_recycling": on.contact_recycling,
+                "gate": on.gate,
+                "world_steps": on.world_steps,
+                "steps": on.steps,
                 "energy_sweep": sweep,
                 "attenuation_runs": extra,
                 "trajectory_hash_on": on.trajectory_hash,
