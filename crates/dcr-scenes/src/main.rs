@@ -6,7 +6,9 @@ use std::process::ExitCode;
 use anyhow::{bail, Context, Result};
 use clap::{Parser, Subcommand, ValueEnum};
 use dcr_rapier::f64::{ApplyMode, StepGate};
-use dcr_scenes::runner::{run_scene, table1, MethodChoice, RunParams, Table1Params};
+use dcr_scenes::runner::{
+    run_scene, stress_bench, table1, MethodChoice, RunParams, StressBenchParams, Table1Params,
+};
 use dcr_scenes::scene::SceneDesc;
 use dcr_scenes::{repo_root, SCENES};
 
@@ -164,6 +166,19 @@ enum Cmd {
         #[arg(long, value_delimiter = ',', value_name = "ETAS")]
         energy_sweep: Vec<f64>,
     },
+    /// The adapter's per-step cost against the number of resting contacts: scenes/stress.json
+    /// cut to its first N boxes, one JSON object on stdout (wall-clock medians).
+    BenchStress {
+        /// Numbers of boxes (comma separated).
+        #[arg(long, value_delimiter = ',', default_value = "100,300,1000")]
+        props: Vec<usize>,
+        /// Simulated seconds per run (default: the scene's).
+        #[arg(long)]
+        seconds: Option<f64>,
+        /// Bases directory (default out/bases).
+        #[arg(long)]
+        bases: Option<PathBuf>,
+    },
 }
 
 fn scene_path(root: &std::path::Path, s: &str) -> PathBuf {
@@ -298,6 +313,26 @@ fn real_main() -> Result<()> {
             } else {
                 print!("{text}");
             }
+        }
+        Cmd::BenchStress {
+            props,
+            seconds,
+            bases,
+        } => {
+            if let Some(s) = seconds {
+                if !(s.is_finite() && s > 0.0) {
+                    bail!("--seconds must be positive, got {s}");
+                }
+            }
+            let value = stress_bench(&StressBenchParams {
+                props,
+                seconds,
+                root: root.clone(),
+                bases_dir: bases.unwrap_or_else(|| root.join("out").join("bases")),
+                progress: true,
+            })
+            .context("bench-stress")?;
+            println!("{}", serde_json::to_string_pretty(&value)?);
         }
     }
     Ok(())

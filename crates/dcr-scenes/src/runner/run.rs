@@ -206,12 +206,32 @@ pub struct RunReport {
     pub gate: String,
     /// Steps on which the contacts were read and the world stepped.
     pub world_steps: usize,
+    /// In-solver path: collider pairs whose replay rapier's hook never saw (applied after the
+    /// step instead).
+    pub replay_missed: usize,
     /// The run's trajectory (not serialised; written as NPZ).
     #[serde(skip)]
     pub trajectory: Trajectory,
     /// Every response impulse issued, in order (not serialised).
     #[serde(skip)]
     pub events: Vec<AppliedEvent>,
+    /// Per step: wall time of rapier's step and of the adapter (µs), whether the world was
+    /// stepped, and the contact reports it was given (not serialised; `timings.npz`).
+    #[serde(skip)]
+    pub step_times: Vec<StepTime>,
+}
+
+/// One step's timing (see [`RunReport::step_times`]).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct StepTime {
+    /// rapier's `step` (µs).
+    pub rapier_us: f64,
+    /// The adapter's `before_step` + `after_step` (µs).
+    pub adapter_us: f64,
+    /// Whether the contacts were read in full and the world stepped.
+    pub world_stepped: bool,
+    /// Contact reports given to the world (0 on quiet steps).
+    pub reports: u32,
 }
 
 fn percentile(v: &[f64], p: f64) -> Option<f64> {
@@ -412,6 +432,8 @@ pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
     let mut adapter_us = Vec::with_capacity(steps);
     let mut events = Vec::new();
     let mut world_steps = 0;
+    let mut replay_missed = 0;
+    let mut step_times = Vec::with_capacity(steps);
     let wall = Instant::now();
     let mut last_progress = Instant::now();
     for k in 0..steps {
@@ -457,6 +479,13 @@ pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
         let us = before_us + ta.elapsed().as_secs_f64() * 1e6;
         adapter_us.push(us);
         world_steps += usize::from(dcr.step_info().world_stepped);
+        replay_missed += dcr.step_info().replay_missed as usize;
+        step_times.push(StepTime {
+            rapier_us: *rapier_us.last().unwrap_or(&0.0),
+            adapter_us: us,
+            world_stepped: dcr.step_info().world_stepped,
+            reports: dcr.step_info().reports,
+        });
         // The world's counters describe its last `step`: read them only when it stepped.
         let stepped = dcr.step_info().world_stepped;
         for (i, &h) in handles.iter().enumerate().filter(|_| stepped) {
@@ -568,8 +597,10 @@ pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
         }
         .to_string(),
         world_steps,
+        replay_missed,
         trajectory: traj,
         events,
+        step_times,
     };
 
     if let Some(dir) = &params.out_dir {
@@ -579,6 +610,16 @@ pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
         let mut npz = NpzWriter::new(f);
         npz.add_array("rapier_us", &Array1::from(rapier_us.clone()))?;
         npz.add_array("adapter_us", &Array1::from(adapter_us.clone()))?;
+        npz.add_array(
+            "world_stepped",
+            &Array1::from(
+                report
+                    .step_times
+                    .iter()
+                    .map(|t| u8::from(t.world_stepped))
+                    .collect::<Vec<u8>>(),
+            ),
+        )?;
         for m in &report.models {
             let q = &m.stats.query_us;
             let arr = Array2::from_shape_vec(

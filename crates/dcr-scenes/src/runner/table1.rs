@@ -307,6 +307,7 @@ pub fn table1(p: &Table1Params) -> Result<(String, Value)> {
                 "contact_recycling": on.contact_recycling,
                 "gate": on.gate,
                 "world_steps": on.world_steps,
+                "replay_missed": on.replay_missed,
                 "steps": on.steps,
                 "energy_sweep": sweep,
                 "attenuation_runs": extra,
