@@ -25,6 +25,7 @@ pub use distant_response::DistantResponse;
 pub use effective_mass::{effective_mass, response_impulse};
 pub use force_input::ForceInput;
 pub use impact::Impact;
+#[cfg(feature = "bench-internals")]
 pub use peak_kernel::{peak_abs_projection, peak_abs_rows};
 pub use response_params::{Method, ParamsError, ResponseParams, TablePolicy, TableStatus, Variant};
 pub use resting_contact::RestingContact;
