@@ -51,10 +51,12 @@ if command -v valgrind >/dev/null; then
       f="$OUT/cg.$s.$g.out"
       valgrind --tool=callgrind --callgrind-out-file="$f" "$BIN" run "$s" --gate "$g" --out "$OUT/run_$s" >/dev/null 2>&1
       callgrind_annotate --inclusive=yes "$f" 2>/dev/null > "$f.txt"
-      r=$(grep -E "=> .*PhysicsWorld::step_with_events \(" "$f.txt" | head -1 | awk '{print $1}' | tr -d ,)
-      a=$(grep -E "=> .*DcrRapier::after_step \(" "$f.txt" | head -1 | awk '{print $1}' | tr -d ,)
-      b=$(grep -E "=> .*DcrRapier::before_step \(" "$f.txt" | head -1 | awk '{print $1}' | tr -d ,)
-      w=$(grep -E "=> .*DcrWorld::step \(" "$f.txt" | head -1 | awk '{print $1}' | tr -d ,)
+      # Inclusive counts at the call sites ("=> … (Nx)"); a function inlined everywhere has none.
+      count() { { grep -E "=> .*$1 \(" "$f.txt" || true; } | head -1 | awk '{print $1}' | tr -d ,; }
+      r=$(count "PhysicsWorld::step_with_events")
+      a=$(count "DcrRapier::after_step")
+      b=$(count "DcrRapier::before_step")
+      w=$(count "DcrWorld::step")
       echo "$s $g ${r:-0} ${a:-0} ${b:-0} ${w:-0}" >> "$OUT/callgrind.txt"
     done
   done

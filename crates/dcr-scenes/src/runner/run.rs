@@ -327,7 +327,12 @@ pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
             Some((c, beta, distance, amplitude)) => {
                 let distance = match distance.as_str() {
                     "euclidean" => DistanceKind::Euclidean,
-                    _ => DistanceKind::Heat,
+                    "heat" => DistanceKind::Heat,
+                    "heat_table" => DistanceKind::HeatTable,
+                    other => bail!(
+                        "elastic object {}: distance {other:?} (expected heat, heat_table or euclidean)",
+                        e.name
+                    ),
                 };
                 let amplitude = match amplitude.as_str() {
                     "per_vertex" => AmplitudeKind::PerVertex,
