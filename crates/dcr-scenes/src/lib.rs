@@ -5,9 +5,12 @@
 //! - [`runner`]: a headless run (scripted drivers, trajectories, timings, outcome figures) and
 //!   the Table 1 report. The response itself is `dcr_rapier::f64::DcrRapier` over
 //!   [`dcr_runtime::DcrWorld`].
+//! - [`export`]: runs as animated glTF (side by side, response events in `extras`) and the
+//!   outcome figures over time as SVG.
 //!
 //! See docs/scenes.md.
 
+pub mod export;
 pub mod runner;
 pub mod scene;
 

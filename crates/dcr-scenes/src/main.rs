@@ -6,8 +6,10 @@ use std::process::ExitCode;
 use anyhow::{bail, Context, Result};
 use clap::{Parser, Subcommand, ValueEnum};
 use dcr_rapier::f64::{ApplyMode, StepGate};
+use dcr_scenes::export::{side_label, write_outcomes_svg, write_scene_glb, Side};
 use dcr_scenes::runner::{
-    run_scene, stress_bench, table1, MethodChoice, RunParams, StressBenchParams, Table1Params,
+    run_scene, stress_bench, table1, MethodChoice, RunParams, RunReport, StressBenchParams,
+    Table1Params,
 };
 use dcr_scenes::scene::SceneDesc;
 use dcr_scenes::{repo_root, SCENES};
@@ -26,6 +28,8 @@ struct Cli {
 enum OnOff {
     On,
     Off,
+    /// Both runs: files in OUT/on and OUT/off, outcomes.svg and --gltf with both.
+    Both,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -142,6 +146,10 @@ enum Cmd {
         /// Bases directory (default out/bases).
         #[arg(long)]
         bases: Option<PathBuf>,
+        /// Also write the run(s) as animated glTF here (side by side with --dcr both; the
+        /// response events in the file's extras). Open it with scripts/view.sh.
+        #[arg(long, value_name = "OUT.glb")]
+        gltf: Option<PathBuf>,
         #[command(flatten)]
         response: ResponseArgs,
     },
@@ -159,6 +167,9 @@ enum Cmd {
         /// Bases directory (default out/bases).
         #[arg(long)]
         bases: Option<PathBuf>,
+        /// Also write every scene's on and off runs side by side as DIR/SCENE.glb.
+        #[arg(long, value_name = "DIR")]
+        gltf: Option<PathBuf>,
         #[command(flatten)]
         response: ResponseArgs,
         /// Energy-bound sweep: also run each scene unbounded and at each η (comma separated,
@@ -189,6 +200,43 @@ fn scene_path(root: &std::path::Path, s: &str) -> PathBuf {
     }
 }
 
+fn print_report(report: &RunReport, out_dir: &std::path::Path) {
+    println!(
+        "{} dcr {} ({} steps): {}",
+        report.scene,
+        if report.dcr { "on" } else { "off" },
+        report.steps,
+        out_dir.display()
+    );
+    for (k, (v, u)) in &report.outcomes {
+        println!("  {k:28} {v:10.3} {u}");
+    }
+    for m in &report.models {
+        println!(
+            "  model {:8} impacts {:4} queries {:4} distant contacts (max) {:3} query µs median {} p99 {}",
+            m.model,
+            m.stats.impacts,
+            m.queries,
+            m.distant_contacts,
+            m.query_us_median.map_or("-".into(), |v| format!("{v:.1}")),
+            m.query_us_p99.map_or("-".into(), |v| format!("{v:.1}"))
+        );
+    }
+    println!(
+        "  rapier {:.1} ms, dcr {:.1} ms ({:.2}% of step); energy injected {:.4e} J, dissipated {:.4e} J",
+        report.rapier_ms,
+        report.adapter_ms,
+        100.0 * report.dcr_share_of_step,
+        report.injected_ke,
+        report.dissipated
+    );
+    println!(
+        "  world stepped on {} of {} steps ({})",
+        report.world_steps, report.steps, report.gate
+    );
+    println!("  trajectory {}", report.trajectory_hash);
+}
+
 fn real_main() -> Result<()> {
     let cli = Cli::parse();
     let root = repo_root();
@@ -201,6 +249,7 @@ fn real_main() -> Result<()> {
             beta,
             out,
             bases,
+            gltf,
             response,
         } => {
             let path = scene_path(&root, &scene);
@@ -224,62 +273,77 @@ fn real_main() -> Result<()> {
                 }
             }
             let out_dir = out.unwrap_or_else(|| root.join("out").join(&desc.name));
-            let report = run_scene(
-                &desc,
-                &RunParams {
-                    seconds,
-                    method,
-                    bases_dir: bases.unwrap_or_else(|| root.join("out").join("bases")),
-                    out_dir: Some(out_dir.clone()),
-                    progress: true,
-                    apply: response.apply.into(),
-                    energy_eta: response.eta(),
-                    lateral_kick: response.lateral_kick,
-                    contact_recycling: !response.no_contact_recycling,
-                    gate: response.gate.into(),
-                    ..RunParams::new(root.clone(), matches!(dcr, OnOff::On))
-                },
-            )?;
-            println!(
-                "{} dcr {} ({} steps): {}",
-                report.scene,
-                if report.dcr { "on" } else { "off" },
-                report.steps,
-                out_dir.display()
-            );
-            for (k, (v, u)) in &report.outcomes {
-                println!("  {k:28} {v:10.3} {u}");
+            let bases_dir = bases.unwrap_or_else(|| root.join("out").join("bases"));
+            let runs: &[bool] = match dcr {
+                OnOff::On => &[true],
+                OnOff::Off => &[false],
+                OnOff::Both => &[true, false],
+            };
+            let mut reports = Vec::new();
+            for &on in runs {
+                let dir = match dcr {
+                    OnOff::Both => out_dir.join(if on { "on" } else { "off" }),
+                    _ => out_dir.clone(),
+                };
+                let report = run_scene(
+                    &desc,
+                    &RunParams {
+                        seconds,
+                        method: method.clone(),
+                        bases_dir: bases_dir.clone(),
+                        out_dir: Some(dir.clone()),
+                        progress: true,
+                        apply: response.apply.into(),
+                        energy_eta: response.eta(),
+                        lateral_kick: response.lateral_kick,
+                        contact_recycling: !response.no_contact_recycling,
+                        gate: response.gate.into(),
+                        ..RunParams::new(root.clone(), on)
+                    },
+                )?;
+                print_report(&report, &dir);
+                reports.push(report);
             }
-            for m in &report.models {
+            let refs: Vec<&RunReport> = reports.iter().collect();
+            if !desc.outcomes.is_empty() {
+                let svg = out_dir.join("outcomes.svg");
+                let t = std::time::Instant::now();
+                write_outcomes_svg(&desc, &refs, &svg)?;
                 println!(
-                    "  model {:8} impacts {:4} queries {:4} distant contacts (max) {:3} query µs median {} p99 {}",
-                    m.model,
-                    m.stats.impacts,
-                    m.queries,
-                    m.distant_contacts,
-                    m.query_us_median.map_or("-".into(), |v| format!("{v:.1}")),
-                    m.query_us_p99.map_or("-".into(), |v| format!("{v:.1}"))
+                    "  outcomes over time: {} ({:.1} KiB, {:.3} s)",
+                    svg.display(),
+                    std::fs::metadata(&svg).map_or(0, |m| m.len()) as f64 / 1024.0,
+                    t.elapsed().as_secs_f64()
                 );
             }
-            println!(
-                "  rapier {:.1} ms, dcr {:.1} ms ({:.2}% of step); energy injected {:.4e} J, dissipated {:.4e} J",
-                report.rapier_ms,
-                report.adapter_ms,
-                100.0 * report.dcr_share_of_step,
-                report.injected_ke,
-                report.dissipated
-            );
-            println!(
-                "  world stepped on {} of {} steps ({})",
-                report.world_steps, report.steps, report.gate
-            );
-            println!("  trajectory {}", report.trajectory_hash);
+            if let Some(path) = gltf {
+                let sides: Vec<Side> = reports
+                    .iter()
+                    .map(|r| Side {
+                        label: side_label(r),
+                        report: r,
+                    })
+                    .collect();
+                let t = std::time::Instant::now();
+                let info = write_scene_glb(&desc, &root, &bases_dir, &sides, &path)
+                    .with_context(|| format!("writing {}", path.display()))?;
+                println!(
+                    "  glTF: {} ({:.1} KiB, {} body nodes, {} keyframes, {} response events, {:.3} s)",
+                    path.display(),
+                    info.bytes as f64 / 1024.0,
+                    info.body_nodes,
+                    info.keyframes,
+                    info.events,
+                    t.elapsed().as_secs_f64()
+                );
+            }
         }
         Cmd::Table1 {
             json,
             seconds,
             scenes,
             bases,
+            gltf,
             response,
             energy_sweep,
         } => {
@@ -306,6 +370,7 @@ fn real_main() -> Result<()> {
                 contact_recycling: !response.no_contact_recycling,
                 gate: response.gate.into(),
                 eta_sweep: energy_sweep,
+                gltf_dir: gltf,
             })
             .context("table1")?;
             if json {

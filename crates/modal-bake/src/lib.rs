@@ -9,6 +9,7 @@
 
 pub mod bake;
 pub mod eigen;
+pub mod export;
 pub mod fem;
 pub mod mesh;
 pub mod transfer;

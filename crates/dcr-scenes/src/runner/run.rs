@@ -120,15 +120,18 @@ pub struct ModelStats {
     pub energy_limited_steps: usize,
 }
 
-/// One response impulse of a run, as issued after step `step` (applied right after it, or
-/// replayed in the solve of step `step + 1` under [`ApplyMode::InSolver`]).
+/// One response impulse of a run (what a viewer marks).
 #[derive(Clone, Copy, Debug, Serialize)]
-pub struct AppliedEvent {
-    /// Index of the rigid-body step after which the world issued it (0 = the first).
-    pub step: u64,
-    /// Receiving body (index into the run's `BuiltWorld::bodies`).
+pub struct ResponseEvent {
+    /// Trajectory row at whose time the impulse acts: after the step it is applied right after
+    /// step `row − 1`'s solve, at t = row · h (s); in the solver path it is replayed during step
+    /// `row − 1` (one step after the step that issued it) and acts at its end.
+    pub row: usize,
+    /// Elastic object (index in the scene's `elastic`) whose response it is.
+    pub model: usize,
+    /// Receiving body (index into `BuiltWorld::bodies`, names in `RunReport::bodies_all`).
     pub body: usize,
-    /// Application point (m, world frame).
+    /// Point of application (m, world frame).
     pub point: [f64; 3],
     /// Impulse (N·s, world frame).
     pub impulse: [f64; 3],
@@ -212,9 +215,13 @@ pub struct RunReport {
     /// The run's trajectory (not serialised; written as NPZ).
     #[serde(skip)]
     pub trajectory: Trajectory,
-    /// Every response impulse issued, in order (not serialised).
+    /// Every response impulse issued, in order, with `body` an index into `bodies_all` (not
+    /// serialised; exported with `--gltf`).
     #[serde(skip)]
-    pub events: Vec<AppliedEvent>,
+    pub events: Vec<ResponseEvent>,
+    /// Names of every body of the built world (events' `body` indexes this).
+    #[serde(skip)]
+    pub bodies_all: Vec<String>,
     /// Per step: wall time of rapier's step and of the adapter (µs), whether the world was
     /// stepped, and the contact reports it was given (not serialised; `timings.npz`).
     #[serde(skip)]
@@ -517,9 +524,14 @@ pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
                 .position(|&h| h == e.object)
                 .unwrap_or_default();
             stats[i].max_delta_v = stats[i].max_delta_v.max(e.delta_v);
+            // Off runs apply nothing: no events to show.
+            if apply == ApplyMode::MeasureOnly {
+                continue;
+            }
             if let Some(&body) = body_index.get(&e.body) {
-                events.push(AppliedEvent {
-                    step: k as u64,
+                events.push(ResponseEvent {
+                    row: k + if apply == ApplyMode::InSolver { 2 } else { 1 },
+                    model: i,
                     body,
                     point: e.point,
                     impulse: e.impulse,
@@ -605,6 +617,7 @@ pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
         replay_missed,
         trajectory: traj,
         events,
+        bodies_all: built.bodies.iter().map(|b| b.name.clone()).collect(),
         step_times,
     };
 

@@ -84,6 +84,8 @@ pub struct Table1Params {
     /// Energy-bound sweep: also run every scene unbounded and at each of these η, and report
     /// which outcomes move by more than 5 % from the unbounded run.
     pub eta_sweep: Vec<f64>,
+    /// If set, write each scene's on and off runs side by side as `DIR/SCENE.glb`.
+    pub gltf_dir: Option<PathBuf>,
 }
 
 /// An outcome "changes" when it moves by more than this fraction of the reference value (or of
@@ -165,6 +167,19 @@ pub fn table1(p: &Table1Params) -> Result<(String, Value)> {
         let run = |dcr: bool, method: MethodChoice| run_eta(dcr, method, p.energy_eta);
         let on = run(true, MethodChoice::Scene)?;
         let off = run(false, MethodChoice::Scene)?;
+        if let Some(dir) = &p.gltf_dir {
+            std::fs::create_dir_all(dir)?;
+            let path = dir.join(format!("{name}.glb"));
+            let sides = [&on, &off].map(|r| crate::export::Side {
+                label: crate::export::side_label(r),
+                report: r,
+            });
+            crate::export::write_scene_glb(&desc, &p.root, &p.bases_dir, &sides, &path)?;
+            eprintln!(
+                "[dcr-scenes] table1: {name} on/off glTF: {}",
+                path.display()
+            );
+        }
         // Energy-bound sweep: the unbounded run, then each η.
         let mut sweep = Vec::new();
         if !p.eta_sweep.is_empty() {

@@ -10,6 +10,7 @@ macro_rules! outln {
 
 mod bake;
 mod check;
+mod export;
 mod fit_attenuation;
 mod geodesic;
 mod info;
@@ -45,6 +46,9 @@ enum Command {
     /// Distant response of one impulse at the contacts of a base (runtime conventions).
     #[command(allow_negative_numbers = true)]
     Probe(probe::ProbeArgs),
+    /// Mode shapes as VTU (ParaView, meshio), GLB (Blender, three.js) and a PNG contact sheet.
+    #[command(allow_negative_numbers = true)]
+    Export(export::ExportArgs),
     /// Heat-method geodesic distances (m) from one surface vertex of a base.
     Geodesic(geodesic::GeodesicArgs),
     /// Full-order reference response of a mesh to an impulse (Newmark or all modes).
@@ -67,6 +71,7 @@ pub fn main() -> ExitCode {
         Command::Bake(a) => bake::run(&a).map(|()| ExitCode::SUCCESS),
         Command::Info(a) => info::run(&a).map(|()| ExitCode::SUCCESS),
         Command::Probe(a) => probe::run(&a).map(|()| ExitCode::SUCCESS),
+        Command::Export(a) => export::run(&a).map(|()| ExitCode::SUCCESS),
         Command::Geodesic(a) => geodesic::run(&a).map(|()| ExitCode::SUCCESS),
         Command::Truth(a) => truth::run(&a).map(|()| ExitCode::SUCCESS),
         Command::FitAttenuation(a) => fit_attenuation::run(&a).map(|()| ExitCode::SUCCESS),
