@@ -120,6 +120,20 @@ macro_rules! backend_tests {
                     b
                 }
 
+                /// A 0.2 kg ball (one contact) resting near the plate's edge for 30 steps, then
+                /// a heavy ball falling on the plate; returns the resting ball.
+                fn resting_ball_then_impact(&mut self) -> RigidBodyHandle {
+                    let ball = self.add(
+                        Vector::new(0.85, 0.3, 0.03),
+                        ColliderBuilder::ball(0.03).mass(0.2),
+                    );
+                    for _ in 0..30 {
+                        self.step();
+                    }
+                    self.drop_ball(0.25, 0.3);
+                    ball
+                }
+
                 fn step(&mut self) -> usize {
                     self.dcr.step(&mut self.world).len()
                 }
@@ -216,14 +230,7 @@ macro_rules! backend_tests {
             fn after_step_events_give_their_delta_v() {
                 for pose in [Pose::IDENTITY, posed()] {
                     let mut s = scene(pose, ApplyMode::AfterStep, None);
-                    let ball = s.add(
-                        Vector::new(0.85, 0.3, 0.03),
-                        ColliderBuilder::ball(0.03).mass(0.2),
-                    );
-                    for _ in 0..30 {
-                        s.step();
-                    }
-                    s.drop_ball(0.25, 0.3);
+                    let ball = s.resting_ball_then_impact();
                     let bid = body_id(ball);
                     let mut checked = 0;
                     for _ in 0..20 {
@@ -277,14 +284,7 @@ macro_rules! backend_tests {
             #[test]
             fn in_solver_replay_gives_the_requested_separation_velocity() {
                 let mut s = scene(Pose::IDENTITY, ApplyMode::InSolver, None);
-                let ball = s.add(
-                    Vector::new(0.85, 0.3, 0.03),
-                    ColliderBuilder::ball(0.03).mass(0.2),
-                );
-                for _ in 0..30 {
-                    s.step();
-                }
-                s.drop_ball(0.25, 0.3);
+                let ball = s.resting_ball_then_impact();
                 let bid = body_id(ball);
                 let mut checked = 0;
                 for _ in 0..20 {
