@@ -168,7 +168,7 @@ fn compute_truth(s: &Scene, seed: u64, fixed_points: Option<FixedPoints>) -> Tru
         }
         None => NEWMARK_DT,
     };
-    let steps = dcr_runtime::samples_per_step(H, dt_req);
+    let steps = dcr_runtime::filter::samples_per_step(H, dt_req);
     out.dt = H / steps as f64;
     for ip in &imp_pts {
         let isp = sys.surface.project(*ip).expect("impact");
@@ -1011,7 +1011,7 @@ fn transfer_study(s: &Scene, truth: &Truth, md: &mut String) {
         .map(|c| sys.surface.project(c.0).expect("contact"))
         .collect();
     let rows: Vec<Vec<f64>> = csp.iter().map(|c| sys.contact_row(c)).collect();
-    let steps = dcr_runtime::samples_per_step(H, truth.dt);
+    let steps = dcr_runtime::filter::samples_per_step(H, truth.dt);
     let mut truth_pk = Vec::new();
     let mut impacts = Vec::new();
     for ip in &imp_pts {

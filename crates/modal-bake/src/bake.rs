@@ -58,8 +58,8 @@ use sha2::{Digest, Sha256};
 use crate::eigen::{self, EigenError, EigenParams, EigenProgress};
 use crate::fem::{self, Material, MaterialError};
 use crate::mesh::{MeshError, DEFAULT_DEGENERATE_REL_TOL};
+use dcr_runtime::attenuation::HeatGeodesic;
 use dcr_runtime::format::{FormatError, ModesMeta, FORMAT_VERSION};
-use dcr_runtime::HeatGeodesic;
 
 /// `modal-bake <version>`, stored in every base.
 pub const TOOL_VERSION: &str = concat!("modal-bake ", env!("CARGO_PKG_VERSION"));

@@ -69,8 +69,8 @@ fn every_input_form_gives_a_byte_identical_base_and_rebaking_is_identical() {
         .as_deref()
         .expect("the bake stores surface_order");
     let (v, t) = (&base.surface_vertices, &base.surface_triangles);
-    let stored = dcr_runtime::HeatGeodesic::with_ordering(v, t, Some(order)).unwrap();
-    let amd = dcr_runtime::HeatGeodesic::new(v, t).unwrap();
+    let stored = dcr_runtime::attenuation::HeatGeodesic::with_ordering(v, t, Some(order)).unwrap();
+    let amd = dcr_runtime::attenuation::HeatGeodesic::new(v, t).unwrap();
     let (mut a, mut b) = (vec![0.0; v.len()], vec![0.0; v.len()]);
     stored.distances_from_vertex(0, &mut a);
     amd.distances_from_vertex(0, &mut b);

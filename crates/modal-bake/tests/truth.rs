@@ -6,7 +6,8 @@
 
 use std::sync::Arc;
 
-use dcr_runtime::{damping_ratio, samples_per_step, ModalModel, ModeFilter};
+use dcr_runtime::filter::{damping_ratio, samples_per_step, ModeFilter};
+use dcr_runtime::ModalModel;
 use modal_bake::bake::{bake_mesh, BakeParams, MaterialSi, ModeRequest};
 use modal_bake::mesh::TetMesh;
 use modal_bake::truth::{run_truth, TruthImpact, TruthMethod, TruthParams};

@@ -21,7 +21,7 @@
 //!
 //! Optional: `surface_order` u32 (ns,), a fill-reducing elimination order of the surface
 //! vertices (a permutation of 0..ns) for the heat-geodesic factor, chosen at bake time
-//! ([`crate::HeatGeodesic::plan_ordering`]); without it the runtime orders with AMD at load.
+//! ([`crate::attenuation::HeatGeodesic::plan_ordering`]); without it the runtime orders with AMD at load.
 //!
 //! Optional (all or none): the peak-transfer table ([`TransferTable`]): `transfer_vertices`
 //! u32 (nr,), `transfer_peaks` f32 (np(np+1)/2,) packed upper triangle over np = nr + ne points

@@ -10,9 +10,10 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 use anyhow::{bail, Context};
+use dcr_runtime::model::SurfacePoint;
 use dcr_runtime::{
     AttenuationParams, DistantResponse, Impact, Method, ModalModel, ResponseParams, RestingContact,
-    Sampling, ServedBy, SurfacePoint, Variant,
+    Sampling, ServedBy, Variant,
 };
 
 /// Distant-response model selectable from the command line.

@@ -41,7 +41,8 @@
 
 use std::time::Instant;
 
-use dcr_runtime::{damping_ratio, HeatGeodesic, ModeFilter};
+use dcr_runtime::attenuation::HeatGeodesic;
+use dcr_runtime::filter::{damping_ratio, ModeFilter};
 use rayon::prelude::*;
 
 use super::{ModalAll, TruthError, TruthParams, TruthSystem};
@@ -753,7 +754,7 @@ pub fn sample_attenuation(
             h / dt_req
         )));
     }
-    let steps = dcr_runtime::samples_per_step(h, dt_req);
+    let steps = dcr_runtime::filter::samples_per_step(h, dt_req);
     let dt = h / steps as f64;
     let cand: Vec<usize> = (0..resp.vertices.len())
         .filter(|&v| resp.eligible[v])

@@ -49,7 +49,9 @@ pub use newmark::{newmark_peaks, newmark_run, NewmarkInfo};
 pub use surface_map::SurfaceMap;
 pub use truth_system::TruthSystem;
 
-use dcr_runtime::{samples_per_step, HeatGeodesic, SurfacePoint};
+use dcr_runtime::attenuation::HeatGeodesic;
+use dcr_runtime::filter::samples_per_step;
+use dcr_runtime::model::SurfacePoint;
 
 use crate::mesh::{MeshError, TetMesh};
 

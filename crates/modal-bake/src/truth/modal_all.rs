@@ -13,7 +13,7 @@
 
 use std::time::Instant;
 
-use dcr_runtime::{damping_ratio, ModeFilter};
+use dcr_runtime::filter::{damping_ratio, ModeFilter};
 use faer::{Mat, Side};
 use rayon::prelude::*;
 

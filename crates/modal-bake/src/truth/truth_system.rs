@@ -4,7 +4,7 @@
 use faer::sparse::SparseColMat;
 use faer::Mat;
 
-use dcr_runtime::SurfacePoint;
+use dcr_runtime::model::SurfacePoint;
 
 use super::surface_map::SurfaceMap;
 use super::{TruthError, TruthParams};
