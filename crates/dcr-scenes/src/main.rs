@@ -17,6 +17,7 @@ use dcr_scenes::{repo_root, SCENES};
 #[derive(Parser)]
 #[command(
     name = "dcr-scenes",
+    version,
     about = "The paper's Table 1 scenes, headless on rapier3d-f64 with dcr-rapier"
 )]
 struct Cli {
@@ -140,7 +141,9 @@ enum Cmd {
         /// Attenuation exponent β (implies --method attenuation).
         #[arg(long)]
         beta: Option<f64>,
-        /// Output directory (default out/SCENE).
+        /// Output directory (default out/SCENE, each run in its own `on/` or `off/` folder so
+        /// the two runs of a comparison never overwrite each other; with --out DIR a single
+        /// run writes into DIR, `--dcr both` into DIR/on and DIR/off).
         #[arg(long)]
         out: Option<PathBuf>,
         /// Bases directory (default out/bases).
@@ -272,6 +275,9 @@ fn real_main() -> Result<()> {
                     bail!("--seconds must be positive, got {s}");
                 }
             }
+            // Default: out/SCENE/on and out/SCENE/off, so an `off` run never overwrites an `on`
+            // run; an explicit --out takes a single run directly (both: OUT/on and OUT/off).
+            let explicit_out = out.is_some();
             let out_dir = out.unwrap_or_else(|| root.join("out").join(&desc.name));
             let bases_dir = bases.unwrap_or_else(|| root.join("out").join("bases"));
             let runs: &[bool] = match dcr {
@@ -282,8 +288,8 @@ fn real_main() -> Result<()> {
             let mut reports = Vec::new();
             for &on in runs {
                 let dir = match dcr {
-                    OnOff::Both => out_dir.join(if on { "on" } else { "off" }),
-                    _ => out_dir.clone(),
+                    OnOff::On | OnOff::Off if explicit_out => out_dir.clone(),
+                    _ => out_dir.join(if on { "on" } else { "off" }),
                 };
                 let report = run_scene(
                     &desc,

@@ -12,5 +12,6 @@ pub mod eigen;
 pub mod export;
 pub mod fem;
 pub mod mesh;
+pub mod signals;
 pub mod transfer;
 pub mod truth;

@@ -133,7 +133,7 @@ pub enum ParamsError {
         detail: String,
     },
     /// The sampling asks for more filter samples per step than supported (10⁶).
-    #[error("{samples} filter samples per step (h/T) exceed the limit of 1000000")]
+    #[error("{samples:.3e} filter samples per step (h/T) exceed the limit of 1e6: use a shorter step h or a longer filter period T")]
     TooManySamples {
         /// S = ⌈h/T⌉.
         samples: f64,

@@ -7,11 +7,13 @@ use anyhow::Context;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use modal_bake::bake::{
-    self, BakeParams, BakeReport, BakeStage, MaterialSi, ModeRequest, ModesPrecision,
+    self, BakeParams, BakeReport, BakeStage, FixedBelow, MaterialSi, ModeRequest, ModesPrecision,
 };
 use modal_bake::transfer::{TransferModes, TransferParams};
 
+use super::mesh::AssetOptions;
 use super::parse;
+use modal_bake::mesh::surface::is_surface_asset;
 
 /// The object's material, boundary conditions and damping (shared by `bake`, `check`,
 /// `truth` and `fit-attenuation`).
@@ -39,6 +41,50 @@ pub struct ModelOptions {
 }
 
 impl ModelOptions {
+    /// Refuses a Young's modulus or density outside the supported ranges, naming the option,
+    /// and warns (stderr) about values that look like a unit mistake.
+    ///
+    /// # Errors
+    /// A one-line message naming `--youngs` or `--density` and the range that works.
+    pub fn check_ranges(&self) -> anyhow::Result<()> {
+        use modal_bake::fem::Material;
+        let [elo, ehi] = Material::YOUNGS_RANGE;
+        if !(self.youngs >= elo && self.youngs <= ehi) {
+            anyhow::bail!(
+                "--youngs {:e} Pa is outside the supported {elo:e} … {ehi:e} Pa (foams ~1e5, polymers ~1e9, steel 2e11)",
+                self.youngs
+            );
+        }
+        let [dlo, dhi] = Material::DENSITY_RANGE;
+        if !(self.density >= dlo && self.density <= dhi) {
+            anyhow::bail!(
+                "--density {:e} kg/m³ is outside the supported {dlo} … {dhi:e} kg/m³ (aerogel ~2, wood ~700, steel 7850)",
+                self.density
+            );
+        }
+        if self.youngs < 1e5 {
+            eprintln!(
+                "warning: --youngs {} Pa is softer than any solid object (plausible: 1e5 Pa foam … 1.2e12 Pa diamond); \
+                 the unit is Pa: did you mean {} GPa = {:e} Pa or {} MPa = {:e} Pa?",
+                self.youngs,
+                self.youngs,
+                self.youngs * 1e9,
+                self.youngs,
+                self.youngs * 1e6
+            );
+        }
+        if self.density < 100.0 {
+            eprintln!(
+                "warning: --density {} kg/m³ is lighter than solids other than foams and aerogels (plausible: 100 … 22600 kg/m³); \
+                 the unit is kg/m³: did you mean {} g/cm³ = {} kg/m³?",
+                self.density,
+                self.density,
+                self.density * 1000.0
+            );
+        }
+        Ok(())
+    }
+
     /// The material in SI units.
     pub fn material(&self) -> MaterialSi {
         MaterialSi {
@@ -63,6 +109,14 @@ pub struct BakeOptions {
     /// Store the surface mode shapes as 32-bit floats (half the file size).
     #[arg(long)]
     pub f32: bool,
+    /// Fix every node at or below a coordinate, e.g. `y=0.01` (m, object frame; repeatable;
+    /// combines with --fixed and --fixed-box). A selector that fixes no node is an error.
+    #[arg(long, value_name = "AXIS=VALUE", value_parser = parse::axis_value, allow_hyphen_values = true)]
+    pub fixed_below: Vec<FixedBelow>,
+    /// Fix every node inside a box X0,Y0,Z0,X1,Y1,Z1 (m, object frame, bounds included;
+    /// repeatable; combines with --fixed and --fixed-below).
+    #[arg(long, value_name = "X0,Y0,Z0,X1,Y1,Z1", value_parser = parse::aabb, allow_hyphen_values = true)]
+    pub fixed_box: Vec<[f64; 6]>,
 }
 
 impl BakeOptions {
@@ -74,6 +128,8 @@ impl BakeOptions {
                 None => ModeRequest::Count(self.modes.unwrap_or(20)),
             },
             fixed: self.model.fixed.clone(),
+            fixed_below: self.fixed_below.clone(),
+            fixed_boxes: self.fixed_box.clone(),
             rayleigh: self.model.rayleigh,
             lumped: self.model.lumped,
             precision: if self.f32 {
@@ -87,7 +143,9 @@ impl BakeOptions {
 
 #[derive(Args)]
 pub struct BakeArgs {
-    /// Tetrahedral mesh: gmsh .msh (2.2 or 4.1, ASCII or binary) or meshio-style .json.
+    /// Tetrahedral mesh: gmsh .msh (2.2 or 4.1, ASCII or binary, 4- or 10-node tetrahedra) or
+    /// meshio-style .json; or a closed surface asset .obj / .stl / .ply (in metres), meshed
+    /// with gmsh first (--size, --order, --gmsh).
     pub mesh: PathBuf,
     /// Output base (written atomically: nothing is left behind on failure).
     #[arg(short = 'o', long = "out", value_name = "OUT.modes")]
@@ -102,6 +160,29 @@ pub struct BakeArgs {
     pub json: bool,
     #[command(flatten)]
     pub transfer: TransferOptions,
+    #[command(flatten)]
+    pub asset: AssetOptions,
+}
+
+/// The tetrahedral mesh of `path`: read, or (a surface asset) meshed with gmsh; with the
+/// seconds it took. Meshing options given with a volume mesh are an error.
+pub fn load_mesh(
+    path: &std::path::Path,
+    asset: &AssetOptions,
+) -> anyhow::Result<(modal_bake::mesh::TetMesh, f64)> {
+    let t = std::time::Instant::now();
+    if is_surface_asset(path) {
+        let (out, _) = super::mesh::mesh_asset(path, 1.0, asset)?;
+        return Ok((out.mesh, t.elapsed().as_secs_f64()));
+    }
+    if asset.any_set() {
+        anyhow::bail!(
+            "--size, --order, --gmsh and --keep-surface apply to surface assets (.obj, .stl, .ply), not to the volume mesh {}",
+            path.display()
+        );
+    }
+    let mesh = modal_bake::mesh::read_mesh(path).map_err(anyhow::Error::new)?;
+    Ok((mesh, t.elapsed().as_secs_f64()))
 }
 
 /// The optional bake-time peak-transfer table (`dcr_runtime::Method::Transfer`).
@@ -213,19 +294,51 @@ impl Progress {
 }
 
 pub fn run(args: &BakeArgs) -> anyhow::Result<()> {
+    super::check_output(&args.out, "-o", &[&args.mesh])?;
+    args.options.model.check_ranges()?;
     let params = args.options.params();
     let mut progress = Progress::new();
     let transfer = args.transfer.params();
-    let report = bake::bake_file_with_transfer(
-        &args.mesh,
-        &params,
-        transfer.as_ref(),
-        &args.out,
-        &mut |s| progress.update(s),
-    );
+    let report = if is_surface_asset(&args.mesh) || args.asset.any_set() {
+        progress.bar.finish_and_clear();
+        let (mesh, read_s) = load_mesh(&args.mesh, &args.asset)?;
+        progress = Progress::new();
+        let file = args.mesh.display().to_string();
+        bake::bake_mesh_with_transfer(mesh, &params, transfer.as_ref(), &file, &mut |s| {
+            progress.update(s)
+        })
+        .and_then(|(base, mut report)| {
+            report.read_s = read_s;
+            progress.update(BakeStage::Write);
+            let t = std::time::Instant::now();
+            base.write_atomic(&args.out)?;
+            report.write_s = t.elapsed().as_secs_f64();
+            Ok(report)
+        })
+    } else {
+        bake::bake_file_with_transfer(
+            &args.mesh,
+            &params,
+            transfer.as_ref(),
+            &args.out,
+            &mut |s| progress.update(s),
+        )
+    };
     progress.bar.finish_and_clear();
     let report = report
         .with_context(|| format!("baking {} failed; nothing was written", args.mesh.display()))?;
+    if let Some(dir) = &report.created_folder {
+        eprintln!("note: created folder {dir}");
+    }
+    if report.extent_m > 100.0 {
+        eprintln!(
+            "warning: {} is {:.4e} m across and weighs {:.4e} kg (plausible objects: 0.01 … 100 m); \
+             bake expects metres: if the mesh is in millimetres, coordinates are 1000× too large",
+            args.mesh.display(),
+            report.extent_m,
+            report.mass_kg
+        );
+    }
     if args.json {
         outln!("{}", serde_json::to_string_pretty(&report)?);
     } else {
@@ -256,9 +369,10 @@ pub fn run(args: &BakeArgs) -> anyhow::Result<()> {
 fn print_report(out: &std::path::Path, r: &BakeReport) {
     outln!("wrote {}", out.display());
     outln!(
-        "  mesh: {} nodes, {} tets, {} free dofs, mass {:.6} kg",
+        "  mesh: {} nodes, {} {}-node tets, {} free dofs, mass {:.6} kg",
         r.nodes,
         r.tets,
+        if r.order == 2 { 10 } else { 4 },
         r.free_dofs,
         r.mass_kg
     );
@@ -278,12 +392,24 @@ fn print_report(out: &std::path::Path, r: &BakeReport) {
         );
     } else {
         outln!("  fixed nodes: {}", r.fixed_nodes);
+        for (what, n) in &r.fixed_by {
+            outln!("    {what}: {n} nodes");
+        }
     }
-    outln!(
-        "  surface: {} vertices, {} triangles",
-        r.surface_vertices,
-        r.surface_triangles
-    );
+    if r.surface_edge_nodes > 0 {
+        outln!(
+            "  surface: {} vertices + {} mid-edge nodes, {} 6-node triangles",
+            r.surface_vertices,
+            r.surface_edge_nodes,
+            r.surface_triangles
+        );
+    } else {
+        outln!(
+            "  surface: {} vertices, {} triangles",
+            r.surface_vertices,
+            r.surface_triangles
+        );
+    }
     let worst = r.residuals.iter().fold(0.0f64, |a, &b| a.max(b));
     outln!(
         "  {} modes, {:.3} Hz … {:.3} Hz, worst relative residual {:.1e}",

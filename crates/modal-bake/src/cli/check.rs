@@ -7,6 +7,7 @@ use clap::Args;
 use modal_bake::bake;
 
 use super::bake::{BakeOptions, TransferOptions};
+use super::mesh::AssetOptions;
 
 #[derive(Args)]
 pub struct CheckArgs {
@@ -20,12 +21,23 @@ pub struct CheckArgs {
     /// table when none is asked for, is stale).
     #[command(flatten)]
     pub transfer: TransferOptions,
+    /// How a surface asset was meshed (it is meshed again with gmsh and compared).
+    #[command(flatten)]
+    pub asset: AssetOptions,
 }
 
 pub fn run(args: &CheckArgs) -> ExitCode {
     let transfer = args.transfer.params();
-    match bake::is_up_to_date_with_transfer(
-        &args.mesh,
+    let (mesh, _) = match super::bake::load_mesh(&args.mesh, &args.asset) {
+        Ok(m) => m,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            return ExitCode::from(2);
+        }
+    };
+    match bake::is_mesh_up_to_date(
+        mesh,
+        &args.mesh.display().to_string(),
         &args.options.params(),
         transfer.as_ref(),
         &args.out,

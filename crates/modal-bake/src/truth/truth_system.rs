@@ -62,6 +62,11 @@ impl TruthSystem {
                 "{file}: the mesh has no tetrahedra"
             )));
         }
+        if mesh.is_quadratic() {
+            return Err(TruthError::Params(format!(
+                "{file}: the full-order reference supports 4-node tetrahedra only (its surface map is linear); use a linear mesh"
+            )));
+        }
         mesh.orient_tets(DEFAULT_DEGENERATE_REL_TOL)
             .map_err(name_file)?;
         let pieces = mesh.connected_components();
