@@ -21,7 +21,7 @@ pub struct SurfacePoint {
 /// field exactly. Corner weights are negative inside the triangle (down to −1/8).
 ///
 /// ```
-/// let w = dcr_runtime::quadratic_triangle_weights([0.5, 0.5, 0.0]);
+/// let w = dcr_runtime::model::quadratic_triangle_weights([0.5, 0.5, 0.0]);
 /// assert_eq!(w, [0.0, 0.0, 0.0, 1.0, 0.0, 0.0]);
 /// ```
 #[inline]
