@@ -45,9 +45,9 @@ pub(super) struct ReportSource {
 ///
 /// The pairs' masks sit in a vector in the order the light pass visits the pairs, which is the
 /// same from step to step (rapier's contact graph), so a pair is found by comparing its key with
-/// the entry under a cursor; a hash index by key catches the pairs that moved. On the dinner
-/// scene this keeps the light pass near 100 instructions per pair (callgrind), against 330 per
-/// point with a hash set of points.
+/// the entry under a cursor; a hash index by key catches the pairs that moved. Measured with
+/// callgrind on the dinner scene (19 pairs, ~54 points per step): the light pass costs about 190
+/// instructions per pair, against 330 with a hash set of loaded points.
 #[derive(Debug, Default)]
 pub(super) struct LoadMemory {
     entries: Vec<PairLoad>,
