@@ -8,8 +8,8 @@ use std::io::Cursor;
 use std::path::Path;
 
 use dcr_runtime::format::{FormatError, ModesFile, QuadraticSurface, TransferTable};
-use dcr_runtime::testing::{box_surface, geometric_omegas, icosphere, synthetic_base, SplitMix64};
 use dcr_runtime::model::quadratic_triangle_weights;
+use dcr_runtime::testing::{box_surface, geometric_omegas, icosphere, synthetic_base, SplitMix64};
 use dcr_runtime::ModalModel;
 
 /// A quadratic vector field (one value per axis and mode j), the "mode shape" of the tests.

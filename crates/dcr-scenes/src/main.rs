@@ -5,8 +5,12 @@ use std::process::ExitCode;
 
 use anyhow::{bail, Context, Result};
 use clap::{Parser, Subcommand, ValueEnum};
+use dcr_rapier::f64::{ApplyMode, StepGate};
 use dcr_scenes::export::{side_label, write_outcomes_svg, write_scene_glb, Side};
-use dcr_scenes::runner::{run_scene, table1, MethodChoice, RunParams, RunReport, Table1Params};
+use dcr_scenes::runner::{
+    run_scene, stress_bench, table1, MethodChoice, RunParams, RunReport, StressBenchParams,
+    Table1Params,
+};
 use dcr_scenes::scene::SceneDesc;
 use dcr_scenes::{repo_root, SCENES};
 
@@ -14,7 +18,7 @@ use dcr_scenes::{repo_root, SCENES};
 #[command(
     name = "dcr-scenes",
     version,
-    about = "The paper's Table 1 scenes, headless on rapier3d-f64"
+    about = "The paper's Table 1 scenes, headless on rapier3d-f64 with dcr-rapier"
 )]
 struct Cli {
     #[command(subcommand)]
@@ -33,6 +37,90 @@ enum OnOff {
 enum MethodArg {
     Modal,
     Attenuation,
+}
+
+/// How the responses reach the bodies.
+#[derive(Clone, Copy, ValueEnum)]
+enum ApplyArg {
+    /// Explicit impulses right after the step (Eq. 17–18).
+    AfterStep,
+    /// Replayed through the next step's contact solver (restitution pass; rapier hooks).
+    InSolver,
+}
+
+impl From<ApplyArg> for ApplyMode {
+    fn from(a: ApplyArg) -> ApplyMode {
+        match a {
+            ApplyArg::AfterStep => ApplyMode::AfterStep,
+            ApplyArg::InSolver => ApplyMode::InSolver,
+        }
+    }
+}
+
+/// Options shared by `run` and `table1`: how the response is applied and bounded.
+#[derive(clap::Args, Clone)]
+struct ResponseArgs {
+    /// Energy bound η in [0, 1] (per object and step, the responses inject at most η × what
+    /// the step's impacts dissipated), or `off` for no bound. Default: the world's (1).
+    #[arg(long, value_name = "ETA|off", value_parser = parse_eta)]
+    energy_eta: Option<Eta>,
+    /// How the responses reach the bodies.
+    #[arg(long, value_enum, default_value = "after-step")]
+    apply: ApplyArg,
+    /// Lateral kick (paper §5.4): the tangential peak displacement also pushes sideways.
+    #[arg(long)]
+    lateral_kick: bool,
+    /// Turn rapier's contact recycling off on the elastic objects (as the in-solver path
+    /// must), to compare the two paths under the same contact generation.
+    #[arg(long)]
+    no_contact_recycling: bool,
+    /// On which steps the contacts are read in full and the world stepped: only the steps
+    /// with an impact (default), or every step.
+    #[arg(long, value_enum, default_value = "impact-steps")]
+    gate: GateArg,
+}
+
+/// On which steps the adapter reads the contacts.
+#[derive(Clone, Copy, ValueEnum)]
+enum GateArg {
+    /// Steps with an impact, found by a light pass over the contacts' impulses
+    /// (engine-newness classification).
+    ImpactSteps,
+    /// Every step (the world's age-based classification).
+    EveryStep,
+}
+
+impl From<GateArg> for StepGate {
+    fn from(g: GateArg) -> StepGate {
+        match g {
+            GateArg::ImpactSteps => StepGate::ImpactSteps,
+            GateArg::EveryStep => StepGate::EveryStep,
+        }
+    }
+}
+
+/// A parsed `--energy-eta`.
+#[derive(Clone, Copy)]
+struct Eta(Option<f64>);
+
+fn parse_eta(s: &str) -> Result<Eta, String> {
+    if s.eq_ignore_ascii_case("off") || s.eq_ignore_ascii_case("none") {
+        return Ok(Eta(None));
+    }
+    let v: f64 = s
+        .parse()
+        .map_err(|_| format!("{s:?} is not a number in [0, 1] or `off`"))?;
+    if !(0.0..=1.0).contains(&v) {
+        return Err(format!("{v} is outside [0, 1]"));
+    }
+    Ok(Eta(Some(v)))
+}
+
+impl ResponseArgs {
+    fn eta(&self) -> Option<f64> {
+        self.energy_eta
+            .map_or(dcr_rapier::WorldParams::default().energy_eta, |e| e.0)
+    }
 }
 
 #[derive(Subcommand)]
@@ -65,6 +153,8 @@ enum Cmd {
         /// response events in the file's extras). Open it with scripts/view.sh.
         #[arg(long, value_name = "OUT.glb")]
         gltf: Option<PathBuf>,
+        #[command(flatten)]
+        response: ResponseArgs,
     },
     /// Bake missing/stale bases, run every scene on and off, print Table 1.
     Table1 {
@@ -83,6 +173,25 @@ enum Cmd {
         /// Also write every scene's on and off runs side by side as DIR/SCENE.glb.
         #[arg(long, value_name = "DIR")]
         gltf: Option<PathBuf>,
+        #[command(flatten)]
+        response: ResponseArgs,
+        /// Energy-bound sweep: also run each scene unbounded and at each η (comma separated,
+        /// e.g. 1,0.5,0.1) and report which outcomes move by more than 5 %.
+        #[arg(long, value_delimiter = ',', value_name = "ETAS")]
+        energy_sweep: Vec<f64>,
+    },
+    /// The adapter's per-step cost against the number of resting contacts: scenes/stress.json
+    /// cut to its first N boxes, one JSON object on stdout (wall-clock medians).
+    BenchStress {
+        /// Numbers of boxes (comma separated).
+        #[arg(long, value_delimiter = ',', default_value = "100,300,1000")]
+        props: Vec<usize>,
+        /// Simulated seconds per run (default: the scene's).
+        #[arg(long)]
+        seconds: Option<f64>,
+        /// Bases directory (default out/bases).
+        #[arg(long)]
+        bases: Option<PathBuf>,
     },
 }
 
@@ -117,12 +226,16 @@ fn print_report(report: &RunReport, out_dir: &std::path::Path) {
         );
     }
     println!(
-        "  rapier {:.1} ms, adapter {:.1} ms ({:.2}% of step); energy injected {:.4e} J, dissipated {:.4e} J",
+        "  rapier {:.1} ms, dcr {:.1} ms ({:.2}% of step); energy injected {:.4e} J, dissipated {:.4e} J",
         report.rapier_ms,
         report.adapter_ms,
         100.0 * report.dcr_share_of_step,
         report.injected_ke,
         report.dissipated
+    );
+    println!(
+        "  world stepped on {} of {} steps ({})",
+        report.world_steps, report.steps, report.gate
     );
     println!("  trajectory {}", report.trajectory_hash);
 }
@@ -140,6 +253,7 @@ fn real_main() -> Result<()> {
             out,
             bases,
             gltf,
+            response,
         } => {
             let path = scene_path(&root, &scene);
             if !path.exists() {
@@ -180,12 +294,16 @@ fn real_main() -> Result<()> {
                     &desc,
                     &RunParams {
                         seconds,
-                        dcr: on,
                         method: method.clone(),
-                        root: root.clone(),
                         bases_dir: bases_dir.clone(),
                         out_dir: Some(dir.clone()),
                         progress: true,
+                        apply: response.apply.into(),
+                        energy_eta: response.eta(),
+                        lateral_kick: response.lateral_kick,
+                        contact_recycling: !response.no_contact_recycling,
+                        gate: response.gate.into(),
+                        ..RunParams::new(root.clone(), on)
                     },
                 )?;
                 print_report(&report, &dir);
@@ -231,7 +349,14 @@ fn real_main() -> Result<()> {
             scenes,
             bases,
             gltf,
+            response,
+            energy_sweep,
         } => {
+            for &e in &energy_sweep {
+                if !(0.0..=1.0).contains(&e) {
+                    bail!("--energy-sweep: {e} is outside [0, 1]");
+                }
+            }
             let scenes = scenes.unwrap_or_else(|| SCENES.iter().map(|s| s.to_string()).collect());
             for s in &scenes {
                 if !SCENES.contains(&s.as_str()) {
@@ -244,6 +369,12 @@ fn real_main() -> Result<()> {
                 root: root.clone(),
                 bases_dir: bases.unwrap_or_else(|| root.join("out").join("bases")),
                 scaffold_betas: vec![0.5, 1.0, 2.0],
+                apply: response.apply.into(),
+                energy_eta: response.eta(),
+                lateral_kick: response.lateral_kick,
+                contact_recycling: !response.no_contact_recycling,
+                gate: response.gate.into(),
+                eta_sweep: energy_sweep,
                 gltf_dir: gltf,
             })
             .context("table1")?;
@@ -252,6 +383,26 @@ fn real_main() -> Result<()> {
             } else {
                 print!("{text}");
             }
+        }
+        Cmd::BenchStress {
+            props,
+            seconds,
+            bases,
+        } => {
+            if let Some(s) = seconds {
+                if !(s.is_finite() && s > 0.0) {
+                    bail!("--seconds must be positive, got {s}");
+                }
+            }
+            let value = stress_bench(&StressBenchParams {
+                props,
+                seconds,
+                root: root.clone(),
+                bases_dir: bases.unwrap_or_else(|| root.join("out").join("bases")),
+                progress: true,
+            })
+            .context("bench-stress")?;
+            println!("{}", serde_json::to_string_pretty(&value)?);
         }
     }
     Ok(())

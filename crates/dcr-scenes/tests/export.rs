@@ -38,12 +38,9 @@ fn run(desc: &SceneDesc, dcr: bool, seconds: f64) -> RunReport {
         desc,
         &RunParams {
             seconds: Some(seconds),
-            dcr,
             method: MethodChoice::Scene,
-            root: repo_root(),
             bases_dir: bases().clone(),
-            out_dir: None,
-            progress: false,
+            ..RunParams::new(repo_root(), dcr)
         },
     )
     .expect("scene runs")

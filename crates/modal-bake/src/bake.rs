@@ -84,8 +84,8 @@ use sha2::{Digest, Sha256};
 use crate::eigen::{self, EigenError, EigenParams, EigenProgress};
 use crate::fem::{self, Material, MaterialError};
 use crate::mesh::{tet_faces, MeshError, DEFAULT_DEGENERATE_REL_TOL, DEFAULT_STRAIGHT_REL_TOL};
-use dcr_runtime::format::{FormatError, ModesMeta, QuadraticSurface};
 use dcr_runtime::attenuation::HeatGeodesic;
+use dcr_runtime::format::{FormatError, ModesMeta, QuadraticSurface};
 
 /// Version of what `modal-bake` writes for given inputs, stored in every base
 /// (`meta.bake_params.output_version`). Bumped by any change of the tool that changes a base's
