@@ -13,7 +13,7 @@
  *   pose   QX QY QZ QW TX TY TZ                      (once: the object's pose)
  *   body   ID INV_MASS I00..I22 CX CY CZ VX VY VZ WX WY WZ
  *   step   STEP NUM_CONTACTS NUM_EVENTS
- *   contact ID BODY1 BODY2 P1X P1Y P1Z P2X P2Y P2Z NX NY NZ IMPULSE
+ *   contact ID BODY1 BODY2 P1X P1Y P1Z P2X P2Y P2Z NX NY NZ IMPULSE IS_NEW
  *   event  BODY PX PY PZ JX JY JZ NX NY NZ DELTA_V OBJECT SERVED_BY CONTACT CHAINED
  *
  * and, at the end, the world's counters. An engine would apply each event with its
@@ -73,7 +73,7 @@ static void print_contact(const DcrContactReport *c) {
     for (int k = 0; k < 3; ++k) printf(" %.17g", c->point1[k]);
     for (int k = 0; k < 3; ++k) printf(" %.17g", c->point2[k]);
     for (int k = 0; k < 3; ++k) printf(" %.17g", c->normal[k]);
-    printf(" %.17g\n", c->impulse);
+    printf(" %.17g %d\n", c->impulse, c->is_new ? 1 : 0);
 }
 
 static void print_event(const DcrImpulseEvent *e) {
@@ -177,7 +177,7 @@ int main(int argc, char **argv) {
         size_t nc = 0;
         /* The box's weight over one step: m g h = 1 kg * 9.81 m/s^2 * 0.01 s. The object is
            body1, so the normal points from it toward the box: the face's outward normal. */
-        DcrContactReport rest = {70, OBJECT_BODY, BOX_BODY, {0}, {0}, {0}, 0.0981};
+        DcrContactReport rest = {70, OBJECT_BODY, BOX_BODY, {0}, {0}, {0}, 0.0981, false};
         for (int k = 0; k < 3; ++k) {
             rest.point1[k] = rest.point2[k] = rest_w[k];
             rest.normal[k] = up_w[k];
@@ -185,7 +185,7 @@ int main(int argc, char **argv) {
         contacts[nc++] = rest;
         if (s == 5) {
             /* The ball is body1 here: the normal points from the ball into the object. */
-            DcrContactReport hit = {90, BALL_BODY, OBJECT_BODY, {0}, {0}, {0}, 2.0};
+            DcrContactReport hit = {90, BALL_BODY, OBJECT_BODY, {0}, {0}, {0}, 2.0, true};
             for (int k = 0; k < 3; ++k) {
                 hit.point1[k] = hit.point2[k] = hit_w[k];
                 hit.normal[k] = -up_w[k];

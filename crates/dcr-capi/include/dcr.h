@@ -555,8 +555,9 @@ typedef struct DcrVersion {
  */
 typedef struct DcrClassifyParams {
   /**
-   * A contact can be an impact while its age (steps since it first appeared) is at most
-   * this, and it has not been an impact on that object yet. Default 2.
+   * Ages rule: a contact can be an impact while its age (steps since it appeared, or last
+   * had zero impulse) is at most this, and it has not been an impact on that object since.
+   * Default 2.
    */
   uint64_t fresh_steps;
   /**
@@ -565,10 +566,17 @@ typedef struct DcrClassifyParams {
    */
   uint64_t settle_steps;
   /**
-   * A contact id absent for at least this many consecutive steps is new when it comes back
-   * (a bounce). Default 1.
+   * Ages rule: a contact id absent for at least this many consecutive steps is new when it
+   * comes back (a bounce). Default 1.
    */
   uint64_t new_after_missing_steps;
+  /**
+   * true: the engine's newness rule instead of ages: an impact is a report with
+   * `DcrContactReport.is_new`, impulse > 0 and ≥ the object's threshold, after the settle
+   * window (no age table). For callers that report contacts only on some steps and pass the
+   * others with `dcr_world_advance`. Default false (ages).
+   */
+  bool engine_newness;
 } DcrClassifyParams;
 
 /**
@@ -709,6 +717,13 @@ typedef struct DcrContactReport {
    * predictive contact that did not touch.
    */
   double impulse;
+  /**
+   * The engine's own newness: true when this point carried no impulse at the engine's
+   * previous step (rapier: the solver contact's warm-start impulse is 0; Box2D: a
+   * begin-touch event). Read only under `DcrClassifyParams.engine_newness`; pass false
+   * otherwise.
+   */
+  bool is_new;
 } DcrContactReport;
 
 /**
@@ -898,6 +913,11 @@ typedef struct DcrObjectStepInfo {
    * Whether the object's response ran this step.
    */
   bool queried;
+  /**
+   * Wall time of the object's response call this step (ns; 0 when it did not run). For
+   * profiling; results never depend on it.
+   */
+  uint64_t response_time_ns;
   /**
    * The response's own counters (zeros when it did not run).
    */
@@ -1477,6 +1497,34 @@ enum DcrStatus dcr_world_step(struct DcrWorld *world,
                               size_t num_bodies,
                               const struct DcrImpulseEvent **events,
                               size_t *num_events);
+
+/**
+ * Counts `steps` rigid-body steps that passed without `dcr_world_step` (quiet steps: no
+ * contact to report and `dcr_world_needs_step` false). Step counts (settle window, ages,
+ * cache eviction) stay in engine steps. O(1), no allocation; the event array becomes empty.
+ * Callers that skip steps should classify with `DcrClassifyParams.engine_newness`.
+ *
+ * # Errors
+ * `DCR_STATUS_NULL_POINTER` when `world` is NULL.
+ *
+ * # Safety
+ * `world` must be NULL or a live handle not used by another thread during the call.
+ */
+enum DcrStatus dcr_world_advance(struct DcrWorld *world,
+                                 uint64_t steps);
+
+/**
+ * `*out` = whether the next step must call `dcr_world_step` even with nothing to report (an
+ * object's carry-over filters still ring); false with the default parameters.
+ *
+ * # Errors
+ * `DCR_STATUS_NULL_POINTER` for a NULL argument.
+ *
+ * # Safety
+ * `world` must be NULL or a live handle; `out` NULL or valid for a write.
+ */
+enum DcrStatus dcr_world_needs_step(const struct DcrWorld *world,
+                                    bool *out);
 
 /**
  * Sets `*events` / `*num_events` to the last step's impulse events again (same array and

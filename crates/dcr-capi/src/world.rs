@@ -60,6 +60,11 @@ pub struct DcrContactReport {
     /// Normal impulse the solver applied at this point during the step (N·s, ≥ 0); 0 for a
     /// predictive contact that did not touch.
     pub impulse: f64,
+    /// The engine's own newness: true when this point carried no impulse at the engine's
+    /// previous step (rapier: the solver contact's warm-start impulse is 0; Box2D: a
+    /// begin-touch event). Read only under `DcrClassifyParams.engine_newness`; pass false
+    /// otherwise.
+    pub is_new: bool,
 }
 
 /// A dynamic or kinematic body after the step (world frame). Give one per body touching an
@@ -185,6 +190,9 @@ pub struct DcrObjectStepInfo {
     pub events: u32,
     /// Whether the object's response ran this step.
     pub queried: bool,
+    /// Wall time of the object's response call this step (ns; 0 when it did not run). For
+    /// profiling; results never depend on it.
+    pub response_time_ns: u64,
     /// The response's own counters (zeros when it did not run).
     pub response: DcrStepInfo,
     /// The energy account.
@@ -215,6 +223,7 @@ fn object_step_info(i: &ObjectStepInfo) -> DcrObjectStepInfo {
         resting: i.resting,
         events: i.events,
         queried: i.queried,
+        response_time_ns: i.response_time_ns,
         response: step_info(&i.response),
         energy: DcrEnergyInfo {
             dissipated: e.dissipated,
@@ -439,6 +448,7 @@ pub unsafe extern "C" fn dcr_world_step(
             point2: c.point2,
             normal: c.normal,
             impulse: c.impulse,
+            is_new: c.is_new,
         }));
         w.bodies.clear();
         w.bodies.extend(bodies.iter().map(|b| BodyState {
@@ -470,6 +480,45 @@ fn publish(w: &DcrWorld, events: *mut *const DcrImpulseEvent, num_events: *mut u
         events.write(p);
         num_events.write(w.events.len());
     }
+}
+
+/// Counts `steps` rigid-body steps that passed without `dcr_world_step` (quiet steps: no
+/// contact to report and `dcr_world_needs_step` false). Step counts (settle window, ages,
+/// cache eviction) stay in engine steps. O(1), no allocation; the event array becomes empty.
+/// Callers that skip steps should classify with `DcrClassifyParams.engine_newness`.
+///
+/// # Errors
+/// `DCR_STATUS_NULL_POINTER` when `world` is NULL.
+///
+/// # Safety
+/// `world` must be NULL or a live handle not used by another thread during the call.
+#[no_mangle]
+pub unsafe extern "C" fn dcr_world_advance(world: *mut DcrWorld, steps: u64) -> DcrStatus {
+    guard("dcr_world_advance", || {
+        // SAFETY: caller contract (NULL is checked).
+        let w = unsafe { arg_mut(world, "world")? };
+        w.world.advance(steps);
+        w.events.clear();
+        Ok(())
+    })
+}
+
+/// `*out` = whether the next step must call `dcr_world_step` even with nothing to report (an
+/// object's carry-over filters still ring); false with the default parameters.
+///
+/// # Errors
+/// `DCR_STATUS_NULL_POINTER` for a NULL argument.
+///
+/// # Safety
+/// `world` must be NULL or a live handle; `out` NULL or valid for a write.
+#[no_mangle]
+pub unsafe extern "C" fn dcr_world_needs_step(world: *const DcrWorld, out: *mut bool) -> DcrStatus {
+    guard("dcr_world_needs_step", || {
+        // SAFETY: caller contract (NULL is checked).
+        let w = unsafe { arg_ref(world, "world")? };
+        // SAFETY: caller contract (NULL is checked).
+        unsafe { write_out(out, w.world.needs_step(), "out") }
+    })
 }
 
 /// Sets `*events` / `*num_events` to the last step's impulse events again (same array and

@@ -47,15 +47,21 @@ impl From<Pose> for DcrPose {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct DcrClassifyParams {
-    /// A contact can be an impact while its age (steps since it first appeared) is at most
-    /// this, and it has not been an impact on that object yet. Default 2.
+    /// Ages rule: a contact can be an impact while its age (steps since it appeared, or last
+    /// had zero impulse) is at most this, and it has not been an impact on that object since.
+    /// Default 2.
     pub fresh_steps: u64,
     /// The contacts of the first `settle_steps` steps (the initial resting set) are never
     /// impacts. Default 3.
     pub settle_steps: u64,
-    /// A contact id absent for at least this many consecutive steps is new when it comes back
-    /// (a bounce). Default 1.
+    /// Ages rule: a contact id absent for at least this many consecutive steps is new when it
+    /// comes back (a bounce). Default 1.
     pub new_after_missing_steps: u64,
+    /// true: the engine's newness rule instead of ages: an impact is a report with
+    /// `DcrContactReport.is_new`, impulse > 0 and ≥ the object's threshold, after the settle
+    /// window (no age table). For callers that report contacts only on some steps and pass the
+    /// others with `dcr_world_advance`. Default false (ages).
+    pub engine_newness: bool,
 }
 
 /// Settings of a world (`dcr_world_create`). Fill with `dcr_world_params_default`.
@@ -92,6 +98,7 @@ impl DcrWorldParams {
                 fresh_steps: w.classify.fresh_steps,
                 settle_steps: w.classify.settle_steps,
                 new_after_missing_steps: w.classify.new_after_missing_steps,
+                engine_newness: w.classify.engine_newness,
             },
             energy_bound: w.energy_eta.is_some(),
             energy_eta: w.energy_eta.unwrap_or(1.0),
@@ -107,6 +114,7 @@ impl DcrWorldParams {
                 fresh_steps: self.classify.fresh_steps,
                 settle_steps: self.classify.settle_steps,
                 new_after_missing_steps: self.classify.new_after_missing_steps,
+                engine_newness: self.classify.engine_newness,
             },
             energy_eta: self.energy_bound.then_some(self.energy_eta),
             max_chain_depth: self.max_chain_depth,

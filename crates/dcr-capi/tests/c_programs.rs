@@ -284,7 +284,7 @@ fn world_c_events_equal_the_rust_world() {
             }
             "step" => steps.push((Vec::new(), Vec::new())),
             "contact" => {
-                let x = nums(&f[4..]);
+                let x = nums(&f[4..14]);
                 steps.last_mut().unwrap().0.push(ContactReport {
                     id: f[1].parse().unwrap(),
                     body1: f[2].parse().unwrap(),
@@ -293,6 +293,7 @@ fn world_c_events_equal_the_rust_world() {
                     point2: v3(&x[3..]),
                     normal: v3(&x[6..]),
                     impulse: x[9],
+                    is_new: f[14] == "1",
                 });
             }
             "event" => {

@@ -145,6 +145,7 @@ fn per_step_calls_do_not_allocate_after_warm_up() {
                 point2: p,
                 normal: [0.0, 0.0, 1.0],
                 impulse: 0.0981,
+                is_new: false,
             }
         })
         .collect();
@@ -180,6 +181,7 @@ fn per_step_calls_do_not_allocate_after_warm_up() {
             point2: p,
             normal: [0.0, 0.0, -1.0],
             impulse: 2.0,
+            is_new: true,
         }
     };
     contacts.push(ball(5000, &mut rng));

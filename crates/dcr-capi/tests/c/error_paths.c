@@ -245,6 +245,13 @@ int main(int argc, char **argv) {
     CHECK(dcr_world_events(world, &events, &ne) == DCR_STATUS_OK && events == NULL && ne == 0);
     DcrWorldStepInfo wi;
     CHECK(dcr_world_step_info(world, &wi) == DCR_STATUS_OK && wi.step == 0);
+    bool ring = true;
+    CHECK(dcr_world_needs_step(world, &ring) == DCR_STATUS_OK && !ring);
+    CHECK(dcr_world_needs_step(world, NULL) == DCR_STATUS_NULL_POINTER);
+    CHECK(dcr_world_advance(world, 3) == DCR_STATUS_OK);
+    CHECK(dcr_world_advance(NULL, 3) == DCR_STATUS_NULL_POINTER);
+    CHECK(dcr_world_step(world, NULL, 0, NULL, 0, &events, &ne) == DCR_STATUS_OK);
+    CHECK(dcr_world_step_info(world, &wi) == DCR_STATUS_OK && wi.step == 4); /* 0, 1-3, 4 */
 
     /* The last error through a caller buffer: size query, truncation, whole. */
     CHECK(dcr_world_set_pose(world, 3, &pose) == DCR_STATUS_INVALID_HANDLE);

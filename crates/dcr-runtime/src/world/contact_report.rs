@@ -31,4 +31,9 @@ pub struct ContactReport {
     /// The normal impulse the solver applied at this point during the step (N·s, ≥ 0); 0 for
     /// a predictive (speculative) contact that did not touch.
     pub impulse: f64,
+    /// The engine's own newness: `true` when this point carried no impulse at the engine's
+    /// previous step (it did not exist, or only predictively). Rapier: the solver contact's
+    /// warm-start impulse is 0; Box2D: a begin-touch event. Read only under
+    /// [`crate::ClassifyParams::engine_newness`]; pass `false` otherwise.
+    pub is_new: bool,
 }

@@ -84,20 +84,26 @@ struct Touched {
 /// # Impacts and resting contacts
 /// Every contact report that touches an elastic object's body is classified, per object
 /// ([`crate::ClassifyParams`]); the rules suit engines that create contacts before they carry
-/// an impulse:
-/// - a contact id's *age* counts world steps since it first appeared; an id absent for
-///   `new_after_missing_steps` steps or more is new again when it returns (a bounce);
+/// an impulse (predictive contacts):
+/// - a contact id's *age* counts world steps since it appeared or last had zero impulse; an id
+///   absent for `new_after_missing_steps` steps or more is new again when it returns (a
+///   bounce), and so is one that touched with zero impulse (a body lifted within the engine's
+///   prediction distance that lands again);
 /// - an **impact** on the object is a contact with age ≤ `fresh_steps` that has not been an
-///   impact on that object yet, whose impulse is > 0 and ≥ the object's
-///   `impact_threshold` (N·s). A zero-impulse (predictive) contact is never an impact and stays
-///   fresh, so it fires when its impulse arrives; the contacts of the first `settle_steps`
-///   steps are the initial resting set and never impacts;
+///   impact on that object since, whose impulse is > 0 and ≥ the object's
+///   `impact_threshold` (N·s). A zero-impulse (predictive) contact is never an impact and
+///   stays fresh, so it fires when its impulse arrives; the contacts that appeared in the
+///   first `settle_steps` steps (the initial resting set) do not fire until they lift off;
 /// - a **resting contact** is any other contact whose other body is dynamic
 ///   ([`BodyState::is_dynamic`]) with impulse > 0: it may receive a response.
 ///
 /// Ages live in a hash table whose entries are dropped once their id has been absent long
 /// enough to count as new, so its size is bounded by the contacts alive in a few steps and it
-/// stops growing after warm-up.
+/// stops growing after warm-up. Engines that know which points are new themselves (and
+/// callers that report only some steps, passing the others with [`DcrWorld::advance`]) use
+/// [`crate::ClassifyParams::engine_newness`] instead: an impact is a report with
+/// [`ContactReport::is_new`] and impulse > 0 and ≥ the threshold, after the settle window, and
+/// no table is kept.
 ///
 /// # Frames
 /// Contacts arrive in the world frame; the response works in the object frame of the base.
@@ -169,13 +175,15 @@ struct Touched {
 /// let pose = world.pose(plate);
 /// let on_plate = |x: [f64; 3]| pose.transform_point(x);
 /// let rest = ContactReport { id: 70, body1: 1, body2: 7, point1: on_plate([0.9, 0.5, 0.0]),
-///     point2: on_plate([0.9, 0.5, 0.0]), normal: [1.0, 0.0, 0.0], impulse: 0.01 };
+///     point2: on_plate([0.9, 0.5, 0.0]), normal: [1.0, 0.0, 0.0], impulse: 0.01,
+///     is_new: false };
 /// for _ in 0..5 {
 ///     assert!(world.step(&[rest], &[boxy]).is_empty());
 /// }
 /// // A ball (body 9) hits the plate's middle with 2 N·s.
 /// let hit = ContactReport { id: 90, body1: 9, body2: 1, point1: on_plate([0.5, 0.3, 0.0]),
-///     point2: on_plate([0.5, 0.3, 0.0]), normal: [-1.0, 0.0, 0.0], impulse: 2.0 };
+///     point2: on_plate([0.5, 0.3, 0.0]), normal: [-1.0, 0.0, 0.0], impulse: 2.0,
+///     is_new: false };
 /// let events = world.step(&[rest, hit], &[boxy]);
 /// assert_eq!(events.len(), 1);
 /// assert_eq!(events[0].body, 7);
@@ -200,8 +208,13 @@ pub struct DcrWorld {
     /// Chained impacts produced by the current object: (target object, impact, depth).
     handed: Vec<(u32, Impact, u32)>,
     step: u64,
+    /// Step at or after which the age table is next purged of dead ids.
+    next_purge: u64,
     info: WorldStepInfo,
 }
+
+/// Steps between purges of the age table.
+const PURGE_EVERY: u64 = 16;
 
 fn invalid(field: &'static str, detail: String) -> WorldError {
     WorldError::Params { field, detail }
@@ -238,6 +251,7 @@ impl DcrWorld {
             events: Vec::new(),
             handed: Vec::new(),
             step: 0,
+            next_purge: 0,
             info: WorldStepInfo::default(),
         })
     }
@@ -368,6 +382,23 @@ impl DcrWorld {
         &self.events
     }
 
+    /// Counts `steps` rigid-body steps that passed without [`DcrWorld::step`] (quiet steps: no
+    /// contact to report, nothing ringing — see [`DcrWorld::needs_step`]). Step counts (settle
+    /// window, ages, cache eviction) stay in engine steps. O(1), no allocation; clears the
+    /// event buffer; [`DcrWorld::step_info`] and [`DcrWorld::object_info`] still describe the
+    /// last call of `step`. Callers that skip steps should classify with
+    /// [`crate::ClassifyParams::engine_newness`]: ages count a contact unseen for a while as new.
+    pub fn advance(&mut self, steps: u64) {
+        self.step += steps;
+        self.events.clear();
+    }
+
+    /// Whether the next step must call [`DcrWorld::step`] even without impacts to report: an
+    /// object's carry-over filters still ring. `false` with the default parameters.
+    pub fn needs_step(&self) -> bool {
+        self.objects.iter().any(|o| o.response.needs_step())
+    }
+
     /// One rigid-body step: classifies `contacts` (world frame, see [`ContactReport`] for the
     /// sign convention), runs the responses of the objects with impacts, and returns the
     /// impulses to apply, valid until the next call. `bodies`: the state after the step of
@@ -426,7 +457,8 @@ impl DcrWorld {
         }
         self.info.events = self.events.len() as u32;
         // Forget ids absent long enough to be new anyway (bounded table, no growth once warm).
-        if step.is_multiple_of(16) {
+        if step >= self.next_purge {
+            self.next_purge = step + PURGE_EVERY;
             let gap = self.params.classify.new_after_missing_steps;
             self.ages.retain(|_, a| a.last_step + gap >= step);
         }
@@ -446,24 +478,29 @@ impl DcrWorld {
                 continue;
             }
             self.info.contacts += 1;
-            let age = self.ages.entry(c.id).or_insert(ContactAge {
-                first_step: step,
-                last_step: step,
-                fired: [false; 2],
-            });
-            if age.last_step + cp.new_after_missing_steps < step {
-                *age = ContactAge {
+            let lambda = c.impulse;
+            let valid = lambda.is_finite() && lambda > 0.0;
+            let mut fired_before: Option<&mut [bool; 2]> = None;
+            let fresh_age = if cp.engine_newness {
+                c.is_new && step >= cp.settle_steps
+            } else {
+                let fresh = ContactAge {
                     first_step: step,
                     last_step: step,
                     fired: [false; 2],
                 };
-            }
-            age.last_step = step;
-            let fresh_age = step >= cp.settle_steps
-                && age.first_step >= cp.settle_steps
-                && step - age.first_step <= cp.fresh_steps;
-            let lambda = c.impulse;
-            let valid = lambda.is_finite() && lambda > 0.0;
+                let age = self.ages.entry(c.id).or_insert(fresh);
+                // Absent for a while, or touching with zero impulse: its age restarts.
+                if age.last_step + cp.new_after_missing_steps < step || !(lambda > 0.0) {
+                    *age = fresh;
+                }
+                age.last_step = step;
+                let f = step >= cp.settle_steps
+                    && age.first_step >= cp.settle_steps
+                    && step - age.first_step <= cp.fresh_steps;
+                fired_before = Some(&mut age.fired);
+                f
+            };
             let bidx = [c.body1, c.body2].map(|b| self.body_index.get(&b).copied());
             let mut fired = [false; 2];
             for side in 0..2 {
@@ -472,8 +509,11 @@ impl DcrWorld {
                 let other = 1 - side;
                 let own_point = if side == 0 { c.point1 } else { c.point2 };
                 let other_point = if side == 0 { c.point2 } else { c.point1 };
-                if fresh_age && !age.fired[side] && valid && lambda >= obj.threshold {
-                    age.fired[side] = true;
+                let already = fired_before.as_ref().is_some_and(|f| f[side]);
+                if fresh_age && !already && valid && lambda >= obj.threshold {
+                    if let Some(f) = fired_before.as_mut() {
+                        f[side] = true;
+                    }
                     fired[side] = true;
                     // The impulse on this object: −λn on body1, +λn on body2.
                     let d = if side == 0 {
@@ -531,26 +571,48 @@ impl DcrWorld {
         obj.info.queried = true;
         self.info.queries += 1;
         let first_event = self.events.len();
+        let t0 = std::time::Instant::now();
         let out = obj.response.step(&obj.impacts, &obj.resting);
+        obj.info.response_time_ns = t0.elapsed().as_nanos() as u64;
         self.touched.clear();
         for (resp, src) in out.iter().zip(&obj.sources) {
-            if !resp.mapped || !(resp.delta_v > 0.0) {
+            let lateral = resp.lateral_delta_v != [0.0; 3];
+            if !resp.mapped || !(resp.delta_v > 0.0 || lateral) {
                 continue;
             }
             let b = &bodies[src.body as usize];
             let n = rotate(&obj.rot, resp.normal);
             let r = sub(src.point, b.center_of_mass);
             let t = &mut self.tracked[src.body as usize];
+            // Normal part: the Δv not yet produced at this point (one Gauss–Seidel pass).
+            let mut j = [0.0; 3];
+            let mut need = 0.0;
             let achieved = dot(add(t.dlin, cross(t.dang, r)), n);
-            let need = obj.gain * resp.delta_v - achieved;
-            if !(need > 0.0) {
+            let want = obj.gain * resp.delta_v - achieved;
+            if want > 0.0 {
+                let m_eff = effective_mass(b.inv_mass, b.inv_inertia, r, n);
+                if m_eff > 0.0 {
+                    need = want;
+                    j = scale(n, m_eff * want);
+                }
+            }
+            // Tangential part (lateral kick), after the normal part, the same way.
+            if lateral {
+                let tw = rotate(&obj.rot, resp.lateral_delta_v);
+                let mag = norm(tw);
+                let dir = scale(tw, 1.0 / mag);
+                let jv = scale(j, b.inv_mass);
+                let jw = mat_vec(&b.inv_inertia, cross(r, j));
+                let achieved = dot(add(add(t.dlin, jv), cross(add(t.dang, jw), r)), dir);
+                let want = obj.gain * mag - achieved;
+                let m_eff = effective_mass(b.inv_mass, b.inv_inertia, r, dir);
+                if want > 0.0 && m_eff > 0.0 {
+                    j = add(j, scale(dir, m_eff * want));
+                }
+            }
+            if j == [0.0; 3] {
                 continue;
             }
-            let m_eff = effective_mass(b.inv_mass, b.inv_inertia, r, n);
-            if !(m_eff > 0.0) {
-                continue;
-            }
-            let j = scale(n, m_eff * need);
             if t.touch == u32::MAX {
                 t.touch = self.touched.len() as u32;
                 self.touched.push(Touched {

@@ -73,6 +73,9 @@ pub struct ObjectStepInfo {
     pub events: u32,
     /// Whether the object's response ran this step.
     pub queried: bool,
+    /// Wall time of the object's response call this step (ns; 0 when it did not run). For
+    /// profiling; the world's results never depend on it.
+    pub response_time_ns: u64,
     /// The response's own counters for the step (zeros when it did not run): impacts applied
     /// or below threshold, contacts mapped, served by the transfer table or by its modal
     /// fallback ([`StepInfo::contacts_table_fallback`]).

@@ -1,21 +1,29 @@
 //! [`WorldParams`] and [`ClassifyParams`]: the settings of a [`crate::DcrWorld`].
 
 /// How the world tells impacts from resting contacts (see [`crate::DcrWorld`], "Impacts and
-/// resting contacts"). All counts are rigid-body steps of the world. The defaults suit engines
-/// that create contacts one step before they carry an impulse (rapier's predictive contacts).
+/// resting contacts"). All counts are rigid-body steps of the world (including those passed
+/// with [`crate::DcrWorld::advance`]). The defaults suit engines that create contacts before
+/// they carry an impulse (rapier's predictive contacts) and report every step.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct ClassifyParams {
-    /// A contact can be an impact while its age (steps since it first appeared) is at most
-    /// this, and it has not been an impact on that object yet. Default 2: a contact created
-    /// predictively at step k with zero impulse fires when its impulse arrives at k + 1 or k + 2.
+    /// Ages rule: a contact can be an impact while its age (steps since it appeared, or last
+    /// had zero impulse) is at most this, and it has not been an impact on that object since.
+    /// Default 2: a contact with zero impulse at step k fires when its impulse arrives at
+    /// k + 1 or k + 2.
     pub fresh_steps: u64,
     /// The contacts of the first `settle_steps` steps (the initial resting set, e.g. objects
     /// placed on a table, settling under gravity) are never impacts. Default 3.
     pub settle_steps: u64,
-    /// A contact id absent from the reports for at least this many consecutive steps is a new
-    /// contact when it comes back: its age restarts, so it can be an impact again (a bouncing
-    /// body). Default 1.
+    /// Ages rule: a contact id absent from the reports for at least this many consecutive
+    /// steps is a new contact when it comes back: its age restarts, so it can be an impact
+    /// again (a bouncing body). Default 1.
     pub new_after_missing_steps: u64,
+    /// `true`: the engine's newness rule instead of ages — an impact is a report with
+    /// [`crate::ContactReport::is_new`], impulse > 0 and ≥ the object's threshold, after the
+    /// settle window; no age table is kept. For callers that report contacts only on some
+    /// steps (passing the others with [`crate::DcrWorld::advance`]), where ages cannot see
+    /// what happened in between. Default `false` (ages).
+    pub engine_newness: bool,
 }
 
 impl Default for ClassifyParams {
@@ -24,6 +32,7 @@ impl Default for ClassifyParams {
             fresh_steps: 2,
             settle_steps: 3,
             new_after_missing_steps: 1,
+            engine_newness: false,
         }
     }
 }

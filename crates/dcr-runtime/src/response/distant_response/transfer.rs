@@ -33,7 +33,7 @@ use std::sync::Arc;
 
 use super::{mapped_response, unmapped_response, DistantResponse, UNMAPPED};
 use crate::math::{dot, normalize};
-use crate::response::{ForceInput, Impact, RestingContact, ServedBy, TableFallback, TableStatus};
+use crate::response::{ForceInput, Impact, RestingContact, ServedBy};
 
 /// Relative tolerance on h and the Rayleigh coefficients for the table to apply.
 const MATCH_REL_TOL: f64 = 1e-9;
@@ -101,25 +101,20 @@ fn close(a: f64, b: f64) -> bool {
 
 impl TransferState {
     /// The state when the base's table applies to steps of length `h` (s) with Rayleigh damping
-    /// `rayleigh` and `carry_over`; otherwise why not (the modal method serves every step).
+    /// `rayleigh` and `carry_over`; `None` otherwise (the modal method serves every step).
     pub(super) fn new(
         model: &crate::ModalModel,
         h: f64,
         rayleigh: [f64; 2],
         carry_over: bool,
-    ) -> Result<TransferState, TableStatus> {
-        let t = model.base().transfer.as_ref().ok_or(TableStatus::NoTable)?;
-        if !close(t.h, h) {
-            return Err(TableStatus::StepMismatch { table_h: t.h, h });
-        }
-        if !close(t.rayleigh[0], rayleigh[0]) || !close(t.rayleigh[1], rayleigh[1]) {
-            return Err(TableStatus::DampingMismatch {
-                table: t.rayleigh,
-                response: rayleigh,
-            });
-        }
-        if carry_over {
-            return Err(TableStatus::CarryOver);
+    ) -> Option<TransferState> {
+        let t = model.base().transfer.as_ref()?;
+        if carry_over
+            || !close(t.h, h)
+            || !close(t.rayleigh[0], rayleigh[0])
+            || !close(t.rayleigh[1], rayleigh[1])
+        {
+            return None;
         }
         let mut local = vec![UNMAPPED; model.num_vertices()];
         for (k, &v) in t.vertices.iter().enumerate() {
@@ -140,7 +135,7 @@ impl TransferState {
                 })
             })
             .collect();
-        Ok(TransferState {
+        Some(TransferState {
             local,
             tri_mids,
             hits: Vec::new(),
@@ -165,13 +160,6 @@ impl DistantResponse {
         resting: &[RestingContact],
     ) -> bool {
         let Some(mut ts) = self.transfer.take() else {
-            if !matches!(
-                self.table_status,
-                TableStatus::NotRequested | TableStatus::NoTable
-            ) {
-                self.info.contacts_table_fallback += resting.len() as u32;
-                self.info.table_fallback = Some(TableFallback::Unavailable);
-            }
             return false;
         };
         let served = self.step_transfer_with(&mut ts, impacts, forces, resting);
@@ -191,7 +179,6 @@ impl DistantResponse {
             .any(|f| f.force != [0.0; 3] && f.force.iter().all(|x| x.is_finite()));
         if nonzero_force {
             self.info.contacts_table_fallback += resting.len() as u32;
-            self.info.table_fallback = Some(TableFallback::Forces);
             return false;
         }
         let model = Arc::clone(&self.model);
@@ -213,7 +200,6 @@ impl DistantResponse {
             let Some(nodes) = table_nodes(ts, sp.triangle, model.triangle(sp.triangle), sp.bary)
             else {
                 self.info.contacts_table_fallback += resting.len() as u32;
-                self.info.table_fallback = Some(TableFallback::ImpactOutsideRegion);
                 return false;
             };
             let lambda_n = imp.impulse * dot(normalize(imp.direction), sp.normal).abs();
@@ -259,7 +245,6 @@ impl DistantResponse {
             // impacts); the in-region contacts take the table's values.
             self.step_modal(impacts, forces, resting);
             self.info.contacts_table_fallback += outside;
-            self.info.table_fallback = Some(TableFallback::ContactsOutsideRegion);
             for (o, &d) in self.out.iter_mut().zip(&ts.peaks) {
                 if d.is_finite() && o.mapped {
                     o.peak_displacement = d;

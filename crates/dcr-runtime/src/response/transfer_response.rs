@@ -1,0 +1,296 @@
+//! [`TransferResponse`]: the transfer-table method ([`crate::Method::Transfer`]): the step's
+//! distant peaks looked up in the base's bake-time peak-transfer table ([`crate::format::TransferTable`]) instead of
+//! filtering the truncated modal base.
+//!
+//! The table's points are the region's vertices and its edge midpoints
+//! ([`crate::format::TransferTable`]). A mapped point with barycentric weights β in triangle
+//! (v₀, v₁, v₂) is spread over the triangle's six P2 nodes with the quadratic Lagrange weights
+//! `N_k = β_k(2β_k − 1)` at vertex k and `N_jk = 4β_jβ_k` at the midpoint of edge (j, k); the
+//! peak normal displacement at a resting contact is
+//! `d = Σ_impacts λ_N max(0, Σ_p Σ_q N_p(β_impact) N_q(β_contact) T[p][q])`, where
+//! λ_N = λ·|d̂·n| is the normal component of the impulse (N·s; the tangential part is ignored).
+//! T is the peak for a unit inward-normal impulse at one table point seen at another, computed
+//! at bake time with many modes. The weights sum to 1 and reproduce T exactly at the nodes.
+//!
+//! Why quadratic: the exact peak is a convex function of β on each side (a maximum of absolute
+//! values of linear functions), so the linear blend of vertex peaks overestimates inside
+//! triangles where the vertex responses are out of phase (by up to +214 % on the ground slab);
+//! the P2 interpolant, which also sees the midpoints, is measured in `docs/accuracy.md`. It may
+//! undershoot, hence the clamp at 0. A table without midpoints (written before they existed)
+//! is blended linearly, as is any triangle one of whose needed midpoints is missing. With
+//! several impacts in one step their peaks are summed, an upper bound of the peak of the summed
+//! response.
+//!
+//! The table serves a step only when it applies: the base has a table whose `h` equals the
+//! step's (relative tolerance 1e-9) and whose Rayleigh damping equals the response's, the
+//! filters restart every step (`carry_over = false`), the step has no force input, and every
+//! applied impact lies on a triangle whose three vertices are in the table's region (a corner
+//! outside with a barycentric weight ≤ 1e-9 is ignored). A contact whose triangle is not
+//! entirely in the region is served by the modal method (the whole modal
+//! step is then run and the in-region contacts are overwritten with the table's values).
+//! Whether the table applies to the run at all is decided at set-up
+//! ([`crate::TablePolicy`]); per-step fallbacks are counted with their reason
+//! ([`crate::StepInfo::table_fallback`]).
+
+use super::modal_response::{ModalResponse, UNMAPPED};
+use super::step_ctx::{mapped_response, unmapped_response, StepCtx};
+use super::{ForceInput, Impact, RestingContact, ServedBy, TableFallback, TableStatus};
+use crate::math::{dot, normalize};
+use crate::model::ModalModel;
+
+/// Relative tolerance on h and the Rayleigh coefficients for the table to apply.
+const MATCH_REL_TOL: f64 = 1e-9;
+
+/// A triangle corner outside the region is ignored when its barycentric weight is at most
+/// this (a point at a region vertex may map to a neighbouring triangle outside the region).
+const NEGLIGIBLE_WEIGHT: f64 = 1e-9;
+
+/// Table nodes of a mapped point (vertices and edge midpoints) with their interpolation
+/// weights; unused slots have weight 0.
+type Nodes = ([u32; 6], [f64; 6]);
+
+/// The P2 (or, lacking midpoints, P1) nodes and weights of a point with barycentric weights
+/// `bary` in surface triangle `t` (corners `tri`), or `None` when a corner with a weight above
+/// [`NEGLIGIBLE_WEIGHT`] is outside the region (negligible ones get weight 0).
+#[inline]
+fn table_nodes(ts: &TransferResponse, t: u32, tri: [usize; 3], bary: [f64; 3]) -> Option<Nodes> {
+    let mut idx = [0u32; 6];
+    let mut w = bary;
+    for k in 0..3 {
+        let l = ts.local[tri[k]];
+        if l == UNMAPPED {
+            if bary[k] > NEGLIGIBLE_WEIGHT {
+                return None;
+            }
+            w[k] = 0.0;
+        } else {
+            idx[k] = l;
+        }
+    }
+    let mids = ts.tri_mids[t as usize];
+    // Midpoint k sits on the edge opposite corner k.
+    let mid_w = [0, 1, 2].map(|k| 4.0 * w[(k + 1) % 3] * w[(k + 2) % 3]);
+    if (0..3).any(|k| mid_w[k] > 0.0 && mids[k] == UNMAPPED) {
+        return Some((idx, [w[0], w[1], w[2], 0.0, 0.0, 0.0]));
+    }
+    let mut nw = [0.0; 6];
+    for k in 0..3 {
+        nw[k] = w[k] * (2.0 * w[k] - 1.0);
+        if mid_w[k] > 0.0 {
+            idx[3 + k] = mids[k];
+            nw[3 + k] = mid_w[k];
+        }
+    }
+    Some((idx, nw))
+}
+
+/// The transfer-table method: table lookups, and the modal method for what the table cannot
+/// serve.
+#[derive(Debug)]
+pub(crate) struct TransferResponse {
+    /// Region index (= table point) of each surface vertex ([`UNMAPPED`]: outside the region).
+    local: Vec<u32>,
+    /// Per surface triangle: the table point of the midpoint of the edge opposite each corner
+    /// ([`UNMAPPED`]: not tabulated).
+    tri_mids: Vec<[u32; 3]>,
+    /// This step's applied impacts: table nodes and weights, λ_N (N·s).
+    hits: Vec<(Nodes, f64)>,
+    /// Table peak per resting contact this step (m); NaN: not served by the table.
+    peaks: Vec<f64>,
+    /// The modal method: serves the steps and contacts the table cannot.
+    modal: ModalResponse,
+}
+
+fn close(a: f64, b: f64) -> bool {
+    (a - b).abs() <= MATCH_REL_TOL * a.abs().max(b.abs())
+}
+
+impl TransferResponse {
+    /// Whether the base's table applies to steps of length `h` (s) with Rayleigh damping
+    /// `rayleigh` and `carry_over`: `Ok` or why not.
+    pub fn check(
+        model: &ModalModel,
+        h: f64,
+        rayleigh: [f64; 2],
+        carry_over: bool,
+    ) -> Result<(), TableStatus> {
+        let t = model.base().transfer.as_ref().ok_or(TableStatus::NoTable)?;
+        if !close(t.h, h) {
+            return Err(TableStatus::StepMismatch { table_h: t.h, h });
+        }
+        if !close(t.rayleigh[0], rayleigh[0]) || !close(t.rayleigh[1], rayleigh[1]) {
+            return Err(TableStatus::DampingMismatch {
+                table: t.rayleigh,
+                response: rayleigh,
+            });
+        }
+        if carry_over {
+            return Err(TableStatus::CarryOver);
+        }
+        Ok(())
+    }
+
+    /// The method over `modal` for a base whose table applies ([`TransferResponse::check`]).
+    ///
+    /// # Panics
+    /// If the base has no transfer table.
+    pub fn new(model: &ModalModel, modal: ModalResponse) -> TransferResponse {
+        let t = model
+            .base()
+            .transfer
+            .as_ref()
+            .expect("checked: the base has a table");
+        let mut local = vec![UNMAPPED; model.num_vertices()];
+        for (k, &v) in t.vertices.iter().enumerate() {
+            local[v as usize] = k as u32;
+        }
+        let nr = t.vertices.len();
+        let tri_mids = (0..model.base().surface_triangles.len())
+            .map(|f| {
+                let tri = model.triangle(f as u32).map(|v| local[v]);
+                [0, 1, 2].map(|k| {
+                    let (a, b) = (tri[(k + 1) % 3], tri[(k + 2) % 3]);
+                    if a == UNMAPPED || b == UNMAPPED {
+                        return UNMAPPED;
+                    }
+                    t.edges
+                        .binary_search(&[a.min(b), a.max(b)])
+                        .map_or(UNMAPPED, |e| (nr + e) as u32)
+                })
+            })
+            .collect();
+        TransferResponse {
+            local,
+            tri_mids,
+            hits: Vec::new(),
+            peaks: Vec::new(),
+            modal,
+        }
+    }
+
+    /// The modal method inside (its filters, for diagnostics).
+    pub fn modal(&self) -> &ModalResponse {
+        &self.modal
+    }
+
+    /// The modal method inside, mutably.
+    pub fn modal_mut(&mut self) -> &mut ModalResponse {
+        &mut self.modal
+    }
+
+    /// One step: the table serves when it applies (see the module doc), else the modal
+    /// method; fills `ctx.out`.
+    pub fn step(
+        &mut self,
+        ctx: &mut StepCtx<'_>,
+        impacts: &[Impact],
+        forces: &[ForceInput],
+        resting: &[RestingContact],
+    ) {
+        let nonzero_force = forces
+            .iter()
+            .any(|f| f.force != [0.0; 3] && f.force.iter().all(|x| x.is_finite()));
+        if nonzero_force {
+            ctx.info.contacts_table_fallback += resting.len() as u32;
+            ctx.info.table_fallback = Some(TableFallback::Forces);
+            self.modal.step(ctx, impacts, forces, resting);
+            return;
+        }
+        let model = ctx.model;
+        let table = model.base().transfer.as_ref().expect("checked at set-up");
+        self.hits.clear();
+        let (mut below, mut unmapped) = (0u32, 0u32);
+        for imp in impacts {
+            let ok = imp.impulse.is_finite()
+                && imp.impulse > 0.0
+                && imp.impulse >= ctx.params.impact_threshold;
+            if !ok {
+                below += 1;
+                continue;
+            }
+            let Some(sp) = model.project(imp.point, ctx.max_map) else {
+                unmapped += 1;
+                continue;
+            };
+            let Some(nodes) = table_nodes(self, sp.triangle, model.triangle(sp.triangle), sp.bary)
+            else {
+                ctx.info.contacts_table_fallback += resting.len() as u32;
+                ctx.info.table_fallback = Some(TableFallback::ImpactOutsideRegion);
+                self.modal.step(ctx, impacts, forces, resting);
+                return;
+            };
+            let lambda_n = imp.impulse * dot(normalize(imp.direction), sp.normal).abs();
+            self.hits.push((nodes, lambda_n));
+        }
+        self.peaks.clear();
+        let mut outside = 0u32;
+        let contacts = ctx.contacts;
+        for &s in contacts.slots() {
+            let d = match contacts.slot(s).surface {
+                Some(sp) => {
+                    match table_nodes(self, sp.triangle, model.triangle(sp.triangle), sp.bary) {
+                        None => {
+                            outside += 1;
+                            f64::NAN
+                        }
+                        Some((loc, wb)) => {
+                            let mut d = 0.0;
+                            for ((src, beta), lambda_n) in &self.hits {
+                                let mut p = 0.0;
+                                for (a, ba) in src.iter().zip(beta) {
+                                    if *ba == 0.0 {
+                                        continue;
+                                    }
+                                    for (b, bb) in loc.iter().zip(&wb) {
+                                        if *bb != 0.0 {
+                                            p += ba * bb * table.peak(*a as usize, *b as usize);
+                                        }
+                                    }
+                                }
+                                d += lambda_n * p.max(0.0);
+                            }
+                            d
+                        }
+                    }
+                }
+                None => f64::NAN,
+            };
+            self.peaks.push(d);
+        }
+        let h = ctx.params.h;
+        if outside > 0 {
+            // Some contacts lie outside the region: the modal step serves them (and counts the
+            // impacts); the in-region contacts take the table's values.
+            self.modal.step(ctx, impacts, forces, resting);
+            ctx.info.contacts_table_fallback += outside;
+            ctx.info.table_fallback = Some(TableFallback::ContactsOutsideRegion);
+            for (o, &d) in ctx.out.iter_mut().zip(&self.peaks) {
+                if d.is_finite() && o.mapped {
+                    o.peak_displacement = d;
+                    o.delta_v = d / h;
+                    o.served_by = ServedBy::TransferTable;
+                    ctx.info.contacts_by_table += 1;
+                }
+            }
+            return;
+        }
+        ctx.info.impacts_below_threshold += below;
+        ctx.info.impacts_unmapped += unmapped;
+        ctx.info.impacts_applied += self.hits.len() as u32;
+        // The filters are not run: leave them at rest (diagnostics read zeros).
+        if !self.modal.asleep() {
+            self.modal.reset();
+        }
+        ctx.out.clear();
+        for ((rc, &s), &d) in resting.iter().zip(contacts.slots()).zip(&self.peaks) {
+            let resp = match contacts.slot(s).surface {
+                Some(sp) if d.is_finite() => {
+                    ctx.info.contacts_by_table += 1;
+                    mapped_response(rc, &sp, d, h, ServedBy::TransferTable)
+                }
+                _ => unmapped_response(rc),
+            };
+            ctx.out.push(resp);
+        }
+    }
+}
