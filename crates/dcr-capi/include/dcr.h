@@ -397,7 +397,7 @@ typedef struct DcrRestingContact {
  * What served one contact's response (`DcrContactResponse.served_by`,
  * `DcrImpulseEvent.served_by`): one of `DCR_SERVED_BY_*`.
  */
-typedef uint32_t DcrServedBy;
+typedef uint8_t DcrServedBy;
 
 /**
  * The distant response at one resting contact for the step (object frame).
@@ -783,6 +783,10 @@ typedef struct DcrImpulseEvent {
    */
   double delta_v;
   /**
+   * The resting contact's id (`DcrContactReport.id`).
+   */
+  uint64_t contact;
+  /**
    * The elastic object whose response this is.
    */
   DcrElasticHandle object;
@@ -790,10 +794,6 @@ typedef struct DcrImpulseEvent {
    * Which method computed the response, `DCR_SERVED_BY_*`.
    */
   DcrServedBy served_by;
-  /**
-   * The resting contact's id (`DcrContactReport.id`).
-   */
-  uint64_t contact;
   /**
    * Whether the object's response this step was driven (in part) by chained impacts.
    */

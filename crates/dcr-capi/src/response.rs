@@ -1,6 +1,7 @@
 //! [`DcrResponse`]: one elastic object's per-step distant response (paper §4.2–4.5), object
 //! frame: impacts and resting contacts in, per-contact Δv and peak displacement out.
 
+use std::mem::{align_of, offset_of, size_of};
 use std::sync::Arc;
 
 use dcr_runtime::{
@@ -50,7 +51,7 @@ pub struct DcrRestingContact {
 
 /// What served one contact's response (`DcrContactResponse.served_by`,
 /// `DcrImpulseEvent.served_by`): one of `DCR_SERVED_BY_*`.
-pub type DcrServedBy = u32;
+pub type DcrServedBy = u8;
 /// The truncated modal base (Eq. 9–13).
 pub const DCR_SERVED_BY_MODAL: DcrServedBy = 0;
 /// Spatial attenuation (Eq. 14–16).
@@ -221,6 +222,49 @@ fn contact_response(c: &ContactResponse) -> DcrContactResponse {
     }
 }
 
+/// `DcrImpact` has `Impact`'s layout: impacts pass to the runtime without a copy.
+const IMPACT_ZERO_COPY: bool = size_of::<Impact>() == size_of::<DcrImpact>()
+    && align_of::<Impact>() == align_of::<DcrImpact>()
+    && offset_of!(Impact, point) == offset_of!(DcrImpact, point)
+    && offset_of!(Impact, direction) == offset_of!(DcrImpact, direction)
+    && offset_of!(Impact, impulse) == offset_of!(DcrImpact, impulse);
+
+/// `DcrRestingContact` has `RestingContact`'s layout.
+const RESTING_ZERO_COPY: bool = size_of::<RestingContact>() == size_of::<DcrRestingContact>()
+    && align_of::<RestingContact>() == align_of::<DcrRestingContact>()
+    && offset_of!(RestingContact, id) == offset_of!(DcrRestingContact, id)
+    && offset_of!(RestingContact, point) == offset_of!(DcrRestingContact, point);
+
+/// `ContactResponse` has `DcrContactResponse`'s layout (and `ServedBy`'s discriminants are the
+/// `DCR_SERVED_BY_*` codes): responses are copied out as whole structs, without conversion.
+const RESPONSE_ZERO_COPY: bool = size_of::<ContactResponse>() == size_of::<DcrContactResponse>()
+    && align_of::<ContactResponse>() == align_of::<DcrContactResponse>()
+    && offset_of!(ContactResponse, id) == offset_of!(DcrContactResponse, id)
+    && offset_of!(ContactResponse, point) == offset_of!(DcrContactResponse, point)
+    && offset_of!(ContactResponse, normal) == offset_of!(DcrContactResponse, normal)
+    && offset_of!(ContactResponse, peak_displacement)
+        == offset_of!(DcrContactResponse, peak_displacement)
+    && offset_of!(ContactResponse, delta_v) == offset_of!(DcrContactResponse, delta_v)
+    && offset_of!(ContactResponse, lateral_delta_v)
+        == offset_of!(DcrContactResponse, lateral_delta_v)
+    && offset_of!(ContactResponse, served_by) == offset_of!(DcrContactResponse, served_by)
+    && offset_of!(ContactResponse, mapped) == offset_of!(DcrContactResponse, mapped)
+    && SERVED_BY_CODES;
+
+/// `ServedBy` is one byte holding the `DCR_SERVED_BY_*` code of each method.
+pub(crate) const SERVED_BY_CODES: bool = size_of::<ServedBy>() == size_of::<DcrServedBy>()
+    && ServedBy::Modal as DcrServedBy == DCR_SERVED_BY_MODAL
+    && ServedBy::Attenuation as DcrServedBy == DCR_SERVED_BY_ATTENUATION
+    && ServedBy::TransferTable as DcrServedBy == DCR_SERVED_BY_TRANSFER_TABLE
+    && ServedBy::Unmapped as DcrServedBy == DCR_SERVED_BY_UNMAPPED;
+
+/// Whether the per-step conversions are copies-free: (impacts, resting contacts, responses).
+/// The tests assert all three on the CI toolchain; a `false` is still correct (field-by-field
+/// conversion), only slower.
+pub fn zero_copy_layouts() -> (bool, bool, bool) {
+    (IMPACT_ZERO_COPY, RESTING_ZERO_COPY, RESPONSE_ZERO_COPY)
+}
+
 /// Sets up a response of `model` with `params` (filters, and for attenuation the local
 /// amplitudes and distance solver). On success `*out` receives a new response (free it with
 /// `dcr_response_free`); on failure `*out` is set to NULL.
@@ -345,22 +389,55 @@ pub unsafe extern "C" fn dcr_response_step(
             check_ptr(out, "out")?;
             check_len::<DcrContactResponse>(num_resting, "out")?;
         }
-        r.impacts.clear();
-        r.impacts.extend(impacts.iter().map(|i| Impact {
-            point: i.point,
-            direction: i.direction,
-            impulse: i.impulse,
-        }));
-        r.resting.clear();
-        r.resting.extend(resting.iter().map(|c| RestingContact {
-            id: c.id,
-            point: c.point,
-        }));
-        let results = r.response.step(&r.impacts, &r.resting);
-        for (k, c) in results.iter().enumerate() {
-            // SAFETY: `out` is non-null, aligned and holds out_capacity ≥ num_resting =
-            // results.len() writable elements (checked above).
-            unsafe { out.add(k).write(contact_response(c)) };
+        let DcrResponse {
+            response,
+            impacts: impact_buf,
+            resting: resting_buf,
+        } = r;
+        let impacts: &[Impact] = if IMPACT_ZERO_COPY {
+            // SAFETY: DcrImpact and Impact have the same size, alignment and field offsets,
+            // with fields of the same types (checked at compile time), all valid for any bits.
+            unsafe { std::slice::from_raw_parts(impacts.as_ptr().cast(), impacts.len()) }
+        } else {
+            impact_buf.clear();
+            impact_buf.extend(impacts.iter().map(|i| Impact {
+                point: i.point,
+                direction: i.direction,
+                impulse: i.impulse,
+            }));
+            impact_buf
+        };
+        let resting: &[RestingContact] = if RESTING_ZERO_COPY {
+            // SAFETY: as above, for DcrRestingContact and RestingContact.
+            unsafe { std::slice::from_raw_parts(resting.as_ptr().cast(), resting.len()) }
+        } else {
+            resting_buf.clear();
+            resting_buf.extend(resting.iter().map(|c| RestingContact {
+                id: c.id,
+                point: c.point,
+            }));
+            resting_buf
+        };
+        let results = response.step(impacts, resting);
+        if RESPONSE_ZERO_COPY && !results.is_empty() {
+            // SAFETY: `out` holds out_capacity ≥ num_resting = results.len() > 0 writable
+            // elements (checked non-null and aligned above); ContactResponse has
+            // DcrContactResponse's size, alignment and field offsets, fields of the same
+            // layout, and ServedBy's discriminants are the DCR_SERVED_BY_* codes (checked at
+            // compile time), so the bytes are valid DcrContactResponse values.
+            unsafe {
+                std::ptr::copy_nonoverlapping(
+                    results.as_ptr(),
+                    out.cast::<ContactResponse>(),
+                    results.len(),
+                )
+            };
+        } else {
+            for (k, c) in results.iter().enumerate() {
+                // SAFETY: `out` is non-null, aligned and holds out_capacity ≥ num_resting =
+                // results.len() writable elements (checked above).
+                unsafe { out.add(k).write(contact_response(c)) };
+            }
         }
         Ok(())
     })
@@ -448,4 +525,42 @@ pub unsafe extern "C" fn dcr_response_info(
         // SAFETY: caller contract (NULL is checked).
         unsafe { write_out(out, response_info(&r.response), "out") }
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The whole-struct copy of the fast path and the field conversion of the fallback give the
+    /// same C values, for every method code.
+    #[test]
+    fn copying_a_response_equals_converting_it() {
+        assert!(
+            zero_copy_layouts().2,
+            "the fast path is off on this toolchain"
+        );
+        for (k, served_by) in [
+            ServedBy::Modal,
+            ServedBy::Attenuation,
+            ServedBy::TransferTable,
+            ServedBy::Unmapped,
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            let c = ContactResponse {
+                id: 40 + k as u64,
+                point: [1.0, 2.0, 3.0],
+                normal: [0.0, 0.6, 0.8],
+                peak_displacement: 1e-6 * k as f64,
+                delta_v: 1e-4 * k as f64,
+                mapped: k != 3,
+                lateral_delta_v: [4.0, 5.0, 6.0],
+                served_by,
+            };
+            // SAFETY: same layout (asserted above), as in `dcr_response_step`.
+            let copied = unsafe { std::ptr::read((&c as *const ContactResponse).cast()) };
+            assert_eq!(contact_response(&c), copied);
+        }
+    }
 }

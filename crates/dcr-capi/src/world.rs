@@ -1,6 +1,7 @@
 //! [`DcrWorld`]: the engine-level API (elastic objects by handle, world-frame contact reports
 //! in, impulse events out), over `dcr_runtime::DcrWorld`.
 
+use std::mem::{align_of, offset_of, size_of};
 use std::sync::Arc;
 
 use dcr_runtime::{
@@ -12,7 +13,7 @@ use crate::guard::guard;
 use crate::ptr::{arg_mut, arg_ref, arg_slice, check_ptr, check_struct_size, write_out};
 use crate::response::{
     read_params, response_info, served_by_code, step_info, DcrResponseInfo, DcrServedBy,
-    DcrStepInfo,
+    DcrStepInfo, SERVED_BY_CODES,
 };
 use crate::status::{DcrStatus, Failure};
 use crate::world_params::{DcrElasticHandle, DcrElasticObjectDesc, DcrPose, DcrWorldParams};
@@ -101,14 +102,60 @@ pub struct DcrImpulseEvent {
     pub normal: [f64; 3],
     /// Velocity change the impulse gives the body at `point` along `normal` (m/s).
     pub delta_v: f64,
+    /// The resting contact's id (`DcrContactReport.id`).
+    pub contact: u64,
     /// The elastic object whose response this is.
     pub object: DcrElasticHandle,
     /// Which method computed the response, `DCR_SERVED_BY_*`.
     pub served_by: DcrServedBy,
-    /// The resting contact's id (`DcrContactReport.id`).
-    pub contact: u64,
     /// Whether the object's response this step was driven (in part) by chained impacts.
     pub chained: bool,
+}
+
+/// `DcrContactReport` has `ContactReport`'s layout: reports pass without a copy.
+const REPORT_ZERO_COPY: bool = size_of::<ContactReport>() == size_of::<DcrContactReport>()
+    && align_of::<ContactReport>() == align_of::<DcrContactReport>()
+    && offset_of!(ContactReport, id) == offset_of!(DcrContactReport, id)
+    && offset_of!(ContactReport, body1) == offset_of!(DcrContactReport, body1)
+    && offset_of!(ContactReport, body2) == offset_of!(DcrContactReport, body2)
+    && offset_of!(ContactReport, point1) == offset_of!(DcrContactReport, point1)
+    && offset_of!(ContactReport, point2) == offset_of!(DcrContactReport, point2)
+    && offset_of!(ContactReport, normal) == offset_of!(DcrContactReport, normal)
+    && offset_of!(ContactReport, impulse) == offset_of!(DcrContactReport, impulse)
+    && offset_of!(ContactReport, is_new) == offset_of!(DcrContactReport, is_new);
+
+/// `DcrBodyState` has `BodyState`'s layout.
+const BODY_ZERO_COPY: bool = size_of::<BodyState>() == size_of::<DcrBodyState>()
+    && align_of::<BodyState>() == align_of::<DcrBodyState>()
+    && offset_of!(BodyState, id) == offset_of!(DcrBodyState, id)
+    && offset_of!(BodyState, inv_mass) == offset_of!(DcrBodyState, inv_mass)
+    && offset_of!(BodyState, inv_inertia) == offset_of!(DcrBodyState, inv_inertia)
+    && offset_of!(BodyState, center_of_mass) == offset_of!(DcrBodyState, center_of_mass)
+    && offset_of!(BodyState, linvel) == offset_of!(DcrBodyState, linvel)
+    && offset_of!(BodyState, angvel) == offset_of!(DcrBodyState, angvel);
+
+/// `ImpulseEvent` has `DcrImpulseEvent`'s layout (the handle is its `u32` index, `ServedBy`'s
+/// discriminants are the `DCR_SERVED_BY_*` codes): `dcr_world_step` lends the runtime's own
+/// event buffer.
+const EVENT_ZERO_COPY: bool = size_of::<ImpulseEvent>() == size_of::<DcrImpulseEvent>()
+    && align_of::<ImpulseEvent>() == align_of::<DcrImpulseEvent>()
+    && offset_of!(ImpulseEvent, body) == offset_of!(DcrImpulseEvent, body)
+    && offset_of!(ImpulseEvent, point) == offset_of!(DcrImpulseEvent, point)
+    && offset_of!(ImpulseEvent, impulse) == offset_of!(DcrImpulseEvent, impulse)
+    && offset_of!(ImpulseEvent, normal) == offset_of!(DcrImpulseEvent, normal)
+    && offset_of!(ImpulseEvent, delta_v) == offset_of!(DcrImpulseEvent, delta_v)
+    && offset_of!(ImpulseEvent, contact) == offset_of!(DcrImpulseEvent, contact)
+    && offset_of!(ImpulseEvent, object) == offset_of!(DcrImpulseEvent, object)
+    && offset_of!(ImpulseEvent, served_by) == offset_of!(DcrImpulseEvent, served_by)
+    && offset_of!(ImpulseEvent, chained) == offset_of!(DcrImpulseEvent, chained)
+    // A 4-byte handle holding one u32 (its index) has that u32 at offset 0.
+    && size_of::<ElasticHandle>() == size_of::<DcrElasticHandle>()
+    && SERVED_BY_CODES;
+
+/// Whether the world's per-step structs convert without copies: (contact reports, body
+/// states, impulse events). See `zero_copy_layouts`.
+pub fn world_zero_copy_layouts() -> (bool, bool, bool) {
+    (REPORT_ZERO_COPY, BODY_ZERO_COPY, EVENT_ZERO_COPY)
 }
 
 fn event(e: &ImpulseEvent) -> DcrImpulseEvent {
@@ -118,9 +165,9 @@ fn event(e: &ImpulseEvent) -> DcrImpulseEvent {
         impulse: e.impulse,
         normal: e.normal,
         delta_v: e.delta_v,
+        contact: e.contact,
         object: e.object.index(),
         served_by: served_by_code(e.served_by),
-        contact: e.contact,
         chained: e.chained,
     }
 }
@@ -439,29 +486,51 @@ pub unsafe extern "C" fn dcr_world_step(
         let contacts = unsafe { arg_slice(contacts, num_contacts, "contacts")? };
         // SAFETY: as above.
         let bodies = unsafe { arg_slice(bodies, num_bodies, "bodies")? };
-        w.contacts.clear();
-        w.contacts.extend(contacts.iter().map(|c| ContactReport {
-            id: c.id,
-            body1: c.body1,
-            body2: c.body2,
-            point1: c.point1,
-            point2: c.point2,
-            normal: c.normal,
-            impulse: c.impulse,
-            is_new: c.is_new,
-        }));
-        w.bodies.clear();
-        w.bodies.extend(bodies.iter().map(|b| BodyState {
-            id: b.id,
-            inv_mass: b.inv_mass,
-            inv_inertia: b.inv_inertia,
-            center_of_mass: b.center_of_mass,
-            linvel: b.linvel,
-            angvel: b.angvel,
-        }));
-        let out = w.world.step(&w.contacts, &w.bodies);
-        w.events.clear();
-        w.events.extend(out.iter().map(event));
+        let DcrWorld {
+            world: rw,
+            contacts: contact_buf,
+            bodies: body_buf,
+            events: event_buf,
+        } = w;
+        let contacts: &[ContactReport] = if REPORT_ZERO_COPY {
+            // SAFETY: DcrContactReport and ContactReport have the same size, alignment and
+            // field offsets with fields of the same types (checked at compile time); the C
+            // `bool` holds 0 or 1 as Rust's does.
+            unsafe { std::slice::from_raw_parts(contacts.as_ptr().cast(), contacts.len()) }
+        } else {
+            contact_buf.clear();
+            contact_buf.extend(contacts.iter().map(|c| ContactReport {
+                id: c.id,
+                body1: c.body1,
+                body2: c.body2,
+                point1: c.point1,
+                point2: c.point2,
+                normal: c.normal,
+                impulse: c.impulse,
+                is_new: c.is_new,
+            }));
+            contact_buf
+        };
+        let bodies: &[BodyState] = if BODY_ZERO_COPY {
+            // SAFETY: as above, for DcrBodyState and BodyState (all fields f64 / u64).
+            unsafe { std::slice::from_raw_parts(bodies.as_ptr().cast(), bodies.len()) }
+        } else {
+            body_buf.clear();
+            body_buf.extend(bodies.iter().map(|b| BodyState {
+                id: b.id,
+                inv_mass: b.inv_mass,
+                inv_inertia: b.inv_inertia,
+                center_of_mass: b.center_of_mass,
+                linvel: b.linvel,
+                angvel: b.angvel,
+            }));
+            body_buf
+        };
+        let out = rw.step(contacts, bodies);
+        if !EVENT_ZERO_COPY {
+            event_buf.clear();
+            event_buf.extend(out.iter().map(event));
+        }
         publish(w, events, num_events);
         Ok(())
     })
@@ -469,16 +538,20 @@ pub unsafe extern "C" fn dcr_world_step(
 
 /// Writes the world's event array to the caller's out-parameters (checked non-null before).
 fn publish(w: &DcrWorld, events: *mut *const DcrImpulseEvent, num_events: *mut usize) {
-    let p = if w.events.is_empty() {
-        std::ptr::null()
+    let (p, n): (*const DcrImpulseEvent, usize) = if EVENT_ZERO_COPY {
+        // The runtime's own buffer, valid until its next step: ImpulseEvent has
+        // DcrImpulseEvent's layout (checked at compile time).
+        let e = w.world.events();
+        (e.as_ptr().cast(), e.len())
     } else {
-        w.events.as_ptr()
+        (w.events.as_ptr(), w.events.len())
     };
+    let p = if n == 0 { std::ptr::null() } else { p };
     // SAFETY: both pointers were checked non-null and aligned by the caller of `publish`
     // (write_out), and are valid for writes per the C caller's contract.
     unsafe {
         events.write(p);
-        num_events.write(w.events.len());
+        num_events.write(n);
     }
 }
 
@@ -659,4 +732,39 @@ pub unsafe extern "C" fn dcr_world_object_of_body(
         // SAFETY: caller contract (NULL is checked).
         unsafe { write_out(out, h.index(), "out") }
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use dcr_runtime::ServedBy;
+
+    /// Lending the runtime's event and reading it as a `DcrImpulseEvent` gives the values the
+    /// field conversion gives.
+    #[test]
+    fn lending_an_event_equals_converting_it() {
+        assert!(
+            world_zero_copy_layouts().2,
+            "the fast path is off on this toolchain"
+        );
+        for (k, served_by) in [ServedBy::Modal, ServedBy::TransferTable]
+            .into_iter()
+            .enumerate()
+        {
+            let e = ImpulseEvent {
+                body: 7,
+                point: [1.0, 2.0, 3.0],
+                impulse: [0.1, 0.2, 0.3],
+                normal: [0.0, 0.0, 1.0],
+                delta_v: 0.5,
+                object: ElasticHandle::from_index(3 + k as u32),
+                served_by,
+                contact: 99,
+                chained: k == 1,
+            };
+            // SAFETY: same layout (asserted above), as in `publish`.
+            let lent = unsafe { std::ptr::read((&e as *const ImpulseEvent).cast()) };
+            assert_eq!(event(&e), lent);
+        }
+    }
 }

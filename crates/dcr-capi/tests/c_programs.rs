@@ -225,7 +225,7 @@ struct Event {
     normal: [f64; 3],
     delta_v: f64,
     object: u32,
-    served_by: u32,
+    served_by: u8,
     contact: u64,
     chained: bool,
 }
@@ -358,7 +358,7 @@ fn world_c_events_equal_the_rust_world() {
     }
 }
 
-fn served(s: dcr_runtime::ServedBy) -> u32 {
+fn served(s: dcr_runtime::ServedBy) -> u8 {
     match s {
         dcr_runtime::ServedBy::Modal => dcr_capi::DCR_SERVED_BY_MODAL,
         dcr_runtime::ServedBy::Attenuation => dcr_capi::DCR_SERVED_BY_ATTENUATION,

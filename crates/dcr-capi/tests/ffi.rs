@@ -355,3 +355,20 @@ fn version_matches_the_crate() {
     let s = unsafe { CStr::from_ptr(dcr_version_string()) };
     assert_eq!(s.to_str().unwrap(), env!("CARGO_PKG_VERSION"));
 }
+
+/// On this toolchain the per-step C structs share the runtime types' layouts, so
+/// `dcr_response_step` passes impacts and resting contacts without a copy and returns the
+/// responses as whole-struct copies (the C call then costs what the Rust call costs; see
+/// docs/benchmarks.md). A failure here is a slowdown, not a wrong result: reorder the C
+/// struct's fields to the runtime type's declared order.
+#[test]
+fn per_step_structs_share_the_runtime_layout() {
+    assert_eq!(zero_copy_layouts(), (true, true, true));
+}
+
+/// The same for the world's per-step structs: contact reports and body states pass without a
+/// copy, and `dcr_world_step` lends the runtime's own event buffer.
+#[test]
+fn world_step_structs_share_the_runtime_layout() {
+    assert_eq!(world_zero_copy_layouts(), (true, true, true));
+}
