@@ -161,11 +161,16 @@ pub fn assert_clean(o: &Output, what: &str) {
     );
 }
 
-/// The `modal-bake` binary of this workspace, built (once per test binary) with the test's
-/// profile by a nested `cargo build`.
+/// The `modal-bake` binary of this workspace: `target/<profile>/modal-bake` when it is newer
+/// than every source it is built from (as after `cargo test --workspace`, which builds it for
+/// modal-bake's own tests), else built (once per test binary) by a nested `cargo build`.
 pub fn modal_bake() -> PathBuf {
     static BIN: OnceLock<PathBuf> = OnceLock::new();
     BIN.get_or_init(|| {
+        let bin = profile_dir().join("modal-bake");
+        if is_fresh(&bin) {
+            return bin;
+        }
         let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
         let mut cmd = Command::new(cargo);
         cmd.current_dir(workspace()).args([
@@ -180,11 +185,42 @@ pub fn modal_bake() -> PathBuf {
             cmd.arg("--release");
         }
         run_ok(&mut cmd);
-        let bin = profile_dir().join("modal-bake");
         assert!(bin.is_file(), "{} is missing", bin.display());
         bin
     })
     .clone()
+}
+
+/// Whether `bin` exists and is newer than modal-bake's and dcr-runtime's sources, manifests
+/// and the lock file.
+fn is_fresh(bin: &Path) -> bool {
+    fn newest(p: &Path, t: &mut std::time::SystemTime) {
+        let Ok(meta) = std::fs::metadata(p) else {
+            return;
+        };
+        if meta.is_dir() {
+            for e in std::fs::read_dir(p).into_iter().flatten().flatten() {
+                newest(&e.path(), t);
+            }
+        } else if let Ok(m) = meta.modified() {
+            *t = (*t).max(m);
+        }
+    }
+    let Ok(built) = std::fs::metadata(bin).and_then(|m| m.modified()) else {
+        return false;
+    };
+    let mut t = std::time::SystemTime::UNIX_EPOCH;
+    let w = workspace();
+    for p in [
+        "crates/modal-bake/src",
+        "crates/modal-bake/Cargo.toml",
+        "crates/dcr-runtime/src",
+        "crates/dcr-runtime/Cargo.toml",
+        "Cargo.lock",
+    ] {
+        newest(&w.join(p), &mut t);
+    }
+    built > t
 }
 
 /// A small free-free base baked from `data/meshes/cube_v41.msh` (unit cube, 8 modes) into
