@@ -112,3 +112,48 @@ pub(crate) fn check_struct_size<T>(found: u32, name: &str, type_name: &str) -> R
     }
     Ok(())
 }
+
+/// Checks that the `bool` fields at byte offsets `fields` of the caller's struct at `p` hold 0
+/// or 1, reading raw bytes before any reference to the struct exists. A C or C++ `bool` always
+/// does, unless its memory was never initialised; Rust may not read another value as `bool`.
+///
+/// # Safety
+/// `p` must be non-null, aligned and point to a readable `T` (each offset inside it).
+pub(crate) unsafe fn check_bools<T>(
+    p: *const T,
+    fields: &[(usize, &str)],
+    name: &str,
+) -> Result<(), Failure> {
+    for &(offset, field) in fields {
+        debug_assert!(offset < size_of::<T>());
+        // SAFETY: `offset` lies inside the readable `T` at `p` (caller contract); a byte read
+        // has no alignment or validity requirement.
+        let b = unsafe { p.cast::<u8>().add(offset).read() };
+        if b > 1 {
+            return Err(Failure::invalid(format!(
+                "`{name}.{field}` holds {b}, not a bool (0 or 1): initialise every field (the \
+                 `*_default` functions do)"
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// [`check_bools`] over each of the `n` elements of the caller's array at `p`.
+///
+/// # Safety
+/// When `n` > 0, `p` must be non-null, aligned and point to `n` readable `T`.
+pub(crate) unsafe fn check_bools_in_array<T>(
+    p: *const T,
+    n: usize,
+    fields: &[(usize, &str)],
+    name: &str,
+) -> Result<(), Failure> {
+    for i in 0..n {
+        // SAFETY: element i of the caller's array (caller contract).
+        let e = unsafe { p.add(i) };
+        // SAFETY: as above.
+        unsafe { check_bools(e, fields, &format!("{name}[{i}]"))? };
+    }
+    Ok(())
+}

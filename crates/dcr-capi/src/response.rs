@@ -316,8 +316,23 @@ pub(crate) unsafe fn read_params(
     // struct, so reading a u32 there never reads past a caller's struct of another layout.
     let size = unsafe { p.cast::<u32>().read() };
     crate::ptr::check_struct_size::<DcrResponseParams>(size, name, "DcrResponseParams")?;
-    // SAFETY: the caller's struct has this library's size; its validity is the caller's
-    // contract, and `runtime_params` reads `amplitude_vertices` under the documented contract.
+    let bools = [
+        (
+            offset_of!(DcrResponseParams, override_rayleigh),
+            "override_rayleigh",
+        ),
+        (offset_of!(DcrResponseParams, carry_over), "carry_over"),
+        (offset_of!(DcrResponseParams, lateral_kick), "lateral_kick"),
+        (
+            offset_of!(DcrResponseParams, attenuation)
+                + offset_of!(crate::DcrAttenuationParams, parallel_heat),
+            "attenuation.parallel_heat",
+        ),
+    ];
+    // SAFETY: the caller's struct has this library's size, so every offset is inside it.
+    unsafe { crate::ptr::check_bools(p, &bools, name)? };
+    // SAFETY: the caller's struct has this library's size and valid bools; the rest is plain
+    // data, and `runtime_params` reads `amplitude_vertices` under the documented contract.
     unsafe { (*p).runtime_params(name) }
 }
 

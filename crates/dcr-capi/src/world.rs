@@ -10,7 +10,10 @@ use dcr_runtime::{
 };
 
 use crate::guard::guard;
-use crate::ptr::{arg_mut, arg_ref, arg_slice, check_ptr, check_struct_size, write_out};
+use crate::ptr::{
+    arg_mut, arg_ref, arg_slice, check_bools, check_bools_in_array, check_ptr, check_struct_size,
+    write_out,
+};
 use crate::response::{
     read_params, response_info, served_by_code, step_info, DcrResponseInfo, DcrServedBy,
     DcrStepInfo, SERVED_BY_CODES,
@@ -321,7 +324,17 @@ pub unsafe extern "C" fn dcr_world_create(
         // SAFETY: non-null, aligned; `struct_size` is at offset 0 of the repr(C) struct.
         let size = unsafe { params.cast::<u32>().read() };
         check_struct_size::<DcrWorldParams>(size, "params", "DcrWorldParams")?;
-        // SAFETY: the caller's struct has this library's size; validity is its contract.
+        let bools = [
+            (offset_of!(DcrWorldParams, energy_bound), "energy_bound"),
+            (
+                offset_of!(DcrWorldParams, classify)
+                    + offset_of!(crate::DcrClassifyParams, engine_newness),
+                "classify.engine_newness",
+            ),
+        ];
+        // SAFETY: the caller's struct has this library's size, so every offset is inside it.
+        unsafe { check_bools(params, &bools, "params")? };
+        // SAFETY: this library's size, valid bools, the rest plain data.
         let p = unsafe { (*params).runtime_params("params")? };
         let world = RtWorld::new(p).map_err(|e| Failure::invalid(e.to_string()))?;
         let handle = Box::into_raw(Box::new(DcrWorld {
@@ -380,12 +393,18 @@ pub unsafe extern "C" fn dcr_world_add_object(
         // SAFETY: non-null, aligned; `struct_size` is at offset 0 of the repr(C) struct.
         let size = unsafe { desc.cast::<u32>().read() };
         check_struct_size::<DcrElasticObjectDesc>(size, "desc", "DcrElasticObjectDesc")?;
-        // SAFETY: the caller's struct has this library's size; validity is its contract.
+        let bools = [(offset_of!(DcrElasticObjectDesc, dynamic), "dynamic")];
+        // SAFETY: the caller's struct has this library's size, so the offset is inside it.
+        unsafe { check_bools(desc, &bools, "desc")? };
+        // SAFETY: a field pointer inside the caller's struct (no reference is created);
+        // `read_params` checks its size and bools before reading it.
+        let response =
+            unsafe { read_params(std::ptr::addr_of!((*desc).response), "desc.response")? };
+        // SAFETY: this library's size, valid bools (checked above and by read_params), the
+        // rest plain data.
         let d = unsafe { &*desc };
         // SAFETY: `desc->model` is NULL or a live handle (caller contract; NULL is checked).
         let model = unsafe { &arg_ref(d.model, "desc.model")?.model };
-        // SAFETY: `d.response` lives inside the caller's struct, valid as above.
-        let response = unsafe { read_params(&d.response, "desc.response")? };
         let mut rd = ElasticObjectDesc::new(Arc::clone(model), d.body);
         rd.response = response;
         rd.dynamic = d.dynamic;
@@ -482,7 +501,15 @@ pub unsafe extern "C" fn dcr_world_step(
         unsafe { write_out(num_events, 0, "num_events")? };
         // SAFETY: caller contract (NULL is checked).
         let w = unsafe { arg_mut(world, "world")? };
-        // SAFETY: caller contract (counts, NULL and alignment checked).
+        if num_contacts > 0 {
+            check_ptr(contacts, "contacts")?;
+            crate::ptr::check_len::<DcrContactReport>(num_contacts, "contacts")?;
+            let bools = [(offset_of!(DcrContactReport, is_new), "is_new")];
+            // SAFETY: `num_contacts` readable reports (caller contract; NULL, alignment and
+            // size checked); only raw bytes are read.
+            unsafe { check_bools_in_array(contacts, num_contacts, &bools, "contacts")? };
+        }
+        // SAFETY: caller contract (counts, NULL and alignment checked; bools valid).
         let contacts = unsafe { arg_slice(contacts, num_contacts, "contacts")? };
         // SAFETY: as above.
         let bodies = unsafe { arg_slice(bodies, num_bodies, "bodies")? };

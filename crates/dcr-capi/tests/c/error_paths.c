@@ -11,6 +11,7 @@
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <stddef.h>
 #include <string.h>
 
 #include "dcr.h"
@@ -147,6 +148,10 @@ int main(int argc, char **argv) {
     bad.method = DCR_METHOD_ATTENUATION;
     bad.attenuation.amplitude = DCR_AMPLITUDE_MEAN_OVER; /* with no vertices */
     CHECK(dcr_response_create(model, &bad, &resp) == DCR_STATUS_INVALID_ARGUMENT);
+    bad = p;
+    memset(&bad.carry_over, 5, 1); /* uninitialised memory: not a bool */
+    CHECK(dcr_response_create(model, &bad, &resp) == DCR_STATUS_INVALID_ARGUMENT);
+    CHECK(last_error_has("params.carry_over") && last_error_has("holds 5"));
     CHECK(dcr_response_create(NULL, &p, &resp) == DCR_STATUS_NULL_POINTER);
     CHECK(dcr_response_create(model, NULL, &resp) == DCR_STATUS_NULL_POINTER);
 
@@ -242,6 +247,11 @@ int main(int argc, char **argv) {
     CHECK(events == NULL && ne == 0);
     CHECK(dcr_world_step(world, NULL, 0, NULL, 0, NULL, &ne) == DCR_STATUS_NULL_POINTER);
     CHECK(dcr_world_step(world, NULL, 0, NULL, 0, &events, &ne) == DCR_STATUS_OK && ne == 0);
+    DcrContactReport reports[2];
+    memset(reports, 0, sizeof reports);
+    memset((unsigned char *)&reports[1] + offsetof(DcrContactReport, is_new), 9, 1);
+    CHECK(dcr_world_step(world, reports, 2, NULL, 0, &events, &ne) == DCR_STATUS_INVALID_ARGUMENT);
+    CHECK(last_error_has("contacts[1].is_new") && last_error_has("holds 9"));
     CHECK(dcr_world_events(world, &events, &ne) == DCR_STATUS_OK && events == NULL && ne == 0);
     DcrWorldStepInfo wi;
     CHECK(dcr_world_step_info(world, &wi) == DCR_STATUS_OK && wi.step == 0);
