@@ -75,6 +75,33 @@ fn c_resting(v: &[RestingContact]) -> Vec<DcrRestingContact> {
         .collect()
 }
 
+/// `dcr_response_step` over slices, offering the first `capacity` entries of `out`: (status,
+/// required count). `r` must be a live handle.
+fn step(
+    r: *mut DcrResponse,
+    impacts: &[DcrImpact],
+    resting: &[DcrRestingContact],
+    out: &mut [DcrContactResponse],
+    capacity: usize,
+) -> (DcrStatus, usize) {
+    assert!(capacity <= out.len());
+    let mut n = 0;
+    // SAFETY: slices with their lengths; `r` is live (caller contract).
+    let st = unsafe {
+        dcr_response_step(
+            r,
+            impacts.as_ptr(),
+            impacts.len(),
+            resting.as_ptr(),
+            resting.len(),
+            out.as_mut_ptr(),
+            capacity,
+            &mut n,
+        )
+    };
+    (st, n)
+}
+
 /// For each method, `dcr_response_step` returns exactly (bit for bit) what
 /// `DistantResponse::step` returns on the same base, parameters and inputs, over steps with
 /// zero, one and two impacts and carried-over filter state.
@@ -116,21 +143,8 @@ fn c_response_step_equals_the_rust_step_bit_for_bit() {
         let cres = c_resting(&resting);
         let mut out = vec![DcrContactResponse::default(); resting.len()];
         for (s, imp) in impacts.iter().enumerate() {
-            let ci = c_impacts(imp);
-            let mut n = 0;
-            // SAFETY: arrays with the counts given; live handle.
-            let st = unsafe {
-                dcr_response_step(
-                    cr,
-                    ci.as_ptr(),
-                    ci.len(),
-                    cres.as_ptr(),
-                    cres.len(),
-                    out.as_mut_ptr(),
-                    out.len(),
-                    &mut n,
-                )
-            };
+            let cap = out.len();
+            let (st, n) = step(cr, &c_impacts(imp), &cres, &mut out, cap);
             assert_eq!(st, DcrStatus::Ok, "{}", last_error());
             assert_eq!(n, resting.len());
             let want = rust.step(imp, &resting);
@@ -197,34 +211,14 @@ fn a_too_small_buffer_changes_no_state() {
     let mut out_b = out_a.clone();
     for imp in &impacts {
         let ci = c_impacts(imp);
-        let (mut na, mut nb) = (0, 0);
-        // SAFETY: arrays with the counts given (capacity 3 < resting.len()); live handles.
-        unsafe {
-            let st = dcr_response_step(
-                a,
-                ci.as_ptr(),
-                ci.len(),
-                cres.as_ptr(),
-                cres.len(),
-                out_a.as_mut_ptr(),
-                3,
-                &mut na,
-            );
-            assert_eq!(st, DcrStatus::BufferTooSmall);
-            assert_eq!(na, resting.len());
-            for (r, o) in [(a, &mut out_a), (b, &mut out_b)] {
-                let st = dcr_response_step(
-                    r,
-                    ci.as_ptr(),
-                    ci.len(),
-                    cres.as_ptr(),
-                    cres.len(),
-                    o.as_mut_ptr(),
-                    o.len(),
-                    &mut nb,
-                );
-                assert_eq!(st, DcrStatus::Ok);
-            }
+        // Capacity 3 < resting.len(): refused, nothing runs.
+        assert_eq!(
+            step(a, &ci, &cres, &mut out_a, 3),
+            (DcrStatus::BufferTooSmall, resting.len())
+        );
+        for (r, o) in [(a, &mut out_a), (b, &mut out_b)] {
+            let cap = o.len();
+            assert_eq!(step(r, &ci, &cres, o, cap).0, DcrStatus::Ok);
         }
         assert_eq!(out_a, out_b);
     }
@@ -308,19 +302,11 @@ fn one_model_serves_several_threads() {
             let cres = c_resting(&resting);
             let mut out = vec![DcrContactResponse::default(); cres.len()];
             for imp in &impacts {
-                let ci = c_impacts(imp);
-                let mut n = 0;
-                let st = dcr_response_step(
-                    r,
-                    ci.as_ptr(),
-                    ci.len(),
-                    cres.as_ptr(),
-                    cres.len(),
-                    out.as_mut_ptr(),
-                    out.len(),
-                    &mut n,
+                let cap = out.len();
+                assert_eq!(
+                    step(r, &c_impacts(imp), &cres, &mut out, cap).0,
+                    DcrStatus::Ok
                 );
-                assert_eq!(st, DcrStatus::Ok);
                 all.extend(out.iter().map(|c| c.delta_v.to_bits()));
             }
             dcr_response_free(r);
