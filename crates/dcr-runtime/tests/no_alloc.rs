@@ -159,6 +159,10 @@ fn steps_do_not_allocate_with(model: &Arc<ModalModel>, seed: u64, parallel: bool
                     heat(64, false),
                     heat(0, false),
                     euclid.clone(),
+                    Method::Attenuation(AttenuationParams {
+                        distance: DistanceKind::HeatTable,
+                        ..Default::default()
+                    }),
                 ]
             };
             for method in methods {

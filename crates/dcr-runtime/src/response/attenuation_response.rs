@@ -4,13 +4,15 @@
 //! (the §4.3 peak procedure for a unit normal impulse at the impacted point, seen at that point)
 //! and λ_N the impulse's normal component; each resting contact p gets
 //! `Δv_p = Σ_c s(r_cp) Δx_c / h` with the attenuation law s (Eq. 14 or the §4.5 simplification)
-//! of the impact–contact distance r (heat-method geodesic, Crane et al. 2013, or Euclidean).
+//! of the impact–contact distance r (heat-method geodesic, Crane et al. 2013: per-contact fields
+//! cached, or read from an all-pairs vertex table; or Euclidean).
 
 use super::impulse_table::ImpulseTable;
 use super::step_ctx::{mapped_response, unmapped_response, StepCtx};
 use super::{ForceInput, Impact, ParamsError, RestingContact, ServedBy};
 use crate::attenuation::{
-    AmplitudeKind, AttenuationLaw, AttenuationParams, DistanceCache, DistanceKind, HeatWorkspace,
+    AmplitudeKind, AttenuationLaw, AttenuationParams, DistanceCache, DistanceKind, GeodesicTable,
+    HeatWorkspace,
 };
 use crate::math::{dot, norm, normalize, sub};
 use crate::model::{ModalModel, SurfacePoint};
@@ -110,6 +112,24 @@ impl AttenuationResponse {
                 let mut ws = heat.workspace();
                 ws.set_parallel(a.parallel_heat);
                 Some(ws)
+            }
+            DistanceKind::HeatTable => {
+                let ns = model.num_vertices();
+                if ns > GeodesicTable::MAX_VERTICES {
+                    return Err(invalid(
+                        "distance",
+                        format!(
+                            "HeatTable over {ns} surface vertices would take {:.0} MiB (ns² × 4 \
+                             bytes); the limit is {} vertices: use DistanceKind::Heat",
+                            (ns * ns * 4) as f64 / (1 << 20) as f64,
+                            GeodesicTable::MAX_VERTICES
+                        ),
+                    ));
+                }
+                model
+                    .geodesic_table()
+                    .map_err(|e| ParamsError::Geodesic(e.to_string()))?;
+                None
             }
             DistanceKind::Euclidean => None,
         };
@@ -214,6 +234,14 @@ impl AttenuationResponse {
                     DistanceKind::Euclidean => {
                         for (hp, dx) in &hits {
                             total += law.factor(norm(sub(hp.point, sp.point))) * dx;
+                        }
+                    }
+                    DistanceKind::HeatTable => {
+                        let table = model.geodesic_table().expect("built at set-up");
+                        let tri = model.triangle(sp.triangle);
+                        for (hp, dx) in &hits {
+                            let r = table.distance(&sp, tri, hp, model.triangle(hp.triangle));
+                            total += law.factor(r) * dx;
                         }
                     }
                     DistanceKind::Heat if budget == 0 && !self.fields.contains(s) => {

@@ -198,10 +198,14 @@ pub struct DcrWorld {
     order: Vec<u32>,
     /// Position of each object in `order`.
     rank: Vec<u32>,
+    /// Engine body id of each object (index = object), scanned when there are few objects.
+    object_bodies: Vec<u64>,
     by_body: HashMap<u64, u32, BuildIdHasher>,
     ages: HashMap<u64, ContactAge, BuildIdHasher>,
     /// This step's `bodies` index by id.
     body_index: HashMap<u64, u32, BuildIdHasher>,
+    /// The ids `body_index` was built for, in order (rebuilt only when they change).
+    body_ids: Vec<u64>,
     tracked: Vec<Tracked>,
     touched: Vec<Touched>,
     events: Vec<ImpulseEvent>,
@@ -243,9 +247,11 @@ impl DcrWorld {
             objects: Vec::new(),
             order: Vec::new(),
             rank: Vec::new(),
+            object_bodies: Vec::new(),
             by_body: HashMap::default(),
             ages: HashMap::default(),
             body_index: HashMap::default(),
+            body_ids: Vec::new(),
             tracked: Vec::new(),
             touched: Vec::new(),
             events: Vec::new(),
@@ -302,6 +308,7 @@ impl DcrWorld {
             info: ObjectStepInfo::default(),
         });
         self.by_body.insert(desc.body, idx);
+        self.object_bodies.push(desc.body);
         self.order = (0..self.objects.len() as u32)
             .filter(|&o| !self.objects[o as usize].dynamic)
             .chain((0..self.objects.len() as u32).filter(|&o| self.objects[o as usize].dynamic))
@@ -413,9 +420,16 @@ impl DcrWorld {
             ..Default::default()
         };
         self.events.clear();
-        self.body_index.clear();
-        for (i, b) in bodies.iter().enumerate() {
-            self.body_index.insert(b.id, i as u32);
+        // The body list usually repeats step after step: rebuild the index only on change.
+        if self.body_ids.len() != bodies.len()
+            || self.body_ids.iter().zip(bodies).any(|(&id, b)| id != b.id)
+        {
+            self.body_index.clear();
+            self.body_ids.clear();
+            for (i, b) in bodies.iter().enumerate() {
+                self.body_index.insert(b.id, i as u32);
+                self.body_ids.push(b.id);
+            }
         }
         self.tracked.clear();
         self.tracked.resize(
@@ -470,10 +484,7 @@ impl DcrWorld {
         let step = self.step - 1;
         let cp = self.params.classify;
         for c in contacts {
-            let objs = [
-                self.by_body.get(&c.body1).copied(),
-                self.by_body.get(&c.body2).copied(),
-            ];
+            let objs = [self.object_at(c.body1), self.object_at(c.body2)];
             if objs == [None, None] || c.body1 == c.body2 {
                 continue;
             }
@@ -684,7 +695,7 @@ impl DcrWorld {
             let e_b = s * ea + s * s * eb;
             injected += e_b;
             // Energy given to a dynamic elastic object's body: its chain budget.
-            if let Some(&target) = self.by_body.get(&b.id) {
+            if let Some(target) = self.object_at(b.id) {
                 if self.forward(o, target as usize, depth) {
                     self.objects[target as usize].info.energy.received += e_b.max(0.0);
                 }
@@ -694,7 +705,7 @@ impl DcrWorld {
         // Chains: impulses on dynamic elastic objects later in the order become impacts.
         self.handed.clear();
         for e in &self.events[first_event..] {
-            let Some(&target) = self.by_body.get(&e.body) else {
+            let Some(target) = self.object_at(e.body) else {
                 continue;
             };
             let mag = norm(e.impulse);
@@ -722,6 +733,19 @@ impl DcrWorld {
             t.depth = t.depth.max(d);
             t.info.chained_impacts += 1;
             self.info.chained_impacts += 1;
+        }
+    }
+
+    /// The object on engine body `body` (a scan of a few ids, else the hash table).
+    #[inline]
+    fn object_at(&self, body: u64) -> Option<u32> {
+        if self.object_bodies.len() <= 8 {
+            self.object_bodies
+                .iter()
+                .position(|&b| b == body)
+                .map(|o| o as u32)
+        } else {
+            self.by_body.get(&body).copied()
         }
     }
 
