@@ -1078,6 +1078,13 @@ typedef struct DcrObjectStepInfo {
 #define DCR_DISTANCE_EUCLIDEAN 1
 
 /**
+ * Heat-method geodesic distances between all surface vertices, computed once per model at
+ * set-up (4 bytes per vertex pair, shared by the model's instances) and read bilinearly per
+ * step: no solve per step. For surfaces up to the runtime's table size limit.
+ */
+#define DCR_DISTANCE_HEAT_TABLE 2
+
+/**
  * The impacted vertices' own amplitudes, interpolated at the impact (Eq. 15; default).
  */
 #define DCR_AMPLITUDE_PER_VERTEX 0

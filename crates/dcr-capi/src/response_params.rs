@@ -62,6 +62,10 @@ pub type DcrDistanceKind = u32;
 pub const DCR_DISTANCE_HEAT: DcrDistanceKind = 0;
 /// Straight-line distance between the mapped surface points (m).
 pub const DCR_DISTANCE_EUCLIDEAN: DcrDistanceKind = 1;
+/// Heat-method geodesic distances between all surface vertices, computed once per model at
+/// set-up (4 bytes per vertex pair, shared by the model's instances) and read bilinearly per
+/// step: no solve per step. For surfaces up to the runtime's table size limit.
+pub const DCR_DISTANCE_HEAT_TABLE: DcrDistanceKind = 2;
 
 /// Where the local amplitude comes from (`DcrAttenuationParams.amplitude`).
 pub type DcrAmplitudeKind = u32;
@@ -246,6 +250,7 @@ impl DcrResponseParams {
                 let distance = match a.distance {
                     DCR_DISTANCE_HEAT => DistanceKind::Heat,
                     DCR_DISTANCE_EUCLIDEAN => DistanceKind::Euclidean,
+                    DCR_DISTANCE_HEAT_TABLE => DistanceKind::HeatTable,
                     c => return Err(bad("attenuation.distance", c)),
                 };
                 let amplitude = match a.amplitude {

@@ -11,7 +11,8 @@ use std::sync::Arc;
 use dcr_capi::*;
 use dcr_runtime::testing::{plate_base, SplitMix64};
 use dcr_runtime::{
-    DistantResponse, Impact, Method, ModalModel, ResponseParams, RestingContact, ServedBy,
+    AttenuationParams, DistanceKind, DistantResponse, Impact, Method, ModalModel, ResponseParams,
+    RestingContact, ServedBy,
 };
 
 /// Loads `base` written to `dir` through the C API.
@@ -111,16 +112,23 @@ fn c_response_step_equals_the_rust_step_bit_for_bit() {
     let cm = c_model(dir.path());
     let model = Arc::new(ModalModel::from_base(plate_base()).unwrap());
     let (impacts, resting) = scene(3, 12);
-    for (method, carry) in [
-        (DCR_METHOD_MODAL, false),
-        (DCR_METHOD_MODAL, true),
-        (DCR_METHOD_ATTENUATION, false),
-        (DCR_METHOD_TRANSFER, false),
+    for (method, carry, distance) in [
+        (DCR_METHOD_MODAL, false, DistanceKind::Heat),
+        (DCR_METHOD_MODAL, true, DistanceKind::Heat),
+        (DCR_METHOD_ATTENUATION, false, DistanceKind::Heat),
+        (DCR_METHOD_ATTENUATION, false, DistanceKind::HeatTable),
+        (DCR_METHOD_ATTENUATION, false, DistanceKind::Euclidean),
+        (DCR_METHOD_TRANSFER, false, DistanceKind::Heat),
     ] {
         let mut p = DcrResponseParams::defaults();
         p.method = method;
         p.carry_over = carry;
         p.lateral_kick = !carry;
+        p.attenuation.distance = match distance {
+            DistanceKind::Heat => DCR_DISTANCE_HEAT,
+            DistanceKind::HeatTable => DCR_DISTANCE_HEAT_TABLE,
+            _ => DCR_DISTANCE_EUCLIDEAN,
+        };
         let mut cr = std::ptr::null_mut();
         // SAFETY: live model, valid params and out pointer.
         assert_eq!(
@@ -133,7 +141,10 @@ fn c_response_step_equals_the_rust_step_bit_for_bit() {
             method: match method {
                 DCR_METHOD_MODAL => Method::Modal,
                 DCR_METHOD_TRANSFER => Method::Transfer,
-                _ => Method::Attenuation(Default::default()),
+                _ => Method::Attenuation(AttenuationParams {
+                    distance,
+                    ..Default::default()
+                }),
             },
             carry_over: carry,
             lateral_kick: !carry,
@@ -149,7 +160,10 @@ fn c_response_step_equals_the_rust_step_bit_for_bit() {
             assert_eq!(n, resting.len());
             let want = rust.step(imp, &resting);
             for (c, r) in out.iter().zip(want) {
-                let tag = format!("method {method} carry {carry} step {s} contact {}", r.id);
+                let tag = format!(
+                    "method {method} carry {carry} {distance:?} step {s} contact {}",
+                    r.id
+                );
                 assert_eq!(c.id, r.id, "{tag}");
                 assert_eq!(c.delta_v.to_bits(), r.delta_v.to_bits(), "{tag}");
                 assert_eq!(
