@@ -113,9 +113,32 @@ pub(crate) fn check_struct_size<T>(found: u32, name: &str, type_name: &str) -> R
     Ok(())
 }
 
+/// The first `bool` field (of those at byte offsets `fields`) of the caller's struct at `p` that
+/// holds neither 0 nor 1, with the byte found; read as raw bytes before any reference to the
+/// struct exists. A C or C++ `bool` is always 0 or 1 unless its memory was never initialised;
+/// Rust may not read another value as `bool`. Does not allocate.
+///
+/// # Safety
+/// `p` must be non-null, aligned and point to a readable `T` (each offset inside it).
+unsafe fn bad_bool<'f, T>(p: *const T, fields: &[(usize, &'f str)]) -> Option<(&'f str, u8)> {
+    fields.iter().find_map(|&(offset, field)| {
+        debug_assert!(offset < size_of::<T>());
+        // SAFETY: `offset` lies inside the readable `T` at `p` (caller contract); a byte read
+        // has no alignment or validity requirement.
+        let b = unsafe { p.cast::<u8>().add(offset).read() };
+        (b > 1).then_some((field, b))
+    })
+}
+
+fn not_a_bool(name: &str, field: &str, b: u8) -> Failure {
+    Failure::invalid(format!(
+        "`{name}.{field}` holds {b}, not a bool (0 or 1): initialise every field (the \
+         `*_default` functions do)"
+    ))
+}
+
 /// Checks that the `bool` fields at byte offsets `fields` of the caller's struct at `p` hold 0
-/// or 1, reading raw bytes before any reference to the struct exists. A C or C++ `bool` always
-/// does, unless its memory was never initialised; Rust may not read another value as `bool`.
+/// or 1 (see `bad_bool`).
 ///
 /// # Safety
 /// `p` must be non-null, aligned and point to a readable `T` (each offset inside it).
@@ -124,22 +147,15 @@ pub(crate) unsafe fn check_bools<T>(
     fields: &[(usize, &str)],
     name: &str,
 ) -> Result<(), Failure> {
-    for &(offset, field) in fields {
-        debug_assert!(offset < size_of::<T>());
-        // SAFETY: `offset` lies inside the readable `T` at `p` (caller contract); a byte read
-        // has no alignment or validity requirement.
-        let b = unsafe { p.cast::<u8>().add(offset).read() };
-        if b > 1 {
-            return Err(Failure::invalid(format!(
-                "`{name}.{field}` holds {b}, not a bool (0 or 1): initialise every field (the \
-                 `*_default` functions do)"
-            )));
-        }
+    // SAFETY: forwarded caller contract.
+    match unsafe { bad_bool(p, fields) } {
+        Some((field, b)) => Err(not_a_bool(name, field, b)),
+        None => Ok(()),
     }
-    Ok(())
 }
 
-/// [`check_bools`] over each of the `n` elements of the caller's array at `p`.
+/// [`check_bools`] over each of the `n` elements of the caller's array at `p` (no allocation
+/// unless one is bad).
 ///
 /// # Safety
 /// When `n` > 0, `p` must be non-null, aligned and point to `n` readable `T`.
@@ -151,9 +167,9 @@ pub(crate) unsafe fn check_bools_in_array<T>(
 ) -> Result<(), Failure> {
     for i in 0..n {
         // SAFETY: element i of the caller's array (caller contract).
-        let e = unsafe { p.add(i) };
-        // SAFETY: as above.
-        unsafe { check_bools(e, fields, &format!("{name}[{i}]"))? };
+        if let Some((field, b)) = unsafe { bad_bool(p.add(i), fields) } {
+            return Err(not_a_bool(&format!("{name}[{i}]"), field, b));
+        }
     }
     Ok(())
 }
