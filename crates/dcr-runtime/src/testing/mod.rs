@@ -32,6 +32,11 @@ impl SplitMix64 {
     pub fn range(&mut self, lo: f64, hi: f64) -> f64 {
         lo + (hi - lo) * self.next_f64()
     }
+
+    /// Uniform integer in 0..n (n > 0), by the high half of a 64 × 64-bit product (Lemire).
+    pub fn below(&mut self, n: usize) -> usize {
+        ((self.next_u64() as u128 * n as u128) >> 64) as usize
+    }
 }
 
 /// A nested-dissection-like vertex order of a connected surface, for tests of split solves: the

@@ -6,48 +6,11 @@ use std::time::Duration;
 use anyhow::Context;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
-use modal_bake::bake::{
-    self, BakeParams, BakeReport, BakeStage, MaterialSi, ModeRequest, ModesPrecision,
-};
+use modal_bake::bake::{self, BakeParams, BakeReport, BakeStage, ModeRequest, ModesPrecision};
 use modal_bake::transfer::{TransferModes, TransferParams};
 
 use super::parse;
-
-/// The object's material, boundary conditions and damping (shared by `bake`, `check`,
-/// `truth` and `fit-attenuation`).
-#[derive(Args, Clone, Debug)]
-pub struct ModelOptions {
-    /// Young's modulus E (Pa).
-    #[arg(long, value_name = "PA", default_value_t = 1.1e9)]
-    pub youngs: f64,
-    /// Poisson ratio ν (−1 < ν < 0.5).
-    #[arg(long, value_name = "NU", default_value_t = 0.3)]
-    pub poisson: f64,
-    /// Density ρ (kg/m³).
-    #[arg(long, value_name = "KG_M3", default_value_t = 770.0)]
-    pub density: f64,
-    /// Fix every node of this named physical group (repeatable). Nothing fixed: free-free (the
-    /// six rigid-body modes, or the rigid-body part of a response, are excluded).
-    #[arg(long, value_name = "NAME")]
-    pub fixed: Vec<String>,
-    /// Rayleigh damping: α0 (1/s), α1 (s); `bake` stores it as the base's default.
-    #[arg(long, value_name = "A0,A1", value_parser = parse::pair, default_value = "10,1e-7")]
-    pub rayleigh: [f64; 2],
-    /// Lumped (diagonal) mass instead of the consistent mass.
-    #[arg(long)]
-    pub lumped: bool,
-}
-
-impl ModelOptions {
-    /// The material in SI units.
-    pub fn material(&self) -> MaterialSi {
-        MaterialSi {
-            youngs: self.youngs,
-            poisson: self.poisson,
-            density: self.density,
-        }
-    }
-}
+pub use modal_bake::args::ModelOptions;
 
 /// Options that determine a base (shared by `bake` and `check`).
 #[derive(Args, Clone, Debug)]

@@ -7,8 +7,8 @@ use faer::{Accum, Mat, Par};
 use rayon::prelude::*;
 
 use crate::bake::{bake_mesh, BakeError, BakeParams, ModeRequest};
+use crate::full_order::{FullOrderError, FullOrderSystem, ModalAll, SystemParams};
 use crate::mesh::TetMesh;
-use crate::truth::{ModalAll, TruthError, TruthParams, TruthSystem};
 
 /// Default oversampling of the table's peak search: T = π/(2 ω_max)/2 for its highest mode.
 pub const DEFAULT_OVERSAMPLE: f64 = 2.0;
@@ -124,7 +124,7 @@ pub enum TransferError {
     Params(String),
     /// The dense eigensolve for the table's modes failed.
     #[error("transfer table modes: {0}")]
-    Truth(#[from] TruthError),
+    FullOrder(#[from] FullOrderError),
     /// The Lanczos bake for the table's modes failed.
     #[error("transfer table modes: {0}")]
     Bake(Box<BakeError>),
@@ -134,7 +134,7 @@ pub enum TransferError {
 /// layout of `template` (a base baked from the same mesh and options: same surface order).
 ///
 /// # Errors
-/// [`TransferError::Truth`] when the system cannot be built or the dense eigensolve fails
+/// [`TransferError::FullOrder`] when the system cannot be built or the dense eigensolve fails
 /// (including more than [`DENSE_MAX_DOFS`] free dofs).
 pub fn mode_set_dense(
     template: &ModesFile,
@@ -143,14 +143,13 @@ pub fn mode_set_dense(
     modes: TransferModes,
     file: &str,
 ) -> Result<ModesFile, TransferError> {
-    let tp = TruthParams {
+    let tp = SystemParams {
         material: params.material,
         fixed: params.fixed.clone(),
         rayleigh: params.rayleigh,
         lumped: params.lumped,
-        ..Default::default()
     };
-    let sys = TruthSystem::new(mesh.clone(), &tp, file)?;
+    let sys = FullOrderSystem::new(mesh.clone(), &tp, file)?;
     let ma = ModalAll::new(&sys, DENSE_MAX_DOFS)?;
     let m = match modes {
         TransferModes::All => ma.eigenvalues.len(),
@@ -163,7 +162,7 @@ pub fn mode_set_dense(
 /// in the layout of `template` (surface rows of U; fixed dofs zero; no table).
 pub fn mode_set_from_dense(
     template: &ModesFile,
-    sys: &TruthSystem,
+    sys: &FullOrderSystem,
     ma: &ModalAll,
     m: usize,
 ) -> ModesFile {

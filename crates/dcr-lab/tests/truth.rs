@@ -2,14 +2,14 @@
 //! equals a baked base read through the runtime (conventions: mapping, normals, weights,
 //! direction, mass normalisation).
 //!
-//! Run with `cargo test --release -p modal-bake --test truth`.
+//! Run with `cargo test --release -p dcr-lab --test truth`.
 
 use std::sync::Arc;
 
+use dcr_lab::truth::{run_truth, TruthImpact, TruthMethod, TruthParams};
 use dcr_runtime::{damping_ratio, samples_per_step, ModalModel, ModeFilter};
 use modal_bake::bake::{bake_mesh, BakeParams, MaterialSi, ModeRequest};
 use modal_bake::mesh::TetMesh;
-use modal_bake::truth::{run_truth, TruthImpact, TruthMethod, TruthParams};
 
 /// 1 m × 0.2 m × 0.15 m: a rectangular section, so bending pairs are not degenerate and "the
 /// lowest 20 modes" is one well-defined subspace.
@@ -244,10 +244,10 @@ fn truth_extreme_materials_agree() {
 /// all-mode peak (= wᵀK⁻¹f) to 1e-4, while 20 modes alone are off by more than that.
 #[test]
 fn static_correction_recovers_static_deflection() {
-    use modal_bake::truth::{ModalAll, ModalInput, TruthSystem};
+    use modal_bake::full_order::{FullOrderSystem, ModalAll, ModalInput};
     let mut p = params(true, TruthMethod::ModalAll);
     p.rayleigh = [2000.0, 0.0];
-    let sys = TruthSystem::new(cantilever(), &p, "c").unwrap();
+    let sys = FullOrderSystem::new(cantilever(), &p.system(), "c").unwrap();
     let ma = ModalAll::new(&sys, 6000).unwrap();
     let isp = sys.surface.project(impact().point).unwrap();
     let f = sys.load_vector(&isp, isp.normal.map(|x| -x), 100.0);

@@ -17,8 +17,8 @@ use std::time::Instant;
 use faer::sparse::SparseColMat;
 use faer::{MatMut, Par};
 
-use super::truth_system::{spmv, TruthSystem};
-use super::TruthError;
+use super::full_order_system::{spmv, FullOrderSystem};
+use super::FullOrderError;
 
 /// What a Newmark run did.
 #[derive(Clone, Debug, Default, serde::Serialize)]
@@ -37,14 +37,14 @@ pub struct NewmarkInfo {
 /// free dofs) at t = 0 from rest. `dt` in s.
 ///
 /// # Errors
-/// [`TruthError::Factorization`] if M or K_eff is not positive definite.
+/// [`FullOrderError::Factorization`] if M or K_eff is not positive definite.
 pub fn newmark_peaks(
-    sys: &TruthSystem,
+    sys: &FullOrderSystem,
     f: &[f64],
     rows: &[Vec<f64>],
     dt: f64,
     steps: usize,
-) -> Result<(Vec<f64>, NewmarkInfo), TruthError> {
+) -> Result<(Vec<f64>, NewmarkInfo), FullOrderError> {
     let mut peaks = vec![0.0f64; rows.len()];
     let info = newmark_run(sys, f, dt, steps, &mut |_, u| {
         for (p, w) in peaks.iter_mut().zip(rows) {
@@ -60,12 +60,12 @@ pub fn newmark_peaks(
 /// # Errors
 /// As [`newmark_peaks`].
 pub fn newmark_run(
-    sys: &TruthSystem,
+    sys: &FullOrderSystem,
     f: &[f64],
     dt: f64,
     steps: usize,
     sample: &mut dyn FnMut(usize, &[f64]),
-) -> Result<NewmarkInfo, TruthError> {
+) -> Result<NewmarkInfo, FullOrderError> {
     let n = sys.n();
     let [a0, a1] = sys.rayleigh;
     let (beta, gamma) = (0.25, 0.5);
@@ -74,7 +74,8 @@ pub fn newmark_run(
     let c2 = 1.0 / (beta * dt);
     let t = Instant::now();
     let factor = |a: &SparseColMat<usize, f64>, what: &str| {
-        ShiftInvert::new(a, Par::Seq).map_err(|e| TruthError::Factorization(format!("{what}: {e}")))
+        ShiftInvert::new(a, Par::Seq)
+            .map_err(|e| FullOrderError::Factorization(format!("{what}: {e}")))
     };
     let mfac = factor(&sys.m, "M")?;
     // K_eff = (1 + c1 α1) K + (c0 + c1 α0) M.

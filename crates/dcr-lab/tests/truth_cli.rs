@@ -1,5 +1,4 @@
-//! End-to-end tests of `modal-bake truth` (needs the `Truth` subcommand wired in
-//! `src/cli/mod.rs`): probe's JSON shape, the two methods agree, clear errors on bad input.
+//! End-to-end tests of `dcr-lab truth`: probe's JSON shape, the two methods agree, clear errors on bad input.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -25,16 +24,18 @@ fn truth(extra: &[&str]) -> Output {
         "0.5,0.05,0.1",
         "--contact",
         "0.8,0.0,0.05",
-        "--h",
-        "0.002",
-        "--dt",
-        "5e-7",
     ];
+    // The window and step unless `extra` sets them.
+    for (flag, value) in [("--h", "0.002"), ("--dt", "5e-7")] {
+        if !extra.contains(&flag) {
+            a.extend_from_slice(&[flag, value]);
+        }
+    }
     a.extend_from_slice(extra);
-    Command::new(env!("CARGO_BIN_EXE_modal-bake"))
+    Command::new(env!("CARGO_BIN_EXE_dcr-lab"))
         .args(&a)
         .output()
-        .expect("modal-bake runs")
+        .expect("dcr-lab runs")
 }
 
 fn peaks(out: &Output) -> Vec<f64> {
@@ -82,7 +83,7 @@ fn truth_json_methods_agree() {
 fn truth_rejects_bad_input_with_a_clear_message() {
     for (extra, needle) in [
         (&["--fixed", "nope"][..], "no node group named"),
-        (&["--dt", "0"][..], "--dt"),
+        (&["--dt", "0"][..], "dt = 0"),
         (&["--modes", "5"][..], "--method modal-all"),
         (&["--impulse", "nan"][..], "impulse"),
         (&["--impulse", "-1"][..], "impulse"),

@@ -3,14 +3,16 @@
 //! (peak at the contact / local peak at the impact) decays with distance (β > 0) and agrees
 //! with `run_truth` at the same points.
 //!
-//! Run with `cargo test --release -p modal-bake --test fit_attenuation`.
+//! Run with `cargo test --release -p dcr-lab --test fit_attenuation`.
 
-use modal_bake::mesh::TetMesh;
-use modal_bake::truth::{
-    fit_attenuation_mesh, fit_eq14, fit_eq14_fixed_r0, fit_simplified, run_truth,
-    sample_attenuation, AttenuationFitParams, FitTruth, ModalAll, SplitMix64, SurfaceResponse,
-    TruthImpact, TruthMethod, TruthParams, TruthSystem,
+use dcr_lab::attenuation_fit::{
+    fit_attenuation_mesh, fit_eq14, fit_eq14_fixed_r0, fit_simplified, sample_attenuation,
+    AttenuationFitParams, FitTruth, SurfaceResponse,
 };
+use dcr_lab::truth::{run_truth, TruthImpact, TruthMethod, TruthParams};
+use dcr_runtime::testing::SplitMix64;
+use modal_bake::full_order::{FullOrderSystem, ModalAll};
+use modal_bake::mesh::TetMesh;
 
 /// Eq. 14.
 fn eq14(r: f64, alpha: f64, beta: f64, r0: f64) -> f64 {
@@ -19,13 +21,13 @@ fn eq14(r: f64, alpha: f64, beta: f64, r0: f64) -> f64 {
 
 /// Distances 0.05 … 3 m (random, seeded) and s with multiplicative noise e^(σ·N(0,1)).
 fn synthetic(alpha: f64, beta: f64, r0: f64, sigma: f64, n: usize) -> (Vec<f64>, Vec<f64>) {
-    let mut rng = SplitMix64::new(7);
-    let r: Vec<f64> = (0..n).map(|_| 0.05 + 2.95 * rng.unit()).collect();
+    let mut rng = SplitMix64(7);
+    let r: Vec<f64> = (0..n).map(|_| 0.05 + 2.95 * rng.next_f64()).collect();
     let s = r
         .iter()
         .map(|&r| {
             // Box–Muller.
-            let (u1, u2) = (rng.unit().max(1e-300), rng.unit());
+            let (u1, u2) = (rng.next_f64().max(1e-300), rng.next_f64());
             let z = (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos();
             eq14(r, alpha, beta, r0) * (sigma * z).exp()
         })
@@ -117,7 +119,7 @@ fn measured_samples_match_run_truth_at_the_same_points() {
         method: TruthMethod::ModalAll,
         ..Default::default()
     };
-    let sys = TruthSystem::new(slab(), &tp, "slab").unwrap();
+    let sys = FullOrderSystem::new(slab(), &tp.system(), "slab").unwrap();
     let ma = ModalAll::new(&sys, 6000).unwrap();
     let resp = SurfaceResponse::from_modal_all(&sys, &ma, None);
     let (samples, kind, dt, _) = sample_attenuation(&resp, tp.rayleigh, tp.h, None, 4, 3).unwrap();
@@ -157,7 +159,7 @@ fn measured_samples_match_run_truth_at_the_same_points() {
 fn small_mesh_fit_is_finite_and_decays_with_distance() {
     let p = AttenuationFitParams {
         fixed: vec!["zmin".into()],
-        material: modal_bake::truth::MaterialSi {
+        material: dcr_lab::truth::MaterialSi {
             youngs: 10e9,
             poisson: 0.3,
             density: 500.0,
@@ -202,14 +204,14 @@ fn sparse_truth_runs_and_decays_with_distance() {
     );
 }
 
-/// `modal-bake fit-attenuation` through the binary: text and JSON output, and a clean error.
+/// `dcr-lab fit-attenuation` through the binary: text and JSON output, and a clean error.
 #[test]
 fn cli_runs_on_a_small_mesh() {
     let beam = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/meshes/beam.msh");
     let run = |extra: &[&str]| {
         let mut argv = vec!["fit-attenuation", beam.to_str().unwrap()];
         argv.extend_from_slice(extra);
-        std::process::Command::new(env!("CARGO_BIN_EXE_modal-bake"))
+        std::process::Command::new(env!("CARGO_BIN_EXE_dcr-lab"))
             .args(&argv)
             .output()
             .unwrap()

@@ -44,9 +44,10 @@ use std::time::Instant;
 use dcr_runtime::{damping_ratio, HeatGeodesic, ModeFilter};
 use rayon::prelude::*;
 
-use super::{ModalAll, TruthError, TruthParams, TruthSystem};
-use crate::bake::{bake_mesh, BakeError, BakeParams, MaterialSi, ModeRequest, ModesFile};
-use crate::mesh::TetMesh;
+use dcr_runtime::testing::SplitMix64;
+use modal_bake::bake::{bake_mesh, BakeError, BakeParams, MaterialSi, ModeRequest, ModesFile};
+use modal_bake::full_order::{FullOrderError, FullOrderSystem, ModalAll, SystemParams};
+use modal_bake::mesh::TetMesh;
 
 /// Fewest usable pairs accepted by the fits.
 pub const MIN_FIT_SAMPLES: usize = 4;
@@ -112,7 +113,7 @@ pub enum FitError {
     Params(String),
     /// The full-order system or dense eigensolve failed.
     #[error(transparent)]
-    Truth(#[from] TruthError),
+    System(#[from] FullOrderError),
     /// The sparse bake failed.
     #[error(transparent)]
     Bake(#[from] BakeError),
@@ -228,7 +229,7 @@ fn solve_r0(alpha: f64, beta: f64, c: f64) -> Option<f64> {
 /// [`FitError::Degenerate`] if no α ≥ 0, β ≥ 0, r0 > 0 fits (e.g. a single distance).
 ///
 /// ```
-/// use modal_bake::truth::fit_eq14;
+/// use dcr_lab::attenuation_fit::fit_eq14;
 /// let r: Vec<f64> = (1..40).map(|i| 0.05 * i as f64).collect();
 /// let s: Vec<f64> = r.iter().map(|r| (-0.5 * (r - 0.03)).exp() * (r / 0.03).powf(-0.8)).collect();
 /// let f = fit_eq14(&r, &s).unwrap();
@@ -293,7 +294,7 @@ pub fn fit_eq14(r: &[f64], s: &[f64]) -> Result<AttenuationFit, FitError> {
 pub fn fit_eq14_fixed_r0(r: &[f64], s: &[f64], r0: f64) -> Result<AttenuationFit, FitError> {
     if !(r0.is_finite() && r0 > 0.0) {
         return Err(FitError::Params(format!(
-            "--r0 must be finite and > 0 m, got {r0}"
+            "r0 must be finite and > 0 m, got {r0}"
         )));
     }
     let (rr, ls) = usable(r, s)?;
@@ -440,7 +441,7 @@ impl SurfaceResponse {
     }
 
     /// From a dense all-mode solve of `sys`, keeping the lowest `modes` (`None`: all).
-    pub fn from_modal_all(sys: &TruthSystem, ma: &ModalAll, modes: Option<usize>) -> Self {
+    pub fn from_modal_all(sys: &FullOrderSystem, ma: &ModalAll, modes: Option<usize>) -> Self {
         let m = modes.unwrap_or(usize::MAX).min(ma.eigenvalues.len());
         let s = &sys.surface;
         let ns = s.vertices.len();
@@ -592,33 +593,6 @@ pub struct AttenuationSample {
     pub ratio: f64,
 }
 
-/// A small seeded generator (SplitMix64) so samples are reproducible without a dependency.
-#[derive(Clone, Debug)]
-pub struct SplitMix64(u64);
-
-impl SplitMix64 {
-    /// Seeded generator.
-    pub fn new(seed: u64) -> Self {
-        SplitMix64(seed)
-    }
-    /// Next 64 random bits.
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    /// Uniform integer in 0..n (n > 0).
-    pub fn below(&mut self, n: usize) -> usize {
-        ((self.next_u64() as u128 * n as u128) >> 64) as usize
-    }
-    /// Uniform in [0, 1).
-    pub fn unit(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
-
 /// How the truth is computed for the fit.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "kebab-case")]
@@ -666,7 +640,7 @@ pub struct AttenuationFitParams {
 
 impl Default for AttenuationFitParams {
     fn default() -> Self {
-        let t = TruthParams::default();
+        let t = SystemParams::default();
         AttenuationFitParams {
             material: t.material,
             fixed: Vec::new(),
@@ -744,7 +718,7 @@ pub fn sample_attenuation(
     let dt_req = dt.unwrap_or_else(|| resp.default_dt());
     if !(h.is_finite() && h > 0.0 && dt_req.is_finite() && dt_req > 0.0) {
         return Err(FitError::Params(format!(
-            "--h and --dt must be finite and > 0 s, got h = {h}, dt = {dt_req}"
+            "the window h and sample period dt must be finite and > 0 s, got h = {h}, dt = {dt_req}"
         )));
     }
     if h / dt_req > 1e7 {
@@ -764,7 +738,7 @@ pub fn sample_attenuation(
             cand.len()
         )));
     }
-    let mut rng = SplitMix64::new(seed);
+    let mut rng = SplitMix64(seed);
     let pairs_v: Vec<(usize, usize)> = (0..pairs)
         .map(|_| {
             let a = cand[rng.below(cand.len())];
@@ -831,7 +805,8 @@ pub fn sample_attenuation(
 /// [`FitError`] naming what failed (mesh, material, eigensolve, too few samples, degenerate).
 ///
 /// ```
-/// use modal_bake::{mesh::TetMesh, truth::*};
+/// use dcr_lab::attenuation_fit::*;
+/// use modal_bake::mesh::TetMesh;
 /// let mesh = TetMesh::structured_box([6, 2, 2], [1.0, 0.2, 0.2]);
 /// let p = AttenuationFitParams { fixed: vec!["xmin".into()], h: 2e-3, pairs: 20, ..Default::default() };
 /// let rep = fit_attenuation_mesh(mesh, &p, "box").unwrap();
@@ -844,26 +819,25 @@ pub fn fit_attenuation_mesh(
 ) -> Result<AttenuationFitReport, FitError> {
     if params.pairs < MIN_FIT_SAMPLES {
         return Err(FitError::Params(format!(
-            "--pairs must be at least {MIN_FIT_SAMPLES}, got {}",
+            "the number of pairs must be at least {MIN_FIT_SAMPLES}, got {}",
             params.pairs
         )));
     }
     if params.modes == Some(0) {
-        return Err(FitError::Params("--modes must be at least 1".into()));
+        return Err(FitError::Params(
+            "the number of modes must be at least 1".into(),
+        ));
     }
-    let tp = TruthParams {
+    let tp = SystemParams {
         material: params.material,
         fixed: params.fixed.clone(),
         rayleigh: params.rayleigh,
         lumped: params.lumped,
-        h: params.h,
-        max_dense_dofs: params.max_dense_dofs,
-        ..Default::default()
     };
     let t = Instant::now();
     let free_dofs;
     let (resp, method) = {
-        let sys = TruthSystem::new(mesh.clone(), &tp, file)?;
+        let sys = FullOrderSystem::new(mesh.clone(), &tp, file)?;
         free_dofs = sys.n();
         let dense = match params.truth {
             FitTruth::Auto => free_dofs <= params.max_dense_dofs,

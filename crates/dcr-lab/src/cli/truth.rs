@@ -1,14 +1,12 @@
-//! `modal-bake truth`: the full-order reference response to an impulse (see
-//! [`modal_bake::truth`]), in `modal-bake probe`'s JSON shape.
+//! `dcr-lab truth`: the full-order reference response to an impulse (see
+//! [`dcr_lab::truth`]), in `modal-bake probe`'s JSON shape.
 
 use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::{Args, ValueEnum};
-use modal_bake::truth::{self, TruthImpact, TruthMethod, TruthParams};
-
-use super::bake::ModelOptions;
-use super::parse;
+use dcr_lab::truth::{self, TruthImpact, TruthMethod, TruthParams};
+use modal_bake::args::{self as parse, ModelOptions};
 
 /// Truth method.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -100,8 +98,7 @@ pub fn run(args: &TruthArgs) -> anyhow::Result<()> {
     let res = truth::truth_file(&args.mesh, &params, &impact, &args.contacts)
         .with_context(|| format!("truth for {} failed", args.mesh.display()))?;
     if args.json {
-        super::emit(&format!("{}\n", serde_json::to_string_pretty(&res)?));
-        return Ok(());
+        return super::emit(&format!("{}\n", serde_json::to_string_pretty(&res)?));
     }
     let i = &res.info;
     let mut s = format!(
@@ -142,6 +139,5 @@ pub fn run(args: &TruthArgs) -> anyhow::Result<()> {
         "  seconds: setup {:.3}, factor/eigensolve {:.3}, stepping {:.3} ({} distance)\n",
         i.setup_s, i.solve_s, i.step_s, i.distance_kind
     );
-    super::emit(&s);
-    Ok(())
+    super::emit(&s)
 }

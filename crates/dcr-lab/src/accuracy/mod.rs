@@ -5,14 +5,14 @@
 //! variant, and the mesh resolution (three structured slabs); plus bake time, base size and
 //! runtime query time per mode count, and the Eq. 14 attenuation fit of each object.
 //!
-//! `cargo run --release -p modal-bake --example accuracy -- [--out docs] [--quick]`
-//! (see scripts/accuracy.sh). Prints Markdown on stdout, writes SVG plots to `<out>/accuracy/`.
+//! `dcr-lab accuracy --out docs [--quick] [--transfer-only]` (see scripts/accuracy.sh) writes
+//! `<out>/accuracy.md` and the SVG plots in `<out>/accuracy/`.
 //!
 //! Truth: the sum over every elastic mode (dense eigensolve, `ModalAll`) where the free dofs
 //! ≤ 6000; full-order Newmark (β = ¼, γ = ½) at Δt = 1e-5 s elsewhere (the scaffold).
 
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -21,11 +21,11 @@ use dcr_runtime::{
     DistantResponse, Impact, ModalModel, ResponseParams, RestingContact, Sampling, Variant,
 };
 use modal_bake::bake::{bake_mesh, BakeParams, MaterialSi, ModeRequest, ModesFile};
+use modal_bake::full_order::{newmark_peaks, FullOrderSystem, ModalAll, SystemParams};
 use modal_bake::mesh::{read_mesh, TetMesh};
-use modal_bake::truth::{
-    fit_attenuation_mesh, newmark_peaks, AttenuationFitParams, ModalAll, SplitMix64, TruthParams,
-    TruthSystem,
-};
+
+use crate::attenuation_fit::{fit_attenuation_mesh, AttenuationFitParams};
+use dcr_runtime::testing::SplitMix64;
 use plotters::prelude::*;
 
 const COUNTS: [usize; 8] = [5, 10, 20, 40, 80, 160, 320, 640];
@@ -70,7 +70,7 @@ struct Truth {
     peaks: Vec<Vec<f64>>,
     fmax_hz: f64,
     /// The dense system and eigenpairs (when the truth is the all-mode sum).
-    dense: Option<(TruthSystem, ModalAll)>,
+    dense: Option<(FullOrderSystem, ModalAll)>,
 }
 
 fn median(v: &[f64]) -> f64 {
@@ -86,11 +86,10 @@ fn maxv(v: &[f64]) -> f64 {
     v.iter().fold(0.0f64, |a, b| a.max(*b))
 }
 
-fn params(s: &Scene) -> TruthParams {
-    TruthParams {
+fn params(s: &Scene) -> SystemParams {
+    SystemParams {
         material: s.material,
         fixed: s.fixed.clone(),
-        h: H,
         ..Default::default()
     }
 }
@@ -98,7 +97,7 @@ fn params(s: &Scene) -> TruthParams {
 /// Impacts and contacts: centroids of seeded random surface triangles with no fixed node
 /// (contacts inside triangles, so per-node and per-contact differ).
 fn pick_points(
-    sys: &TruthSystem,
+    sys: &FullOrderSystem,
     n_imp: usize,
     n_con: usize,
     seed: u64,
@@ -111,7 +110,7 @@ fn pick_points(
                 .all(|&v| sys.map.free_index(3 * v).is_some())
         })
         .collect();
-    let mut rng = SplitMix64::new(seed);
+    let mut rng = SplitMix64(seed);
     let mut pick = |n: usize| {
         (0..n)
             .map(|_| free[rng.below(free.len())])
@@ -120,7 +119,7 @@ fn pick_points(
     (pick(n_imp), pick(n_con))
 }
 
-fn centroid(sys: &TruthSystem, t: usize) -> [f64; 3] {
+fn centroid(sys: &FullOrderSystem, t: usize) -> [f64; 3] {
     let v = sys.surface.triangles[t].map(|i| sys.surface.vertices[i as usize]);
     [0, 1, 2].map(|k| (v[0][k] + v[1][k] + v[2][k]) / 3.0)
 }
@@ -131,7 +130,7 @@ type FixedPoints = (Vec<[f64; 3]>, Vec<[f64; 3]>);
 fn compute_truth(s: &Scene, seed: u64, fixed_points: Option<FixedPoints>) -> Truth {
     let p = params(s);
     let t0 = Instant::now();
-    let sys = TruthSystem::new(s.mesh.clone(), &p, &s.file).expect("system");
+    let sys = FullOrderSystem::new(s.mesh.clone(), &p, &s.file).expect("system");
     let (imp_pts, con_pts) = match fixed_points {
         Some(x) => x,
         None => {
@@ -435,19 +434,10 @@ fn plot_cost(
     Ok(())
 }
 
-fn main() {
-    let mut out_dir = PathBuf::from("docs");
-    let mut quick = false;
-    let mut transfer_only = false;
-    let mut it = std::env::args().skip(1);
-    while let Some(a) = it.next() {
-        match a.as_str() {
-            "--out" => out_dir = PathBuf::from(it.next().expect("--out DIR")),
-            "--quick" => quick = true,
-            "--transfer-only" => transfer_only = true,
-            x => panic!("unknown argument {x} (use --out DIR, --quick, --transfer-only)"),
-        }
-    }
+/// Runs the whole study and returns the Markdown of `docs/accuracy.md`; writes the SVG plots to
+/// `out_dir/accuracy/`. `quick`: the table only, up to 40 modes; `transfer_only`: the transfer
+/// tables only.
+pub fn generate(out_dir: &Path, quick: bool, transfer_only: bool) -> String {
     let svg_dir = out_dir.join("accuracy");
     std::fs::create_dir_all(&svg_dir).expect("create svg dir");
     let t_all = Instant::now();
@@ -510,7 +500,7 @@ fn main() {
         "# Accuracy of truncated modal bases vs full-order truth\n"
     )
     .unwrap();
-    writeln!(md, "Regenerate everything on this page (tables and `docs/accuracy/*.svg`) with\n\n```sh\n{cmd}\n```\n\n(= `cargo run --release -p modal-bake --example accuracy -- --out docs > docs/accuracy.md`). Do not edit by hand; every figure below comes from that one command.\n").unwrap();
+    writeln!(md, "Regenerate everything on this page (tables and `docs/accuracy/*.svg`) with\n\n```sh\n{cmd}\n```\n\n(= `dcr-lab accuracy --out docs`). Do not edit by hand; every figure below comes from that one command.\n").unwrap();
     writeln!(md, "## Set-up\n").unwrap();
     writeln!(md, "- Impulse {IMPULSE} N·s at t = 0 into the surface at 2 impacts; peak |normal displacement| over h = {H} s at 8 distant contacts (centroids of seeded random surface triangles with no fixed node, seed 1), so 16 (impact, contact) pairs per object.").unwrap();
     writeln!(md, "- Truth: the sum over **every** elastic mode (dense eigensolve) where free dofs ≤ {DENSE_MAX}, sampled at Δt = min(1 µs, π/(4ω_max)); otherwise full-order implicit Newmark (β = ¼, γ = ½) at Δt = {NEWMARK_DT:.0e} s (the scaffold, ≈ 15 000 dofs — a modest step to keep the run short; average-acceleration Newmark is unconditionally stable and loses accuracy only for modes above ≈ 1/(20 Δt) = 5 kHz, far above the bases' highest modes there).").unwrap();
@@ -667,8 +657,7 @@ fn main() {
     }
 
     if transfer_only {
-        print!("{md}");
-        return;
+        return md;
     }
     writeln!(md, "## Cost per mode count\n").unwrap();
     for (file, title, ylabel, series) in [
@@ -779,10 +768,10 @@ fn main() {
 
     writeln!(
         md,
-        "## Eq. 14 attenuation fitted to the truth (`modal-bake fit-attenuation`)\n"
+        "## Eq. 14 attenuation fitted to the truth (`dcr-lab fit-attenuation`)\n"
     )
     .unwrap();
-    writeln!(md, "200 random surface-vertex pairs (seed 1), unit impulse into the surface at the impact, s = peak |normal displacement| at the contact / peak at the impact over h = 0.01 s, r = heat-method geodesic distance; least squares in log space (see `modal_bake::truth::attenuation_fit`). Reproduce one row with e.g. `modal-bake fit-attenuation data/scenes/table.msh --fixed feet` (add `--youngs 10e9 --density 500 --fixed bottom --fixed sides` for the ground; `--youngs 10e9 --density 100 --modes 40` for the scaffold).\n").unwrap();
+    writeln!(md, "200 random surface-vertex pairs (seed 1), unit impulse into the surface at the impact, s = peak |normal displacement| at the contact / peak at the impact over h = 0.01 s, r = heat-method geodesic distance; least squares in log space (see `dcr_lab::attenuation_fit`). Reproduce one row with e.g. `dcr-lab fit-attenuation data/scenes/table.msh --fixed feet` (add `--youngs 10e9 --density 500 --fixed bottom --fixed sides` for the ground; `--youngs 10e9 --density 100 --modes 40` for the scaffold).\n").unwrap();
     writeln!(md, "| object | truth | pairs | α (1/m) | β | r0 (m) | R² / RMS (ln s) | C (§4.5) | β (§4.5) | R² (§4.5) | s |").unwrap();
     writeln!(md, "|---|---|---|---|---|---|---|---|---|---|---|").unwrap();
     for l in fit_lines {
@@ -794,7 +783,7 @@ fn main() {
         t_all.elapsed().as_secs_f64()
     )
     .unwrap();
-    print!("{md}");
+    md
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -971,7 +960,7 @@ fn transfer_study(s: &Scene, truth: &Truth, md: &mut String) {
         let (mut a, mut b) = if centroid {
             (1.0 / 3.0, 1.0 / 3.0)
         } else {
-            (rng.unit(), rng.unit())
+            (rng.next_f64(), rng.next_f64())
         };
         if a + b > 1.0 {
             (a, b) = (1.0 - a, 1.0 - b);
@@ -981,7 +970,7 @@ fn transfer_study(s: &Scene, truth: &Truth, md: &mut String) {
     };
     // (point, at a vertex): a third at vertices, a third at centroids, a third at random
     // interior points.
-    let mut rng = SplitMix64::new(2);
+    let mut rng = SplitMix64(2);
     let mut pick = |n: usize| -> Vec<([f64; 3], bool)> {
         (0..n)
             .map(|k| match 3 * k / n {
@@ -1002,7 +991,7 @@ fn transfer_study(s: &Scene, truth: &Truth, md: &mut String) {
     let sys = match &truth.dense {
         Some((sys, _)) => sys,
         None => {
-            owned_sys = TruthSystem::new(s.mesh.clone(), &p, &s.file).expect("system");
+            owned_sys = FullOrderSystem::new(s.mesh.clone(), &p, &s.file).expect("system");
             &owned_sys
         }
     };

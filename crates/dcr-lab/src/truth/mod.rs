@@ -5,14 +5,14 @@
 //! Two independent methods on the same FEM system (paper Eq. 5, M ü + D u̇ + K u = f,
 //! D = α0 M + α1 K, every dof of the mesh):
 //!
-//! - [`newmark_peaks`]: implicit Newmark average acceleration (β = ¼, γ = ½) with a small step,
-//!   one sparse Cholesky of K_eff, one back-solve per step (`newmark`).
-//! - [`ModalAll`]: dense generalized eigensolve of every mode and the exact damped impulse
-//!   response of each (ξ < 1, = 1, > 1) — small meshes only (`modal_all`).
+//! - Newmark ([`modal_bake::full_order::newmark_peaks`]): implicit average acceleration
+//!   (β = ¼, γ = ½) with a small step, one sparse Cholesky of K_eff, one back-solve per step.
+//! - Modal-all ([`modal_bake::full_order::ModalAll`]): dense generalized eigensolve of every mode
+//!   and the exact damped impulse response of each (ξ < 1, = 1, > 1) — small meshes only.
 //!
 //! Conventions (identical to `modal-bake probe` and `dcr_runtime::ModalModel`):
 //! - points are mapped to the closest triangle of the extracted boundary surface (brute force,
-//!   [`SurfaceMap`]) and refused farther than [`MAP_DISTANCE_REL`] × the bounding-box diagonal;
+//!   `modal_bake::full_order::SurfaceMap`) and refused farther than [`MAP_DISTANCE_REL`] × the bounding-box diagonal;
 //!   weights in triangle order; normals are area-weighted vertex normals
 //!   interpolated with the weights and normalised;
 //! - the impulse acts at t = 0 along `direction`, by default *into* the surface (−normal at
@@ -21,37 +21,23 @@
 //!   k = 1 … S, S = `samples_per_step(h, dt)` and Δt = h/S (never longer than `dt`);
 //!   `delta_v_mps` = peak / h (Eq. 12);
 //! - free-free objects: the **elastic** displacement only — the rigid-body part of the motion is
-//!   projected out M-orthogonally (see [`TruthSystem::remove_rigid`]), which is what the sum
+//!   projected out M-orthogonally (`FullOrderSystem::remove_rigid`), which is what the sum
 //!   over every elastic mode (a base with all modes) gives. Clamped objects: as is.
 //! - `distance_m` is the heat-method geodesic distance on the surface
 //!   (`dcr_runtime::HeatGeodesic`, Crane et al. 2013) from the impact point, interpolated at the
 //!   contact with its barycentric weights; Euclidean if the geodesic solver cannot be built
 //!   (reported in [`TruthInfo::distance_kind`]).
 
-mod attenuation_fit;
-mod modal_all;
-mod newmark;
-mod surface_map;
-mod truth_system;
-
 use std::path::Path;
 use std::time::Instant;
 
-pub use attenuation_fit::{
-    fit_attenuation_mesh, fit_eq14, fit_eq14_fixed_r0, fit_simplified, sample_attenuation,
-    AttenuationFit, AttenuationFitInfo, AttenuationFitParams, AttenuationFitReport,
-    AttenuationSample, FitError, FitTruth, SimplifiedFit, SplitMix64, SurfaceResponse,
-    DEFAULT_SPARSE_MODES, MIN_FIT_SAMPLES,
+pub use modal_bake::full_order::MaterialSi;
+use modal_bake::full_order::{
+    newmark_peaks, FullOrderError, FullOrderSystem, ModalAll, SystemParams,
 };
-pub use dcr_runtime::format::MaterialSi;
-pub use modal_all::{ModalAll, ModalInput};
-pub use newmark::{newmark_peaks, newmark_run, NewmarkInfo};
-pub use surface_map::SurfaceMap;
-pub use truth_system::TruthSystem;
+use modal_bake::mesh::{MeshError, TetMesh};
 
 use dcr_runtime::{samples_per_step, HeatGeodesic, SurfacePoint};
-
-use crate::mesh::{MeshError, TetMesh};
 
 /// Which truth to compute.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -192,29 +178,28 @@ pub struct TruthResult {
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum TruthError {
-    /// The mesh could not be read or is invalid.
+    /// The mesh could not be read.
     #[error(transparent)]
     Mesh(#[from] MeshError),
-    /// Invalid parameters or inputs (message names what).
+    /// The full-order system or its solve failed (mesh, material, factorization, size).
+    #[error(transparent)]
+    System(#[from] FullOrderError),
+    /// Invalid parameters or inputs (the message names which).
     #[error("{0}")]
     Params(String),
-    /// A sparse Cholesky factorization failed.
-    #[error("factorization failed: {0}")]
-    Factorization(String),
-    /// The dense eigensolve failed.
-    #[error("modal-all eigensolve failed: {0}")]
-    Eigen(String),
-    /// Too many dofs for the dense modal-all method.
-    #[error("modal-all needs a dense eigensolve: {dofs} free dofs exceeds the limit {max} (use --method newmark)")]
-    TooLarge {
-        /// Free dofs.
-        dofs: usize,
-        /// Limit.
-        max: usize,
-    },
 }
 
 impl TruthParams {
+    /// The full-order system these parameters describe.
+    pub fn system(&self) -> SystemParams {
+        SystemParams {
+            material: self.material,
+            fixed: self.fixed.clone(),
+            rayleigh: self.rayleigh,
+            lumped: self.lumped,
+        }
+    }
+
     /// (samples S, step h/S).
     ///
     /// # Errors
@@ -222,7 +207,7 @@ impl TruthParams {
     pub fn sampling(&self) -> Result<(usize, f64), TruthError> {
         if !(self.h.is_finite() && self.h > 0.0 && self.dt.is_finite() && self.dt > 0.0) {
             return Err(TruthError::Params(format!(
-                "--h and --dt must be finite and > 0 s, got h = {}, dt = {}",
+                "the window h and step dt must be finite and > 0 s, got h = {}, dt = {}",
                 self.h, self.dt
             )));
         }
@@ -240,13 +225,13 @@ impl TruthParams {
 /// Maps the impact and contacts onto the surface and returns (impact point, unit direction,
 /// contact points).
 fn map_points(
-    sys: &TruthSystem,
+    sys: &FullOrderSystem,
     impact: &TruthImpact,
     contacts: &[[f64; 3]],
 ) -> Result<(SurfacePoint, [f64; 3], Vec<SurfacePoint>), TruthError> {
     if !(impact.impulse.is_finite() && impact.impulse > 0.0) {
         return Err(TruthError::Params(format!(
-            "--impulse must be a finite number > 0 (N·s), got {}",
+            "the impulse must be a finite number > 0 (N·s), got {}",
             impact.impulse
         )));
     }
@@ -264,10 +249,10 @@ fn map_points(
     let isp = map(impact.point, "impact point")?;
     let dir = match impact.direction {
         Some(d) => {
-            let n = surface_map::normalize(d);
+            let n = normalize(d);
             if n == [0.0; 3] {
                 return Err(TruthError::Params(format!(
-                    "--direction must be a non-zero finite vector, got {d:?}"
+                    "the impulse direction must be a non-zero finite vector, got {d:?}"
                 )));
             }
             n
@@ -283,7 +268,11 @@ fn map_points(
 }
 
 /// Distances (m) from the impact to each contact, and the kind used.
-fn distances(sys: &TruthSystem, isp: &SurfacePoint, csp: &[SurfacePoint]) -> (Vec<f64>, String) {
+fn distances(
+    sys: &FullOrderSystem,
+    isp: &SurfacePoint,
+    csp: &[SurfacePoint],
+) -> (Vec<f64>, String) {
     if let Ok(heat) = HeatGeodesic::new(&sys.surface.vertices, &sys.surface.triangles) {
         let mut d = vec![0.0; sys.surface.vertices.len()];
         heat.distances_from_point(isp, &mut d);
@@ -301,10 +290,7 @@ fn distances(sys: &TruthSystem, isp: &SurfacePoint, csp: &[SurfacePoint]) -> (Ve
             return (out, "geodesic".into());
         }
     }
-    let out = csp
-        .iter()
-        .map(|c| surface_map::norm2(surface_map::sub(c.point, isp.point)).sqrt())
-        .collect();
+    let out = csp.iter().map(|c| dist(c.point, isp.point)).collect();
     (out, "euclidean".into())
 }
 
@@ -315,7 +301,8 @@ fn distances(sys: &TruthSystem, isp: &SurfacePoint, csp: &[SurfacePoint]) -> (Ve
 /// [`TruthError`] naming what failed (material, mesh, mapping, factorization, size).
 ///
 /// ```
-/// use modal_bake::{mesh::TetMesh, truth::*};
+/// use dcr_lab::truth::*;
+/// use modal_bake::mesh::TetMesh;
 /// let mesh = TetMesh::structured_box([4, 1, 1], [1.0, 0.2, 0.2]);
 /// let params = TruthParams {
 ///     fixed: vec!["xmin".into()],
@@ -337,7 +324,7 @@ pub fn run_truth(
 ) -> Result<TruthResult, TruthError> {
     let (steps, dt) = params.sampling()?;
     let t = Instant::now();
-    let sys = TruthSystem::new(mesh, params, file)?;
+    let sys = FullOrderSystem::new(mesh, &params.system(), file)?;
     let (isp, dir, csp) = map_points(&sys, impact, contacts)?;
     let f = sys.load_vector(&isp, dir, impact.impulse);
     let rows: Vec<Vec<f64>> = csp.iter().map(|c| sys.contact_row(c)).collect();
@@ -407,6 +394,21 @@ pub fn truth_file(
     impact: &TruthImpact,
     contacts: &[[f64; 3]],
 ) -> Result<TruthResult, TruthError> {
-    let mesh = crate::mesh::read_mesh(path)?;
+    let mesh = modal_bake::mesh::read_mesh(path)?;
     run_truth(mesh, params, impact, contacts, &path.display().to_string())
+}
+
+/// `a/|a|`, or zero for a zero or non-finite vector.
+fn normalize(a: [f64; 3]) -> [f64; 3] {
+    let n = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
+    if n > 0.0 && n.is_finite() {
+        a.map(|x| x / n)
+    } else {
+        [0.0; 3]
+    }
+}
+
+/// Euclidean distance (m).
+fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
+    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
 }

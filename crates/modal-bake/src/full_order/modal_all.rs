@@ -9,7 +9,7 @@
 //!
 //! Free-free: the six lowest eigenpairs (λ ≈ 0) are the rigid modes; they are dropped (the load
 //! and the rows are also M-orthogonally stripped of their rigid part by
-//! [`super::TruthSystem::remove_rigid`], so their coefficients are ≈ 0 anyway).
+//! [`super::FullOrderSystem::remove_rigid`], so their coefficients are ≈ 0 anyway).
 
 use std::time::Instant;
 
@@ -17,7 +17,7 @@ use dcr_runtime::{damping_ratio, ModeFilter};
 use faer::{Mat, Side};
 use rayon::prelude::*;
 
-use super::{TruthError, TruthSystem};
+use super::{FullOrderError, FullOrderSystem};
 
 /// A near-zero eigenvalue is rigid when |λ| ≤ this × the first elastic λ (as in the bake).
 const RIGID_REL_TOL: f64 = 1e-6;
@@ -39,13 +39,13 @@ impl ModalAll {
     /// Dense generalized eigensolve of the system's (K, M).
     ///
     /// # Errors
-    /// [`TruthError::TooLarge`] above `max_dofs` free dofs; [`TruthError::Eigen`] if M is not
+    /// [`FullOrderError::TooLarge`] above `max_dofs` free dofs; [`FullOrderError::Eigen`] if M is not
     /// positive definite, the eigensolver fails, or a free-free object does not show exactly
     /// six near-zero eigenvalues.
-    pub fn new(sys: &TruthSystem, max_dofs: usize) -> Result<ModalAll, TruthError> {
+    pub fn new(sys: &FullOrderSystem, max_dofs: usize) -> Result<ModalAll, FullOrderError> {
         let n = sys.n();
         if n > max_dofs {
-            return Err(TruthError::TooLarge {
+            return Err(FullOrderError::TooLarge {
                 dofs: n,
                 max: max_dofs,
             });
@@ -55,7 +55,7 @@ impl ModalAll {
         let kd = sys.k.to_dense();
         let llt = md
             .llt(Side::Lower)
-            .map_err(|e| TruthError::Eigen(format!("M is not positive definite: {e:?}")))?;
+            .map_err(|e| FullOrderError::Eigen(format!("M is not positive definite: {e:?}")))?;
         let l = llt.L().to_owned();
         // X = L⁻¹ K, C = L⁻¹ Xᵀ = L⁻¹ K L⁻ᵀ.
         let mut x = kd;
@@ -65,7 +65,7 @@ impl ModalAll {
         let c = Mat::from_fn(n, n, |i, j| 0.5 * (c[(i, j)] + c[(j, i)]));
         let eig = c
             .self_adjoint_eigen(Side::Lower)
-            .map_err(|e| TruthError::Eigen(format!("dense eigensolver failed: {e:?}")))?;
+            .map_err(|e| FullOrderError::Eigen(format!("dense eigensolver failed: {e:?}")))?;
         let vals: Vec<f64> = (0..n).map(|i| eig.S()[i]).collect();
         let mut phi = eig.U().to_owned();
         l.transpose().solve_upper_triangular_in_place(phi.as_mut());
@@ -77,13 +77,13 @@ impl ModalAll {
                 .filter(|l| l.abs() <= RIGID_REL_TOL * lam7)
                 .count();
             if near != rigid {
-                return Err(TruthError::Eigen(format!(
+                return Err(FullOrderError::Eigen(format!(
                     "expected 6 rigid-body modes for a free-free object, found {near}"
                 )));
             }
         }
         if !vals.iter().all(|v| v.is_finite()) {
-            return Err(TruthError::Eigen("non-finite eigenvalue".into()));
+            return Err(FullOrderError::Eigen("non-finite eigenvalue".into()));
         }
         let vectors = phi.subcols(rigid, n - rigid).to_owned();
         Ok(ModalAll {
