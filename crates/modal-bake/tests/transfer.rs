@@ -245,6 +245,33 @@ fn baking_twice_is_bit_identical_and_info_shows_the_table() {
     assert_eq!(v["transfer"]["modes"], 60);
 }
 
+/// The same inputs give the same bytes on any thread count: a table whose 100 modes come from
+/// the dense all-mode eigensolve (the base keeps 8), baked with RAYON_NUM_THREADS = 1, 2 and 4.
+#[test]
+fn table_is_bit_identical_on_any_thread_count() {
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = data("data/meshes/beam.msh");
+    let bytes: Vec<Vec<u8>> = [1, 2, 4]
+        .iter()
+        .map(|threads| {
+            let out = dir.path().join(format!("t{threads}.modes"));
+            let o = bin()
+                .env("RAYON_NUM_THREADS", threads.to_string())
+                .args(["bake", mesh.to_str().unwrap(), "-o", out.to_str().unwrap()])
+                .args(["--fixed", "clamp", "--modes", "8", "--transfer-h", "0.01"])
+                .args(["--transfer-modes", "100", "--json"])
+                .output()
+                .unwrap();
+            assert!(o.status.success(), "{}", text(&o));
+            let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+            assert_eq!(v["transfer_mode_source"], "dense", "{v}");
+            std::fs::read(&out).unwrap()
+        })
+        .collect();
+    assert!(bytes[0] == bytes[1], "1 vs 2 threads differ");
+    assert!(bytes[0] == bytes[2], "1 vs 4 threads differ");
+}
+
 #[test]
 fn region_options_select_vertices() {
     let dir = tempfile::tempdir().unwrap();
