@@ -122,7 +122,8 @@ fn measured_samples_match_run_truth_at_the_same_points() {
     let sys = FullOrderSystem::new(slab(), &tp.system(), "slab").unwrap();
     let ma = ModalAll::new(&sys, 6000).unwrap();
     let resp = SurfaceResponse::from_modal_all(&sys, &ma, None);
-    let (samples, kind, dt, _) = sample_attenuation(&resp, tp.rayleigh, tp.h, None, 4, 3).unwrap();
+    let (samples, kind, dt, _) =
+        sample_attenuation(&resp, tp.rayleigh, tp.h, None, 4, 3, &mut |_| {}).unwrap();
     assert_eq!(kind, "geodesic");
     for smp in &samples {
         let p = TruthParams { dt, ..tp.clone() };
@@ -169,7 +170,7 @@ fn small_mesh_fit_is_finite_and_decays_with_distance() {
         seed: 11,
         ..Default::default()
     };
-    let rep = fit_attenuation_mesh(slab(), &p, "slab").unwrap();
+    let rep = fit_attenuation_mesh(slab(), &p, "slab", &mut |_| {}).unwrap();
     let f = rep.fit;
     assert!(
         f.alpha.is_finite() && f.beta.is_finite() && f.r0.is_finite(),
@@ -180,7 +181,7 @@ fn small_mesh_fit_is_finite_and_decays_with_distance() {
     assert_eq!(rep.samples.len(), 60);
     assert_eq!(rep.info.method, "modal-all");
     // Same seed, same samples.
-    let again = fit_attenuation_mesh(slab(), &p, "slab").unwrap();
+    let again = fit_attenuation_mesh(slab(), &p, "slab", &mut |_| {}).unwrap();
     assert_eq!(again.samples, rep.samples);
 }
 
@@ -194,7 +195,7 @@ fn sparse_truth_runs_and_decays_with_distance() {
         modes: Some(60),
         ..Default::default()
     };
-    let rep = fit_attenuation_mesh(slab(), &p, "slab").unwrap();
+    let rep = fit_attenuation_mesh(slab(), &p, "slab", &mut |_| {}).unwrap();
     assert_eq!(rep.info.method, "modes");
     assert_eq!(rep.info.modes, 60);
     assert!(
@@ -229,10 +230,16 @@ fn cli_runs_on_a_small_mesh() {
         "10,1e-7",
     ];
     let text = run(&base);
+    let err = String::from_utf8_lossy(&text.stderr);
+    assert!(text.status.success(), "{err}");
+    // stderr is not a terminal here: progress comes as plain lines, ending with the last pair.
     assert!(
-        text.status.success(),
-        "{}",
-        String::from_utf8_lossy(&text.stderr)
+        err.contains("fit-attenuation: solving for the modes"),
+        "{err}"
+    );
+    assert!(
+        err.contains("fit-attenuation: pair responses 30/30"),
+        "{err}"
     );
     let mut with_json = base.to_vec();
     with_json.push("--json");
@@ -241,6 +248,14 @@ fn cli_runs_on_a_small_mesh() {
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("one JSON object");
     let text = v.to_string();
     assert!(text.contains("beta"), "{text}");
+    // An absurd pair count is refused at once, naming the limit (it would need gigabytes).
+    let absurd = run(&["--fixed", "clamp", "--pairs", "1000000000"]);
+    let err = String::from_utf8_lossy(&absurd.stderr);
+    assert!(!absurd.status.success() && err.contains("100000"), "{err}");
+    assert!(
+        err.contains("1000000000") && !err.contains("panicked"),
+        "{err}"
+    );
     // A user error is a clean error, not a panic.
     let bad = run(&["--fixed", "nope"]);
     let err = String::from_utf8_lossy(&bad.stderr);

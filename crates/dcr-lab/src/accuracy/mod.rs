@@ -645,7 +645,7 @@ pub fn generate(out_dir: &Path, quick: bool, transfer_only: bool) -> String {
             ..Default::default()
         };
         let t = Instant::now();
-        match fit_attenuation_mesh(s.mesh.clone(), &fp, &s.file) {
+        match fit_attenuation_mesh(s.mesh.clone(), &fp, &s.file, &mut |_| {}) {
             Ok(f) => fit_lines.push(format!(
                 "| {} | {} ({} modes) | {} | {:.3} | {:.3} | {:.2e} | {:.3} / {:.3} | {:.3} | {:.3} | {:.3} | {:.0} |",
                 s.name, f.info.method, f.info.modes, f.info.pairs_used, f.fit.alpha, f.fit.beta, f.fit.r0,

@@ -6,8 +6,10 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::{Args, ValueEnum};
-use dcr_lab::attenuation_fit::{self, AttenuationFitParams, FitTruth};
+use dcr_lab::attenuation_fit::{self, AttenuationFitParams, FitProgress, FitTruth};
 use modal_bake::args::ModelOptions;
+
+use super::progress::Progress;
 
 /// Truth used for the pairs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -82,12 +84,24 @@ impl FitAttenuationArgs {
 pub fn run(args: &FitAttenuationArgs) -> anyhow::Result<()> {
     let mesh = modal_bake::mesh::read_mesh(&args.mesh)
         .with_context(|| format!("reading {} failed", args.mesh.display()))?;
+    let mut progress = Progress::new("fit-attenuation");
     let rep = attenuation_fit::fit_attenuation_mesh(
         mesh,
         &args.params(),
         &args.mesh.display().to_string(),
-    )
-    .with_context(|| format!("fit-attenuation for {} failed", args.mesh.display()))?;
+        &mut |p| match p {
+            FitProgress::Solve { method } => {
+                progress.stage(&format!("solving for the modes ({method})"))
+            }
+            FitProgress::Distances { done, total } => {
+                progress.count("geodesic distances", done, total)
+            }
+            FitProgress::Pairs { done, total } => progress.count("pair responses", done, total),
+            _ => {}
+        },
+    );
+    progress.finish();
+    let rep = rep.with_context(|| format!("fit-attenuation for {} failed", args.mesh.display()))?;
     if args.json {
         return super::emit(&format!("{}\n", serde_json::to_string_pretty(&rep)?));
     }

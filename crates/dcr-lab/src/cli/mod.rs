@@ -2,6 +2,7 @@
 
 mod accuracy;
 mod fit_attenuation;
+mod progress;
 mod truth;
 
 use std::process::ExitCode;
