@@ -9,9 +9,9 @@ use dcr_lab::attenuation_fit::{
     fit_attenuation_mesh, fit_eq14, fit_eq14_fixed_r0, fit_simplified, sample_attenuation,
     AttenuationFitParams, FitTruth, SurfaceResponse,
 };
-use dcr_lab::truth::{run_truth, TruthImpact, TruthMethod, TruthParams};
+use dcr_lab::truth::{run_truth, CrossCheck, TruthImpact, TruthMethod, TruthParams};
 use dcr_runtime::testing::SplitMix64;
-use modal_bake::full_order::{FullOrderSystem, ModalAll};
+use modal_bake::full_order::{FullOrderSystem, ModalAll, RefineParams};
 use modal_bake::mesh::TetMesh;
 
 /// Eq. 14.
@@ -126,7 +126,16 @@ fn measured_samples_match_run_truth_at_the_same_points() {
         sample_attenuation(&resp, tp.rayleigh, tp.h, None, 4, 3, &mut |_| {}).unwrap();
     assert_eq!(kind, "geodesic");
     for smp in &samples {
-        let p = TruthParams { dt, ..tp.clone() };
+        // One run at exactly the sampler's period (no refinement), to compare like with like.
+        let p = TruthParams {
+            dt,
+            refine: RefineParams {
+                max_refinements: 0,
+                ..RefineParams::default()
+            },
+            cross_check: CrossCheck::Off,
+            ..tp.clone()
+        };
         let imp = TruthImpact {
             point: smp.impact_point,
             impulse: 1.0,
@@ -138,6 +147,7 @@ fn measured_samples_match_run_truth_at_the_same_points() {
             &imp,
             &[smp.impact_point, smp.contact_point],
             "slab",
+            &mut |_| {},
         )
         .unwrap();
         let (local, far) = (

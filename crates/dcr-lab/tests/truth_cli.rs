@@ -117,3 +117,43 @@ fn truth_accepts_negative_coordinates() {
     let d = v["info"]["impact_direction"].as_array().unwrap();
     assert!(d[0].as_f64().unwrap() < 0.0);
 }
+
+/// Exit status 3 and `"converged": false` when the step cannot be refined enough; exit 0 and
+/// the step reached otherwise.
+#[test]
+fn truth_exit_status_says_whether_it_converged() {
+    let out = truth(&[
+        "--json",
+        "--dt",
+        "1e-4",
+        "--tol",
+        "1e-7",
+        "--max-refinements",
+        "1",
+    ]);
+    assert_eq!(
+        out.status.code(),
+        Some(3),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["convergence"]["converged"], false);
+    assert_eq!(v["convergence"]["history"].as_array().unwrap().len(), 2);
+    let out = truth(&["--json", "--dt", "1e-4", "--method", "modal-all"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let c = &v["convergence"];
+    assert_eq!(c["converged"], true);
+    assert!(c["estimated_error_pct"].as_f64().unwrap() < 0.5);
+    assert!(c["history"].as_array().unwrap().len() >= 3);
+    assert_eq!(c["cross_check"]["method"], "newmark");
+    assert_eq!(c["dt_reached"], v["info"]["dt"]);
+    let text = truth(&["--dt", "1e-4", "--method", "modal-all"]);
+    let s = String::from_utf8_lossy(&text.stdout);
+    assert!(s.contains("converged at dt ="), "{s}");
+}

@@ -49,11 +49,11 @@ pub fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Truth(a) => truth::run(&a),
-        Command::FitAttenuation(a) => fit_attenuation::run(&a),
-        Command::Accuracy(a) => accuracy::run(&a),
+        Command::FitAttenuation(a) => fit_attenuation::run(&a).map(|()| ExitCode::SUCCESS),
+        Command::Accuracy(a) => accuracy::run(&a).map(|()| ExitCode::SUCCESS),
     };
     match result {
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(code) => code,
         Err(e) => {
             eprintln!("error: {e:#}");
             ExitCode::FAILURE

@@ -2,10 +2,14 @@
 //! [`dcr_lab::truth`]), in `modal-bake probe`'s JSON shape.
 
 use std::path::PathBuf;
+use std::process::ExitCode;
 
 use anyhow::Context;
 use clap::{Args, ValueEnum};
-use dcr_lab::truth::{self, TruthImpact, TruthMethod, TruthParams};
+use dcr_lab::truth::{self, CrossCheck, TruthImpact, TruthMethod, TruthParams};
+use modal_bake::full_order::RefineParams;
+
+use super::progress::Progress;
 use modal_bake::args::{self as parse, ModelOptions};
 
 /// Truth method.
@@ -17,6 +21,23 @@ pub enum MethodArg {
     ModalAll,
 }
 
+/// When to run the independent check.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum CrossCheckArg {
+    /// When cheap (at most 3000 free dofs).
+    Auto,
+    /// Always.
+    On,
+    /// Never.
+    Off,
+}
+
+/// Exit status of a run whose peaks did not converge (the peaks are still printed).
+pub const EXIT_NOT_CONVERGED: u8 = 3;
+
+/// Full-order reference response of a mesh to an impulse, with the time step refined until
+/// the peaks converge. Exit status: 0 converged, 1 error, 3 not converged (--tol not reached
+/// within --max-refinements; the peaks and `"converged": false` are still printed).
 #[derive(Args, Clone, Debug)]
 pub struct TruthArgs {
     /// Tetrahedral mesh: gmsh .msh (2.2 or 4.1, ASCII or binary) or meshio-style .json.
@@ -45,9 +66,20 @@ pub struct TruthArgs {
     /// Window h (s) over which the peak displacement is taken.
     #[arg(long, value_name = "S", default_value_t = 0.01)]
     pub h: f64,
-    /// Time step / sample period (s); the step used is h/⌈h/dt⌉.
-    #[arg(long, value_name = "S", default_value_t = 1e-6)]
+    /// First time step / sample period (s; the step used is h/⌈h/dt⌉), halved until every peak
+    /// changes by less than --tol.
+    #[arg(long, value_name = "S", default_value_t = 1e-5)]
     pub dt: f64,
+    /// Convergence tolerance (%): the run stops refining when no peak changes by more.
+    #[arg(long, value_name = "PCT", default_value_t = 0.5)]
+    pub tol: f64,
+    /// Most halvings of the step after the first run (0: a single unchecked run at --dt).
+    #[arg(long, value_name = "N", default_value_t = 6)]
+    pub max_refinements: usize,
+    /// Run the other method at the step reached as an independent check (auto: when the mesh
+    /// has at most 3000 free dofs).
+    #[arg(long, value_enum, default_value_t = CrossCheckArg::Auto)]
+    pub cross_check: CrossCheckArg,
     /// Method.
     #[arg(long, value_enum, default_value_t = MethodArg::Newmark)]
     pub method: MethodArg,
@@ -78,11 +110,24 @@ impl TruthArgs {
             },
             modes: self.modes,
             max_dense_dofs: self.max_dense_dofs,
+            refine: RefineParams {
+                tolerance: self.tol / 100.0,
+                max_refinements: self.max_refinements,
+                ..RefineParams::default()
+            },
+            cross_check: match self.cross_check {
+                CrossCheckArg::Auto => CrossCheck::Auto,
+                CrossCheckArg::On => CrossCheck::On,
+                CrossCheckArg::Off => CrossCheck::Off,
+            },
         }
     }
 }
 
-pub fn run(args: &TruthArgs) -> anyhow::Result<()> {
+pub fn run(args: &TruthArgs) -> anyhow::Result<ExitCode> {
+    if !(args.tol.is_finite() && args.tol > 0.0) {
+        anyhow::bail!("--tol must be a percentage > 0, got {}", args.tol);
+    }
     if args.modes.is_some() && args.method != MethodArg::ModalAll {
         anyhow::bail!("--modes truncates the modal sum; it needs --method modal-all");
     }
@@ -95,10 +140,20 @@ pub fn run(args: &TruthArgs) -> anyhow::Result<()> {
         impulse: args.impulse,
         direction: args.direction,
     };
-    let res = truth::truth_file(&args.mesh, &params, &impact, &args.contacts)
-        .with_context(|| format!("truth for {} failed", args.mesh.display()))?;
+    let mut progress = Progress::new("truth");
+    let res = truth::truth_file(&args.mesh, &params, &impact, &args.contacts, &mut |p| {
+        progress.count(&format!("step {:.3e} s", p.dt), p.done, p.total)
+    });
+    progress.finish();
+    let res = res.with_context(|| format!("truth for {} failed", args.mesh.display()))?;
+    let code = if res.convergence.converged || args.max_refinements == 0 {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(EXIT_NOT_CONVERGED)
+    };
     if args.json {
-        return super::emit(&format!("{}\n", serde_json::to_string_pretty(&res)?));
+        super::emit(&format!("{}\n", serde_json::to_string_pretty(&res)?))?;
+        return Ok(code);
     }
     let i = &res.info;
     let mut s = format!(
@@ -136,8 +191,48 @@ pub fn run(args: &TruthArgs) -> anyhow::Result<()> {
         );
     }
     s += &format!(
-        "  seconds: setup {:.3}, factor/eigensolve {:.3}, stepping {:.3} ({} distance)\n",
+        "  seconds: setup {:.3}, eigensolve {:.3}, stepping {:.3} ({} distance)\n",
         i.setup_s, i.solve_s, i.step_s, i.distance_kind
     );
-    super::emit(&s)
+    s += &convergence_lines(&res.convergence, args.max_refinements);
+    super::emit(&s)?;
+    Ok(code)
+}
+
+/// The convergence summary of the text output.
+fn convergence_lines(c: &truth::TruthConvergence, max_refinements: usize) -> String {
+    let steps: Vec<String> = c
+        .history
+        .iter()
+        .map(|l| match l.change_pct {
+            Some(d) => format!("{:.2e} s ({d:.3} %)", l.dt),
+            None => format!("{:.2e} s", l.dt),
+        })
+        .collect();
+    let mut s = format!(
+        "  steps tried (largest peak change): {}\n",
+        steps.join(", ")
+    );
+    s += &match (c.converged, c.estimated_error_pct) {
+        (true, Some(e)) => format!(
+            "  converged at dt = {:.3e} s: last two changes ≤ {e:.3} % < {} % (last {:.3} %)\n",
+            c.dt_reached,
+            c.tolerance_pct,
+            c.last_change_pct.unwrap_or(f64::NAN),
+        ),
+        _ if max_refinements == 0 => "  single run (--max-refinements 0): convergence not checked\n".into(),
+        _ => format!(
+            "  NOT CONVERGED at dt = {:.3e} s: last two changes up to {:.3} %, tolerance {} % (raise --max-refinements or lower --dt)\n",
+            c.dt_reached,
+            c.estimated_error_pct.or(c.last_change_pct).unwrap_or(f64::NAN),
+            c.tolerance_pct
+        ),
+    };
+    if let Some(x) = &c.cross_check {
+        s += &format!(
+            "  cross-check: {} at dt = {:.3e} s differs by at most {:.3} %\n",
+            x.method, x.dt, x.max_diff_pct
+        );
+    }
+    s
 }

@@ -33,7 +33,8 @@ use std::time::Instant;
 
 pub use modal_bake::full_order::MaterialSi;
 use modal_bake::full_order::{
-    newmark_peaks, FullOrderError, FullOrderSystem, ModalAll, SystemParams,
+    converged_peaks, FullOrderError, FullOrderSystem, ModalAll, PeakSolver, PeakWindow,
+    RefineParams, RefineProgress, SystemParams,
 };
 use modal_bake::mesh::{MeshError, TetMesh};
 
@@ -62,7 +63,8 @@ pub struct TruthParams {
     pub lumped: bool,
     /// Window h (s) over which the peak is taken. Default 0.01.
     pub h: f64,
-    /// Sample/step size Δt (s); the step used is h/⌈h/Δt⌉. Default 1e-6.
+    /// First sample/step size Δt (s); the first step used is h/⌈h/Δt⌉, then halved until the
+    /// peaks converge ([`TruthParams::refine`]). Default 1e-5.
     pub dt: f64,
     /// Method. Default [`TruthMethod::Newmark`].
     pub method: TruthMethod,
@@ -71,6 +73,71 @@ pub struct TruthParams {
     /// Modal-all only: refuse meshes with more free dofs than this (dense memory 8n² bytes per
     /// matrix). Default 6000.
     pub max_dense_dofs: usize,
+    /// Step refinement: tolerance, halvings, sample budget (`max_refinements = 0`: one run at
+    /// `dt`, unchecked). Default [`RefineParams::default`] (0.5 %, 6 halvings).
+    pub refine: RefineParams,
+    /// Whether the other method is run at the finest step as an independent check. Default
+    /// [`CrossCheck::Auto`].
+    pub cross_check: CrossCheck,
+}
+
+/// The independent check of a truth run: the other method at the step the run reached.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum CrossCheck {
+    /// When cheap: free dofs ≤ [`CROSS_CHECK_AUTO_DOFS`] (a dense solve of at most that size).
+    #[default]
+    Auto,
+    /// Always (modal-all needs free dofs ≤ `max_dense_dofs`).
+    On,
+    /// Never.
+    Off,
+}
+
+/// [`CrossCheck::Auto`] runs the check up to this many free dofs.
+pub const CROSS_CHECK_AUTO_DOFS: usize = 3000;
+
+/// How a truth run converged (percentages of each peak).
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct TruthConvergence {
+    /// Whether every peak changed by less than the tolerance over the last two halvings.
+    pub converged: bool,
+    /// Tolerance (%).
+    pub tolerance_pct: f64,
+    /// Step reached (s).
+    pub dt_reached: f64,
+    /// Largest change of a peak between the last two steps (%; null with one step).
+    pub last_change_pct: Option<f64>,
+    /// Estimated error of the reported peaks: the larger of the last two changes (%; null with
+    /// fewer than three steps).
+    pub estimated_error_pct: Option<f64>,
+    /// Every step tried, coarsest first: `dt`, `samples`, `change_pct`, `seconds`.
+    pub history: Vec<TruthLevel>,
+    /// The other method at the step reached, if run.
+    pub cross_check: Option<TruthCrossCheck>,
+}
+
+/// One step of the refinement.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct TruthLevel {
+    /// Step (s).
+    pub dt: f64,
+    /// Samples over the window.
+    pub samples: usize,
+    /// Largest change of a peak from the previous step (%; null first).
+    pub change_pct: Option<f64>,
+    /// Wall seconds.
+    pub seconds: f64,
+}
+
+/// The independent check.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct TruthCrossCheck {
+    /// `newmark` or `modal-all`.
+    pub method: String,
+    /// Its step (s).
+    pub dt: f64,
+    /// Largest relative difference of a peak from the reported one (%).
+    pub max_diff_pct: f64,
 }
 
 impl Default for TruthParams {
@@ -85,10 +152,12 @@ impl Default for TruthParams {
             rayleigh: [10.0, 1e-7],
             lumped: false,
             h: 0.01,
-            dt: 1e-6,
+            dt: 1e-5,
             method: TruthMethod::Newmark,
             modes: None,
             max_dense_dofs: 6000,
+            refine: RefineParams::default(),
+            cross_check: CrossCheck::Auto,
         }
     }
 }
@@ -96,9 +165,6 @@ impl Default for TruthParams {
 /// Points farther than this fraction of the surface's bounding-box diagonal are refused (as
 /// `modal-bake probe` and `DistantResponse` do by default).
 pub const MAP_DISTANCE_REL: f64 = 0.05;
-
-/// Largest number of steps accepted (h/dt).
-pub const MAX_STEPS: usize = 100_000_000;
 
 /// An impulse applied at t = 0.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -172,6 +238,8 @@ pub struct TruthResult {
     pub contacts: Vec<TruthContact>,
     /// Run information.
     pub info: TruthInfo,
+    /// How the step was refined and whether the peaks converged.
+    pub convergence: TruthConvergence,
 }
 
 /// Why a truth run failed.
@@ -203,7 +271,8 @@ impl TruthParams {
     /// (samples S, step h/S).
     ///
     /// # Errors
-    /// [`TruthError::Params`] for non-positive h or dt or more than [`MAX_STEPS`] steps.
+    /// [`TruthError::Params`] for non-positive h or dt or more than the refinement's sample
+    /// budget ([`RefineParams::max_samples`]).
     pub fn sampling(&self) -> Result<(usize, f64), TruthError> {
         if !(self.h.is_finite() && self.h > 0.0 && self.dt.is_finite() && self.dt > 0.0) {
             return Err(TruthError::Params(format!(
@@ -211,10 +280,11 @@ impl TruthParams {
                 self.h, self.dt
             )));
         }
-        if self.h / self.dt > MAX_STEPS as f64 {
+        if !(self.h / self.dt <= self.refine.max_samples as f64) {
             return Err(TruthError::Params(format!(
-                "h/dt = {:.3e} steps exceeds the limit {MAX_STEPS}",
-                self.h / self.dt
+                "h/dt = {:.3e} steps exceeds the limit {}",
+                self.h / self.dt,
+                self.refine.max_samples
             )));
         }
         let s = samples_per_step(self.h, self.dt);
@@ -294,11 +364,13 @@ fn distances(
     (out, "euclidean".into())
 }
 
-/// Truth for an in-memory mesh: impulse `impact` at t = 0, peaks at `contacts` (m).
-/// `file` names the source in messages.
+/// Truth for an in-memory mesh: impulse `impact` at t = 0, peaks at `contacts` (m), with the
+/// step refined until the peaks converge (`params.refine`; the result says whether they did).
+/// `file` names the source in messages; `progress` hears each refinement level and step.
 ///
 /// # Errors
-/// [`TruthError`] naming what failed (material, mesh, mapping, factorization, size).
+/// [`TruthError`] naming what failed (material, mesh, mapping, factorization, size). A run that
+/// does not converge is not an error: [`TruthConvergence::converged`] is false.
 ///
 /// ```
 /// use dcr_lab::truth::*;
@@ -312,8 +384,8 @@ fn distances(
 ///     ..Default::default()
 /// };
 /// let impact = TruthImpact { point: [1.0, 0.1, 0.2], impulse: 1.0, direction: None };
-/// let res = run_truth(mesh, &params, &impact, &[[0.5, 0.1, 0.2]], "box").unwrap();
-/// assert!(res.contacts[0].peak_displacement_m > 0.0);
+/// let res = run_truth(mesh, &params, &impact, &[[0.5, 0.1, 0.2]], "box", &mut |_| {}).unwrap();
+/// assert!(res.contacts[0].peak_displacement_m > 0.0 && res.convergence.converged);
 /// ```
 pub fn run_truth(
     mesh: TetMesh,
@@ -321,8 +393,9 @@ pub fn run_truth(
     impact: &TruthImpact,
     contacts: &[[f64; 3]],
     file: &str,
+    progress: &mut dyn FnMut(RefineProgress),
 ) -> Result<TruthResult, TruthError> {
-    let (steps, dt) = params.sampling()?;
+    let (_, dt0) = params.sampling()?;
     let t = Instant::now();
     let sys = FullOrderSystem::new(mesh, &params.system(), file)?;
     let (isp, dir, csp) = map_points(&sys, impact, contacts)?;
@@ -332,8 +405,6 @@ pub fn run_truth(
     let mut info = TruthInfo {
         free_dofs: sys.n(),
         fixed_nodes: sys.fixed_nodes,
-        samples: steps,
-        dt,
         h: params.h,
         impact_point: isp.point,
         impact_triangle: isp.triangle,
@@ -343,31 +414,119 @@ pub fn run_truth(
         setup_s: t.elapsed().as_secs_f64(),
         ..Default::default()
     };
-    let peaks = match params.method {
-        TruthMethod::Newmark => {
-            info.method = "newmark".into();
-            let (p, ni) = newmark_peaks(&sys, &f, &rows, dt, steps)?;
-            info.solve_s = ni.factor_s;
-            info.step_s = ni.step_s;
-            p
-        }
-        TruthMethod::ModalAll => {
+    let loads = [f];
+    let dense_ok = sys.n() <= params.max_dense_dofs;
+    let check = match params.cross_check {
+        CrossCheck::Off => false,
+        CrossCheck::On => true,
+        CrossCheck::Auto => sys.n() <= CROSS_CHECK_AUTO_DOFS.min(params.max_dense_dofs),
+    };
+    let need_dense = params.method == TruthMethod::ModalAll || (check && dense_ok);
+    let t = Instant::now();
+    let ma = if need_dense {
+        let ma = ModalAll::new(&sys, params.max_dense_dofs)?;
+        info.rigid_modes_dropped = ma.rigid_dropped;
+        Some(ma)
+    } else {
+        None
+    };
+    let dense_s = t.elapsed().as_secs_f64();
+    let t = Instant::now();
+    let (solver, other) = match (params.method, &ma) {
+        (TruthMethod::ModalAll, Some(ma)) => {
             info.method = "modal-all".into();
-            let ma = ModalAll::new(&sys, params.max_dense_dofs)?;
-            info.solve_s = ma.solve_s;
-            info.rigid_modes_dropped = ma.rigid_dropped;
+            // A truncated sum is not the full-order response: nothing to check it against.
+            let check = check && params.modes.is_none();
             info.modes_used = params.modes.unwrap_or(usize::MAX).min(ma.eigenvalues.len());
-            let t = Instant::now();
-            let p = ma.peaks(&f, &rows, params.rayleigh, dt, steps, params.modes);
-            info.step_s = t.elapsed().as_secs_f64();
-            p
+            info.solve_s = dense_s;
+            (
+                PeakSolver::ModalAll(ma, params.modes),
+                check.then_some(PeakSolver::Newmark),
+            )
+        }
+        (_, ma) => {
+            info.method = "newmark".into();
+            let other = ma
+                .as_ref()
+                .filter(|_| check)
+                .map(|m| PeakSolver::ModalAll(m, None));
+            (PeakSolver::Newmark, other)
         }
     };
+    let conv = converged_peaks(
+        &sys,
+        solver,
+        &loads,
+        &rows,
+        PeakWindow {
+            h: params.h,
+            dt: dt0,
+        },
+        &params.refine,
+        progress,
+    )?;
+    info.step_s = t.elapsed().as_secs_f64();
+    info.samples = conv.samples;
+    info.dt = conv.dt;
+    let peaks = conv.peaks[0].clone();
     if !peaks.iter().all(|p| p.is_finite()) {
         return Err(TruthError::Params(
             "the response is not finite (overflow: impulse or material out of range)".into(),
         ));
     }
+    let cross_check = match other {
+        Some(o) => {
+            let single = RefineParams {
+                max_refinements: 0,
+                ..params.refine
+            };
+            let c = converged_peaks(
+                &sys,
+                o,
+                &loads,
+                &rows,
+                PeakWindow {
+                    h: params.h,
+                    dt: conv.dt,
+                },
+                &single,
+                &mut |_| {},
+            )?;
+            let diff = peaks
+                .iter()
+                .zip(&c.peaks[0])
+                .filter(|(p, _)| **p > 1e-12 * peaks.iter().fold(0.0f64, |a, b| a.max(*b)))
+                .fold(0.0f64, |m, (p, q)| m.max(((q - p) / p).abs()));
+            Some(TruthCrossCheck {
+                method: match o {
+                    PeakSolver::Newmark => "newmark".into(),
+                    PeakSolver::ModalAll(..) => "modal-all".into(),
+                },
+                dt: c.dt,
+                max_diff_pct: 100.0 * diff,
+            })
+        }
+        None => None,
+    };
+    let pct = |x: f64| x.is_finite().then_some(100.0 * x);
+    let convergence = TruthConvergence {
+        converged: conv.converged,
+        tolerance_pct: 100.0 * conv.tolerance,
+        dt_reached: conv.dt,
+        last_change_pct: pct(conv.last_change),
+        estimated_error_pct: pct(conv.estimated_error),
+        history: conv
+            .history
+            .iter()
+            .map(|l| TruthLevel {
+                dt: l.dt,
+                samples: l.samples,
+                change_pct: pct(l.change),
+                seconds: l.seconds,
+            })
+            .collect(),
+        cross_check,
+    };
     let contacts = csp
         .iter()
         .zip(peaks)
@@ -381,7 +540,11 @@ pub fn run_truth(
             delta_v_mps: p / params.h,
         })
         .collect();
-    Ok(TruthResult { contacts, info })
+    Ok(TruthResult {
+        contacts,
+        info,
+        convergence,
+    })
 }
 
 /// [`run_truth`] on a mesh file (gmsh MSH 2.2/4.1 or meshio JSON).
@@ -393,9 +556,17 @@ pub fn truth_file(
     params: &TruthParams,
     impact: &TruthImpact,
     contacts: &[[f64; 3]],
+    progress: &mut dyn FnMut(RefineProgress),
 ) -> Result<TruthResult, TruthError> {
     let mesh = modal_bake::mesh::read_mesh(path)?;
-    run_truth(mesh, params, impact, contacts, &path.display().to_string())
+    run_truth(
+        mesh,
+        params,
+        impact,
+        contacts,
+        &path.display().to_string(),
+        progress,
+    )
 }
 
 /// `a/|a|`, or zero for a zero or non-finite vector.

@@ -13,15 +13,22 @@
 //!   Cholesky of K_eff and one back-solve per step; exact impulse initial state.
 //! - [`ModalAll`]: dense generalized eigensolve of every mode (small meshes) and the exact damped
 //!   impulse response of each mode in every damping regime (ξ < 1, = 1, > 1).
+//! - [`converged_peaks`]: either solver with its step halved until the peaks change by less
+//!   than a tolerance (0.5 % by default), reporting the step reached and the estimated error.
 
+mod convergence;
 mod full_order_system;
 mod modal_all;
 mod newmark;
 mod surface_map;
 
+pub use convergence::{
+    converged_peaks, ConvergedPeaks, PeakSolver, PeakWindow, RefineParams, RefineProgress,
+    Refinement,
+};
 pub use full_order_system::FullOrderSystem;
 pub use modal_all::{ModalAll, ModalInput};
-pub use newmark::{newmark_peaks, newmark_run, NewmarkInfo};
+pub use newmark::{newmark_peaks, newmark_peaks_multi, newmark_run, NewmarkInfo};
 pub use surface_map::SurfaceMap;
 
 pub use dcr_runtime::format::MaterialSi;
