@@ -154,6 +154,97 @@ fn attenuation(c: &mut Criterion) {
     );
 }
 
+/// The cached modal query with cold caches, as in a scene where the rigid-body step runs
+/// between two queries: a 32 MB buffer is swept before each timed query (printed, not a
+/// criterion bench: median, 10th and 90th percentile of 2000 single queries, which criterion's
+/// mean would let a few preempted queries dominate). Compare with `modal-best-of`, where
+/// everything stays in cache. Runs when the bench arguments include `modal-cold`.
+fn modal_cold(_c: &mut Criterion) {
+    if !std::env::args().any(|a| a == "modal-cold") {
+        return;
+    }
+    let mut junk = vec![1u64; 4 << 20];
+    for &(name, s, nc, verts, paper) in &ROWS {
+        let w = workload(verts, nc, 17);
+        let params = ResponseParams {
+            sampling: Sampling::Substep(H / s as f64),
+            method: Method::Modal,
+            ..Default::default()
+        };
+        let mut r = DistantResponse::new(Arc::clone(&w.model), params).unwrap();
+        for imp in &w.impacts {
+            r.step(&[*imp], &w.resting);
+        }
+        let mut times = Vec::with_capacity(2000);
+        for i in 0..2000 {
+            for (k, x) in junk.iter_mut().enumerate().step_by(8) {
+                *x = x.wrapping_add(k as u64);
+            }
+            let imp = [w.impacts[i % w.impacts.len()]];
+            let t0 = std::time::Instant::now();
+            black_box(r.step(&imp, &w.resting)[0].delta_v);
+            times.push(t0.elapsed().as_secs_f64());
+        }
+        times.sort_by(f64::total_cmp);
+        let q = |f: f64| times[(f * times.len() as f64) as usize] * 1e6;
+        println!(
+            "cold modal/{name}/cached median {:.3} µs (p10 {:.3}, p90 {:.3}; {:.0}x paper)",
+            q(0.5),
+            q(0.1),
+            q(0.9),
+            paper * 1e3 / q(0.5)
+        );
+    }
+    black_box(junk[3]);
+}
+
+/// The low-rider as it runs in the scene: its resting contacts (cones and posts rocking)
+/// move farther than the remap tolerance between queries, so every query re-maps them — with
+/// per-contact heat fields that means new solves; with the all-pairs vertex table, none.
+/// Plus the table's one-off set-up on the low-rider's surface.
+fn attenuation_moving(c: &mut Criterion) {
+    let (name, s, nc, verts, _) = ROWS[3];
+    let w = workload(verts, nc, 17);
+    for (label, distance) in [
+        ("heat", DistanceKind::Heat),
+        ("heat-table", DistanceKind::HeatTable),
+    ] {
+        let params = ResponseParams {
+            sampling: Sampling::Substep(H / s as f64),
+            method: Method::Attenuation(AttenuationParams {
+                law: AttenuationLaw::Simplified { c: 1.0, beta: 0.5 },
+                distance,
+                amplitude: AmplitudeKind::PerVertex,
+                cache_capacity: 64,
+                parallel_heat: false,
+            }),
+            ..Default::default()
+        };
+        let mut r = DistantResponse::new(Arc::clone(&w.model), params).unwrap();
+        let mut resting = w.resting.clone();
+        let mut i = 0usize;
+        c.bench_function(&format!("attenuation-moving/{name}/{label}"), |b| {
+            b.iter(|| {
+                i += 1;
+                // Each contact slides 1 mm (> 1 % of the mean edge) one way, then back.
+                let dx = if i % 2 == 0 { 1e-3 } else { -1e-3 };
+                for rc in resting.iter_mut() {
+                    rc.point[0] += dx;
+                }
+                let imp = [w.impacts[i % w.impacts.len()]];
+                black_box(r.step(&imp, &resting)[0].delta_v)
+            })
+        });
+    }
+    let heat = w.model.heat_geodesic().unwrap();
+    let mut group = c.benchmark_group("heat-table");
+    group.sample_size(10);
+    group.bench_function(format!("setup/{}v", w.model.num_vertices()), |b| {
+        b.iter(|| black_box(dcr_runtime::attenuation::GeodesicTable::build(heat).size_bytes()))
+    });
+    group.finish();
+}
+
 fn geodesic(c: &mut Criterion) {
     let (v, t) = box_surface(29, [1.2, 0.8, 0.6]); // 5048 vertices
     c.bench_function(&format!("heat/setup/{}v", v.len()), |b| {
@@ -487,7 +578,9 @@ criterion_group!(
     kernel,
     kernel_rows,
     modal,
+    modal_cold,
     attenuation,
+    attenuation_moving,
     geodesic
 );
 criterion_main!(benches);

@@ -47,6 +47,14 @@ pub enum DistanceKind {
     /// distance is symmetric up to the method's discretisation error): at most 2 × impacts
     /// heat solves per step.
     Heat,
+    /// Heat-method geodesic distances between every pair of surface vertices, computed once
+    /// per model at set-up (ns heat solves on the rayon pool, ns² × 4 bytes shared by every
+    /// instance of the model; [`crate::attenuation::GeodesicTable`]) and read bilinearly
+    /// between the contact's and the impact's triangles: no solve per step, whatever the
+    /// contacts do. For surfaces of up to [`crate::attenuation::GeodesicTable::MAX_VERTICES`]
+    /// vertices; differs from [`DistanceKind::Heat`] inside triangles by the interpolation
+    /// error.
+    HeatTable,
     /// Straight-line distance between the mapped surface points.
     Euclidean,
 }

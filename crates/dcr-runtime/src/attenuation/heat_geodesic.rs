@@ -399,6 +399,15 @@ impl HeatGeodesic {
         self.distances_with(&[(v, 1.0)], out, &mut ws);
     }
 
+    /// As [`HeatGeodesic::distances_from_vertex`] with caller-owned scratch: does not allocate.
+    ///
+    /// # Panics
+    /// If `v` ≥ ns or `out.len()` ≠ ns.
+    pub fn distances_from_vertex_with(&self, v: usize, out: &mut [f64], ws: &mut HeatWorkspace) {
+        assert!(v < self.n, "vertex {v} out of range");
+        self.distances_with(&[(v, 1.0)], out, ws);
+    }
+
     /// Distances (m) from a surface point (its triangle and barycentric weights; the triangle
     /// indexes the `triangles` this was built with) to every vertex, written to `out`.
     ///

@@ -565,3 +565,48 @@ fn heat_query_percentiles() {
         );
     }
 }
+
+/// The all-pairs table: each row is the heat solve from that vertex (to f32 rounding), the same
+/// bits on one thread or two, and between surface points it is the bilinear blend of rows.
+#[test]
+fn geodesic_table_rows_are_heat_solves() {
+    let (v, t) = plate_grid(10, 7, 1.0, 0.7);
+    let heat = HeatGeodesic::new(&v, &t).unwrap();
+    let pool = |n| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build()
+            .unwrap()
+    };
+    let one = pool(1).install(|| GeodesicTable::build(&heat));
+    let two = pool(2).install(|| GeodesicTable::build(&heat));
+    assert_eq!(one.size_bytes(), v.len() * v.len() * 4);
+    let mut out = vec![0.0; v.len()];
+    for a in [0, 13, v.len() - 1] {
+        heat.distances_from_vertex(a, &mut out);
+        for b in 0..v.len() {
+            let d = one.vertex_distance(a, b);
+            assert_eq!(d.to_bits(), two.vertex_distance(a, b).to_bits());
+            assert!((d - out[b]).abs() <= 1e-6 * out[b].max(1e-3), "{a}→{b}");
+        }
+    }
+    // Between points: Σ β_i γ_j D[a_i][b_j].
+    let sp = |tri: usize, bary: [f64; 3]| crate::model::SurfacePoint {
+        triangle: tri as u32,
+        bary,
+        point: [0.0; 3],
+        normal: [0.0, 0.0, 1.0],
+        distance: 0.0,
+    };
+    let (ta, tb) = (3, 100);
+    let (ba, bb) = ([0.2, 0.3, 0.5], [0.6, 0.1, 0.3]);
+    let cor = |ti: usize| t[ti].map(|x| x as usize);
+    let mut want = 0.0;
+    for i in 0..3 {
+        for j in 0..3 {
+            want += ba[i] * bb[j] * one.vertex_distance(cor(ta)[i], cor(tb)[j]);
+        }
+    }
+    let got = one.distance(&sp(ta, ba), cor(ta), &sp(tb, bb), cor(tb));
+    assert!((got - want).abs() <= 1e-15 * want);
+}

@@ -6,4 +6,5 @@ mod contact_cache;
 mod id_hasher;
 
 pub use contact_cache::{CachedContact, ContactCache};
+pub(crate) use id_hasher::BuildIdHasher;
 pub use id_hasher::IdHasher;

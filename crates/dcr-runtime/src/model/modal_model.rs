@@ -8,7 +8,7 @@ use parry3d_f64::query::PointQueryWithLocation;
 use parry3d_f64::shape::TriMesh;
 
 use super::{LoadError, SurfacePoint};
-use crate::attenuation::{GeodesicError, HeatGeodesic};
+use crate::attenuation::{GeodesicError, GeodesicTable, HeatGeodesic};
 use crate::format::ModesFile;
 use crate::math::{add, cross, norm, normalize, scale, sub};
 
@@ -26,6 +26,7 @@ pub struct ModalModel {
     bbox_diagonal: f64,
     mean_edge_length: f64,
     heat: OnceLock<Result<HeatGeodesic, GeodesicError>>,
+    geodesic_table: OnceLock<GeodesicTable>,
 }
 
 impl ModalModel {
@@ -104,6 +105,7 @@ impl ModalModel {
             bbox_diagonal,
             mean_edge_length,
             heat: OnceLock::new(),
+            geodesic_table: OnceLock::new(),
         })
     }
 
@@ -253,5 +255,18 @@ impl ModalModel {
                 )
             })
             .as_ref()
+    }
+
+    /// All-pairs heat-method distances over the surface's vertices, computed on first use
+    /// (ns solves) and shared by every instance using the model.
+    ///
+    /// # Errors
+    /// As [`ModalModel::heat_geodesic`]; a surface of more than
+    /// [`GeodesicTable::MAX_VERTICES`] vertices is refused by the caller before this.
+    pub fn geodesic_table(&self) -> Result<&GeodesicTable, &GeodesicError> {
+        let heat = self.heat_geodesic()?;
+        Ok(self
+            .geodesic_table
+            .get_or_init(|| GeodesicTable::build(heat)))
     }
 }

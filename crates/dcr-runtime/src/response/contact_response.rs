@@ -16,6 +16,10 @@ pub struct ContactResponse {
     pub delta_v: f64,
     /// `false`: the contact is farther than `max_map_distance` from the surface: zero response.
     pub mapped: bool,
+    /// Tangential velocity change (m/s, object frame, ⟂ `normal`): the peak tangential
+    /// displacement over the step / h, along its direction at the peak (the lateral kick,
+    /// paper §5.4). `[0, 0, 0]` unless [`crate::ResponseParams::lateral_kick`].
+    pub lateral_delta_v: [f64; 3],
     /// Which method produced `peak_displacement` (the modal method also serves the contacts a
     /// [`crate::Method::Transfer`] table cannot: outside its region, forces, h mismatch).
     pub served_by: ServedBy,

@@ -2,25 +2,34 @@
 //! displacement and velocity change out (Eq. 9–13 modal, Eq. 14–16 attenuation), and the
 //! impulse conversion of Eq. 17–19.
 
+mod attenuation_response;
 mod contact_response;
+mod contact_set;
 mod distant_response;
 mod effective_mass;
 mod force_input;
 mod impact;
+mod impulse_table;
+mod lateral_kick;
+mod modal_response;
 mod peak_kernel;
 mod response_params;
 mod resting_contact;
+mod step_ctx;
 mod step_info;
+mod transfer_response;
 
 pub use contact_response::{ContactResponse, ServedBy};
+pub(crate) use contact_set::ContactSet;
 pub use distant_response::DistantResponse;
 pub use effective_mass::{effective_mass, response_impulse};
 pub use force_input::ForceInput;
 pub use impact::Impact;
+#[cfg(feature = "bench-internals")]
 pub use peak_kernel::{peak_abs_projection, peak_abs_rows};
-pub use response_params::{Method, ParamsError, ResponseParams, Variant};
+pub use response_params::{Method, ParamsError, ResponseParams, TablePolicy, TableStatus, Variant};
 pub use resting_contact::RestingContact;
-pub use step_info::StepInfo;
+pub use step_info::{StepInfo, TableFallback};
 
 #[cfg(test)]
 mod tests;

@@ -18,6 +18,9 @@
 //! the kernels are compiled for those features and picked at run time (`pulp` dispatch);
 //! elsewhere the baseline build is used.
 
+// The panel kernel serves the benchmarks and tests only (the step uses the rows kernel).
+#![cfg_attr(not(any(test, feature = "bench-internals")), allow(dead_code))]
+
 use crate::math::fmadd;
 
 /// Samples per SIMD vector in [`peak_abs_rows`] (its sample stride is a multiple of this).

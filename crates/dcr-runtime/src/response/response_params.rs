@@ -64,8 +64,40 @@ pub struct ResponseParams {
     pub carry_over: bool,
     /// Relative sleep threshold for `carry_over`. Default 1e-12.
     pub sleep_energy_rel: f64,
-    /// Cached resting contacts unseen for more than this many steps are evicted. Default 120.
+    /// Cached resting contacts unseen for more than this many rigid-body steps are evicted
+    /// (steps passed without a call count, see [`crate::DistantResponse::skip_steps`]).
+    /// Default 120.
     pub evict_after_steps: u32,
+    /// What [`Method::Transfer`] does when the base's table cannot serve. Default
+    /// [`TablePolicy::FallBackToModal`].
+    pub table_policy: TablePolicy,
+    /// The lateral kick (paper §5.4): also report the peak tangential displacement at each
+    /// contact as a tangential velocity change ([`crate::ContactResponse::lateral_delta_v`]),
+    /// which [`crate::DcrWorld`] adds to the impulse. Computed from the modal base (3 mode rows
+    /// per vertex) whichever method serves the normal part. Default `false`.
+    pub lateral_kick: bool,
+}
+
+/// What a [`Method::Transfer`] response does when the base's transfer table cannot serve it.
+///
+/// Whether the table applies to the whole run (the base has one, baked for this h and
+/// Rayleigh damping, filters restarting every step) is known at set-up
+/// ([`crate::DistantResponse::table_status`]); whether it serves a step is known per step (an
+/// impact or resting contact outside the table's region, a force input). Per-step cases
+/// always fall back to the modal method, counted in
+/// [`crate::StepInfo::contacts_table_fallback`] with the reason in
+/// [`crate::StepInfo::table_fallback`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum TablePolicy {
+    /// A table that does not apply to the run is not used: the modal method serves, and every
+    /// resting contact of every step counts in `contacts_table_fallback` (reason
+    /// [`crate::TableFallback::Unavailable`]). A base without any table is plain modal (not
+    /// counted; [`crate::TableStatus::NoTable`]). Default.
+    #[default]
+    FallBackToModal,
+    /// Set-up fails ([`ParamsError::TableRefused`], with the numbers) when the base has no
+    /// table or its table does not apply to the run.
+    Refuse,
 }
 
 impl Default for ResponseParams {
@@ -81,6 +113,8 @@ impl Default for ResponseParams {
             carry_over: false,
             sleep_energy_rel: 1e-12,
             evict_after_steps: 120,
+            table_policy: TablePolicy::FallBackToModal,
+            lateral_kick: false,
         }
     }
 }
@@ -106,4 +140,66 @@ pub enum ParamsError {
     /// The heat-method operators could not be built for this surface.
     #[error("heat geodesics: {0}")]
     Geodesic(String),
+    /// [`TablePolicy::Refuse`]: the base's transfer table does not apply to this response.
+    #[error("transfer table refused: {status}")]
+    TableRefused {
+        /// Why (with the numbers).
+        status: TableStatus,
+    },
+}
+
+/// Whether a response's transfer table is in use, and if not, why
+/// ([`crate::DistantResponse::table_status`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum TableStatus {
+    /// The table serves the steps (contacts and impacts inside its region).
+    Active,
+    /// The method is not [`Method::Transfer`].
+    NotRequested,
+    /// The base has no transfer table: the modal method serves.
+    NoTable,
+    /// The table was baked for another rigid-body step (relative tolerance 1e-9).
+    StepMismatch {
+        /// The table's h (s).
+        table_h: f64,
+        /// The response's h (s).
+        h: f64,
+    },
+    /// The table was baked with other Rayleigh damping (relative tolerance 1e-9).
+    DampingMismatch {
+        /// The table's [α0 (1/s), α1 (s)].
+        table: [f64; 2],
+        /// The response's [α0, α1].
+        response: [f64; 2],
+    },
+    /// `carry_over` is on: the table assumes filters at rest at every step's start.
+    CarryOver,
+}
+
+impl std::fmt::Display for TableStatus {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match *self {
+            TableStatus::Active => write!(f, "the table applies"),
+            TableStatus::NotRequested => write!(f, "the method is not Transfer"),
+            TableStatus::NoTable => write!(
+                f,
+                "the base has no transfer table (bake one with `modal-bake bake --transfer-h H`)"
+            ),
+            TableStatus::StepMismatch { table_h, h } => write!(
+                f,
+                "the table was baked for h = {table_h} s but the response steps h = {h} s \
+                 (rebake with --transfer-h {h})"
+            ),
+            TableStatus::DampingMismatch { table, response } => write!(
+                f,
+                "the table was baked with Rayleigh damping [{}, {}] but the response uses \
+                 [{}, {}]",
+                table[0], table[1], response[0], response[1]
+            ),
+            TableStatus::CarryOver => write!(
+                f,
+                "carry_over is on, but the table assumes filters at rest at each step's start"
+            ),
+        }
+    }
 }

@@ -23,7 +23,25 @@ pub struct StepInfo {
     pub asleep: bool,
     /// Resting contacts whose response came from the transfer table ([`crate::Method::Transfer`]).
     pub contacts_by_table: u32,
-    /// Resting contacts the transfer table could not serve this step (impact or contact outside
-    /// its region, or a force input), served by the modal method instead.
+    /// Resting contacts a [`crate::Method::Transfer`] response served with the modal method
+    /// instead of its table this step (why: `table_fallback`).
     pub contacts_table_fallback: u32,
+    /// Why the table did not serve (some of) this step's contacts; `None` when it served all
+    /// of them or was not requested.
+    pub table_fallback: Option<TableFallback>,
+}
+
+/// Why a [`crate::Method::Transfer`] response fell back to the modal method in a step.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TableFallback {
+    /// The table does not apply to this response at all (see
+    /// [`crate::DistantResponse::table_status`]); every contact is modal.
+    Unavailable,
+    /// The step has a force input (the table holds impulse responses only); every contact is
+    /// modal.
+    Forces,
+    /// An applied impact lies outside the table's region; every contact is modal.
+    ImpactOutsideRegion,
+    /// Some resting contacts lie outside the table's region; those are modal.
+    ContactsOutsideRegion,
 }

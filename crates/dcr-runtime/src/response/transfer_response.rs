@@ -1,5 +1,5 @@
-//! The transfer-table method ([`crate::Method::Transfer`]): the step's distant peaks looked up in
-//! the base's bake-time peak-transfer table ([`crate::format::TransferTable`]) instead of
+//! [`TransferResponse`]: the transfer-table method ([`crate::Method::Transfer`]): the step's
+//! distant peaks looked up in the base's bake-time peak-transfer table ([`crate::format::TransferTable`]) instead of
 //! filtering the truncated modal base.
 //!
 //! The table's points are the region's vertices and its edge midpoints
@@ -28,12 +28,15 @@
 //! outside with a barycentric weight ≤ 1e-9 is ignored). A contact whose triangle is not
 //! entirely in the region is served by the modal method (the whole modal
 //! step is then run and the in-region contacts are overwritten with the table's values).
+//! Whether the table applies to the run at all is decided at set-up
+//! ([`crate::TablePolicy`]); per-step fallbacks are counted with their reason
+//! ([`crate::StepInfo::table_fallback`]).
 
-use std::sync::Arc;
-
-use super::{mapped_response, unmapped_response, DistantResponse, UNMAPPED};
+use super::modal_response::{ModalResponse, UNMAPPED};
+use super::step_ctx::{mapped_response, unmapped_response, StepCtx};
+use super::{ForceInput, Impact, RestingContact, ServedBy, TableFallback, TableStatus};
 use crate::math::{dot, normalize};
-use crate::response::{ForceInput, Impact, RestingContact, ServedBy};
+use crate::model::ModalModel;
 
 /// Relative tolerance on h and the Rayleigh coefficients for the table to apply.
 const MATCH_REL_TOL: f64 = 1e-9;
@@ -50,7 +53,7 @@ type Nodes = ([u32; 6], [f64; 6]);
 /// `bary` in surface triangle `t` (corners `tri`), or `None` when a corner with a weight above
 /// [`NEGLIGIBLE_WEIGHT`] is outside the region (negligible ones get weight 0).
 #[inline]
-fn table_nodes(ts: &TransferState, t: u32, tri: [usize; 3], bary: [f64; 3]) -> Option<Nodes> {
+fn table_nodes(ts: &TransferResponse, t: u32, tri: [usize; 3], bary: [f64; 3]) -> Option<Nodes> {
     let mut idx = [0u32; 6];
     let mut w = bary;
     for k in 0..3 {
@@ -81,9 +84,10 @@ fn table_nodes(ts: &TransferState, t: u32, tri: [usize; 3], bary: [f64; 3]) -> O
     Some((idx, nw))
 }
 
-/// Per-instance state of the transfer-table method.
+/// The transfer-table method: table lookups, and the modal method for what the table cannot
+/// serve.
 #[derive(Debug)]
-pub(super) struct TransferState {
+pub(crate) struct TransferResponse {
     /// Region index (= table point) of each surface vertex ([`UNMAPPED`]: outside the region).
     local: Vec<u32>,
     /// Per surface triangle: the table point of the midpoint of the edge opposite each corner
@@ -93,29 +97,49 @@ pub(super) struct TransferState {
     hits: Vec<(Nodes, f64)>,
     /// Table peak per resting contact this step (m); NaN: not served by the table.
     peaks: Vec<f64>,
+    /// The modal method: serves the steps and contacts the table cannot.
+    modal: ModalResponse,
 }
 
 fn close(a: f64, b: f64) -> bool {
     (a - b).abs() <= MATCH_REL_TOL * a.abs().max(b.abs())
 }
 
-impl TransferState {
-    /// The state when the base's table applies to steps of length `h` (s) with Rayleigh damping
-    /// `rayleigh` and `carry_over`; `None` otherwise (the modal method serves every step).
-    pub(super) fn new(
-        model: &crate::ModalModel,
+impl TransferResponse {
+    /// Whether the base's table applies to steps of length `h` (s) with Rayleigh damping
+    /// `rayleigh` and `carry_over`: `Ok` or why not.
+    pub fn check(
+        model: &ModalModel,
         h: f64,
         rayleigh: [f64; 2],
         carry_over: bool,
-    ) -> Option<TransferState> {
-        let t = model.base().transfer.as_ref()?;
-        if carry_over
-            || !close(t.h, h)
-            || !close(t.rayleigh[0], rayleigh[0])
-            || !close(t.rayleigh[1], rayleigh[1])
-        {
-            return None;
+    ) -> Result<(), TableStatus> {
+        let t = model.base().transfer.as_ref().ok_or(TableStatus::NoTable)?;
+        if !close(t.h, h) {
+            return Err(TableStatus::StepMismatch { table_h: t.h, h });
         }
+        if !close(t.rayleigh[0], rayleigh[0]) || !close(t.rayleigh[1], rayleigh[1]) {
+            return Err(TableStatus::DampingMismatch {
+                table: t.rayleigh,
+                response: rayleigh,
+            });
+        }
+        if carry_over {
+            return Err(TableStatus::CarryOver);
+        }
+        Ok(())
+    }
+
+    /// The method over `modal` for a base whose table applies ([`TransferResponse::check`]).
+    ///
+    /// # Panics
+    /// If the base has no transfer table.
+    pub fn new(model: &ModalModel, modal: ModalResponse) -> TransferResponse {
+        let t = model
+            .base()
+            .transfer
+            .as_ref()
+            .expect("checked: the base has a table");
         let mut local = vec![UNMAPPED; model.num_vertices()];
         for (k, &v) in t.vertices.iter().enumerate() {
             local[v as usize] = k as u32;
@@ -135,89 +159,83 @@ impl TransferState {
                 })
             })
             .collect();
-        Some(TransferState {
+        TransferResponse {
             local,
             tri_mids,
             hits: Vec::new(),
             peaks: Vec::new(),
-        })
-    }
-}
-
-impl DistantResponse {
-    /// Whether the transfer table is in use for this instance (the base has one that matches
-    /// h, Rayleigh damping and `carry_over = false`, and the method is [`crate::Method::Transfer`]).
-    pub fn transfer_active(&self) -> bool {
-        self.transfer.is_some()
+            modal,
+        }
     }
 
-    /// Serves the step from the table when it applies; returns `false` (nothing done) when the
-    /// modal method must serve the whole step.
-    pub(super) fn step_transfer(
+    /// The modal method inside (its filters, for diagnostics).
+    pub fn modal(&self) -> &ModalResponse {
+        &self.modal
+    }
+
+    /// The modal method inside, mutably.
+    pub fn modal_mut(&mut self) -> &mut ModalResponse {
+        &mut self.modal
+    }
+
+    /// One step: the table serves when it applies (see the module doc), else the modal
+    /// method; fills `ctx.out`.
+    pub fn step(
         &mut self,
+        ctx: &mut StepCtx<'_>,
         impacts: &[Impact],
         forces: &[ForceInput],
         resting: &[RestingContact],
-    ) -> bool {
-        let Some(mut ts) = self.transfer.take() else {
-            return false;
-        };
-        let served = self.step_transfer_with(&mut ts, impacts, forces, resting);
-        self.transfer = Some(ts);
-        served
-    }
-
-    fn step_transfer_with(
-        &mut self,
-        ts: &mut TransferState,
-        impacts: &[Impact],
-        forces: &[ForceInput],
-        resting: &[RestingContact],
-    ) -> bool {
+    ) {
         let nonzero_force = forces
             .iter()
             .any(|f| f.force != [0.0; 3] && f.force.iter().all(|x| x.is_finite()));
         if nonzero_force {
-            self.info.contacts_table_fallback += resting.len() as u32;
-            return false;
+            ctx.info.contacts_table_fallback += resting.len() as u32;
+            ctx.info.table_fallback = Some(TableFallback::Forces);
+            self.modal.step(ctx, impacts, forces, resting);
+            return;
         }
-        let model = Arc::clone(&self.model);
+        let model = ctx.model;
         let table = model.base().transfer.as_ref().expect("checked at set-up");
-        ts.hits.clear();
+        self.hits.clear();
         let (mut below, mut unmapped) = (0u32, 0u32);
         for imp in impacts {
             let ok = imp.impulse.is_finite()
                 && imp.impulse > 0.0
-                && imp.impulse >= self.params.impact_threshold;
+                && imp.impulse >= ctx.params.impact_threshold;
             if !ok {
                 below += 1;
                 continue;
             }
-            let Some(sp) = model.project(imp.point, self.max_map) else {
+            let Some(sp) = model.project(imp.point, ctx.max_map) else {
                 unmapped += 1;
                 continue;
             };
-            let Some(nodes) = table_nodes(ts, sp.triangle, model.triangle(sp.triangle), sp.bary)
+            let Some(nodes) = table_nodes(self, sp.triangle, model.triangle(sp.triangle), sp.bary)
             else {
-                self.info.contacts_table_fallback += resting.len() as u32;
-                return false;
+                ctx.info.contacts_table_fallback += resting.len() as u32;
+                ctx.info.table_fallback = Some(TableFallback::ImpactOutsideRegion);
+                self.modal.step(ctx, impacts, forces, resting);
+                return;
             };
             let lambda_n = imp.impulse * dot(normalize(imp.direction), sp.normal).abs();
-            ts.hits.push((nodes, lambda_n));
+            self.hits.push((nodes, lambda_n));
         }
-        ts.peaks.clear();
+        self.peaks.clear();
         let mut outside = 0u32;
-        for &s in &self.slots {
-            let d = match self.cache.slot(s).surface {
+        let contacts = ctx.contacts;
+        for &s in contacts.slots() {
+            let d = match contacts.slot(s).surface {
                 Some(sp) => {
-                    match table_nodes(ts, sp.triangle, model.triangle(sp.triangle), sp.bary) {
+                    match table_nodes(self, sp.triangle, model.triangle(sp.triangle), sp.bary) {
                         None => {
                             outside += 1;
                             f64::NAN
                         }
                         Some((loc, wb)) => {
                             let mut d = 0.0;
-                            for ((src, beta), lambda_n) in &ts.hits {
+                            for ((src, beta), lambda_n) in &self.hits {
                                 let mut p = 0.0;
                                 for (a, ba) in src.iter().zip(beta) {
                                     if *ba == 0.0 {
@@ -237,42 +255,42 @@ impl DistantResponse {
                 }
                 None => f64::NAN,
             };
-            ts.peaks.push(d);
+            self.peaks.push(d);
         }
-        let h = self.params.h;
+        let h = ctx.params.h;
         if outside > 0 {
             // Some contacts lie outside the region: the modal step serves them (and counts the
             // impacts); the in-region contacts take the table's values.
-            self.step_modal(impacts, forces, resting);
-            self.info.contacts_table_fallback += outside;
-            for (o, &d) in self.out.iter_mut().zip(&ts.peaks) {
+            self.modal.step(ctx, impacts, forces, resting);
+            ctx.info.contacts_table_fallback += outside;
+            ctx.info.table_fallback = Some(TableFallback::ContactsOutsideRegion);
+            for (o, &d) in ctx.out.iter_mut().zip(&self.peaks) {
                 if d.is_finite() && o.mapped {
                     o.peak_displacement = d;
                     o.delta_v = d / h;
                     o.served_by = ServedBy::TransferTable;
-                    self.info.contacts_by_table += 1;
+                    ctx.info.contacts_by_table += 1;
                 }
             }
-            return true;
+            return;
         }
-        self.info.impacts_below_threshold += below;
-        self.info.impacts_unmapped += unmapped;
-        self.info.impacts_applied += ts.hits.len() as u32;
+        ctx.info.impacts_below_threshold += below;
+        ctx.info.impacts_unmapped += unmapped;
+        ctx.info.impacts_applied += self.hits.len() as u32;
         // The filters are not run: leave them at rest (diagnostics read zeros).
-        if !self.asleep {
-            self.reset();
+        if !self.modal.asleep() {
+            self.modal.reset();
         }
-        self.out.clear();
-        for ((rc, &s), &d) in resting.iter().zip(&self.slots).zip(&ts.peaks) {
-            let resp = match self.cache.slot(s).surface {
+        ctx.out.clear();
+        for ((rc, &s), &d) in resting.iter().zip(contacts.slots()).zip(&self.peaks) {
+            let resp = match contacts.slot(s).surface {
                 Some(sp) if d.is_finite() => {
-                    self.info.contacts_by_table += 1;
+                    ctx.info.contacts_by_table += 1;
                     mapped_response(rc, &sp, d, h, ServedBy::TransferTable)
                 }
                 _ => unmapped_response(rc),
             };
-            self.out.push(resp);
+            ctx.out.push(resp);
         }
-        true
     }
 }

@@ -1,0 +1,871 @@
+//! [`DcrWorld`]: the elastic objects of a rigid-body world and their per-step responses.
+
+use std::collections::HashMap;
+
+use super::pose::{rotate, rotate_back};
+use super::{
+    BodyState, ContactReport, ElasticHandle, ElasticObjectDesc, EnergyInfo, ImpulseEvent,
+    ObjectStepInfo, Pose, WorldError, WorldParams, WorldStepInfo,
+};
+use crate::mapping::BuildIdHasher;
+use crate::math::{add, cross, dot, norm, scale, sub};
+use crate::response::{effective_mass, DistantResponse, Impact, RestingContact};
+
+/// Age record of one contact id (classification).
+#[derive(Clone, Copy, Debug)]
+struct ContactAge {
+    first_step: u64,
+    last_step: u64,
+    /// Whether the contact has been an impact on the object on side 1 / side 2.
+    fired: [bool; 2],
+}
+
+/// Where a resting contact's response goes.
+#[derive(Clone, Copy, Debug)]
+struct Source {
+    /// Index of the receiving body in this step's `bodies`.
+    body: u32,
+    /// Application point on the receiving body (m, world).
+    point: [f64; 3],
+}
+
+/// One elastic object.
+#[derive(Debug)]
+struct Object {
+    body: u64,
+    dynamic: bool,
+    gain: f64,
+    pose: Pose,
+    rot: [[f64; 3]; 3],
+    threshold: f64,
+    response: DistantResponse,
+    /// World step of the last response call.
+    last_called: Option<u64>,
+    /// This step's impacts (object frame): engine impacts first, then chained ones.
+    impacts: Vec<Impact>,
+    resting: Vec<RestingContact>,
+    sources: Vec<Source>,
+    /// Chain depth of this step's chained impacts (0: none).
+    depth: u32,
+    info: ObjectStepInfo,
+}
+
+/// Per-body velocity change from the impulses issued this step (world frame).
+#[derive(Clone, Copy, Debug, Default)]
+struct Tracked {
+    dlin: [f64; 3],
+    dang: [f64; 3],
+    /// Index into `touched` while the current object is processed, else `u32::MAX`.
+    touch: u32,
+}
+
+/// A body pushed by the current object: its velocity change before the object and the
+/// object's summed impulse on it.
+#[derive(Clone, Copy, Debug, Default)]
+struct Touched {
+    body: u32,
+    dlin0: [f64; 3],
+    dang0: [f64; 3],
+    p_lin: [f64; 3],
+    p_ang: [f64; 3],
+}
+
+/// The elastic objects of a rigid-body world and their distant collision responses (paper
+/// §4.2–4.5), driven by plain world-frame contact data from any engine.
+///
+/// Set up once: [`DcrWorld::new`] with [`WorldParams`], then [`DcrWorld::add_object`] per
+/// elastic object ([`ElasticObjectDesc`]: a shared [`crate::ModalModel`], its
+/// [`crate::ResponseParams`], the engine body carrying it, static or dynamic, a gain). After
+/// every rigid-body step, once: [`DcrWorld::set_pose`] for the dynamic objects, then
+/// [`DcrWorld::step`] with the step's contact reports and the states of the bodies that touch
+/// elastic objects; apply the returned [`ImpulseEvent`]s with the engine's
+/// `apply_impulse_at_point`. A step does not allocate after warm-up and never fails.
+///
+/// # Impacts and resting contacts
+/// Every contact report that touches an elastic object's body is classified, per object
+/// ([`crate::ClassifyParams`]); the rules suit engines that create contacts before they carry
+/// an impulse (predictive contacts):
+/// - a contact id's *age* counts world steps since it appeared or last had zero impulse; an id
+///   absent for `new_after_missing_steps` steps or more is new again when it returns (a
+///   bounce), and so is one that touched with zero impulse (a body lifted within the engine's
+///   prediction distance that lands again);
+/// - an **impact** on the object is a contact with age ≤ `fresh_steps` that has not been an
+///   impact on that object since, whose impulse is > 0 and ≥ the object's
+///   `impact_threshold` (N·s). A zero-impulse (predictive) contact is never an impact and
+///   stays fresh, so it fires when its impulse arrives; the contacts that appeared in the
+///   first `settle_steps` steps (the initial resting set) do not fire until they lift off;
+/// - a **resting contact** is any other contact whose other body is dynamic
+///   ([`BodyState::is_dynamic`]) with impulse > 0: it may receive a response.
+///
+/// Ages live in a hash table whose entries are dropped once their id has been absent long
+/// enough to count as new, so its size is bounded by the contacts alive in a few steps and it
+/// stops growing after warm-up. Engines that know which points are new themselves (and
+/// callers that report only some steps, passing the others with [`DcrWorld::advance`]) use
+/// [`crate::ClassifyParams::engine_newness`] instead: an impact is a report with
+/// [`ContactReport::is_new`] and impulse > 0 and ≥ the threshold, after the settle window, and
+/// no table is kept.
+///
+/// # Frames
+/// Contacts arrive in the world frame; the response works in the object frame of the base.
+/// With the object's pose `x_w = R x_o + t` the world converts impact points `Rᵀ(p − t)` and
+/// directions `Rᵀd`, resting-contact points the same way, and the response's outward normals
+/// back `n_w = R n_o`. Impacts use the point on the elastic object's surface; impulses are
+/// applied at the point on the receiving body's surface.
+///
+/// # Impulses (Eq. 17–18) and one Gauss–Seidel pass per body
+/// A resting contact's response asks for a normal velocity change `Δv` (m/s) at the contact;
+/// the world issues `j = m_eff (g Δv − a) n` with the gain g, the effective mass of the body at
+/// the point along n (Eq. 17, [`crate::effective_mass`]) and `a` the normal velocity change the
+/// impulses already issued to that body this step produce at that point (tracked from the
+/// body's inverse mass and world inverse inertia, so the engine is not re-read); nothing when
+/// `g Δv ≤ a`. A plate on four contacts that all ask for Δv thus gets Δv, not four times it —
+/// one Gauss–Seidel pass, in contact-report order.
+///
+/// # Chains through dynamic elastic objects
+/// An impulse issued to the body of a dynamic elastic object becomes an impact on that object
+/// in the same step (point and direction in its frame, magnitude |j|), so a hit floor pushes a
+/// fridge that pushes the plant on it. Objects are processed in a fixed order — static objects
+/// first, then dynamic ones, each group in the order added — and a chain only goes forward in
+/// it, at most [`WorldParams::max_chain_depth`] links: a chain always terminates and every
+/// object's response runs at most once per step (add a dynamic object after the one it rests
+/// on). Impulses that cannot chain are still issued and counted in
+/// [`WorldStepInfo::chains_dropped`].
+///
+/// # Eviction
+/// A response runs only on steps with impacts (or while carry-over filters ring), but its
+/// contact cache counts world steps: resting contacts unseen for more than
+/// [`crate::ResponseParams::evict_after_steps`] world steps are evicted.
+///
+/// # Energy bound
+/// With `η = WorldParams::energy_eta`, per object and step the kinetic energy its responses
+/// inject, `E_in = Σ_bodies (P·V + ½ PᵀM⁻¹P)` (P the body's summed linear and angular impulse
+/// from this object, V its velocity before them, M⁻¹ from its inverse mass and world inverse
+/// inertia — exact for rigid bodies), is at most `η (D + R)`: D the energy the step's impacts
+/// on the object dissipated, R the kinetic energy chained impulses gave its body. When over,
+/// all the object's impulses are scaled by the largest s ∈ [0, 1] with
+/// `s A + s² B ≤ η (D + R)` (E_in is quadratic in s; closed form).
+///
+/// D is estimated per impact from post-step data only: with λ the impact's normal impulse,
+/// `u⁺` the relative normal velocity of the two bodies at the contact after the step
+/// (separating > 0) and `k = k₁ + k₂` the pair's inverse effective mass along the normal
+/// (`kᵢ = mᵢ⁻¹ + (rᵢ × n)ᵀ Iᵢ⁻¹ (rᵢ × n)`, 0 for a body without state),
+/// `D = max(0, ½ k λ² − λ u⁺)`. This is the exact kinetic energy an impulse λ removes from two
+/// rigid bodies that leave with relative velocity u⁺ (their approach speed was u⁺ − kλ): ½ m u⁻²
+/// for a plastic impact (u⁺ = 0), 0 for a perfectly elastic one, whatever restitution model the
+/// engine uses and without its pre-step velocities. Gravity and other contacts acting during
+/// the step make it an estimate. An impact between two elastic objects shares its D equally.
+///
+/// A chain passes on at most η of what it received, so over a chain of depth k the energy
+/// injected is at most (η + … + η^(k+1))·D.
+///
+/// ```
+/// use std::sync::Arc;
+/// use dcr_runtime::{testing, BodyState, ContactReport, DcrWorld, ElasticObjectDesc, ModalModel,
+///     Pose, WorldParams};
+///
+/// let model = Arc::new(ModalModel::from_base(testing::plate_base())?);
+/// let mut world = DcrWorld::new(WorldParams { energy_eta: None, ..Default::default() })?;
+/// // The plate (engine body 1) stands upright: its +z normal points along world +x.
+/// let mut desc = ElasticObjectDesc::new(model, 1);
+/// desc.pose = Pose::from_axis_angle([0.0, 1.0, 0.0], std::f64::consts::FRAC_PI_2, [2.0, 0.0, 0.0]);
+/// let plate = world.add_object(desc)?;
+/// // A 1 kg box (body 7) leaning on it; its contact settles during the first steps.
+/// let mut boxy = BodyState::fixed(7);
+/// boxy.inv_mass = 1.0;
+/// let pose = world.pose(plate);
+/// let on_plate = |x: [f64; 3]| pose.transform_point(x);
+/// let rest = ContactReport { id: 70, body1: 1, body2: 7, point1: on_plate([0.9, 0.5, 0.0]),
+///     point2: on_plate([0.9, 0.5, 0.0]), normal: [1.0, 0.0, 0.0], impulse: 0.01,
+///     is_new: false };
+/// for _ in 0..5 {
+///     assert!(world.step(&[rest], &[boxy]).is_empty());
+/// }
+/// // A ball (body 9) hits the plate's middle with 2 N·s.
+/// let hit = ContactReport { id: 90, body1: 9, body2: 1, point1: on_plate([0.5, 0.3, 0.0]),
+///     point2: on_plate([0.5, 0.3, 0.0]), normal: [-1.0, 0.0, 0.0], impulse: 2.0,
+///     is_new: false };
+/// let events = world.step(&[rest, hit], &[boxy]);
+/// assert_eq!(events.len(), 1);
+/// assert_eq!(events[0].body, 7);
+/// assert!(events[0].impulse[0] > 0.0); // pushed away from the plate: world +x
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+#[derive(Debug)]
+pub struct DcrWorld {
+    params: WorldParams,
+    objects: Vec<Object>,
+    /// Processing order (indices into `objects`): static, then dynamic, each in order added.
+    order: Vec<u32>,
+    /// Position of each object in `order`.
+    rank: Vec<u32>,
+    /// Engine body id of each object (index = object), scanned when there are few objects.
+    object_bodies: Vec<u64>,
+    by_body: HashMap<u64, u32, BuildIdHasher>,
+    ages: HashMap<u64, ContactAge, BuildIdHasher>,
+    /// This step's `bodies` index by id.
+    body_index: HashMap<u64, u32, BuildIdHasher>,
+    /// The ids `body_index` was built for, in order (rebuilt only when they change).
+    body_ids: Vec<u64>,
+    tracked: Vec<Tracked>,
+    touched: Vec<Touched>,
+    events: Vec<ImpulseEvent>,
+    /// Chained impacts produced by the current object: (target object, impact, depth).
+    handed: Vec<(u32, Impact, u32)>,
+    step: u64,
+    /// Step at or after which the age table is next purged of dead ids.
+    next_purge: u64,
+    info: WorldStepInfo,
+}
+
+/// Steps between purges of the age table.
+const PURGE_EVERY: u64 = 16;
+
+fn invalid(field: &'static str, detail: String) -> WorldError {
+    WorldError::Params { field, detail }
+}
+
+impl DcrWorld {
+    /// An empty world.
+    ///
+    /// # Errors
+    /// [`WorldError::Params`] for a non-positive or non-finite `h`, or `energy_eta` outside
+    /// [0, 1].
+    pub fn new(params: WorldParams) -> Result<DcrWorld, WorldError> {
+        if !(params.h.is_finite() && params.h > 0.0) {
+            return Err(invalid(
+                "h",
+                format!("{} s (must be finite and > 0)", params.h),
+            ));
+        }
+        if let Some(eta) = params.energy_eta {
+            if !(0.0..=1.0).contains(&eta) {
+                return Err(invalid("energy_eta", format!("{eta} (must be in [0, 1])")));
+            }
+        }
+        Ok(DcrWorld {
+            params,
+            objects: Vec::new(),
+            order: Vec::new(),
+            rank: Vec::new(),
+            object_bodies: Vec::new(),
+            by_body: HashMap::default(),
+            ages: HashMap::default(),
+            body_index: HashMap::default(),
+            body_ids: Vec::new(),
+            tracked: Vec::new(),
+            touched: Vec::new(),
+            events: Vec::new(),
+            handed: Vec::new(),
+            step: 0,
+            next_purge: 0,
+            info: WorldStepInfo::default(),
+        })
+    }
+
+    /// Adds an elastic object; its response uses the world's `h`.
+    ///
+    /// # Errors
+    /// [`WorldError::DuplicateBody`] if another object is on the same body,
+    /// [`WorldError::Object`] for a negative or non-finite gain, [`WorldError::Response`] if
+    /// the response cannot be set up ([`DistantResponse::new`]), e.g. a transfer table refused
+    /// under [`crate::TablePolicy::Refuse`].
+    pub fn add_object(&mut self, desc: ElasticObjectDesc) -> Result<ElasticHandle, WorldError> {
+        if let Some(&existing) = self.by_body.get(&desc.body) {
+            return Err(WorldError::DuplicateBody {
+                body: desc.body,
+                existing,
+            });
+        }
+        if !(desc.gain.is_finite() && desc.gain >= 0.0) {
+            return Err(WorldError::Object {
+                body: desc.body,
+                field: "gain",
+                detail: format!("{} (must be finite and ≥ 0)", desc.gain),
+            });
+        }
+        let mut rp = desc.response;
+        rp.h = self.params.h;
+        let threshold = rp.impact_threshold;
+        let response =
+            DistantResponse::new(desc.model, rp).map_err(|source| WorldError::Response {
+                body: desc.body,
+                source,
+            })?;
+        let idx = self.objects.len() as u32;
+        self.objects.push(Object {
+            body: desc.body,
+            dynamic: desc.dynamic,
+            gain: desc.gain,
+            pose: desc.pose,
+            rot: desc.pose.rotation_matrix(),
+            threshold,
+            response,
+            last_called: None,
+            impacts: Vec::new(),
+            resting: Vec::new(),
+            sources: Vec::new(),
+            depth: 0,
+            info: ObjectStepInfo::default(),
+        });
+        self.by_body.insert(desc.body, idx);
+        self.object_bodies.push(desc.body);
+        self.order = (0..self.objects.len() as u32)
+            .filter(|&o| !self.objects[o as usize].dynamic)
+            .chain((0..self.objects.len() as u32).filter(|&o| self.objects[o as usize].dynamic))
+            .collect();
+        self.rank = vec![0; self.objects.len()];
+        for (r, &o) in self.order.iter().enumerate() {
+            self.rank[o as usize] = r as u32;
+        }
+        Ok(ElasticHandle(idx))
+    }
+
+    /// Sets an object's pose (object frame → world) for the coming [`DcrWorld::step`]: the
+    /// body's pose after the rigid-body step. Static objects keep the pose they were added with.
+    ///
+    /// # Panics
+    /// If `handle` is not from this world.
+    pub fn set_pose(&mut self, handle: ElasticHandle, pose: Pose) {
+        let o = &mut self.objects[handle.0 as usize];
+        o.pose = pose;
+        o.rot = pose.rotation_matrix();
+    }
+
+    /// The object's current pose.
+    ///
+    /// # Panics
+    /// If `handle` is not from this world.
+    pub fn pose(&self, handle: ElasticHandle) -> Pose {
+        self.objects[handle.0 as usize].pose
+    }
+
+    /// The parameters the world was built with.
+    pub fn params(&self) -> &WorldParams {
+        &self.params
+    }
+
+    /// Number of elastic objects.
+    pub fn num_objects(&self) -> usize {
+        self.objects.len()
+    }
+
+    /// The object on engine body `body`, if any.
+    pub fn object_of_body(&self, body: u64) -> Option<ElasticHandle> {
+        self.by_body.get(&body).map(|&o| ElasticHandle(o))
+    }
+
+    /// Engine body id of an object.
+    ///
+    /// # Panics
+    /// If `handle` is not from this world.
+    pub fn body_of(&self, handle: ElasticHandle) -> u64 {
+        self.objects[handle.0 as usize].body
+    }
+
+    /// An object's response (its method, transfer-table status, cached contacts, …).
+    ///
+    /// # Panics
+    /// If `handle` is not from this world.
+    pub fn response(&self, handle: ElasticHandle) -> &DistantResponse {
+        &self.objects[handle.0 as usize].response
+    }
+
+    /// What the last step did, all objects.
+    pub fn step_info(&self) -> WorldStepInfo {
+        self.info
+    }
+
+    /// What the last step did for one object (counters, the response's [`crate::StepInfo`],
+    /// energy account).
+    ///
+    /// # Panics
+    /// If `handle` is not from this world.
+    pub fn object_info(&self, handle: ElasticHandle) -> ObjectStepInfo {
+        self.objects[handle.0 as usize].info
+    }
+
+    /// The last step's impulse events (as returned by [`DcrWorld::step`]).
+    pub fn events(&self) -> &[ImpulseEvent] {
+        &self.events
+    }
+
+    /// Counts `steps` rigid-body steps that passed without [`DcrWorld::step`] (quiet steps: no
+    /// contact to report, nothing ringing — see [`DcrWorld::needs_step`]). Step counts (settle
+    /// window, ages, cache eviction) stay in engine steps. O(1), no allocation; clears the
+    /// event buffer; [`DcrWorld::step_info`] and [`DcrWorld::object_info`] still describe the
+    /// last call of `step`. Callers that skip steps should classify with
+    /// [`crate::ClassifyParams::engine_newness`]: ages count a contact unseen for a while as new.
+    pub fn advance(&mut self, steps: u64) {
+        self.step += steps;
+        self.events.clear();
+    }
+
+    /// Whether the next step must call [`DcrWorld::step`] even without impacts to report: an
+    /// object's carry-over filters still ring. `false` with the default parameters.
+    pub fn needs_step(&self) -> bool {
+        self.objects.iter().any(|o| o.response.needs_step())
+    }
+
+    /// One rigid-body step: classifies `contacts` (world frame, see [`ContactReport`] for the
+    /// sign convention), runs the responses of the objects with impacts, and returns the
+    /// impulses to apply, valid until the next call. `bodies`: the state after the step of
+    /// every dynamic or kinematic body that touches an elastic object (ids unique; others are
+    /// treated as immovable and at rest). Set the dynamic objects' poses first
+    /// ([`DcrWorld::set_pose`]). Does not allocate after warm-up.
+    pub fn step(&mut self, contacts: &[ContactReport], bodies: &[BodyState]) -> &[ImpulseEvent] {
+        let step = self.step;
+        self.step += 1;
+        self.info = WorldStepInfo {
+            step,
+            ..Default::default()
+        };
+        self.events.clear();
+        // The body list usually repeats step after step: rebuild the index only on change.
+        if self.body_ids.len() != bodies.len()
+            || self.body_ids.iter().zip(bodies).any(|(&id, b)| id != b.id)
+        {
+            self.body_index.clear();
+            self.body_ids.clear();
+            for (i, b) in bodies.iter().enumerate() {
+                self.body_index.insert(b.id, i as u32);
+                self.body_ids.push(b.id);
+            }
+        }
+        self.tracked.clear();
+        self.tracked.resize(
+            bodies.len(),
+            Tracked {
+                touch: u32::MAX,
+                ..Default::default()
+            },
+        );
+        for o in &mut self.objects {
+            o.impacts.clear();
+            o.resting.clear();
+            o.sources.clear();
+            o.depth = 0;
+            let e = o.info.energy;
+            o.info = ObjectStepInfo {
+                energy: EnergyInfo {
+                    scale: 1.0,
+                    total_dissipated: e.total_dissipated,
+                    total_received: e.total_received,
+                    total_injected: e.total_injected,
+                    ..Default::default()
+                },
+                ..Default::default()
+            };
+        }
+        self.classify(contacts, bodies);
+        for k in 0..self.order.len() {
+            let o = self.order[k] as usize;
+            self.respond(o, bodies);
+        }
+        for o in &mut self.objects {
+            let e = &mut o.info.energy;
+            e.total_dissipated += e.dissipated;
+            e.total_received += e.received;
+            e.total_injected += e.injected;
+            self.info.injected += e.injected;
+            self.info.dissipated += e.dissipated;
+        }
+        self.info.events = self.events.len() as u32;
+        // Forget ids absent long enough to be new anyway (bounded table, no growth once warm).
+        if step >= self.next_purge {
+            self.next_purge = step + PURGE_EVERY;
+            let gap = self.params.classify.new_after_missing_steps;
+            self.ages.retain(|_, a| a.last_step + gap >= step);
+        }
+        &self.events
+    }
+
+    /// Splits the step's contact reports into impacts and resting contacts per object.
+    fn classify(&mut self, contacts: &[ContactReport], bodies: &[BodyState]) {
+        let step = self.step - 1;
+        let cp = self.params.classify;
+        for c in contacts {
+            let objs = [self.object_at(c.body1), self.object_at(c.body2)];
+            if objs == [None, None] || c.body1 == c.body2 {
+                continue;
+            }
+            self.info.contacts += 1;
+            let lambda = c.impulse;
+            let valid = lambda.is_finite() && lambda > 0.0;
+            let mut fired_before: Option<&mut [bool; 2]> = None;
+            let fresh_age = if cp.engine_newness {
+                c.is_new && step >= cp.settle_steps
+            } else {
+                let fresh = ContactAge {
+                    first_step: step,
+                    last_step: step,
+                    fired: [false; 2],
+                };
+                let age = self.ages.entry(c.id).or_insert(fresh);
+                // Absent for a while, or touching with zero impulse: its age restarts.
+                if age.last_step + cp.new_after_missing_steps < step || !(lambda > 0.0) {
+                    *age = fresh;
+                }
+                age.last_step = step;
+                let f = step >= cp.settle_steps
+                    && age.first_step >= cp.settle_steps
+                    && step - age.first_step <= cp.fresh_steps;
+                fired_before = Some(&mut age.fired);
+                f
+            };
+            let bidx = [c.body1, c.body2].map(|b| self.body_index.get(&b).copied());
+            let mut fired = [false; 2];
+            for side in 0..2 {
+                let Some(o) = objs[side] else { continue };
+                let obj = &mut self.objects[o as usize];
+                let other = 1 - side;
+                let own_point = if side == 0 { c.point1 } else { c.point2 };
+                let other_point = if side == 0 { c.point2 } else { c.point1 };
+                let already = fired_before.as_ref().is_some_and(|f| f[side]);
+                if fresh_age && !already && valid && lambda >= obj.threshold {
+                    if let Some(f) = fired_before.as_mut() {
+                        f[side] = true;
+                    }
+                    fired[side] = true;
+                    // The impulse on this object: −λn on body1, +λn on body2.
+                    let d = if side == 0 {
+                        scale(c.normal, -1.0)
+                    } else {
+                        c.normal
+                    };
+                    obj.impacts.push(Impact {
+                        point: rotate_back(&obj.rot, sub(own_point, obj.pose.translation)),
+                        direction: rotate_back(&obj.rot, d),
+                        impulse: lambda,
+                    });
+                    obj.info.impacts += 1;
+                    self.info.impacts += 1;
+                } else if valid {
+                    if let Some(b) = bidx[other].filter(|&b| bodies[b as usize].is_dynamic()) {
+                        obj.resting.push(RestingContact {
+                            id: c.id,
+                            point: rotate_back(&obj.rot, sub(own_point, obj.pose.translation)),
+                        });
+                        obj.sources.push(Source {
+                            body: b,
+                            point: other_point,
+                        });
+                        obj.info.resting += 1;
+                        self.info.resting += 1;
+                    }
+                }
+            }
+            let nfired = fired.iter().filter(|&&f| f).count();
+            if nfired > 0 {
+                let lost = dissipated(c, bidx, bodies) / nfired as f64;
+                for side in 0..2 {
+                    if fired[side] {
+                        let o = objs[side].expect("fired side has an object") as usize;
+                        self.objects[o].info.energy.dissipated += lost;
+                    }
+                }
+            }
+        }
+    }
+
+    /// Runs object `o`'s response (if it has impacts), issues its impulses, bounds their
+    /// energy and hands chained impacts forward.
+    fn respond(&mut self, o: usize, bodies: &[BodyState]) {
+        let step = self.step - 1;
+        let obj = &mut self.objects[o];
+        if obj.impacts.is_empty() && !obj.response.needs_step() {
+            return;
+        }
+        if let Some(last) = obj.last_called {
+            obj.response.skip_steps(step - last - 1);
+        }
+        obj.last_called = Some(step);
+        obj.info.queried = true;
+        self.info.queries += 1;
+        let first_event = self.events.len();
+        let t0 = std::time::Instant::now();
+        let out = obj.response.step(&obj.impacts, &obj.resting);
+        obj.info.response_time_ns = t0.elapsed().as_nanos() as u64;
+        self.touched.clear();
+        for (resp, src) in out.iter().zip(&obj.sources) {
+            let lateral = resp.lateral_delta_v != [0.0; 3];
+            if !resp.mapped || !(resp.delta_v > 0.0 || lateral) {
+                continue;
+            }
+            let b = &bodies[src.body as usize];
+            let n = rotate(&obj.rot, resp.normal);
+            let r = sub(src.point, b.center_of_mass);
+            let t = &mut self.tracked[src.body as usize];
+            // Normal part: the Δv not yet produced at this point (one Gauss–Seidel pass).
+            let mut j = [0.0; 3];
+            let mut need = 0.0;
+            let achieved = dot(add(t.dlin, cross(t.dang, r)), n);
+            let want = obj.gain * resp.delta_v - achieved;
+            if want > 0.0 {
+                let m_eff = effective_mass(b.inv_mass, b.inv_inertia, r, n);
+                if m_eff > 0.0 {
+                    need = want;
+                    j = scale(n, m_eff * want);
+                }
+            }
+            // Tangential part (lateral kick), after the normal part, the same way.
+            if lateral {
+                let tw = rotate(&obj.rot, resp.lateral_delta_v);
+                let mag = norm(tw);
+                let dir = scale(tw, 1.0 / mag);
+                let jv = scale(j, b.inv_mass);
+                let jw = mat_vec(&b.inv_inertia, cross(r, j));
+                let achieved = dot(add(add(t.dlin, jv), cross(add(t.dang, jw), r)), dir);
+                let want = obj.gain * mag - achieved;
+                let m_eff = effective_mass(b.inv_mass, b.inv_inertia, r, dir);
+                if want > 0.0 && m_eff > 0.0 {
+                    j = add(j, scale(dir, m_eff * want));
+                }
+            }
+            if j == [0.0; 3] {
+                continue;
+            }
+            if t.touch == u32::MAX {
+                t.touch = self.touched.len() as u32;
+                self.touched.push(Touched {
+                    body: src.body,
+                    dlin0: t.dlin,
+                    dang0: t.dang,
+                    ..Default::default()
+                });
+            }
+            let tc = &mut self.touched[t.touch as usize];
+            let rj = cross(r, j);
+            tc.p_lin = add(tc.p_lin, j);
+            tc.p_ang = add(tc.p_ang, rj);
+            t.dlin = add(t.dlin, scale(j, b.inv_mass));
+            t.dang = add(t.dang, mat_vec(&b.inv_inertia, rj));
+            self.events.push(ImpulseEvent {
+                body: b.id,
+                point: src.point,
+                impulse: j,
+                normal: n,
+                delta_v: need,
+                object: ElasticHandle(o as u32),
+                served_by: resp.served_by,
+                contact: resp.id,
+                chained: obj.depth > 0,
+            });
+        }
+        obj.info.response = obj.response.last_step_info();
+        // Energy of this object's impulses, E(s) = s A + s² B, and the bound.
+        let (mut a, mut bq) = (0.0, 0.0);
+        for tc in &self.touched {
+            let b = &bodies[tc.body as usize];
+            let (ea, eb) = body_energy_terms(b, tc);
+            a += ea;
+            bq += eb;
+        }
+        let requested = a + bq;
+        let budget = self
+            .params
+            .energy_eta
+            .map(|eta| eta * (obj.info.energy.dissipated + obj.info.energy.received));
+        let s = match budget {
+            Some(budget) if requested > budget => {
+                self.info.energy_limited += 1;
+                bound_scale(a, bq, budget)
+            }
+            _ => 1.0,
+        };
+        obj.info.energy.requested = requested;
+        obj.info.energy.scale = s;
+        obj.info.events = (self.events.len() - first_event) as u32;
+        if s != 1.0 {
+            for e in &mut self.events[first_event..] {
+                e.impulse = scale(e.impulse, s);
+                e.delta_v *= s;
+            }
+        }
+        let mut injected = 0.0;
+        let depth = obj.depth;
+        for tc in &self.touched {
+            let b = &bodies[tc.body as usize];
+            let t = &mut self.tracked[tc.body as usize];
+            if s != 1.0 {
+                t.dlin = add(tc.dlin0, scale(sub(t.dlin, tc.dlin0), s));
+                t.dang = add(tc.dang0, scale(sub(t.dang, tc.dang0), s));
+            }
+            t.touch = u32::MAX;
+            let (ea, eb) = body_energy_terms(b, tc);
+            let e_b = s * ea + s * s * eb;
+            injected += e_b;
+            // Energy given to a dynamic elastic object's body: its chain budget.
+            if let Some(target) = self.object_at(b.id) {
+                if self.forward(o, target as usize, depth) {
+                    self.objects[target as usize].info.energy.received += e_b.max(0.0);
+                }
+            }
+        }
+        self.objects[o].info.energy.injected = injected;
+        // Chains: impulses on dynamic elastic objects later in the order become impacts.
+        self.handed.clear();
+        for e in &self.events[first_event..] {
+            let Some(target) = self.object_at(e.body) else {
+                continue;
+            };
+            let mag = norm(e.impulse);
+            if !(mag > 0.0) {
+                continue;
+            }
+            if !self.forward(o, target as usize, depth) {
+                self.info.chains_dropped += 1;
+                continue;
+            }
+            let t = &self.objects[target as usize];
+            self.handed.push((
+                target,
+                Impact {
+                    point: rotate_back(&t.rot, sub(e.point, t.pose.translation)),
+                    direction: rotate_back(&t.rot, scale(e.impulse, 1.0 / mag)),
+                    impulse: mag,
+                },
+                depth + 1,
+            ));
+        }
+        for &(target, imp, d) in &self.handed {
+            let t = &mut self.objects[target as usize];
+            t.impacts.push(imp);
+            t.depth = t.depth.max(d);
+            t.info.chained_impacts += 1;
+            self.info.chained_impacts += 1;
+        }
+    }
+
+    /// The object on engine body `body` (a scan of a few ids, else the hash table).
+    #[inline]
+    fn object_at(&self, body: u64) -> Option<u32> {
+        if self.object_bodies.len() <= 8 {
+            self.object_bodies
+                .iter()
+                .position(|&b| b == body)
+                .map(|o| o as u32)
+        } else {
+            self.by_body.get(&body).copied()
+        }
+    }
+
+    /// Whether an impulse from object `from` (at chain depth `depth`) on object `to`'s body
+    /// chains: `to` is dynamic, later in the order, and the chain is not at its limit.
+    fn forward(&self, from: usize, to: usize, depth: u32) -> bool {
+        self.objects[to].dynamic
+            && self.rank[to] > self.rank[from]
+            && depth < self.params.max_chain_depth
+    }
+}
+
+/// `M v` for a row-major 3 × 3 matrix.
+#[inline]
+fn mat_vec(m: &[[f64; 3]; 3], v: [f64; 3]) -> [f64; 3] {
+    [dot(m[0], v), dot(m[1], v), dot(m[2], v)]
+}
+
+/// Velocity of body `b` at world point `p` (m/s; zero for a body without state).
+#[inline]
+fn velocity_at(b: Option<&BodyState>, p: [f64; 3]) -> [f64; 3] {
+    match b {
+        Some(b) => add(b.linvel, cross(b.angvel, sub(p, b.center_of_mass))),
+        None => [0.0; 3],
+    }
+}
+
+/// Inverse effective mass `m⁻¹ + (r × n)ᵀ I⁻¹ (r × n)` (1/kg) of body `b` at `p` along `n`.
+#[inline]
+fn inverse_effective_mass(b: Option<&BodyState>, p: [f64; 3], n: [f64; 3]) -> f64 {
+    match b {
+        Some(b) => {
+            let rn = cross(sub(p, b.center_of_mass), n);
+            b.inv_mass + dot(rn, mat_vec(&b.inv_inertia, rn))
+        }
+        None => 0.0,
+    }
+}
+
+/// Energy an impact dissipated (J): `max(0, ½ k λ² − λ u⁺)` (see [`DcrWorld`], "Energy bound").
+fn dissipated(c: &ContactReport, bidx: [Option<u32>; 2], bodies: &[BodyState]) -> f64 {
+    let b1 = bidx[0].map(|i| &bodies[i as usize]);
+    let b2 = bidx[1].map(|i| &bodies[i as usize]);
+    let u_plus = dot(
+        sub(velocity_at(b2, c.point2), velocity_at(b1, c.point1)),
+        c.normal,
+    );
+    let k = inverse_effective_mass(b1, c.point1, c.normal)
+        + inverse_effective_mass(b2, c.point2, c.normal);
+    let lambda = c.impulse;
+    let lost = 0.5 * k * lambda * lambda - lambda * u_plus;
+    if lost.is_finite() {
+        lost.max(0.0)
+    } else {
+        0.0
+    }
+}
+
+/// (A, B) of a body's kinetic-energy change `A + B` from the summed impulse of `tc`: A = P·V
+/// with V the body's velocity before them (after the step plus earlier objects' impulses),
+/// B = ½ PᵀM⁻¹P.
+#[inline]
+fn body_energy_terms(b: &BodyState, tc: &Touched) -> (f64, f64) {
+    let v = add(b.linvel, tc.dlin0);
+    let w = add(b.angvel, tc.dang0);
+    let a = dot(tc.p_lin, v) + dot(tc.p_ang, w);
+    let bq = 0.5
+        * (b.inv_mass * dot(tc.p_lin, tc.p_lin) + dot(tc.p_ang, mat_vec(&b.inv_inertia, tc.p_ang)));
+    (a, bq)
+}
+
+/// The largest s ∈ [0, 1] with `s a + s² b ≤ budget`, given `a + b > budget ≥ 0` and b ≥ 0.
+fn bound_scale(a: f64, b: f64, budget: f64) -> f64 {
+    let budget = budget.max(0.0);
+    let s = if b > 0.0 {
+        let disc = (a * a + 4.0 * b * budget).sqrt();
+        if a >= 0.0 {
+            // 2·budget / (a + √…): no cancellation.
+            if a + disc > 0.0 {
+                2.0 * budget / (a + disc)
+            } else {
+                0.0
+            }
+        } else {
+            (disc - a) / (2.0 * b)
+        }
+    } else if a > 0.0 {
+        budget / a
+    } else {
+        1.0
+    };
+    s.clamp(0.0, 1.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::bound_scale;
+
+    /// The scale meets the budget exactly (to rounding) and is the largest such.
+    #[test]
+    fn bound_scale_is_the_largest_root() {
+        for &(a, b, budget) in &[
+            (2.0, 1.0, 1.0),
+            (0.0, 3.0, 0.5),
+            (-1.0, 2.0, 0.1),
+            (-1.0, 2.0, 0.0),
+            (4.0, 0.0, 1.0),
+            (1e-3, 1e3, 1e-6),
+        ] {
+            let s = bound_scale(a, b, budget);
+            let e = s * a + s * s * b;
+            assert!(
+                e <= budget * (1.0 + 1e-12) + 1e-300,
+                "{a} {b} {budget}: {e}"
+            );
+            let s2 = (s * (1.0 + 1e-9)).min(1.0) + 1e-12;
+            assert!(
+                s2 * a + s2 * s2 * b > budget,
+                "{a} {b} {budget}: not the largest"
+            );
+        }
+    }
+}

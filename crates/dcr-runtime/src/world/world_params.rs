@@ -1,0 +1,69 @@
+//! [`WorldParams`] and [`ClassifyParams`]: the settings of a [`crate::DcrWorld`].
+
+/// How the world tells impacts from resting contacts (see [`crate::DcrWorld`], "Impacts and
+/// resting contacts"). All counts are rigid-body steps of the world (including those passed
+/// with [`crate::DcrWorld::advance`]). The defaults suit engines that create contacts before
+/// they carry an impulse (rapier's predictive contacts) and report every step.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ClassifyParams {
+    /// Ages rule: a contact can be an impact while its age (steps since it appeared, or last
+    /// had zero impulse) is at most this, and it has not been an impact on that object since.
+    /// Default 2: a contact with zero impulse at step k fires when its impulse arrives at
+    /// k + 1 or k + 2.
+    pub fresh_steps: u64,
+    /// The contacts of the first `settle_steps` steps (the initial resting set, e.g. objects
+    /// placed on a table, settling under gravity) are never impacts. Default 3.
+    pub settle_steps: u64,
+    /// Ages rule: a contact id absent from the reports for at least this many consecutive
+    /// steps is a new contact when it comes back: its age restarts, so it can be an impact
+    /// again (a bouncing body). Default 1.
+    pub new_after_missing_steps: u64,
+    /// `true`: the engine's newness rule instead of ages — an impact is a report with
+    /// [`crate::ContactReport::is_new`], impulse > 0 and ≥ the object's threshold, after the
+    /// settle window; no age table is kept. For callers that report contacts only on some
+    /// steps (passing the others with [`crate::DcrWorld::advance`]), where ages cannot see
+    /// what happened in between. Default `false` (ages).
+    pub engine_newness: bool,
+}
+
+impl Default for ClassifyParams {
+    fn default() -> Self {
+        ClassifyParams {
+            fresh_steps: 2,
+            settle_steps: 3,
+            new_after_missing_steps: 1,
+            engine_newness: false,
+        }
+    }
+}
+
+/// Settings of a [`crate::DcrWorld`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WorldParams {
+    /// Rigid-body time step h (s), the same every step; every object's response uses it.
+    /// Default 0.01.
+    pub h: f64,
+    /// Impact / resting classification. Default [`ClassifyParams::default`].
+    pub classify: ClassifyParams,
+    /// Energy bound η ∈ [0, 1]: per elastic object and step, the kinetic energy its responses
+    /// give the receiving bodies is at most η × the energy the step's impacts on the object
+    /// dissipated (plus what chained impulses gave its body); the object's impulses are scaled
+    /// uniformly when they would exceed it. `None`: no bound. Default `Some(1.0)`: passive (a
+    /// response never adds more energy than its impacts lost), which leaves responses well
+    /// below the bound untouched.
+    pub energy_eta: Option<f64>,
+    /// Longest chain of responses through dynamic elastic objects in one step (an impulse on an
+    /// elastic object's body becomes an impact on it): 0 disables chains. Default 4.
+    pub max_chain_depth: u32,
+}
+
+impl Default for WorldParams {
+    fn default() -> Self {
+        WorldParams {
+            h: 0.01,
+            classify: ClassifyParams::default(),
+            energy_eta: Some(1.0),
+            max_chain_depth: 4,
+        }
+    }
+}
