@@ -187,8 +187,12 @@ pub struct BakeReport {
     pub transfer_s: f64,
     /// Transfer table: region vertices (0: no table).
     pub transfer_vertices: usize,
-    /// Transfer table: region edges whose midpoints are tabulated.
+    /// Transfer table: region edges whose points are tabulated.
     pub transfer_edges: usize,
+    /// Transfer table: interpolation order (1, 2, 3; 0 without a table).
+    pub transfer_order: u8,
+    /// Transfer table: points (vertices, edge and face points).
+    pub transfer_points: usize,
     /// Transfer table: modes summed.
     pub transfer_modes: usize,
     /// Transfer table: samples per step.
@@ -747,6 +751,8 @@ pub fn bake_mesh_with_transfer(
     report.transfer_s = t.elapsed().as_secs_f64();
     report.transfer_vertices = table.len();
     report.transfer_edges = table.edges.len();
+    report.transfer_order = table.order;
+    report.transfer_points = table.num_points();
     report.transfer_modes = table.modes as usize;
     report.transfer_samples = table.samples as usize;
     if let Some(obj) = base.meta.bake_params.as_object_mut() {
@@ -770,6 +776,12 @@ fn transfer_meta(tp: &crate::transfer::TransferParams) -> serde_json::Value {
         "up": tp.up,
         "up_min_cos": tp.up_min_cos,
         "oversample": tp.oversample,
+        "order": match tp.order {
+            crate::transfer::TableOrder::Auto => serde_json::json!("auto"),
+            crate::transfer::TableOrder::Linear => serde_json::json!(1),
+            crate::transfer::TableOrder::Quadratic => serde_json::json!(2),
+            crate::transfer::TableOrder::Cubic => serde_json::json!(3),
+        },
     })
 }
 

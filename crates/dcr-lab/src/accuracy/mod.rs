@@ -825,7 +825,9 @@ fn vertex_only(t: &TransferTable) -> TransferTable {
         }
     }
     TransferTable {
+        order: 1,
         edges: Vec::new(),
+        faces: Vec::new(),
         peaks,
         ..t.clone()
     }

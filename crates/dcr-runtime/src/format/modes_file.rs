@@ -27,8 +27,9 @@
 //! u32 (nr,), `transfer_peaks` f32 (np(np+1)/2,) packed upper triangle over np = nr + ne points
 //! (m per N·s),
 //! `transfer_h` f64 () (s), `transfer_rayleigh` f64 (2,), `transfer_modes` u32 (),
-//! `transfer_samples` u32 (), and `transfer_edges` u32 (ne, 2) (absent in tables written
-//! before it: vertex points only). Readers that predate the table ignore these entries.
+//! `transfer_samples` u32 (), and optionally `transfer_edges` u32 (ne, 2), `transfer_order`
+//! u32 () (1, 2, 3; absent: 2 with edges, else 1) and `transfer_faces` u32 (nf, 3) (order 3).
+//! Readers that predate the table ignore these entries.
 //!
 //! Files are written deterministically (fixed zip timestamps, fixed entry order, stored) and
 //! atomically (temporary file in the target directory, then rename).
@@ -42,7 +43,10 @@ use ndarray_npy::npy::header::Header;
 use ndarray_npy::{NpzWriter, ReadNpyExt, ReadableElement};
 use serde::{Deserialize, Serialize};
 
-use super::transfer_table::{TransferTable, TRANSFER_EDGES_ENTRY, TRANSFER_ENTRIES};
+use super::transfer_table::{
+    TransferTable, TRANSFER_EDGES_ENTRY, TRANSFER_ENTRIES, TRANSFER_FACES_ENTRY,
+    TRANSFER_ORDER_ENTRY,
+};
 
 /// Current `.modes` schema version.
 pub const FORMAT_VERSION: u32 = 1;
@@ -444,6 +448,22 @@ impl ModesFile {
                 &Array2::from_shape_vec((t.edges.len(), 2), edges).map_err(|x| x.to_string())?,
             )
             .map_err(e)?;
+            // Only when it differs from what a reader infers (2 with edges, else 1), so that
+            // order-1 and order-2 files keep the bytes of readers that predate the entry.
+            if t.order != if t.edges.is_empty() { 1 } else { 2 } {
+                npz.add_array(
+                    TRANSFER_ORDER_ENTRY,
+                    &Array0::from_elem((), u32::from(t.order)),
+                )
+                .map_err(e)?;
+                let faces: Vec<u32> = t.faces.iter().flatten().copied().collect();
+                npz.add_array(
+                    TRANSFER_FACES_ENTRY,
+                    &Array2::from_shape_vec((t.faces.len(), 3), faces)
+                        .map_err(|x| x.to_string())?,
+                )
+                .map_err(e)?;
+            }
         }
         Ok(npz.finish().map_err(e)?.into_inner())
     }
@@ -747,6 +767,27 @@ impl<R: Read + Seek> EntryReader<'_, R> {
         } else {
             Vec::new()
         };
+        let has = |rd: &Self, e: &str| rd.zip.index_for_name(&format!("{e}.npy")).is_some();
+        let order = if has(self, TRANSFER_ORDER_ENTRY) {
+            let o: u32 = self.scalar(TRANSFER_ORDER_ENTRY)?;
+            u8::try_from(o).unwrap_or(u8::MAX)
+        } else if edges.is_empty() {
+            1
+        } else {
+            2
+        };
+        let faces = if has(self, TRANSFER_FACES_ENTRY) {
+            let (flat, shape) = self.array::<u32>(TRANSFER_FACES_ENTRY, 2)?;
+            if shape[1] != 3 {
+                return Err(self.err(
+                    TRANSFER_FACES_ENTRY,
+                    format!("expected shape (nf, 3), found {shape:?}"),
+                ));
+            }
+            flat.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect()
+        } else {
+            Vec::new()
+        };
         if rayleigh.len() != 2 {
             return Err(self.err(
                 "transfer_rayleigh",
@@ -759,7 +800,9 @@ impl<R: Read + Seek> EntryReader<'_, R> {
             modes,
             samples,
             vertices,
+            order,
             edges,
+            faces,
             peaks,
         }))
     }

@@ -7,7 +7,7 @@ use anyhow::Context;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use modal_bake::bake::{self, BakeParams, BakeReport, BakeStage, ModeRequest, ModesPrecision};
-use modal_bake::transfer::{TransferModes, TransferParams};
+use modal_bake::transfer::{TableOrder, TransferModes, TransferParams};
 
 use super::parse;
 pub use modal_bake::args::ModelOptions;
@@ -90,6 +90,21 @@ pub struct TransferOptions {
     /// Peak-search oversampling of the table: T = π/(2 ω_max)/K for its highest mode [default: 2].
     #[arg(long, value_name = "K", requires = "transfer_h")]
     pub transfer_oversample: Option<f64>,
+    /// Interpolation order over each region triangle: 1 (vertices), 2 (+ edge midpoints), 3
+    /// (+ two points per edge and face centroids: exact-looking inside triangles, ≈ 5× the
+    /// size of 2), or auto (3 when its table has at most 5792 points, else 2).
+    #[arg(long, value_name = "auto|1|2|3", requires = "transfer_h", value_parser = parse_order)]
+    pub transfer_order: Option<TableOrder>,
+}
+
+fn parse_order(s: &str) -> Result<TableOrder, String> {
+    match s.trim() {
+        "auto" => Ok(TableOrder::Auto),
+        "1" => Ok(TableOrder::Linear),
+        "2" => Ok(TableOrder::Quadratic),
+        "3" => Ok(TableOrder::Cubic),
+        _ => Err(format!("expected auto, 1, 2 or 3, got `{s}`")),
+    }
 }
 
 fn parse_modes(s: &str) -> Result<TransferModes, String> {
@@ -113,6 +128,7 @@ impl TransferOptions {
             boxes: self.transfer_region.clone(),
             up: self.transfer_up,
             oversample: self.transfer_oversample.unwrap_or(d.oversample),
+            order: self.transfer_order.unwrap_or(d.order),
             ..d
         })
     }
@@ -257,7 +273,9 @@ fn print_report(out: &std::path::Path, r: &BakeReport) {
     );
     if r.transfer_vertices > 0 {
         outln!(
-            "  transfer table: {} region vertices + {} edge midpoints, {} modes ({}), {} samples per step, built in {:.2} s",
+            "  transfer table: order {}, {} points ({} region vertices, {} edges), {} modes ({}), {} samples per step, built in {:.2} s",
+            r.transfer_order,
+            r.transfer_points,
             r.transfer_vertices,
             r.transfer_edges,
             r.transfer_modes,

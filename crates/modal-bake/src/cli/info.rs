@@ -109,9 +109,12 @@ pub fn run(args: &InfoArgs) -> anyhow::Result<()> {
     match &base.transfer {
         Some(t) => writeln!(
             out,
-            "  transfer table: {} region vertices + {} edge midpoints ({} f32 values, {:.1} KiB), h {} s, {} modes, {} samples per step, Rayleigh α0 {} α1 {}, largest peak {:.4e} m per N·s",
+            "  transfer table: {} region vertices, {} edges, {} faces, order {} ({} points; {} f32 values, {:.1} KiB), h {} s, {} modes, {} samples per step, Rayleigh α0 {} α1 {}, largest peak {:.4e} m per N·s",
             t.len(),
             t.edges.len(),
+            t.faces.len(),
+            t.order,
+            t.num_points(),
             t.peaks.len(),
             t.peaks.len() as f64 * 4.0 / 1024.0,
             t.h,
