@@ -719,6 +719,10 @@ pub fn bake_mesh_with_transfer(
     tp.check().map_err(terr)?;
     let (mut base, mut report) = bake_mesh(mesh.clone(), params, file, progress)?;
     let t = Instant::now();
+    let tp = &tr::TransferParams {
+        modes: tp.modes.resolve(report.free_dofs),
+        ..tp.clone()
+    };
     let enough = matches!(tp.modes, TransferModes::Count(n) if n <= base.num_modes());
     let set = if enough {
         report.transfer_mode_source = "base".into();
@@ -770,6 +774,7 @@ fn transfer_meta(tp: &crate::transfer::TransferParams) -> serde_json::Value {
         "h": tp.h,
         "modes": match tp.modes {
             TransferModes::All => serde_json::json!("all"),
+            TransferModes::Auto => serde_json::json!("auto"),
             TransferModes::Count(n) => serde_json::json!(n),
         },
         "regions": tp.boxes,

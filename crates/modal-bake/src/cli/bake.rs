@@ -76,8 +76,9 @@ pub struct TransferOptions {
     /// for this h and the base's Rayleigh damping.
     #[arg(long, value_name = "SECONDS", allow_hyphen_values = true)]
     pub transfer_h: Option<f64>,
-    /// Modes the table sums: a count or `all` (dense eigensolve; small meshes) [default: 640].
-    #[arg(long, value_name = "N|all", requires = "transfer_h", value_parser = parse_modes)]
+    /// Modes the table sums: a count, `all` (dense eigensolve; small meshes) or `auto` (all up
+    /// to 6000 free dofs, else 640) [default: auto].
+    #[arg(long, value_name = "N|all|auto", requires = "transfer_h", value_parser = parse_modes)]
     pub transfer_modes: Option<TransferModes>,
     /// Region box (m, object frame), repeatable: surface vertices inside any box [default: the
     /// whole surface].
@@ -87,7 +88,7 @@ pub struct TransferOptions {
     /// `0,0,1` for the top faces).
     #[arg(long, value_name = "DX,DY,DZ", requires = "transfer_h", value_parser = parse::vec3, allow_hyphen_values = true)]
     pub transfer_up: Option<[f64; 3]>,
-    /// Peak-search oversampling of the table: T = π/(2 ω_max)/K for its highest mode [default: 2].
+    /// Peak-search oversampling of the table: T = π/(2 ω_max)/K for its highest mode [default: 1].
     #[arg(long, value_name = "K", requires = "transfer_h")]
     pub transfer_oversample: Option<f64>,
     /// Interpolation order over each region triangle: 1 (vertices), 2 (+ edge midpoints), 3
@@ -111,9 +112,14 @@ fn parse_modes(s: &str) -> Result<TransferModes, String> {
     if s.eq_ignore_ascii_case("all") {
         return Ok(TransferModes::All);
     }
+    if s.eq_ignore_ascii_case("auto") {
+        return Ok(TransferModes::Auto);
+    }
     match s.trim().parse::<usize>() {
         Ok(n) if n >= 1 => Ok(TransferModes::Count(n)),
-        _ => Err(format!("expected a mode count ≥ 1 or `all`, got `{s}`")),
+        _ => Err(format!(
+            "expected a mode count ≥ 1, `all` or `auto`, got `{s}`"
+        )),
     }
 }
 

@@ -25,5 +25,5 @@ pub use region::{select_region, RegionBox};
 pub use table_builder::{build_transfer_table, CLUSTER_BYTES};
 pub use transfer_params::{
     TableOrder, TransferError, TransferModes, TransferParams, TransferProgress,
-    AUTO_CUBIC_MAX_POINTS, DEFAULT_OVERSAMPLE, DENSE_MAX_DOFS, UP_MIN_COS,
+    AUTO_CUBIC_MAX_POINTS, AUTO_LANCZOS_MODES, DEFAULT_OVERSAMPLE, DENSE_MAX_DOFS, UP_MIN_COS,
 };

@@ -30,7 +30,7 @@ pub fn mode_set_dense(
     let sys = FullOrderSystem::new(mesh.clone(), &tp, file)?;
     let ma = ModalAll::new(&sys, DENSE_MAX_DOFS)?;
     let m = match modes {
-        TransferModes::All => ma.eigenvalues.len(),
+        TransferModes::All | TransferModes::Auto => ma.eigenvalues.len(),
         TransferModes::Count(n) => n.min(ma.eigenvalues.len()),
     };
     Ok(mode_set_from_dense(template, &sys, &ma, m))

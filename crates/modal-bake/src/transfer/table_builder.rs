@@ -48,7 +48,7 @@ pub fn build_transfer_table(
 ) -> Result<TransferTable, TransferError> {
     params.check()?;
     let m = match params.modes {
-        TransferModes::All => modes.num_modes(),
+        TransferModes::All | TransferModes::Auto => modes.num_modes(),
         TransferModes::Count(n) => n.min(modes.num_modes()),
     };
     let mut set = modes.clone();

@@ -4,8 +4,9 @@
 use crate::bake::BakeError;
 use crate::full_order::FullOrderError;
 
-/// Default oversampling of the table's peak search: T = π/(2 ω_max)/2 for its highest mode.
-pub const DEFAULT_OVERSAMPLE: f64 = 2.0;
+/// Default oversampling of the table's peak search: T = π/(2 ω_max) for its highest mode (the
+/// paper's period; measured against finer sampling in `docs/accuracy.md`).
+pub const DEFAULT_OVERSAMPLE: f64 = 1.0;
 
 /// Meshes with at most this many free dofs get their table's modes from the dense all-mode
 /// eigensolve; larger ones from a Lanczos bake.
@@ -53,6 +54,9 @@ impl TableOrder {
     }
 }
 
+/// Modes of a table under [`TransferModes::Auto`] for meshes too large for the dense solve.
+pub const AUTO_LANCZOS_MODES: usize = 640;
+
 /// How many modes the table sums.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum TransferModes {
@@ -60,6 +64,20 @@ pub enum TransferModes {
     Count(usize),
     /// Every elastic mode (dense eigensolve: small meshes only).
     All,
+    /// Every mode when the mesh has at most [`DENSE_MAX_DOFS`] free dofs (the dense solve),
+    /// else the lowest [`AUTO_LANCZOS_MODES`] (Lanczos).
+    Auto,
+}
+
+impl TransferModes {
+    /// [`TransferModes::Auto`] resolved for a mesh of `free_dofs` (the others unchanged).
+    pub fn resolve(self, free_dofs: usize) -> TransferModes {
+        match self {
+            TransferModes::Auto if free_dofs <= DENSE_MAX_DOFS => TransferModes::All,
+            TransferModes::Auto => TransferModes::Count(AUTO_LANCZOS_MODES),
+            m => m,
+        }
+    }
 }
 
 /// What to tabulate (SI units, object frame).
@@ -68,7 +86,7 @@ pub struct TransferParams {
     /// Rigid-body step h (s) the peaks are taken over; the runtime uses the table only for
     /// this h (relative tolerance 1e-9).
     pub h: f64,
-    /// Modes summed. Default 640.
+    /// Modes summed. Default [`TransferModes::Auto`].
     pub modes: TransferModes,
     /// Region boxes (m): vertices inside any of them (empty: no box filter).
     pub boxes: Vec<[f64; 6]>,
@@ -87,7 +105,7 @@ impl Default for TransferParams {
     fn default() -> Self {
         TransferParams {
             h: 0.01,
-            modes: TransferModes::Count(640),
+            modes: TransferModes::Auto,
             boxes: Vec::new(),
             up: None,
             up_min_cos: UP_MIN_COS,
