@@ -4,24 +4,37 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::Args;
+use dcr_lab::accuracy::{all_objects, AccuracyOptions};
 
 #[derive(Args, Clone, Debug)]
 pub struct AccuracyArgs {
     /// Folder of the report: writes OUT/accuracy.md and OUT/accuracy/*.svg.
     #[arg(long, value_name = "DIR", default_value = "docs")]
     pub out: PathBuf,
-    /// A short run (the table only, up to 40 modes) to check the pipeline.
+    /// Repository root (scene meshes are read from ROOT/data/scenes).
+    #[arg(long, value_name = "DIR", default_value = ".")]
+    pub root: PathBuf,
+    /// Only these objects (repeatable): table, roof, scaffold, ground, cliff, floor, fridge,
+    /// slab.
+    #[arg(long, value_name = "NAME")]
+    pub only: Vec<String>,
+    /// Fewer method rows and no attenuation fit (a pipeline check).
     #[arg(long)]
     pub quick: bool,
-    /// Only the transfer-table study of each object.
-    #[arg(long)]
-    pub transfer_only: bool,
 }
 
 pub fn run(args: &AccuracyArgs) -> anyhow::Result<()> {
-    std::fs::create_dir_all(args.out.join("accuracy"))
-        .with_context(|| format!("creating {}", args.out.join("accuracy").display()))?;
-    let md = dcr_lab::accuracy::generate(&args.out, args.quick, args.transfer_only);
+    let known: Vec<&str> = all_objects().iter().map(|o| o.name).collect();
+    if let Some(bad) = args.only.iter().find(|n| !known.contains(&n.as_str())) {
+        anyhow::bail!("--only {bad}: no such object (known: {})", known.join(", "));
+    }
+    let svg = args.out.join("accuracy");
+    std::fs::create_dir_all(&svg).with_context(|| format!("creating {}", svg.display()))?;
+    let opts = AccuracyOptions {
+        only: args.only.clone(),
+        quick: args.quick,
+    };
+    let md = dcr_lab::accuracy::generate(&args.root, &args.out, &opts)?;
     let path = args.out.join("accuracy.md");
     let tmp = args
         .out
@@ -31,7 +44,7 @@ pub fn run(args: &AccuracyArgs) -> anyhow::Result<()> {
     eprintln!(
         "wrote {} and {}",
         path.display(),
-        args.out.join("accuracy/*.svg").display()
+        svg.join("*.svg").display()
     );
     Ok(())
 }

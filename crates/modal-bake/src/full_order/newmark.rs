@@ -106,22 +106,23 @@ pub fn newmark_run(
     // K_eff = (1 + c1 α1) K + (c0 + c1 α0) M.
     let keff = lin_comb(&sys.k, 1.0 + c1 * a1, &sys.m, c0 + c1 * a0);
     let kfac = factor(&keff, "K_eff")?;
-    let mut mem = kfac.solve_buffer(nb);
-    let mut solve = |fac: &ShiftInvert, x: &mut [f64]| {
-        fac.solve_in_place(MatMut::from_column_major_slice_mut(x, n, nb), &mut mem);
+    // One scratch per factor: their symbolic structures (and solve paths) differ.
+    let (mut mmem, mut kmem) = (mfac.solve_buffer(nb), kfac.solve_buffer(nb));
+    let solve = |fac: &ShiftInvert, mem: &mut _, x: &mut [f64]| {
+        fac.solve_in_place(MatMut::from_column_major_slice_mut(x, n, nb), mem);
     };
     let factor_s = t.elapsed().as_secs_f64();
     let t = Instant::now();
 
     let mut u = vec![0.0; len];
     let mut v: Vec<f64> = loads.iter().flat_map(|f| f.iter().copied()).collect();
-    solve(&mfac, &mut v);
+    solve(&mfac, &mut mmem, &mut v);
     // ü(0) = −α0 v − α1 M⁻¹ K v.
     let mut acc = vec![0.0; len];
     for i in 0..nb {
         spmv(&sys.k, &v[i * n..(i + 1) * n], &mut acc[i * n..(i + 1) * n]);
     }
-    solve(&mfac, &mut acc);
+    solve(&mfac, &mut mmem, &mut acc);
     for (ai, vi) in acc.iter_mut().zip(&v) {
         *ai = -a0 * vi - a1 * *ai;
     }
@@ -143,7 +144,7 @@ pub fn newmark_run(
                 *o = p + q;
             }
         }
-        solve(&kfac, &mut un);
+        solve(&kfac, &mut kmem, &mut un);
         for i in 0..len {
             let an = c0 * (un[i] - u[i]) - c2 * v[i] - acc[i];
             v[i] += 0.5 * dt * (acc[i] + an);

@@ -305,7 +305,7 @@ fn tabulate(
                                     })
                                 }
                             };
-                            (table.packed_index(p as usize, q), peak as f32)
+                            (table.packed_index(p as usize, q), peak)
                         })
                         .collect()
                 },
