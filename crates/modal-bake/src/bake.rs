@@ -678,6 +678,7 @@ pub fn bake_mesh(
             rigid_modes_excluded: first,
             mass_kg: report.mass_kg,
             reoriented_tets: reoriented,
+            accuracy: None,
         },
         precision: params.precision,
         transfer: None,

@@ -14,4 +14,5 @@ pub mod eigen;
 pub mod fem;
 pub mod full_order;
 pub mod mesh;
+pub mod target_error;
 pub mod transfer;

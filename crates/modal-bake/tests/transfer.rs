@@ -221,6 +221,42 @@ fn every_point_kind_equals_the_probe_at_that_point() {
         if let (Some(&f1), Some(&f2)) = (face_pts.first(), face_pts.last()) {
             cases.extend([(f1, f2), (f1, e2), (v1, f2)]);
         }
+        // Points next to the beam's edges, whose corners' normals differ: the table holds the
+        // response along their interpolated normal (the runtime's and the probe's).
+        let blended = |p: usize| {
+            let (vs, ws) = t.point_support(p);
+            let mut q = [0.0; 3];
+            for k in 0..3 {
+                for c in 0..3 {
+                    q[c] += ws[k] * n[vert(vs[k])][c];
+                }
+            }
+            let l = (q[0] * q[0] + q[1] * q[1] + q[2] * q[2]).sqrt();
+            q.map(|x| x / l)
+        };
+        let bent: Vec<usize> = (nr..t.num_points())
+            .filter(|&p| {
+                let (vs, ws) = t.point_support(p);
+                let vs: Vec<usize> = (0..3)
+                    .filter(|&k| ws[k] != 0.0)
+                    .map(|k| vert(vs[k]))
+                    .collect();
+                vs.iter().all(|&v| !fixed(v))
+                    && vs
+                        .iter()
+                        .any(|&v| (0..3).any(|k| (n[v][k] - n[vs[0]][k]).abs() > 1e-3))
+            })
+            .collect();
+        assert!(bent.len() > 10, "{} bent points", bent.len());
+        let (b1, b2) = (bent[1], bent[bent.len() - 2]);
+        cases.extend([(b1, b2), (b1, e2), (e1, b2), (v1, b2), (b2, v1)]);
+        let inward = |p: usize| {
+            if bent.contains(&p) {
+                blended(p).map(|c| -c)
+            } else {
+                inward(p)
+            }
+        };
         for (p, q) in cases {
             let got = probe_point(&path, &t, pos(p), inward(p), pos(q), "modal");
             let table = t.peak(p, q);

@@ -6,16 +6,14 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use dcr_runtime::format::ModesFile;
-use dcr_runtime::testing::SplitMix64;
-use dcr_runtime::{
-    DistantResponse, Impact, Method, ModalModel, ResponseParams, RestingContact, ServedBy,
-};
+use dcr_runtime::{DistantResponse, Impact, Method, ModalModel, RestingContact, ServedBy};
 use modal_bake::bake::{bake_mesh, BakeParams, ModeRequest};
 use modal_bake::full_order::{
     converged_peaks, ConvergedPeaks, FullOrderSystem, ModalAll, PeakSolver, PeakWindow,
     RefineParams, SystemParams,
 };
 use modal_bake::mesh::TetMesh;
+use modal_bake::target_error::{PairsParams, ReferencePairs};
 use modal_bake::transfer::{
     build_transfer_table, mode_set_from_dense, mode_set_lanczos, select_region, TableOrder,
     TransferModes, TransferParams, AUTO_LANCZOS_MODES, DENSE_MAX_DOFS, UP_MIN_COS,
@@ -38,15 +36,6 @@ pub const MIN_DISTANCE: f64 = 0.1;
 pub const TRUTH_DT0: f64 = 1e-5;
 /// Modes of the runtime base every table sits in (the paper's count).
 pub const BASE_MODES: usize = 20;
-
-/// A sampled surface point: position (m) and whether it is a region vertex.
-#[derive(Clone, Copy, Debug)]
-pub struct Point {
-    /// Position (m, object frame).
-    pub at: [f64; 3],
-    /// At a vertex (else inside a triangle).
-    pub vertex: bool,
-}
 
 /// One method's result on an object.
 #[derive(Clone, Debug)]
@@ -107,56 +96,6 @@ pub struct ObjectStudy {
     pub notes: Vec<String>,
 }
 
-/// Seeded points in `region`'s triangles (every corner in the region, none fixed).
-fn pick_points(base: &ModesFile, region: &[u32], n: usize, rng: &mut SplitMix64) -> Vec<Point> {
-    let fixed: std::collections::HashSet<u32> = base.fixed_nodes.iter().copied().collect();
-    let ok = |v: u32| {
-        region.binary_search(&v).is_ok() && !fixed.contains(&base.surface_to_volume[v as usize])
-    };
-    let tris: Vec<usize> = (0..base.surface_triangles.len())
-        .filter(|&t| base.surface_triangles[t].iter().all(|&v| ok(v)))
-        .collect();
-    let verts: Vec<u32> = {
-        let mut v: Vec<u32> = tris
-            .iter()
-            .flat_map(|&t| base.surface_triangles[t])
-            .collect();
-        v.sort_unstable();
-        v.dedup();
-        v
-    };
-    let x = &base.surface_vertices;
-    (0..n)
-        .map(|k| match 3 * k / n {
-            0 => Point {
-                at: x[verts[rng.below(verts.len())] as usize],
-                vertex: true,
-            },
-            c => {
-                let t = base.surface_triangles[tris[rng.below(tris.len())]];
-                let (mut a, mut b) = if c == 1 {
-                    (1.0 / 3.0, 1.0 / 3.0)
-                } else {
-                    (rng.next_f64(), rng.next_f64())
-                };
-                if a + b > 1.0 {
-                    (a, b) = (1.0 - a, 1.0 - b);
-                }
-                let w = [a, b, 1.0 - a - b];
-                let v = t.map(|i| x[i as usize]);
-                Point {
-                    at: [0, 1, 2].map(|k| w[0] * v[0][k] + w[1] * v[1][k] + w[2] * v[2][k]),
-                    vertex: false,
-                }
-            }
-        })
-        .collect()
-}
-
-fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
-    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
-}
-
 /// The lowest `m` modes of `base` (same surface and metadata; no table).
 pub fn truncate(base: &ModesFile, m: usize) -> ModesFile {
     let mm = base.num_modes();
@@ -196,13 +135,9 @@ fn time_step(dr: &mut DistantResponse, imp: &[Impact], resting: &[RestingContact
         .fold(f64::INFINITY, f64::min)
 }
 
-/// Everything the runtime rows share: the impacts, resting contacts and truth.
+/// Every runtime row is scored on the same pairs.
 struct Bench<'a> {
-    impacts: &'a [Impact],
-    resting: &'a [RestingContact],
-    truth: &'a [Vec<f64>],
-    contact_at_vertex: &'a [bool],
-    pair_ok: &'a [Vec<bool>],
+    pairs: &'a ReferencePairs,
 }
 
 impl Bench<'_> {
@@ -233,26 +168,11 @@ impl Bench<'_> {
     ) -> MethodRow {
         let bytes = base_bytes(&base, tag);
         let model = Arc::new(ModalModel::from_base(base).expect("a valid base"));
-        let params = ResponseParams {
-            h: H,
-            method,
-            ..Default::default()
-        };
-        let mut dr = DistantResponse::new(model, params).expect("valid parameters");
-        let mut errors = Vec::new();
-        for (i, imp) in self.impacts.iter().enumerate() {
-            let out = dr.step(std::slice::from_ref(imp), self.resting);
-            for (c, o) in out.iter().enumerate() {
-                assert_eq!(o.served_by, served, "{label}: contact {c}");
-                if self.pair_ok[i][c] {
-                    let t = self.truth[i][c];
-                    let p = gain * o.peak_displacement;
-                    errors.push((100.0 * (p - t) / t, self.contact_at_vertex[c]));
-                }
-            }
-        }
-        let n = self.resting.len().min(8);
-        let query_us = time_step(&mut dr, &self.impacts[..1], &self.resting[..n]);
+        let mut dr = self.pairs.response(model, method);
+        let (errors, by) = self.pairs.errors(&mut dr, gain);
+        assert!(by.iter().all(|b| *b == served), "{label}: served by {by:?}");
+        let n = self.pairs.resting.len().min(8);
+        let query_us = time_step(&mut dr, &self.pairs.impacts[..1], &self.pairs.resting[..n]);
         MethodRow {
             label,
             best: false,
@@ -283,10 +203,6 @@ pub fn study_object(spec: &ObjectSpec, mesh: TetMesh, quick: bool) -> ObjectStud
     let dofs = rep.free_dofs;
     let model20 = ModalModel::from_base(base20.clone()).expect("model");
     let region = select_region(&model20, &spec.boxes, spec.up, UP_MIN_COS);
-    // Points.
-    let mut rng = SplitMix64(2);
-    let imp_pts = pick_points(&base20, &region, IMPACTS, &mut rng);
-    let con_pts = pick_points(&base20, &region, CONTACTS, &mut rng);
     // Truth: the dense all-mode sum where it fits, else Newmark; refined until converged.
     eprintln!("{name}: truth ({dofs} free dofs)…");
     let t = Instant::now();
@@ -296,40 +212,24 @@ pub fn study_object(spec: &ObjectSpec, mesh: TetMesh, quick: bool) -> ObjectStud
         ..Default::default()
     };
     let sys = FullOrderSystem::new(mesh.clone(), &sp, &file).expect("full-order system");
-    let isp: Vec<_> = imp_pts
-        .iter()
-        .map(|p| sys.surface.project(p.at).expect("impact on the surface"))
-        .collect();
-    let csp: Vec<_> = con_pts
-        .iter()
-        .map(|p| sys.surface.project(p.at).expect("contact on the surface"))
-        .collect();
-    let loads: Vec<Vec<f64>> = isp
-        .iter()
-        .map(|s| sys.load_vector(s, s.normal.map(|x| -x), IMPULSE))
-        .collect();
-    let rows: Vec<Vec<f64>> = csp.iter().map(|c| sys.contact_row(c)).collect();
     let dense = dofs <= DENSE_MAX_DOFS;
     let ma = dense.then(|| ModalAll::new(&sys, DENSE_MAX_DOFS).expect("dense eigensolve"));
     let dense_s = t.elapsed().as_secs_f64();
-    let (solver, other, truth_method) = match &ma {
-        Some(m) => (
-            PeakSolver::ModalAll(m, None),
-            Some(PeakSolver::Newmark),
-            "sum over every mode (dense)",
-        ),
-        None => (PeakSolver::Newmark, None, "Newmark (β = ¼, γ = ½)"),
-    };
-    let refine = RefineParams {
-        max_refinements: 8,
-        ..RefineParams::default()
-    };
-    let window = PeakWindow {
+    let pp = PairsParams {
+        impacts: IMPACTS,
+        contacts: CONTACTS,
+        seed: 2,
+        min_distance: MIN_DISTANCE,
+        impulse: IMPULSE,
         h: H,
-        dt: TRUTH_DT0,
+        dt0: TRUTH_DT0,
+        refine: RefineParams {
+            max_refinements: 8,
+            ..RefineParams::default()
+        },
     };
     let mut last_line = Instant::now();
-    let truth = converged_peaks(&sys, solver, &loads, &rows, window, &refine, &mut |p| {
+    let pairs = ReferencePairs::new(&sys, ma.as_ref(), &base20, &region, &pp, &mut |p| {
         if p.done == 0 || last_line.elapsed().as_secs() >= 10 {
             eprintln!(
                 "{name}: truth level {} (dt {:.2e} s) {}/{}",
@@ -340,14 +240,46 @@ pub fn study_object(spec: &ObjectSpec, mesh: TetMesh, quick: bool) -> ObjectStud
     })
     .expect("truth");
     let truth_s = t.elapsed().as_secs_f64();
-    let cross_check = other.map(|o| {
+    let truth_method = if dense {
+        "sum over every mode (dense)"
+    } else {
+        "Newmark (β = ¼, γ = ½)"
+    };
+    // The independent check of the dense sum: Newmark at the step it reached.
+    let cross_check = ma.as_ref().map(|_| {
+        let loads: Vec<Vec<f64>> = pairs
+            .impacts
+            .iter()
+            .map(|i| {
+                let s = sys.surface.project(i.point).expect("on the surface");
+                sys.load_vector(&s, i.direction, i.impulse)
+            })
+            .collect();
+        let rows: Vec<Vec<f64>> = pairs
+            .resting
+            .iter()
+            .map(|c| sys.contact_row(&sys.surface.project(c.point).expect("on the surface")))
+            .collect();
         let single = RefineParams {
             max_refinements: 0,
-            ..refine
+            ..pp.refine
         };
-        let w = PeakWindow { h: H, dt: truth.dt };
-        let c = converged_peaks(&sys, o, &loads, &rows, w, &single, &mut |_| {}).expect("check");
-        let d = truth
+        let w = PeakWindow {
+            h: H,
+            dt: pairs.truth.dt,
+        };
+        let c = converged_peaks(
+            &sys,
+            PeakSolver::Newmark,
+            &loads,
+            &rows,
+            w,
+            &single,
+            &mut |_| {},
+        )
+        .expect("Newmark check");
+        let d = pairs
+            .truth
             .peaks
             .iter()
             .flatten()
@@ -357,47 +289,12 @@ pub fn study_object(spec: &ObjectSpec, mesh: TetMesh, quick: bool) -> ObjectStud
     });
     eprintln!(
         "{name}: truth converged {} at dt {:.2e} s, est. error {:.3} %, {:.0} s",
-        truth.converged,
-        truth.dt,
-        100.0 * truth.estimated_error,
+        pairs.truth.converged,
+        pairs.truth.dt,
+        100.0 * pairs.truth.estimated_error,
         truth_s
     );
-    // Runtime inputs.
-    let impacts: Vec<Impact> = isp
-        .iter()
-        .map(|s| Impact {
-            point: s.point,
-            direction: s.normal.map(|x| -x),
-            impulse: IMPULSE,
-        })
-        .collect();
-    let resting: Vec<RestingContact> = csp
-        .iter()
-        .enumerate()
-        .map(|(i, c)| RestingContact {
-            id: i as u64,
-            point: c.point,
-        })
-        .collect();
-    let truth_scaled: Vec<Vec<f64>> = truth.peaks.clone();
-    let pair_ok: Vec<Vec<bool>> = impacts
-        .iter()
-        .map(|i| {
-            resting
-                .iter()
-                .map(|c| dist(i.point, c.point) >= MIN_DISTANCE)
-                .collect()
-        })
-        .collect();
-    let pairs = pair_ok.iter().flatten().filter(|x| **x).count();
-    let contact_at_vertex: Vec<bool> = con_pts.iter().map(|p| p.vertex).collect();
-    let bench = Bench {
-        impacts: &impacts,
-        resting: &resting,
-        truth: &truth_scaled,
-        contact_at_vertex: &contact_at_vertex,
-        pair_ok: &pair_ok,
-    };
+    let bench = Bench { pairs: &pairs };
     // The many-mode set: every dense mode, or a Lanczos bake of 640.
     eprintln!("{name}: mode set…");
     let t = Instant::now();
@@ -542,10 +439,10 @@ pub fn study_object(spec: &ObjectSpec, mesh: TetMesh, quick: bool) -> ObjectStud
         dofs,
         region: region.len(),
         truth_method: truth_method.into(),
-        truth,
+        truth: pairs.truth.clone(),
         cross_check,
         truth_s,
-        pairs,
+        pairs: pairs.pairs(),
         rows: out,
         attenuation_c: c_fit,
         notes,

@@ -4,7 +4,7 @@ mod modes_file;
 mod transfer_table;
 
 pub use modes_file::{
-    FormatError, MaterialSi, ModesFile, ModesMeta, ModesPrecision, FORMAT_VERSION,
+    AccuracyRecord, FormatError, MaterialSi, ModesFile, ModesMeta, ModesPrecision, FORMAT_VERSION,
 };
 pub use transfer_table::{TransferTable, MAX_TRANSFER_POINTS};
 

@@ -102,6 +102,48 @@ pub struct ModesMeta {
     pub mass_kg: f64,
     /// Inverted tetrahedra that were reoriented while baking.
     pub reoriented_tets: usize,
+    /// What `modal-bake bake --target-error` chose and its measured error (absent otherwise;
+    /// files without it read as `None` and are written byte for byte as before).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub accuracy: Option<AccuracyRecord>,
+}
+
+/// The accuracy a base was chosen for (`modal-bake bake --target-error PCT`): its error against
+/// the bake's own converged full-order truth at seeded pairs of the region, and its cost. Every
+/// figure is deterministic (no timings), so the file stays bit-identical.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct AccuracyRecord {
+    /// Target: worst |error| allowed over the pairs (%).
+    pub target_pct: f64,
+    /// Whether the chosen representation meets it (else it is the most accurate tried).
+    pub met: bool,
+    /// Median |error| over the pairs (%).
+    pub median_pct: f64,
+    /// Worst |error| over the pairs (%).
+    pub worst_pct: f64,
+    /// Pairs measured (impact, resting contact; vertices and points inside triangles).
+    pub pairs: usize,
+    /// Rigid-body step h the peaks are taken over (s).
+    pub h: f64,
+    /// The truth: `all-modes` (dense sum) or `newmark`.
+    pub truth: String,
+    /// The truth's step after refinement (s).
+    pub truth_dt: f64,
+    /// The truth's estimated error (%), see `modal_bake::full_order::converged_peaks`.
+    pub truth_error_pct: f64,
+    /// Runtime modes kept in the base.
+    pub modes: usize,
+    /// Modes summed by its transfer table (`None`: no table).
+    pub table_modes: Option<usize>,
+    /// Interpolation order of its table (`None`: no table).
+    pub table_order: Option<u8>,
+    /// Query cost model: multiply-adds per (impact, resting contact) pair — m·S for m modal
+    /// filters sampled S times per step, (nodes per triangle)² table lookups for a table.
+    pub query_cost: f64,
+    /// The same for the paper's 20 modes, for comparison.
+    pub query_cost_20: f64,
+    /// Bytes of the numeric payload (mode rows and table entries; the file adds a few KiB).
+    pub payload_bytes: u64,
 }
 
 /// A modal base in memory: exactly what a `.modes` file holds.

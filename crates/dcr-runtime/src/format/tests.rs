@@ -39,6 +39,7 @@ pub(crate) fn tiny_base() -> ModesFile {
             rigid_modes_excluded: 6,
             mass_kg: 700.0 / 6.0,
             reoriented_tets: 0,
+            accuracy: None,
         },
         precision: ModesPrecision::F64,
         transfer: None,

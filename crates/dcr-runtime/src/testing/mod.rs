@@ -287,6 +287,7 @@ pub fn synthetic_base(surface: Surface, omega: &[f64], rayleigh: [f64; 2], seed:
             rigid_modes_excluded: 6,
             mass_kg: 1.0,
             reoriented_tets: 0,
+            accuracy: None,
         },
         precision: ModesPrecision::F64,
         transfer: None,

@@ -65,6 +65,18 @@ pub struct BakeArgs {
     pub json: bool,
     #[command(flatten)]
     pub transfer: TransferOptions,
+    /// Choose the cheapest representation (modes; a transfer table, its modes and order) whose
+    /// worst peak error against the bake's own converged full-order truth, at seeded pairs of
+    /// the table region (--transfer-up / --transfer-region), is at most PCT percent; needs
+    /// --transfer-h (the scene's step). The estimate, query cost and size are stored in the
+    /// base (`info` shows them). Overrides --modes and --transfer-modes / --transfer-order.
+    #[arg(
+        long,
+        value_name = "PCT",
+        requires = "transfer_h",
+        conflicts_with = "max_freq"
+    )]
+    pub target_error: Option<f64>,
 }
 
 /// The optional bake-time peak-transfer table (`dcr_runtime::Method::Transfer`).
@@ -141,18 +153,18 @@ impl TransferOptions {
 }
 
 /// A spinner per stage, a bar for the eigensolve; hidden when stderr is not a terminal.
-struct Progress {
-    bar: ProgressBar,
+pub(super) struct Progress {
+    pub(super) bar: ProgressBar,
 }
 
 impl Progress {
-    fn new() -> Progress {
+    pub(super) fn new() -> Progress {
         let bar = ProgressBar::new_spinner();
         bar.enable_steady_tick(Duration::from_millis(120));
         Progress { bar }
     }
 
-    fn update(&mut self, stage: BakeStage) {
+    pub(super) fn update(&mut self, stage: BakeStage) {
         match stage {
             BakeStage::Read => self.bar.set_message("reading mesh"),
             BakeStage::Assemble => self.bar.set_message("assembling K and M"),
@@ -198,6 +210,9 @@ impl Progress {
 }
 
 pub fn run(args: &BakeArgs) -> anyhow::Result<()> {
+    if let Some(target) = args.target_error {
+        return super::target::run(args, target);
+    }
     let params = args.options.params();
     let mut progress = Progress::new();
     let transfer = args.transfer.params();
@@ -238,7 +253,7 @@ pub fn run(args: &BakeArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-fn print_report(out: &std::path::Path, r: &BakeReport) {
+pub(super) fn print_report(out: &std::path::Path, r: &BakeReport) {
     outln!("wrote {}", out.display());
     outln!(
         "  mesh: {} nodes, {} tets, {} free dofs, mass {:.6} kg",

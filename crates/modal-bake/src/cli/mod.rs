@@ -15,6 +15,7 @@ mod info;
 mod lab_alias;
 mod parse;
 mod probe;
+mod target;
 
 use std::process::ExitCode;
 

@@ -117,11 +117,66 @@ pub fn build_transfer_table(
     let adjacency = TransferTable::region_edges(tris, &table.vertices);
     let g = Mat::<Real>::from_fn(s, m, |k, l| g[(k, l)] as Real);
     let w = Mat::<Real>::from_fn(m, nr, |l, c| w[(l, c)] as Real);
-    table.peaks = tabulate(&table, &adjacency, &g, &w, progress);
+    let bent = bent_point_rows(&table, &model, m);
+    table.peaks = tabulate(&table, &adjacency, &g, &w, &bent, progress);
     table
         .check(modes.num_surface_vertices())
         .map_err(TransferError::Params)?;
     Ok(table)
+}
+
+/// Normal rows of the points whose vertices' normals differ ("bent" points, next to edges and
+/// corners of the surface): `rows` (m × n) with column k the row of point `points[k]`
+/// (ascending).
+struct BentRows {
+    points: Vec<u32>,
+    rows: Mat<Real>,
+}
+
+/// The rows of the bent points: `w̃_pl = n̂_pᵀ Σ_a λ_pa U_al` with `n̂_p` the normalised blend of
+/// the vertices' normals — the runtime's (and the truth's) normal at that point. At the other
+/// points every vertex has the same normal and the row is the blend of the vertex rows.
+fn bent_point_rows(table: &TransferTable, model: &ModalModel, m: usize) -> BentRows {
+    let normals = model.vertex_normals();
+    let base = model.base();
+    let mm = base.num_modes();
+    let mut points = Vec::new();
+    let mut cols: Vec<Vec<f64>> = Vec::new();
+    for p in table.len()..table.num_points() {
+        let (vs, ws) = table.point_support(p);
+        let used: Vec<(usize, f64)> = (0..3)
+            .filter(|&k| ws[k] != 0.0)
+            .map(|k| (table.vertices[vs[k] as usize] as usize, ws[k]))
+            .collect();
+        let n0 = normals[used[0].0];
+        if used
+            .iter()
+            .all(|&(v, _)| (0..3).all(|c| (normals[v][c] - n0[c]).abs() <= 1e-12))
+        {
+            continue;
+        }
+        let mut n = [0.0; 3];
+        for &(v, l) in &used {
+            for c in 0..3 {
+                n[c] += l * normals[v][c];
+            }
+        }
+        let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+        let n = if len > 0.0 { n.map(|x| x / len) } else { n0 };
+        let mut row = vec![0.0f64; m];
+        for &(v, l) in &used {
+            for c in 0..3 {
+                let u = &base.modes[(v * 3 + c) * mm..(v * 3 + c) * mm + m];
+                for (r, x) in row.iter_mut().zip(u) {
+                    *r += l * n[c] * x;
+                }
+            }
+        }
+        points.push(p as u32);
+        cols.push(row);
+    }
+    let rows = Mat::<Real>::from_fn(m, points.len(), |l, k| cols[k][l] as Real);
+    BentRows { points, rows }
 }
 
 /// A table point's support: region vertices and barycentric weights (1 to 3 of them).
@@ -188,38 +243,53 @@ fn processing_order(nr: usize, edges: &[[u32; 2]], sup: &[Support]) -> Vec<u32> 
 }
 
 /// The packed upper triangle of peaks (see the module docs); `edges`: the region's edges (for
-/// the processing order).
+/// the processing order); `bent`: the rows of the points whose vertices' normals differ.
 fn tabulate(
     table: &TransferTable,
     edges: &[[u32; 2]],
     g: &Mat<Real>,
     w: &Mat<Real>,
+    bent: &BentRows,
     progress: &mut dyn FnMut(TransferProgress),
 ) -> Vec<f32> {
     let np = table.num_points();
     let nr = table.len();
     let s = g.nrows();
+    let m = g.ncols();
     let sup = supports(table);
     let order = processing_order(nr, edges, &sup);
-    // Last position at which each vertex supports a point.
+    let mut bent_of = vec![usize::MAX; np];
+    for (k, &p) in bent.points.iter().enumerate() {
+        bent_of[p as usize] = k;
+    }
+    let mut pos = vec![0usize; np];
+    for (i, &p) in order.iter().enumerate() {
+        pos[p as usize] = i;
+    }
+    // Last position at which each vertex supports a point blended from vertex series.
     let mut last_use = vec![0usize; nr];
     for (i, &p) in order.iter().enumerate() {
+        if bent_of[p as usize] != usize::MAX {
+            continue;
+        }
         let sp = &sup[p as usize];
         for &v in &sp.verts[..sp.len] {
             last_use[v as usize] = last_use[v as usize].max(i);
         }
     }
     let mut peaks = vec![0.0f32; TransferTable::packed_len(np)];
-    let per_vertex = s * nr * std::mem::size_of::<Real>();
+    let per_vertex = s * (nr + bent.points.len()) * std::mem::size_of::<Real>();
     let max_vertices = (CLUSTER_BYTES / per_vertex.max(1)).max(4);
-    // Series kept from the previous cluster: vertex → (its target columns, S × columns).
+    // Series kept from the previous cluster: vertex → (its column keys, S × columns). Column
+    // keys: vertex v is v, bent point q is nr + q (ascending: vertices first).
     let mut kept: HashMap<u32, (Vec<u32>, Mat<Real>)> = HashMap::new();
     let mut start = 0;
     progress(TransferProgress { done: 0, total: np });
     while start < np {
-        let end = cluster_end(&order, &sup, start, max_vertices);
+        let end = cluster_end(&order, &sup, &bent_of, start, max_vertices);
         let mut verts: Vec<u32> = order[start..end]
             .iter()
+            .filter(|&&p| bent_of[p as usize] == usize::MAX)
             .flat_map(|&p| {
                 let sp = sup[p as usize];
                 sp.verts.into_iter().take(sp.len)
@@ -227,35 +297,53 @@ fn tabulate(
             .collect();
         verts.sort_unstable();
         verts.dedup();
-        // Target vertices still in use from `start` on, and each target point's columns.
-        let cols: Vec<u32> = (0..nr as u32)
+        // Targets from `start` on: the vertices their blends need, and the bent points.
+        let mut keys: Vec<u32> = (0..nr as u32)
             .filter(|&v| last_use[v as usize] >= start)
             .collect();
-        let col_of = |b: u32| cols.binary_search(&b).expect("target vertex in use");
-        let tcols: Vec<[usize; 3]> = order[start..]
+        keys.extend(
+            bent.points
+                .iter()
+                .filter(|&&q| pos[q as usize] >= start)
+                .map(|&q| nr as u32 + q),
+        );
+        let wc = Mat::<Real>::from_fn(m, keys.len(), |l, c| {
+            let k = keys[c] as usize;
+            if k < nr {
+                w[(l, k)]
+            } else {
+                bent.rows[(l, bent_of[k - nr])]
+            }
+        });
+        let col_of = |key: u32| keys.binary_search(&key).expect("target in use");
+        // Per target (position start + j): its columns and weights.
+        let targets: Vec<([usize; 3], [Real; 3], usize)> = order[start..]
             .iter()
             .map(|&q| {
+                if bent_of[q as usize] != usize::MAX {
+                    return ([col_of(nr as u32 + q), 0, 0], [1.0, 0.0, 0.0], 1);
+                }
                 let sq = &sup[q as usize];
                 let mut c = [0usize; 3];
                 for k in 0..sq.len {
                     c[k] = col_of(sq.verts[k]);
                 }
-                c
+                (c, sq.weights.map(|x| x as Real), sq.len)
             })
             .collect();
-        // Vertex series over `cols`: kept ones cut down to them, the rest computed.
+        // Vertex series over the columns: kept ones cut down to them, the rest computed.
         let series: HashMap<u32, Mat<Real>> = verts
             .par_iter()
             .map(|&a| {
                 let y = match kept.get(&a) {
                     Some((kc, ky)) => {
-                        let map: Vec<usize> = cols
+                        let map: Vec<usize> = keys
                             .iter()
                             .map(|b| kc.binary_search(b).expect("kept columns cover"))
                             .collect();
-                        Mat::from_fn(s, cols.len(), |t, c| ky[(t, map[c])])
+                        Mat::from_fn(s, keys.len(), |t, c| ky[(t, map[c])])
                     }
-                    None => vertex_series(g, w, a as usize, &cols),
+                    None => series_against(g, w.col(a as usize), &wc),
                 };
                 (a, y)
             })
@@ -264,42 +352,47 @@ fn tabulate(
             .par_iter()
             .enumerate()
             .map_init(
-                || Mat::<Real>::zeros(s, cols.len()),
+                || Mat::<Real>::zeros(s, keys.len()),
                 |z, (k, &p)| {
-                    let sp = &sup[p as usize];
-                    // Z_p over `cols`.
-                    z.fill(0.0);
-                    for (a, &la) in sp.verts[..sp.len].iter().zip(&sp.weights) {
-                        let la = la as Real;
-                        let ya = &series[a];
-                        for c in 0..cols.len() {
-                            let src = ya.col(c);
-                            let mut dst = z.col_mut(c);
-                            for t in 0..s {
-                                dst[t] += la * src[t];
+                    let bp = bent_of[p as usize];
+                    if bp != usize::MAX {
+                        *z = series_against(g, bent.rows.col(bp), &wc);
+                    } else {
+                        // Z_p: the blend of its vertices' series.
+                        let sp = &sup[p as usize];
+                        z.fill(0.0);
+                        for (a, &la) in sp.verts[..sp.len].iter().zip(&sp.weights) {
+                            let la = la as Real;
+                            let ya = &series[a];
+                            for c in 0..keys.len() {
+                                let src = ya.col(c);
+                                let mut dst = z.col_mut(c);
+                                for t in 0..s {
+                                    dst[t] += la * src[t];
+                                }
                             }
                         }
                     }
-                    (k..tcols.len())
+                    (k..targets.len())
                         .map(|j| {
                             let q = order[start + j] as usize;
-                            let sq = &sup[q];
-                            let tc = &tcols[j];
-                            let peak = match sq.len {
+                            let (tc, tw, len) = &targets[j];
+                            let peak = match len {
                                 1 => {
                                     let c = z.col(tc[0]);
-                                    (0..s).fold(0.0, |pk: Real, t| pk.max(c[t].abs()))
+                                    let l0 = tw[0];
+                                    (0..s).fold(0.0, |pk: Real, t| pk.max((l0 * c[t]).abs()))
                                 }
                                 2 => {
                                     let (c0, c1) = (z.col(tc[0]), z.col(tc[1]));
-                                    let [l0, l1, _] = sq.weights.map(|x| x as Real);
+                                    let [l0, l1, _] = *tw;
                                     (0..s).fold(0.0, |pk: Real, t| {
                                         pk.max((l0 * c0[t] + l1 * c1[t]).abs())
                                     })
                                 }
                                 _ => {
                                     let (c0, c1, c2) = (z.col(tc[0]), z.col(tc[1]), z.col(tc[2]));
-                                    let [l0, l1, l2] = sq.weights.map(|x| x as Real);
+                                    let [l0, l1, l2] = *tw;
                                     (0..s).fold(0.0, |pk: Real, t| {
                                         pk.max((l0 * c0[t] + l1 * c1[t] + l2 * c2[t]).abs())
                                     })
@@ -320,7 +413,7 @@ fn tabulate(
         kept = series
             .into_iter()
             .filter(|(v, _)| last_use[*v as usize] >= end)
-            .map(|(v, y)| (v, (cols.clone(), y)))
+            .map(|(v, y)| (v, (keys.clone(), y)))
             .collect();
         start = end;
         progress(TransferProgress {
@@ -333,10 +426,21 @@ fn tabulate(
 
 /// End of the cluster of points starting at position `start` of `order`: as many points as
 /// keep the cluster's vertices within `max_vertices` (one point at least).
-fn cluster_end(order: &[u32], sup: &[Support], start: usize, max_vertices: usize) -> usize {
+fn cluster_end(
+    order: &[u32],
+    sup: &[Support],
+    bent_of: &[usize],
+    start: usize,
+    max_vertices: usize,
+) -> usize {
     let mut verts: Vec<u32> = Vec::new();
     let mut end = start;
     while end < order.len() {
+        if bent_of[order[end] as usize] != usize::MAX {
+            // Computed on its own: no vertex series.
+            end += 1;
+            continue;
+        }
         let sp = &sup[order[end] as usize];
         let new = sp.verts[..sp.len]
             .iter()
@@ -355,17 +459,16 @@ fn cluster_end(order: &[u32], sup: &[Support], start: usize, max_vertices: usize
     end
 }
 
-/// `Y_a = (G ∘ w_a) W[:, cols]` (S × cols): the series at the target vertices `cols` after a unit
-/// inward impulse at region vertex `a` (the sign is dropped: only |·| is used).
-fn vertex_series(g: &Mat<Real>, w: &Mat<Real>, a: usize, cols: &[u32]) -> Mat<Real> {
+/// `(G ∘ r) Wc` (S × columns): the series at the target columns `wc` (m × columns) after a unit
+/// inward impulse at a point of normal row `r` (m); the sign is dropped (only |·| is used).
+fn series_against(g: &Mat<Real>, r: faer::ColRef<'_, Real>, wc: &Mat<Real>) -> Mat<Real> {
     let (s, m) = (g.nrows(), g.ncols());
-    let ga = Mat::from_fn(s, m, |k, l| g[(k, l)] * w[(l, a)]);
-    let wc = Mat::from_fn(m, cols.len(), |l, c| w[(l, cols[c] as usize)]);
-    let mut y = Mat::<Real>::zeros(s, cols.len());
+    let gr = Mat::from_fn(s, m, |k, l| g[(k, l)] * r[l]);
+    let mut y = Mat::<Real>::zeros(s, wc.ncols());
     matmul(
         y.as_mut(),
         Accum::Replace,
-        ga.as_ref(),
+        gr.as_ref(),
         wc.as_ref(),
         1.0,
         Par::Seq,
