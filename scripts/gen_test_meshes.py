@@ -172,6 +172,23 @@ def gen_beam(out):
     gmsh.finalize()
 
 
+def gen_unsnapped(out):
+    """A small cylinder left as gmsh meshes it (coordinates not snapped), written as MSH 4.1
+    ASCII and MSH 2.2 binary: gmsh's ASCII `%.16g` moves some coordinates by an ulp, so the two
+    files carry different bits for one mesh (what the geometry hash must see through)."""
+    gmsh_start()
+    gmsh.model.add("cylinder")
+    gmsh.model.occ.addCylinder(0, 0, 0, 0, 0, 0.3, 0.1)
+    gmsh.model.occ.synchronize()
+    gmsh.option.setNumber("Mesh.MeshSizeMax", 0.08)
+    gmsh.model.addPhysicalGroup(2, surfaces_at(2, 0.0), name="bottom")
+    gmsh.model.addPhysicalGroup(3, [1], name="volume")
+    gmsh.model.mesh.generate(3)
+    write_msh(os.path.join(out, "cylinder_v41.msh"), 4.1, False)
+    write_msh(os.path.join(out, "cylinder_v22_bin.msh"), 2.2, True)
+    gmsh.finalize()
+
+
 # ---------------------------------------------------------------------------------------
 # data/bad: small hand-written MSH 2.2 ASCII / JSON files, one defect each.
 
@@ -205,6 +222,28 @@ def tets(tet_list, phys=1):
     return [(t, 4, [phys, 1], ns) for t, ns in tet_list]
 
 
+def msh41_nodes(nodes):
+    """An MSH 4.1 ASCII $Nodes section: one volume block, tags then coordinates."""
+    tags = [n[0] for n in nodes]
+    out = ["$Nodes", "1 %d %d %d" % (len(nodes), min(tags), max(tags)),
+           "3 1 0 %d" % len(nodes)]
+    out += [str(t) for t in tags]
+    out += [" ".join(str(v) for v in n[1:]) for n in nodes]
+    return out + ["$EndNodes"]
+
+
+def msh41(nodes, tet_list, extra=()):
+    """MSH 4.1 ASCII text of tetrahedra (tag, [nodes]) in one volume block; `extra` lines
+    are appended after $EndElements."""
+    etags = [t for t, _ in tet_list]
+    out = ["$MeshFormat", "4.1 0 8", "$EndMeshFormat"] + msh41_nodes(nodes)
+    out += ["$Elements", "1 %d %d %d" % (len(tet_list), min(etags), max(etags)),
+            "3 1 4 %d" % len(tet_list)]
+    out += [" ".join(str(v) for v in [t] + ns) for t, ns in tet_list]
+    out += ["$EndElements"] + list(extra)
+    return "\n".join(out) + "\n"
+
+
 def gen_bad(out):
     files = {}
     good = msh22(NODES, tets(TETS), names=[(3, 1, "volume")])
@@ -230,6 +269,24 @@ def gen_bad(out):
     files["missing_elements.msh"] = msh22(NODES, tets(TETS), sections=["Nodes"])
     files["duplicate_node.msh"] = msh22(NODES + [(3, 0.0, 2.0, 0.0)], tets(TETS))
     files["not_a_mesh.msh"] = "solid cube\n  facet normal 0 0 1\nendsolid\n"
+    # Structure: sections repeated or out of order, tags and records that must not be
+    # guessed, elements that overlap.
+    again = msh22(NODES[:4], [], sections=["Nodes"]).split("$EndMeshFormat\n")[1]
+    files["repeated_nodes.msh"] = good + again
+    files["repeated_nodes_v41.msh"] = msh41(NODES, TETS, extra=msh41_nodes(NODES[:4]))
+    files["elements_before_nodes.msh"] = msh22(NODES, tets(TETS), sections=["Elements"]) \
+        + msh22(NODES, [], sections=["Nodes"]).split("$EndMeshFormat\n")[1]
+    files["negative_node_tag.msh"] = msh22(NODES, tets([(5, [1, 2, 3, 4]), (6, [2, 3, 4, -5])]))
+    files["zero_node_tag.msh"] = msh22(
+        [(t - 1, x, y, z) for t, x, y, z in NODES],
+        tets([(5, [0, 1, 2, 3]), (6, [1, 2, 3, 4])]))
+    files["extra_value.msh"] = good.replace("\n5 4 2 1 1 1 2 3 4\n", "\n5 4 2 1 1 1 2 3 4 5\n")
+    files["short_record.msh"] = good.replace("\n5 4 2 1 1 1 2 3 4\n", "\n5 4 2 1 1 1 2 3\n")
+    files["permuted_duplicate_tet.msh"] = msh22(NODES, tets(TETS + [(7, [2, 1, 3, 4])]))
+    files["overlapping_tets.msh"] = msh22(
+        NODES + [(6, 0.1, 0.1, 0.5)], tets(TETS + [(7, [1, 2, 3, 6])]))
+    files["comments_first.msh"] = "$Comments\nwritten by hand; $Nodes here is text\n" \
+        "$EndComments\n" + good
 
     pts = [[n[1], n[2], n[3]] for n in NODES]
     tetra = {"type": "tetra", "data": [[0, 1, 2, 3], [1, 2, 3, 4]]}
@@ -257,6 +314,7 @@ def generate(root):
     os.makedirs(bad, exist_ok=True)
     gen_cube(meshes)
     gen_beam(meshes)
+    gen_unsnapped(meshes)
     gen_bad(bad)
 
 

@@ -7,7 +7,8 @@
 use std::sync::Arc;
 
 use dcr_lab::truth::{run_truth, TruthImpact, TruthMethod, TruthParams};
-use dcr_runtime::{damping_ratio, ModalModel, ModeFilter};
+use dcr_runtime::filter::{damping_ratio, ModeFilter};
+use dcr_runtime::ModalModel;
 use modal_bake::bake::{bake_mesh, BakeParams, MaterialSi, ModeRequest};
 use modal_bake::mesh::TetMesh;
 

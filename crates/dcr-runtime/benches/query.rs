@@ -10,10 +10,11 @@ use std::hint::black_box;
 use std::sync::Arc;
 
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
+use dcr_runtime::attenuation::HeatGeodesic;
 use dcr_runtime::testing::{box_surface, geometric_omegas, synthetic_base, SplitMix64};
 use dcr_runtime::{
-    AmplitudeKind, AttenuationLaw, AttenuationParams, DistanceKind, DistantResponse, HeatGeodesic,
-    Impact, Method, ModalModel, ResponseParams, RestingContact, Sampling,
+    AmplitudeKind, AttenuationLaw, AttenuationParams, DistanceKind, DistantResponse, Impact,
+    Method, ModalModel, ResponseParams, RestingContact, Sampling,
 };
 
 /// (name, samples per step, distant contacts, surface vertices, paper ms).
@@ -227,7 +228,7 @@ fn attenuation_moving(c: &mut Criterion) {
             b.iter(|| {
                 i += 1;
                 // Each contact slides 1 mm (> 1 % of the mean edge) one way, then back.
-                let dx = if i % 2 == 0 { 1e-3 } else { -1e-3 };
+                let dx = if i.is_multiple_of(2) { 1e-3 } else { -1e-3 };
                 for rc in resting.iter_mut() {
                     rc.point[0] += dx;
                 }

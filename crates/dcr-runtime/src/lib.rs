@@ -67,7 +67,7 @@
 //! ```
 //!
 //! Pipeline, one module per stage:
-//! [`model`] (validated base, vertex normals, surface BVH) → [`mapping`] (impacts and resting
+//! [`model`] (validated base, vertex normals, surface BVH) → `mapping` (impacts and resting
 //! contacts onto the surface, per-contact cache) → [`filter`] (exact modal IIR filters, Eq. 10)
 //! or [`attenuation`] (spatial attenuation over heat-method geodesics, Eq. 14–16) →
 //! [`response`] (peak displacement, Δv, Eq. 11–13, one type per method) → [`world`] (the
@@ -77,14 +77,14 @@
 //! world frame; [`DistantResponse`] and the types under it work in the base's object frame.
 //! Engine-boundary types are plain data (`[f64; 3]`, `u64` ids, slices).
 //!
-//! Features: `testing` (synthetic bases such as [`testing::plate_base`], for tests and
+//! Features: `testing` (synthetic bases such as `testing::plate_base`, for tests and
 //! doctests, also of other crates), `bench-internals` (the peak kernels, for benchmarks),
 //! `metis` (bake-time nested-dissection orderings).
 
 pub mod attenuation;
 pub mod filter;
 pub mod format;
-pub mod mapping;
+pub(crate) mod mapping;
 mod math;
 pub mod model;
 pub mod response;
@@ -92,12 +92,9 @@ pub mod response;
 pub mod testing;
 pub mod world;
 
-pub use attenuation::{
-    AmplitudeKind, AttenuationLaw, AttenuationParams, DistanceKind, GeodesicError, HeatGeodesic,
-    HeatWorkspace,
-};
-pub use filter::{damping_ratio, samples_per_step, ModalBank, ModeFilter, Sampling};
-pub use model::{LoadError, ModalModel, SurfacePoint};
+pub use attenuation::{AmplitudeKind, AttenuationLaw, AttenuationParams, DistanceKind};
+pub use filter::Sampling;
+pub use model::{LoadError, ModalModel};
 pub use response::{
     effective_mass, response_impulse, ContactResponse, DistantResponse, ForceInput, Impact, Method,
     ParamsError, ResponseParams, RestingContact, ServedBy, StepInfo, TableFallback, TablePolicy,

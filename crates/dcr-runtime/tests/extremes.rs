@@ -8,9 +8,10 @@
 
 use std::sync::Arc;
 
+use dcr_runtime::filter::{damping_ratio, samples_per_step, ModeFilter};
 use dcr_runtime::{
-    damping_ratio, samples_per_step, testing, DistantResponse, Impact, ModalModel, ModeFilter,
-    ParamsError, ResponseParams, RestingContact, Sampling,
+    testing, DistantResponse, Impact, ModalModel, ParamsError, ResponseParams, RestingContact,
+    Sampling,
 };
 
 const HIT: [f64; 3] = [0.5, 0.3, 0.0];

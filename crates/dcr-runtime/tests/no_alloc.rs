@@ -15,11 +15,12 @@ use std::cell::Cell;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Arc;
 
+use dcr_runtime::attenuation::HeatGeodesic;
 use dcr_runtime::testing::{box_surface, geometric_omegas, synthetic_base, SplitMix64};
 use dcr_runtime::{
     AmplitudeKind, AttenuationLaw, AttenuationParams, BodyState, ContactReport, DcrWorld,
-    DistanceKind, DistantResponse, ElasticObjectDesc, ForceInput, HeatGeodesic, Impact, Method,
-    ModalModel, Pose, ResponseParams, RestingContact, Variant, WorldParams,
+    DistanceKind, DistantResponse, ElasticObjectDesc, ForceInput, Impact, Method, ModalModel, Pose,
+    ResponseParams, RestingContact, Variant, WorldParams,
 };
 
 struct Counting;

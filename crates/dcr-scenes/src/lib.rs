@@ -1,14 +1,16 @@
-//! `dcr-scenes`: the paper's §5.1 / Table 1 examples, headless on rapier3d-f64, with the
-//! distant collision response on and off.
+//! `dcr-scenes`: the paper's §5.1 / Table 1 examples, headless on rapier3d-f64 through
+//! `dcr-rapier`, with the distant collision response on and off.
 //!
 //! - [`scene`]: the scene file format (`scenes/*.json`) and the rapier world built from it.
-//! - [`adapter`]: rapier contacts → impacts / resting contacts → [`dcr_runtime::DistantResponse`]
-//!   → impulses at the resting contacts (Eq. 17–19).
-//! - [`runner`]: a headless run (trajectories, timings, outcome figures) and the Table 1 report.
+//! - [`runner`]: a headless run (scripted drivers, trajectories, timings, outcome figures) and
+//!   the Table 1 report. The response itself is `dcr_rapier::f64::DcrRapier` over
+//!   [`dcr_runtime::DcrWorld`].
+//! - [`export`]: runs as animated glTF (side by side, response events in `extras`) and the
+//!   outcome figures over time as SVG.
 //!
 //! See docs/scenes.md.
 
-pub mod adapter;
+pub mod export;
 pub mod runner;
 pub mod scene;
 

@@ -5,14 +5,20 @@ use std::process::ExitCode;
 
 use anyhow::{bail, Context, Result};
 use clap::{Parser, Subcommand, ValueEnum};
-use dcr_scenes::runner::{run_scene, table1, MethodChoice, RunParams, Table1Params};
+use dcr_rapier::f64::{ApplyMode, StepGate};
+use dcr_scenes::export::{side_label, write_outcomes_svg, write_scene_glb, Side};
+use dcr_scenes::runner::{
+    run_scene, stress_bench, table1, MethodChoice, RunParams, RunReport, StressBenchParams,
+    Table1Params,
+};
 use dcr_scenes::scene::SceneDesc;
 use dcr_scenes::{repo_root, SCENES};
 
 #[derive(Parser)]
 #[command(
     name = "dcr-scenes",
-    about = "The paper's Table 1 scenes, headless on rapier3d-f64"
+    version,
+    about = "The paper's Table 1 scenes, headless on rapier3d-f64 with dcr-rapier"
 )]
 struct Cli {
     #[command(subcommand)]
@@ -23,12 +29,98 @@ struct Cli {
 enum OnOff {
     On,
     Off,
+    /// Both runs: files in OUT/on and OUT/off, outcomes.svg and --gltf with both.
+    Both,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
 enum MethodArg {
     Modal,
     Attenuation,
+}
+
+/// How the responses reach the bodies.
+#[derive(Clone, Copy, ValueEnum)]
+enum ApplyArg {
+    /// Explicit impulses right after the step (Eq. 17–18).
+    AfterStep,
+    /// Replayed through the next step's contact solver (restitution pass; rapier hooks).
+    InSolver,
+}
+
+impl From<ApplyArg> for ApplyMode {
+    fn from(a: ApplyArg) -> ApplyMode {
+        match a {
+            ApplyArg::AfterStep => ApplyMode::AfterStep,
+            ApplyArg::InSolver => ApplyMode::InSolver,
+        }
+    }
+}
+
+/// Options shared by `run` and `table1`: how the response is applied and bounded.
+#[derive(clap::Args, Clone)]
+struct ResponseArgs {
+    /// Energy bound η in [0, 1] (per object and step, the responses inject at most η × what
+    /// the step's impacts dissipated), or `off` for no bound. Default: the world's (1).
+    #[arg(long, value_name = "ETA|off", value_parser = parse_eta)]
+    energy_eta: Option<Eta>,
+    /// How the responses reach the bodies.
+    #[arg(long, value_enum, default_value = "after-step")]
+    apply: ApplyArg,
+    /// Lateral kick (paper §5.4): the tangential peak displacement also pushes sideways.
+    #[arg(long)]
+    lateral_kick: bool,
+    /// Turn rapier's contact recycling off on the elastic objects (as the in-solver path
+    /// must), to compare the two paths under the same contact generation.
+    #[arg(long)]
+    no_contact_recycling: bool,
+    /// On which steps the contacts are read in full and the world stepped: only the steps
+    /// with an impact (default), or every step.
+    #[arg(long, value_enum, default_value = "impact-steps")]
+    gate: GateArg,
+}
+
+/// On which steps the adapter reads the contacts.
+#[derive(Clone, Copy, ValueEnum)]
+enum GateArg {
+    /// Steps with an impact, found by a light pass over the contacts' impulses
+    /// (engine-newness classification).
+    ImpactSteps,
+    /// Every step (the world's age-based classification).
+    EveryStep,
+}
+
+impl From<GateArg> for StepGate {
+    fn from(g: GateArg) -> StepGate {
+        match g {
+            GateArg::ImpactSteps => StepGate::ImpactSteps,
+            GateArg::EveryStep => StepGate::EveryStep,
+        }
+    }
+}
+
+/// A parsed `--energy-eta`.
+#[derive(Clone, Copy)]
+struct Eta(Option<f64>);
+
+fn parse_eta(s: &str) -> Result<Eta, String> {
+    if s.eq_ignore_ascii_case("off") || s.eq_ignore_ascii_case("none") {
+        return Ok(Eta(None));
+    }
+    let v: f64 = s
+        .parse()
+        .map_err(|_| format!("{s:?} is not a number in [0, 1] or `off`"))?;
+    if !(0.0..=1.0).contains(&v) {
+        return Err(format!("{v} is outside [0, 1]"));
+    }
+    Ok(Eta(Some(v)))
+}
+
+impl ResponseArgs {
+    fn eta(&self) -> Option<f64> {
+        self.energy_eta
+            .map_or(dcr_rapier::WorldParams::default().energy_eta, |e| e.0)
+    }
 }
 
 #[derive(Subcommand)]
@@ -49,12 +141,20 @@ enum Cmd {
         /// Attenuation exponent β (implies --method attenuation).
         #[arg(long)]
         beta: Option<f64>,
-        /// Output directory (default out/SCENE).
+        /// Output directory (default out/SCENE). Without --out the runs go to out/SCENE/on
+        /// and out/SCENE/off (as with --dcr both), so an on and an off run never overwrite
+        /// each other; with --out a single run writes there.
         #[arg(long)]
         out: Option<PathBuf>,
         /// Bases directory (default out/bases).
         #[arg(long)]
         bases: Option<PathBuf>,
+        /// Also write the run(s) as animated glTF here (side by side with --dcr both; the
+        /// response events in the file's extras). Open it with scripts/view.sh.
+        #[arg(long, value_name = "OUT.glb")]
+        gltf: Option<PathBuf>,
+        #[command(flatten)]
+        response: ResponseArgs,
     },
     /// Bake missing/stale bases, run every scene on and off, print Table 1.
     Table1 {
@@ -70,6 +170,28 @@ enum Cmd {
         /// Bases directory (default out/bases).
         #[arg(long)]
         bases: Option<PathBuf>,
+        /// Also write every scene's on and off runs side by side as DIR/SCENE.glb.
+        #[arg(long, value_name = "DIR")]
+        gltf: Option<PathBuf>,
+        #[command(flatten)]
+        response: ResponseArgs,
+        /// Energy-bound sweep: also run each scene unbounded and at each η (comma separated,
+        /// e.g. 1,0.5,0.1) and report which outcomes move by more than 5 %.
+        #[arg(long, value_delimiter = ',', value_name = "ETAS")]
+        energy_sweep: Vec<f64>,
+    },
+    /// The adapter's per-step cost against the number of resting contacts: scenes/stress.json
+    /// cut to its first N boxes, one JSON object on stdout (wall-clock medians).
+    BenchStress {
+        /// Numbers of boxes (comma separated).
+        #[arg(long, value_delimiter = ',', default_value = "100,300,1000")]
+        props: Vec<usize>,
+        /// Simulated seconds per run (default: the scene's).
+        #[arg(long)]
+        seconds: Option<f64>,
+        /// Bases directory (default out/bases).
+        #[arg(long)]
+        bases: Option<PathBuf>,
     },
 }
 
@@ -79,6 +201,43 @@ fn scene_path(root: &std::path::Path, s: &str) -> PathBuf {
     } else {
         root.join("scenes").join(format!("{s}.json"))
     }
+}
+
+fn print_report(report: &RunReport, out_dir: &std::path::Path) {
+    println!(
+        "{} dcr {} ({} steps): {}",
+        report.scene,
+        if report.dcr { "on" } else { "off" },
+        report.steps,
+        out_dir.display()
+    );
+    for (k, (v, u)) in &report.outcomes {
+        println!("  {k:28} {v:10.3} {u}");
+    }
+    for m in &report.models {
+        println!(
+            "  model {:8} impacts {:4} queries {:4} distant contacts (max) {:3} query µs median {} p99 {}",
+            m.model,
+            m.stats.impacts,
+            m.queries,
+            m.distant_contacts,
+            m.query_us_median.map_or("-".into(), |v| format!("{v:.1}")),
+            m.query_us_p99.map_or("-".into(), |v| format!("{v:.1}"))
+        );
+    }
+    println!(
+        "  rapier {:.1} ms, dcr {:.1} ms ({:.2}% of step); energy injected {:.4e} J, dissipated {:.4e} J",
+        report.rapier_ms,
+        report.adapter_ms,
+        100.0 * report.dcr_share_of_step,
+        report.injected_ke,
+        report.dissipated
+    );
+    println!(
+        "  world stepped on {} of {} steps ({})",
+        report.world_steps, report.steps, report.gate
+    );
+    println!("  trajectory {}", report.trajectory_hash);
 }
 
 fn real_main() -> Result<()> {
@@ -93,6 +252,8 @@ fn real_main() -> Result<()> {
             beta,
             out,
             bases,
+            gltf,
+            response,
         } => {
             let path = scene_path(&root, &scene);
             if !path.exists() {
@@ -114,56 +275,88 @@ fn real_main() -> Result<()> {
                     bail!("--seconds must be positive, got {s}");
                 }
             }
+            let split = out.is_none() || matches!(dcr, OnOff::Both);
             let out_dir = out.unwrap_or_else(|| root.join("out").join(&desc.name));
-            let report = run_scene(
-                &desc,
-                &RunParams {
-                    seconds,
-                    dcr: matches!(dcr, OnOff::On),
-                    method,
-                    root: root.clone(),
-                    bases_dir: bases.unwrap_or_else(|| root.join("out").join("bases")),
-                    out_dir: Some(out_dir.clone()),
-                    progress: true,
-                },
-            )?;
-            println!(
-                "{} dcr {} ({} steps): {}",
-                report.scene,
-                if report.dcr { "on" } else { "off" },
-                report.steps,
-                out_dir.display()
-            );
-            for (k, (v, u)) in &report.outcomes {
-                println!("  {k:28} {v:10.3} {u}");
+            let bases_dir = bases.unwrap_or_else(|| root.join("out").join("bases"));
+            let runs: &[bool] = match dcr {
+                OnOff::On => &[true],
+                OnOff::Off => &[false],
+                OnOff::Both => &[true, false],
+            };
+            let mut reports = Vec::new();
+            for &on in runs {
+                let dir = if split {
+                    out_dir.join(if on { "on" } else { "off" })
+                } else {
+                    out_dir.clone()
+                };
+                let report = run_scene(
+                    &desc,
+                    &RunParams {
+                        seconds,
+                        method: method.clone(),
+                        bases_dir: bases_dir.clone(),
+                        out_dir: Some(dir.clone()),
+                        progress: true,
+                        apply: response.apply.into(),
+                        energy_eta: response.eta(),
+                        lateral_kick: response.lateral_kick,
+                        contact_recycling: !response.no_contact_recycling,
+                        gate: response.gate.into(),
+                        ..RunParams::new(root.clone(), on)
+                    },
+                )?;
+                print_report(&report, &dir);
+                reports.push(report);
             }
-            for m in &report.models {
+            let refs: Vec<&RunReport> = reports.iter().collect();
+            if !desc.outcomes.is_empty() {
+                let svg = out_dir.join("outcomes.svg");
+                let t = std::time::Instant::now();
+                write_outcomes_svg(&desc, &refs, &svg)?;
                 println!(
-                    "  model {:8} impacts {:4} queries {:4} distant contacts (max) {:3} query µs median {} p99 {}",
-                    m.model,
-                    m.stats.impacts,
-                    m.queries,
-                    m.distant_contacts,
-                    m.query_us_median.map_or("-".into(), |v| format!("{v:.1}")),
-                    m.query_us_p99.map_or("-".into(), |v| format!("{v:.1}"))
+                    "  outcomes over time: {} ({:.1} KiB, {:.3} s)",
+                    svg.display(),
+                    std::fs::metadata(&svg).map_or(0, |m| m.len()) as f64 / 1024.0,
+                    t.elapsed().as_secs_f64()
                 );
             }
-            println!(
-                "  rapier {:.1} ms, adapter {:.1} ms ({:.2}% of step); energy injected {:.4e} J, dissipated {:.4e} J",
-                report.rapier_ms,
-                report.adapter_ms,
-                100.0 * report.dcr_share_of_step,
-                report.injected_ke,
-                report.dissipated
-            );
-            println!("  trajectory {}", report.trajectory_hash);
+            if let Some(path) = gltf {
+                let sides: Vec<Side> = reports
+                    .iter()
+                    .map(|r| Side {
+                        label: side_label(r),
+                        report: r,
+                    })
+                    .collect();
+                let t = std::time::Instant::now();
+                let info = write_scene_glb(&desc, &root, &bases_dir, &sides, &path)
+                    .with_context(|| format!("writing {}", path.display()))?;
+                println!(
+                    "  glTF: {} ({:.1} KiB, {} body nodes, {} keyframes, {} response events, {:.3} s)",
+                    path.display(),
+                    info.bytes as f64 / 1024.0,
+                    info.body_nodes,
+                    info.keyframes,
+                    info.events,
+                    t.elapsed().as_secs_f64()
+                );
+            }
         }
         Cmd::Table1 {
             json,
             seconds,
             scenes,
             bases,
+            gltf,
+            response,
+            energy_sweep,
         } => {
+            for &e in &energy_sweep {
+                if !(0.0..=1.0).contains(&e) {
+                    bail!("--energy-sweep: {e} is outside [0, 1]");
+                }
+            }
             let scenes = scenes.unwrap_or_else(|| SCENES.iter().map(|s| s.to_string()).collect());
             for s in &scenes {
                 if !SCENES.contains(&s.as_str()) {
@@ -176,6 +369,13 @@ fn real_main() -> Result<()> {
                 root: root.clone(),
                 bases_dir: bases.unwrap_or_else(|| root.join("out").join("bases")),
                 scaffold_betas: vec![0.5, 1.0, 2.0],
+                apply: response.apply.into(),
+                energy_eta: response.eta(),
+                lateral_kick: response.lateral_kick,
+                contact_recycling: !response.no_contact_recycling,
+                gate: response.gate.into(),
+                eta_sweep: energy_sweep,
+                gltf_dir: gltf,
             })
             .context("table1")?;
             if json {
@@ -183,6 +383,26 @@ fn real_main() -> Result<()> {
             } else {
                 print!("{text}");
             }
+        }
+        Cmd::BenchStress {
+            props,
+            seconds,
+            bases,
+        } => {
+            if let Some(s) = seconds {
+                if !(s.is_finite() && s > 0.0) {
+                    bail!("--seconds must be positive, got {s}");
+                }
+            }
+            let value = stress_bench(&StressBenchParams {
+                props,
+                seconds,
+                root: root.clone(),
+                bases_dir: bases.unwrap_or_else(|| root.join("out").join("bases")),
+                progress: true,
+            })
+            .context("bench-stress")?;
+            println!("{}", serde_json::to_string_pretty(&value)?);
         }
     }
     Ok(())

@@ -38,12 +38,9 @@ fn run(desc: &SceneDesc, dcr: bool, method: MethodChoice) -> RunReport {
         desc,
         &RunParams {
             seconds: desc.test_seconds,
-            dcr,
             method,
-            root: repo_root(),
             bases_dir: bases().clone(),
-            out_dir: None,
-            progress: false,
+            ..RunParams::new(repo_root(), dcr)
         },
     )
     .expect("scene runs")
@@ -225,4 +222,35 @@ fn every_scene_file_builds() {
             );
         }
     }
+}
+
+/// The stress scene (cut to its first 100 boxes): every landing of the hopping balls reaches the
+/// resting boxes with the response on and not off, and the adapter steps the world only on the
+/// landing steps (the impact-step gate), each time with every box's four resting contacts.
+#[test]
+fn stress_scene_responds_on_impact_steps_only() {
+    let mut desc = scene("stress");
+    let boxes = desc
+        .props
+        .iter()
+        .position(|p| p.name == "box")
+        .expect("stress scene has boxes");
+    assert!(desc.props[boxes].copies.len() >= 500, "at least 500 props");
+    desc.props[boxes].copies.truncate(100);
+    let on = run(&desc, true, MethodChoice::Scene);
+    let off = run(&desc, false, MethodChoice::Scene);
+    let lift_on = outcome(&on, "boxes_max_lift");
+    let lift_off = outcome(&off, "boxes_max_lift");
+    assert!(
+        lift_on > 0.05 && lift_off < 0.01,
+        "boxes lift {lift_on} mm with the response, {lift_off} mm without"
+    );
+    assert!(on.models[0].stats.impacts >= 2, "{:?}", on.models[0].stats);
+    assert!(
+        on.world_steps * 5 < on.steps,
+        "world stepped on {} of {} steps",
+        on.world_steps,
+        on.steps
+    );
+    assert_eq!(on.models[0].distant_contacts, 400, "100 boxes × 4 contacts");
 }

@@ -32,6 +32,56 @@ pub struct ModelOptions {
 }
 
 impl ModelOptions {
+    /// Refuses a Young's modulus or density outside the supported ranges, naming the option,
+    /// and warns (stderr) about values that look like a unit mistake.
+    ///
+    /// # Errors
+    /// A one-line message naming `--youngs` or `--density` and the range that works.
+    pub fn check_ranges(&self) -> anyhow::Result<()> {
+        use crate::fem::Material;
+        let [elo, ehi] = Material::YOUNGS_RANGE;
+        if !(self.youngs >= elo && self.youngs <= ehi) {
+            anyhow::bail!(
+                "--youngs {:e} Pa is outside the supported {elo:e} … {ehi:e} Pa (foams ~1e5, polymers ~1e9, steel 2e11)",
+                self.youngs
+            );
+        }
+        if !(self.poisson > -1.0 && self.poisson < 0.5) {
+            anyhow::bail!(
+                "--poisson {} must satisfy −1 < ν < 0.5 (rubber ~0.49, metals ~0.3, cork ~0)",
+                self.poisson
+            );
+        }
+        let [dlo, dhi] = Material::DENSITY_RANGE;
+        if !(self.density >= dlo && self.density <= dhi) {
+            anyhow::bail!(
+                "--density {:e} kg/m³ is outside the supported {dlo} … {dhi:e} kg/m³ (aerogel ~2, wood ~700, steel 7850)",
+                self.density
+            );
+        }
+        if self.youngs < 1e5 {
+            eprintln!(
+                "warning: --youngs {} Pa is softer than any solid object (plausible: 1e5 Pa foam … 1.2e12 Pa diamond); \
+                 the unit is Pa: did you mean {} GPa = {:e} Pa or {} MPa = {:e} Pa?",
+                self.youngs,
+                self.youngs,
+                self.youngs * 1e9,
+                self.youngs,
+                self.youngs * 1e6
+            );
+        }
+        if self.density < 100.0 {
+            eprintln!(
+                "warning: --density {} kg/m³ is lighter than solids other than foams and aerogels (plausible: 100 … 22600 kg/m³); \
+                 the unit is kg/m³: did you mean {} g/cm³ = {} kg/m³?",
+                self.density,
+                self.density,
+                self.density * 1000.0
+            );
+        }
+        Ok(())
+    }
+
     /// The material in SI units.
     pub fn material(&self) -> MaterialSi {
         MaterialSi {

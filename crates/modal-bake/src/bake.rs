@@ -26,12 +26,36 @@ pub struct BakeParams {
     pub modes: ModeRequest,
     /// Names of physical groups whose nodes are fixed (empty: free-free).
     pub fixed: Vec<String>,
+    /// Fix every node at or below a coordinate (`--fixed-below y=0.01`); combined with the
+    /// other selectors by union.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub fixed_below: Vec<FixedBelow>,
+    /// Fix every node inside an axis-aligned box `[x0, y0, z0, x1, y1, z1]` (m, object frame,
+    /// bounds included; `--fixed-box`).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub fixed_boxes: Vec<[f64; 6]>,
     /// Default Rayleigh damping stored in the base (α0 in 1/s, α1 in s). Default (10, 1e-7).
     pub rayleigh: [f64; 2],
     /// Lumped (diagonal) mass instead of consistent mass.
     pub lumped: bool,
     /// Storage precision of the surface mode shapes.
     pub precision: ModesPrecision,
+}
+
+/// A half-space selector of fixed nodes: every node whose coordinate `axis` is ≤ `value`.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct FixedBelow {
+    /// The axis: 0 = x, 1 = y, 2 = z (object frame).
+    pub axis: usize,
+    /// The threshold (m); nodes at or below it are fixed.
+    pub value: f64,
+}
+
+impl std::fmt::Display for FixedBelow {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let axis = ["x", "y", "z"].get(self.axis).copied().unwrap_or("?");
+        write!(f, "{axis}={}", self.value)
+    }
 }
 
 impl Default for BakeParams {
@@ -44,6 +68,8 @@ impl Default for BakeParams {
             },
             modes: ModeRequest::Count(20),
             fixed: Vec::new(),
+            fixed_below: Vec::new(),
+            fixed_boxes: Vec::new(),
             rayleigh: [10.0, 1e-7],
             lumped: false,
             precision: ModesPrecision::F64,
@@ -57,12 +83,23 @@ use sha2::{Digest, Sha256};
 
 use crate::eigen::{self, EigenError, EigenParams, EigenProgress};
 use crate::fem::{self, Material, MaterialError};
-use crate::mesh::{MeshError, DEFAULT_DEGENERATE_REL_TOL};
-use dcr_runtime::format::{FormatError, ModesMeta, FORMAT_VERSION};
-use dcr_runtime::HeatGeodesic;
+use crate::mesh::{tet_faces, MeshError, DEFAULT_DEGENERATE_REL_TOL, DEFAULT_STRAIGHT_REL_TOL};
+use dcr_runtime::attenuation::HeatGeodesic;
+use dcr_runtime::format::{FormatError, ModesMeta, QuadraticSurface};
+
+/// Version of what `modal-bake` writes for given inputs, stored in every base
+/// (`meta.bake_params.output_version`). Bumped by any change of the tool that changes a base's
+/// content for the same mesh and options (assembly, eigensolver, surface extraction, hashing),
+/// and only then — not by the crate version — so `check` calls bases of an older output stale
+/// and an upgrade that changes nothing keeps them fresh.
+pub const OUTPUT_VERSION: u32 = 1;
 
 /// `modal-bake <version>`, stored in every base.
 pub const TOOL_VERSION: &str = concat!("modal-bake ", env!("CARGO_PKG_VERSION"));
+
+/// The schema number mixed into [`BakeParams::hash`]; changes only when the meaning of a
+/// parameter changes (new parameters at their defaults leave the hash unchanged).
+const PARAMS_HASH_VERSION: u32 = 1;
 
 /// A near-zero eigenvalue is a rigid-body mode when |λ| ≤ this × the first elastic λ.
 pub const RIGID_REL_TOL: f64 = 1e-6;
@@ -156,8 +193,15 @@ pub struct BakeReport {
     pub free_dofs: usize,
     /// Inverted tetrahedra reoriented.
     pub reoriented_tets: usize,
-    /// Fixed nodes.
+    /// Fixed nodes (the union of every selector's).
     pub fixed_nodes: usize,
+    /// What each fixed-node selector picked: (`group NAME` / `below y=0.01` / `box ...`,
+    /// nodes), in the order groups, half-spaces, boxes; selectors may overlap.
+    pub fixed_by: Vec<(String, usize)>,
+    /// Element order: 1 (4-node tetrahedra) or 2 (10-node).
+    pub order: u8,
+    /// Second-order bases: surface mid-edge nodes whose mode rows are stored (0 for P1).
+    pub surface_edge_nodes: usize,
     /// Rigid-body modes detected and excluded (6 when free-free).
     pub rigid_modes_excluded: usize,
     /// Their eigenvalues (rad²/s²), as computed (≈ 0).
@@ -199,6 +243,10 @@ pub struct BakeReport {
     pub transfer_samples: usize,
     /// Transfer table: where its modes came from (`base`, `dense`, `lanczos`).
     pub transfer_mode_source: String,
+    /// Bounding-box diagonal of the mesh (m).
+    pub extent_m: f64,
+    /// The output's folder, when the bake had to create it ([`bake_file`]).
+    pub created_folder: Option<String>,
 }
 
 /// Progress of a bake, for a CLI bar.
@@ -208,7 +256,9 @@ pub enum BakeStage {
     Read,
     /// Assembling K and M.
     Assemble,
-    /// Factoring and iterating; carries the eigensolver's progress.
+    /// Factoring K − σM (before the first Lanczos step).
+    Factor,
+    /// Iterating; carries the eigensolver's progress.
     Eigensolve(EigenProgress),
     /// Solving for the transfer table's modes (dense or Lanczos).
     TransferModes,
@@ -255,26 +305,50 @@ impl BakeParams {
                 self.rayleigh
             )));
         }
+        for b in &self.fixed_below {
+            if b.axis > 2 || !b.value.is_finite() {
+                return Err(BakeError::Params(format!(
+                    "--fixed-below needs an axis x, y or z and a finite value in m, got axis {} value {}",
+                    b.axis, b.value
+                )));
+            }
+        }
+        for b in &self.fixed_boxes {
+            if !b.iter().all(|x| x.is_finite()) || (0..3).any(|k| b[k] > b[k + 3]) {
+                return Err(BakeError::Params(format!(
+                    "--fixed-box {b:?}: expected finite X0,Y0,Z0,X1,Y1,Z1 (m) with each minimum ≤ its maximum"
+                )));
+            }
+        }
         Ok(mat)
     }
 
-    /// `sha256:<hex>` of everything in these parameters that changes the result, plus the
-    /// format version.
+    /// `sha256:<hex>` of everything in these parameters that changes the result, plus a
+    /// schema number.
     pub fn hash(&self) -> String {
-        let json = serde_json::to_vec(&(FORMAT_VERSION, self)).expect("params serialise");
+        let json = serde_json::to_vec(&(PARAMS_HASH_VERSION, self)).expect("params serialise");
         format!("sha256:{:x}", Sha256::digest(&json))
     }
 }
 
-/// `sha256:<hex>` of the canonical geometry: node positions (f64 bits), tetrahedra (after
-/// orientation) and the sorted fixed-node set. Independent of the file's format and bytes.
+/// `sha256:<hex>` of the canonical geometry: node positions rounded to 16 significant
+/// digits, tetrahedra (after orientation) and the sorted fixed-node set. Independent of the
+/// file's format and bytes.
+///
+/// Why 16 digits: gmsh prints ASCII MSH coordinates with `%.16g`, which does not round-trip
+/// every `f64`, so its ASCII and binary files of one mesh can differ by an ulp per coordinate.
+/// Rounding is idempotent on what gmsh prints (x and the double nearest its 16-digit decimal
+/// round alike), so every form gmsh writes of one mesh — MSH 2.2 or 4.1, ASCII or binary —
+/// and a meshio JSON of it hash alike. Two meshes whose coordinates differ only beyond the
+/// 16th significant digit (relative change below ~5e-16) share a hash; their bases differ by
+/// rounding only.
 pub fn geometry_hash(mesh: &TetMesh, fixed: &[usize]) -> String {
     let mut h = Sha256::new();
-    h.update(b"dcr-geometry-v1");
+    h.update(b"dcr-geometry-v2");
     h.update((mesh.nodes.len() as u64).to_le_bytes());
     for p in &mesh.nodes {
-        for x in p {
-            h.update(x.to_bits().to_le_bytes());
+        for &x in p {
+            h.update(round_16_digits(x).to_bits().to_le_bytes());
         }
     }
     h.update((mesh.tets.len() as u64).to_le_bytes());
@@ -287,15 +361,116 @@ pub fn geometry_hash(mesh: &TetMesh, fixed: &[usize]) -> String {
     for &v in fixed {
         h.update((v as u64).to_le_bytes());
     }
+    // Second-order meshes only, so linear meshes keep their hash.
+    if mesh.is_quadratic() {
+        h.update(b"tet10");
+        for e in &mesh.mid_edges {
+            for &v in e {
+                h.update((v as u64).to_le_bytes());
+            }
+        }
+    }
     format!("sha256:{:x}", h.finalize())
+}
+
+/// `x` rounded to 16 significant decimal digits (the double nearest `%.16g` of `x`); non-finite
+/// values unchanged.
+pub fn round_16_digits(x: f64) -> f64 {
+    use std::io::Write;
+    if !x.is_finite() {
+        return x;
+    }
+    // "-d.ddddddddddddddde-308" is 23 bytes.
+    let mut buf = [0u8; 32];
+    let mut w = &mut buf[..];
+    let _ = write!(w, "{x:.15e}");
+    let n = 32 - w.len();
+    std::str::from_utf8(&buf[..n])
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(x)
 }
 
 /// A mesh prepared for baking: oriented, checked, with its fixed-node set and hash.
 struct Prepared {
     mesh: TetMesh,
     fixed: Vec<usize>,
+    /// What each selector fixed: (description, nodes), in the order groups, below, boxes.
+    fixed_by: Vec<(String, usize)>,
+    /// Second-order meshes: each edge (sorted corner pair) with its mid-edge node, sorted.
+    mid_table: Vec<([usize; 2], usize)>,
     reoriented: usize,
     hash: String,
+}
+
+/// The nodes (sorted) each fixed-node selector of `params` picks, with a description per
+/// selector (`group bottom`, `below y=0.01`, `box [..]`).
+///
+/// # Errors
+/// An unknown group, or a selector that picks no node (it names the mesh's extent).
+fn select_fixed(
+    mesh: &TetMesh,
+    params: &BakeParams,
+    file: &str,
+) -> Result<Vec<(String, Vec<usize>)>, BakeError> {
+    let name_file = |mut e: MeshError| {
+        if e.file.is_empty() {
+            e.file = file.to_string();
+        }
+        e
+    };
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for p in &mesh.nodes {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    let extent = || {
+        format!(
+            "the mesh spans x {:.6}…{:.6}, y {:.6}…{:.6}, z {:.6}…{:.6} m",
+            lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]
+        )
+    };
+    let mut out = Vec::new();
+    for name in &params.fixed {
+        let nodes = mesh.group_nodes(name).map_err(name_file)?.to_vec();
+        if nodes.is_empty() {
+            return Err(BakeError::Params(format!(
+                "{file}: --fixed {name} fixes no node (the group has no node on the tetrahedra)"
+            )));
+        }
+        out.push((format!("group {name}"), nodes));
+    }
+    for b in &params.fixed_below {
+        let nodes: Vec<usize> = (0..mesh.nodes.len())
+            .filter(|&v| mesh.nodes[v][b.axis] <= b.value)
+            .collect();
+        if nodes.is_empty() {
+            return Err(BakeError::Params(format!(
+                "{file}: --fixed-below {b} fixes no node ({})",
+                extent()
+            )));
+        }
+        out.push((format!("below {b}"), nodes));
+    }
+    for bx in &params.fixed_boxes {
+        let nodes: Vec<usize> = (0..mesh.nodes.len())
+            .filter(|&v| (0..3).all(|k| (bx[k]..=bx[k + 3]).contains(&mesh.nodes[v][k])))
+            .collect();
+        if nodes.is_empty() {
+            return Err(BakeError::Params(format!(
+                "{file}: --fixed-box {} fixes no node ({})",
+                bx.map(|x| x.to_string()).join(","),
+                extent()
+            )));
+        }
+        out.push((
+            format!("box {}", bx.map(|x| x.to_string()).join(",")),
+            nodes,
+        ));
+    }
+    Ok(out)
 }
 
 fn prepare(mut mesh: TetMesh, params: &BakeParams, file: &str) -> Result<Prepared, BakeError> {
@@ -310,9 +485,14 @@ fn prepare(mut mesh: TetMesh, params: &BakeParams, file: &str) -> Result<Prepare
             "{file}: the mesh has no tetrahedra"
         )));
     }
+    mesh.check_extent().map_err(name_file)?;
     let reoriented = mesh
         .orient_tets(DEFAULT_DEGENERATE_REL_TOL)
         .map_err(name_file)?;
+    mesh.check_straight(DEFAULT_STRAIGHT_REL_TOL)
+        .map_err(name_file)?;
+    let mid_table = mesh.edge_mid_nodes().map_err(name_file)?;
+    mesh.check_overlaps().map_err(name_file)?;
     let pieces = mesh.connected_components();
     if pieces != 1 {
         return Err(BakeError::Disconnected {
@@ -320,18 +500,20 @@ fn prepare(mut mesh: TetMesh, params: &BakeParams, file: &str) -> Result<Prepare
             pieces,
         });
     }
-    let mut fixed = Vec::new();
-    for name in &params.fixed {
-        fixed.extend_from_slice(mesh.group_nodes(name).map_err(name_file)?);
-    }
+    let selected = select_fixed(&mesh, params, file)?;
+    let fixed_by: Vec<(String, usize)> = selected
+        .iter()
+        .map(|(what, nodes)| (what.clone(), nodes.len()))
+        .collect();
+    let mut fixed: Vec<usize> = selected.into_iter().flat_map(|(_, n)| n).collect();
     fixed.sort_unstable();
     fixed.dedup();
     if !fixed.is_empty() && !spans_a_plane(&mesh, &fixed) {
         return Err(BakeError::Params(format!(
-            "{file}: the fixed nodes ({} of them, groups {:?}) are collinear, so rotations about their line stay free \
+            "{file}: the fixed nodes ({} of them: {}) are collinear, so rotations about their line stay free \
              (a mechanism, K is singular); fix a patch of at least three non-collinear nodes",
             fixed.len(),
-            params.fixed
+            fixed_by.iter().map(|(w, _)| w.as_str()).collect::<Vec<_>>().join(", ")
         )));
     }
     if !fixed.is_empty() && fixed.len() == mesh.nodes.len() {
@@ -343,6 +525,8 @@ fn prepare(mut mesh: TetMesh, params: &BakeParams, file: &str) -> Result<Prepare
     Ok(Prepared {
         mesh,
         fixed,
+        fixed_by,
+        mid_table,
         reoriented,
         hash,
     })
@@ -390,10 +574,15 @@ struct Surface {
     /// A surface the heat method cannot factor (degenerate triangles) simply stores none; the
     /// runtime reports the problem if the heat method is used.
     order: Option<Vec<u32>>,
+    /// Second-order meshes: the surface edges (surface-vertex pairs, sorted) and the volume
+    /// node of each one's mid-edge node. Empty for a linear mesh.
+    edges: Vec<[u32; 2]>,
+    edge_nodes: Vec<usize>,
 }
 
 impl Surface {
-    fn of(mesh: &TetMesh) -> Surface {
+    /// `mid_table`: [`TetMesh::edge_mid_nodes`] (empty for a linear mesh).
+    fn of(mesh: &TetMesh, mid_table: &[([usize; 2], usize)]) -> Surface {
         let (nodes, tris) = extract_surface(mesh);
         let mut local = vec![u32::MAX; mesh.nodes.len()];
         for (i, &v) in nodes.iter().enumerate() {
@@ -402,11 +591,28 @@ impl Surface {
         let triangles: Vec<[u32; 3]> = tris.iter().map(|t| t.map(|v| local[v])).collect();
         let positions: Vec<[f64; 3]> = nodes.iter().map(|&v| mesh.nodes[v]).collect();
         let order = HeatGeodesic::plan_ordering(&positions, &triangles).ok();
+        let (mut edges, mut edge_nodes) = (Vec::new(), Vec::new());
+        if mesh.is_quadratic() {
+            edges = QuadraticSurface::edges_of(&triangles);
+            // Every surface edge is a tet edge, so the look-up succeeds on a mesh that passed
+            // `edge_mid_nodes`; `usize::MAX` would fail the base's validation, not panic.
+            edge_nodes = edges
+                .iter()
+                .map(|&[a, b]| {
+                    let key = [nodes[a as usize], nodes[b as usize]];
+                    mid_table
+                        .binary_search_by(|x| x.0.cmp(&key))
+                        .map_or(usize::MAX, |i| mid_table[i].1)
+                })
+                .collect();
+        }
         Surface {
             nodes,
             positions,
             triangles,
             order,
+            edges,
+            edge_nodes,
         }
     }
 }
@@ -427,11 +633,6 @@ pub fn extract_surface(mesh: &TetMesh) -> (Vec<usize>, Vec<[usize; 3]>) {
     verts.sort_unstable();
     verts.dedup();
     (verts, tris)
-}
-
-/// The faces of a positively oriented tet (a, b, c, d), with outward normals.
-fn tet_faces([a, b, c, d]: [usize; 4]) -> [[usize; 3]; 4] {
-    [[a, c, b], [a, b, d], [a, d, c], [b, c, d]]
 }
 
 /// A face rotated so its smallest index comes first (canonical, orientation kept).
@@ -518,11 +719,16 @@ pub fn bake_mesh(
     let Prepared {
         mesh,
         fixed,
+        fixed_by,
+        mid_table,
         reoriented,
         hash,
     } = prepare(mesh, params, file)?;
+    report.order = if mesh.is_quadratic() { 2 } else { 1 };
+    report.fixed_by = fixed_by;
     report.nodes = mesh.nodes.len();
     report.tets = mesh.tets.len();
+    report.extent_m = mesh.extent();
     report.reoriented_tets = reoriented;
     report.fixed_nodes = fixed.len();
     report.source_hash = hash.clone();
@@ -540,9 +746,13 @@ pub fn bake_mesh(
     let wanted = params.min_modes() + rigid;
     if wanted > map.n_free() {
         return Err(BakeError::Params(format!(
-            "{file}: {} modes requested but the mesh has only {} free degrees of freedom",
+            "{file}: --modes {}: at most {} modes for this mesh (3 × {} nodes − {} fixed dofs{} = {})",
             params.min_modes(),
-            map.n_free()
+            map.n_free().saturating_sub(rigid),
+            mesh.nodes.len(),
+            3 * mesh.nodes.len() - map.n_free(),
+            if rigid > 0 { " − 6 rigid" } else { "" },
+            map.n_free().saturating_sub(rigid)
         )));
     }
     let eparams = EigenParams {
@@ -568,8 +778,9 @@ pub fn bake_mesh(
     // The surface and its heat-geodesic ordering depend on the mesh only: they are computed
     // on a second thread during the factorization and eigensolve (the bake bench's 3k / 15k
     // beams: ≈ 5 / 17 ms, otherwise after it).
+    progress(BakeStage::Factor);
     let (res, surface) = std::thread::scope(|scope| {
-        let surface = scope.spawn(|| Surface::of(&mesh));
+        let surface = scope.spawn(|| Surface::of(&mesh, &mid_table));
         let res = eigen::solve_lowest(&kf, &mf, &eparams, &mut |p| {
             progress(BakeStage::Eigensolve(p))
         });
@@ -645,16 +856,31 @@ pub fn bake_mesh(
         positions,
         triangles,
         order,
+        edges,
+        edge_nodes,
     } = surface;
     let nm = elastic.len();
-    let mut modes = Vec::with_capacity(surf.len() * 3 * nm);
-    for &v in &surf {
-        for axis in 0..3 {
-            for &j in &elastic {
-                modes.push(full[(3 * v + axis, j)]);
+    let rows_of = |nodes: &[usize]| {
+        let mut modes = Vec::with_capacity(nodes.len() * 3 * nm);
+        for &v in nodes {
+            for axis in 0..3 {
+                for &j in &elastic {
+                    modes.push(if v < mesh.nodes.len() {
+                        full[(3 * v + axis, j)]
+                    } else {
+                        f64::NAN // refused by the base's validation
+                    });
+                }
             }
         }
-    }
+        modes
+    };
+    let modes = rows_of(&surf);
+    let quadratic = mesh.is_quadratic().then(|| QuadraticSurface {
+        edge_to_volume: edge_nodes.iter().map(|&v| v as u32).collect(),
+        modes: rows_of(&edge_nodes),
+        edges,
+    });
     let eigenvalues: Vec<f64> = elastic.iter().map(|&j| res.eigenvalues[j]).collect();
     let residuals: Vec<f64> = elastic.iter().map(|&j| res.residuals[j]).collect();
     let base = ModesFile {
@@ -668,11 +894,17 @@ pub fn bake_mesh(
         fixed_nodes: fixed.iter().map(|&v| v as u32).collect(),
         residuals,
         meta: ModesMeta {
-            format_version: FORMAT_VERSION,
+            format_version: 1,
             tool_version: TOOL_VERSION.to_string(),
             source_hash: hash,
             params_hash: params.hash(),
-            bake_params: serde_json::to_value(params).expect("params serialise"),
+            bake_params: {
+                let mut v = serde_json::to_value(params).expect("params serialise");
+                if let Some(obj) = v.as_object_mut() {
+                    obj.insert("output_version".into(), OUTPUT_VERSION.into());
+                }
+                v
+            },
             volume_nodes: mesh.nodes.len(),
             volume_tets: mesh.tets.len(),
             rigid_modes_excluded: first,
@@ -683,7 +915,11 @@ pub fn bake_mesh(
         precision: params.precision,
         transfer: None,
         surface_order: order,
+        quadratic,
     };
+    let mut base = base;
+    base.meta.format_version = base.required_format_version();
+    report.surface_edge_nodes = base.quadratic.as_ref().map_or(0, |q| q.edges.len());
     report.modes = nm;
     report.frequencies_hz = base.frequencies_hz();
     report.residuals = base.residuals.clone();
@@ -718,6 +954,11 @@ pub fn bake_mesh_with_transfer(
         error: Box::new(error),
     };
     tp.check().map_err(terr)?;
+    if mesh.is_quadratic() {
+        return Err(terr(tr::TransferError::Params(
+            "--transfer-h is not supported for second-order (10-node) meshes: the table interpolates P1 midpoint rows; bake the linear mesh for a table".into(),
+        )));
+    }
     let (mut base, mut report) = bake_mesh(mesh.clone(), params, file, progress)?;
     let t = Instant::now();
     let tp = &tr::TransferParams {
@@ -791,7 +1032,8 @@ fn transfer_meta(tp: &crate::transfer::TransferParams) -> serde_json::Value {
     })
 }
 
-/// Reads `mesh_path`, bakes it and writes `out` atomically (nothing is left on failure).
+/// Reads `mesh_path`, bakes it and writes `out` atomically (nothing is left on failure),
+/// creating `out`'s folder if it is missing ([`BakeReport::created_folder`]).
 ///
 /// # Errors
 /// A [`BakeError`] naming the file and what failed.
@@ -829,6 +1071,15 @@ pub fn bake_file_with_transfer(
     report.read_s = read_s;
     progress(BakeStage::Write);
     let t = Instant::now();
+    if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
+        if !dir.exists() {
+            std::fs::create_dir_all(dir).map_err(|source| FormatError::Io {
+                path: dir.to_path_buf(),
+                source,
+            })?;
+            report.created_folder = Some(dir.display().to_string());
+        }
+    }
     base.write_atomic(out)?;
     report.write_s = t.elapsed().as_secs_f64();
     Ok(report)
@@ -863,44 +1114,175 @@ pub fn is_up_to_date_with_transfer(
     transfer: Option<&crate::transfer::TransferParams>,
     modes: &Path,
 ) -> Result<bool, BakeError> {
+    Ok(base_status(mesh_path, params, transfer, modes)? == BaseStatus::UpToDate)
+}
+
+/// Whether a base is up to date, and if not why (what `modal-bake check --json` reports).
+#[derive(Clone, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum BaseStatus {
+    /// The base holds what a bake of this mesh with these options would write.
+    UpToDate,
+    /// No file at the base's path.
+    Missing,
+    /// The file does not read as a valid base (the reader's message).
+    Unreadable(String),
+    /// Written by a `modal-bake` whose output differs ([`OUTPUT_VERSION`]), or without what
+    /// this one stores (the heat-geodesic order).
+    ToolChanged,
+    /// The mesh's geometry or fixed set differs ([`geometry_hash`]).
+    GeometryChanged,
+    /// The bake parameters differ ([`BakeParams::hash`]).
+    ParametersChanged,
+    /// The peak-transfer table is missing, unwanted or built with other parameters.
+    TransferTableChanged,
+}
+
+impl BaseStatus {
+    /// The reason as one word (`up_to_date`, `missing`, `unreadable`, `tool_changed`,
+    /// `geometry_changed`, `parameters_changed`, `transfer_table_changed`).
+    pub fn reason(&self) -> &'static str {
+        match self {
+            BaseStatus::UpToDate => "up_to_date",
+            BaseStatus::Missing => "missing",
+            BaseStatus::Unreadable(_) => "unreadable",
+            BaseStatus::ToolChanged => "tool_changed",
+            BaseStatus::GeometryChanged => "geometry_changed",
+            BaseStatus::ParametersChanged => "parameters_changed",
+            BaseStatus::TransferTableChanged => "transfer_table_changed",
+        }
+    }
+}
+
+/// Compares the base at `modes` with what a bake of `mesh_path` with `params` (and `transfer`)
+/// would write: by content hashes of the parsed geometry and of the parameters, and the
+/// [`OUTPUT_VERSION`] of the tool that wrote it — never by file times.
+///
+/// # Errors
+/// A [`BakeError`] when the mesh itself cannot be read or prepared, or the parameters are
+/// invalid (what `check` exits 2 on).
+pub fn base_status(
+    mesh_path: &Path,
+    params: &BakeParams,
+    transfer: Option<&crate::transfer::TransferParams>,
+    modes: &Path,
+) -> Result<BaseStatus, BakeError> {
+    let file = mesh_path.display().to_string();
+    check_options(params, transfer, &file)?;
+    let mesh = crate::mesh::read_mesh(mesh_path)?;
+    mesh_base_status(mesh, &file, params, transfer, modes)
+}
+
+/// Checks the bake and transfer-table parameters (what `check` exits 2 on before any mesh work).
+fn check_options(
+    params: &BakeParams,
+    transfer: Option<&crate::transfer::TransferParams>,
+    file: &str,
+) -> Result<(), BakeError> {
     params.check()?;
     if let Some(tp) = transfer {
         tp.check().map_err(|error| BakeError::Transfer {
-            file: mesh_path.display().to_string(),
+            file: file.to_string(),
             error: Box::new(error),
         })?;
     }
-    let mesh = crate::mesh::read_mesh(mesh_path)?;
-    let prepared = prepare(mesh, params, &mesh_path.display().to_string())?;
-    if !modes.exists() {
-        return Ok(false);
+    Ok(())
+}
+
+/// As [`is_up_to_date_with_transfer`] for a mesh already in memory (e.g. one gmsh made from a
+/// surface asset); `file` names it in messages.
+///
+/// # Errors
+/// As [`is_up_to_date`].
+pub fn is_mesh_up_to_date(
+    mesh: TetMesh,
+    file: &str,
+    params: &BakeParams,
+    transfer: Option<&crate::transfer::TransferParams>,
+    modes: &Path,
+) -> Result<bool, BakeError> {
+    Ok(mesh_base_status(mesh, file, params, transfer, modes)? == BaseStatus::UpToDate)
+}
+
+/// As [`base_status`] for a mesh already in memory; `file` names it in messages.
+///
+/// # Errors
+/// As [`base_status`].
+pub fn mesh_base_status(
+    mesh: TetMesh,
+    file: &str,
+    params: &BakeParams,
+    transfer: Option<&crate::transfer::TransferParams>,
+    modes: &Path,
+) -> Result<BaseStatus, BakeError> {
+    check_options(params, transfer, file)?;
+    let prepared = prepare(mesh, params, file)?;
+    if std::fs::symlink_metadata(modes).is_err() {
+        return Ok(BaseStatus::Missing);
     }
-    Ok(match ModesFile::read(modes) {
-        Ok(base) => {
-            let table_matches = match transfer {
-                None => base.transfer.is_none(),
-                Some(tp) => {
-                    base.transfer.is_some()
-                        && base.meta.bake_params.get("transfer") == Some(&transfer_meta(tp))
-                }
-            };
-            // A base without the stored heat-geodesic order (baked before it existed, or
-            // written elsewhere) is stale when this tool would store one.
-            let order_matches = base.surface_order.is_some()
-                || HeatGeodesic::plan_ordering(&base.surface_vertices, &base.surface_triangles)
-                    .is_err();
-            base.meta.source_hash == prepared.hash
-                && base.meta.params_hash == params.hash()
-                && table_matches
-                && order_matches
+    let base = match ModesFile::read(modes) {
+        Ok(base) => base,
+        Err(e) => return Ok(BaseStatus::Unreadable(e.to_string())),
+    };
+    let output_version = base.meta.bake_params.get("output_version");
+    // A base without the stored heat-geodesic order (baked before it existed, or written
+    // elsewhere) is stale when this tool would store one.
+    let order_matches = base.surface_order.is_some()
+        || HeatGeodesic::plan_ordering(&base.surface_vertices, &base.surface_triangles).is_err();
+    if output_version != Some(&serde_json::json!(OUTPUT_VERSION)) || !order_matches {
+        return Ok(BaseStatus::ToolChanged);
+    }
+    if base.meta.source_hash != prepared.hash {
+        return Ok(BaseStatus::GeometryChanged);
+    }
+    if base.meta.params_hash != params.hash() {
+        return Ok(BaseStatus::ParametersChanged);
+    }
+    let table_matches = match transfer {
+        None => base.transfer.is_none(),
+        Some(tp) => {
+            base.transfer.is_some()
+                && base.meta.bake_params.get("transfer") == Some(&transfer_meta(tp))
         }
-        Err(_) => false,
-    })
+    };
+    if !table_matches {
+        return Ok(BaseStatus::TransferTableChanged);
+    }
+    Ok(BaseStatus::UpToDate)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Rounding to 16 digits is idempotent (the geometry hash relies on it: a coordinate and
+    /// its `%.16g` print round alike), exact where 16 digits suffice, and moves a value by at
+    /// most half a unit of its 16th digit (plus the parse's half ulp). Random bit patterns over
+    /// the whole finite range.
+    #[test]
+    fn rounding_to_16_digits_is_idempotent() {
+        let mut state = 0x9E37_79B9_7F4A_7C15u64;
+        let mut checked = 0;
+        for _ in 0..200_000 {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            let x = f64::from_bits(state);
+            if !x.is_finite() {
+                continue;
+            }
+            let r = round_16_digits(x);
+            let printed: f64 = format!("{x:.15e}").parse().unwrap();
+            assert_eq!(r.to_bits(), printed.to_bits(), "{x:e}");
+            assert_eq!(round_16_digits(r).to_bits(), r.to_bits(), "{x:e}");
+            assert!((r - x).abs() <= 6.2e-16 * x.abs(), "{x:e} → {r:e}");
+            checked += 1;
+        }
+        assert!(checked > 190_000);
+        for x in [0.0, -0.0, 1.0, 0.1, 0.3, -2.5e-7, 1e300, 5e-324] {
+            assert_eq!(round_16_digits(x).to_bits(), x.to_bits(), "{x:e}");
+        }
+    }
 
     /// The packed-key boundary faces equal the general ones (same faces, same order), on a
     /// structured box and on the same box with its tets listed in reverse.

@@ -11,8 +11,10 @@
 pub mod args;
 pub mod bake;
 pub mod eigen;
+pub mod export;
 pub mod fem;
 pub mod full_order;
 pub mod mesh;
+pub mod signals;
 pub mod target_error;
 pub mod transfer;

@@ -69,8 +69,8 @@ fn every_input_form_gives_a_byte_identical_base_and_rebaking_is_identical() {
         .as_deref()
         .expect("the bake stores surface_order");
     let (v, t) = (&base.surface_vertices, &base.surface_triangles);
-    let stored = dcr_runtime::HeatGeodesic::with_ordering(v, t, Some(order)).unwrap();
-    let amd = dcr_runtime::HeatGeodesic::new(v, t).unwrap();
+    let stored = dcr_runtime::attenuation::HeatGeodesic::with_ordering(v, t, Some(order)).unwrap();
+    let amd = dcr_runtime::attenuation::HeatGeodesic::new(v, t).unwrap();
     let (mut a, mut b) = (vec![0.0; v.len()], vec![0.0; v.len()]);
     stored.distances_from_vertex(0, &mut a);
     amd.distances_from_vertex(0, &mut b);
@@ -243,12 +243,26 @@ fn bad_inputs_fail_cleanly_with_located_errors() {
         ("bad/bad_shape.json", &[], "bad_shape.json"),
         ("bad/negative_index.json", &[], "negative_index.json"),
         ("bad/not_a_mesh.msh", &[], "not_a_mesh.msh"),
+        ("bad/repeated_nodes.msh", &[], "repeated_nodes.msh:21:"),
+        (
+            "bad/repeated_nodes_v41.msh",
+            &[],
+            "repeated_nodes_v41.msh:24:",
+        ),
+        (
+            "bad/negative_node_tag.msh",
+            &[],
+            "negative_node_tag.msh:15:",
+        ),
+        ("bad/extra_value.msh", &[], "extra_value.msh:18:"),
+        ("bad/permuted_duplicate_tet.msh", &[], "elements 5 and 7"),
+        ("bad/overlapping_tets.msh", &[], "elements 5 and 7 overlap"),
         (
             "meshes/cube_v41.msh",
             &["--fixed", "no_such_group"],
             "no_such_group",
         ),
-        ("meshes/cube_v41.msh", &["--youngs", "-5"], "material"),
+        ("meshes/cube_v41.msh", &["--youngs", "-5"], "--youngs"),
         ("meshes/cube_v41.msh", &["--modes", "0"], "--modes"),
         ("meshes/cube_v41.msh", &["--modes", "100000"], "modes"),
         ("meshes/cube_v41.msh", &["--rayleigh", "nan,1"], "rayleigh"),
@@ -268,6 +282,73 @@ fn bad_inputs_fail_cleanly_with_located_errors() {
     }
     // Nothing half-written: no temporary files either.
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+}
+
+// Regression: `check` panicked (exit 101) on a mesh whose `$Nodes` repeats after `$Elements`.
+// A mesh that cannot be read is an error (exit 2) naming the file and line, for every kind of
+// refusal in data/bad, and `check` never panics.
+#[test]
+fn check_exits_2_on_every_unreadable_mesh() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("never.modes");
+    let mut checked = 0;
+    for entry in std::fs::read_dir(data("bad")).unwrap() {
+        let path = entry.unwrap().path();
+        let o = run(&["check", path.to_str().unwrap(), out.to_str().unwrap()]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(
+            matches!(o.status.code(), Some(1) | Some(2)),
+            "{}: exit {:?}: {err}",
+            path.display(),
+            o.status.code()
+        );
+        if o.status.code() == Some(2) {
+            assert!(
+                err.contains(path.file_name().unwrap().to_str().unwrap()),
+                "{}: {err}",
+                path.display()
+            );
+            checked += 1;
+        }
+    }
+    assert!(checked >= 25, "{checked} refusals");
+    let o = run(&[
+        "check",
+        data("bad/repeated_nodes.msh").to_str().unwrap(),
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("repeated_nodes.msh:21:"));
+}
+
+// Regression: a base baked from gmsh's MSH 2.2 binary file was stale for the MSH 4.1 ASCII
+// file of the same mesh (coordinates an ulp apart through `%.16g`).
+#[test]
+fn check_sees_gmsh_ascii_and_binary_forms_as_one_geometry() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("cyl.modes");
+    let o = bake(
+        &data("meshes/cylinder_v22_bin.msh"),
+        &out,
+        &["--modes", "4", "--fixed", "bottom"],
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let ascii = data("meshes/cylinder_v41.msh");
+    let o = run(&[
+        "check",
+        ascii.to_str().unwrap(),
+        out.to_str().unwrap(),
+        "--modes",
+        "4",
+        "--fixed",
+        "bottom",
+    ]);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stdout)
+    );
 }
 
 #[test]

@@ -249,8 +249,14 @@ fn bad_msh_files_give_located_errors() {
 
     let e = read_err("bad/no_tets.msh");
     assert_eq!(e.kind, MeshErrorKind::NoTets);
-    let e = read_err("bad/second_order_only.msh");
-    assert_eq!(e.kind, MeshErrorKind::NoTets);
+    // A 10-node tet reads as second-order; its mid-edge nodes are off the edges (curved).
+    let m = read_ok("bad/second_order_only.msh");
+    assert!(m.is_quadratic() && m.tets.len() == 1 && m.nodes.len() == 10);
+    let e = m.check_straight(1e-6).unwrap_err();
+    assert!(
+        matches!(e.kind, MeshErrorKind::CurvedTet { element: 1, .. }),
+        "{e}"
+    );
 
     let e = read_err("bad/huge_count.msh");
     assert_eq!(
@@ -536,5 +542,207 @@ fn binary_nan_is_located_by_byte_offset() {
     assert_eq!(
         e.to_string(),
         format!("nan_bin.msh: byte {record}: non-finite coordinate in node {tag}")
+    );
+}
+
+// Regression: a section repeated after the data that depends on it (a second `$Nodes` after
+// `$Elements`, MSH 2.2 and 4.1) replaced the node table under the elements and panicked; an
+// `$Elements` before `$Nodes` cannot be read. Each is refused at the offending header's line.
+#[test]
+fn repeated_or_out_of_order_sections_are_refused_at_their_line() {
+    for rel in ["bad/repeated_nodes.msh", "bad/repeated_nodes_v41.msh"] {
+        let e = read_err(rel);
+        let first = line_of(rel, "$Nodes");
+        assert_eq!(
+            e.kind,
+            MeshErrorKind::DuplicateSection {
+                section: "Nodes",
+                first
+            },
+            "{rel}: {e}"
+        );
+        let text = std::fs::read_to_string(data(rel)).unwrap();
+        let second = 1 + text
+            .lines()
+            .enumerate()
+            .filter(|(_, l)| *l == "$Nodes")
+            .nth(1)
+            .unwrap()
+            .0;
+        assert_located(&e, rel, Location::Line(second));
+    }
+    let rel = "bad/elements_before_nodes.msh";
+    let e = read_err(rel);
+    assert!(
+        matches!(e.kind, MeshErrorKind::MissingSection(s) if s.contains("$Nodes")),
+        "{e}"
+    );
+    assert_located(&e, rel, Location::Line(line_of(rel, "$Elements")));
+}
+
+// Regression: tags and records are read as written, never guessed. A negative node tag in an
+// element was read as node 0, a tag 0 accepted, an extra value on an element line swallowed the
+// next element, a short line borrowed the next line's first value.
+#[test]
+fn bad_tags_and_records_are_refused_at_their_line() {
+    let rel = "bad/negative_node_tag.msh";
+    let e = read_err(rel);
+    assert_eq!(
+        e.kind,
+        MeshErrorKind::InvalidTag {
+            what: "element node tag",
+            found: "-5".into()
+        },
+        "{e}"
+    );
+    assert_located(&e, rel, Location::Line(line_of(rel, "6 4 ")));
+
+    let rel = "bad/zero_node_tag.msh";
+    let e = read_err(rel);
+    assert!(
+        matches!(&e.kind, MeshErrorKind::InvalidTag { what: "node tag", found } if found == "0"),
+        "{e}"
+    );
+    assert_located(&e, rel, Location::Line(line_of(rel, "0 0.0")));
+
+    let rel = "bad/extra_value.msh";
+    let e = read_err(rel);
+    assert!(
+        matches!(&e.kind, MeshErrorKind::ExtraValue { found, .. } if found == "5"),
+        "{e}"
+    );
+    assert_located(&e, rel, Location::Line(line_of(rel, "5 4 ")));
+
+    let rel = "bad/short_record.msh";
+    let e = read_err(rel);
+    assert!(matches!(e.kind, MeshErrorKind::ShortLine(_)), "{e}");
+    assert_located(&e, rel, Location::Line(line_of(rel, "5 4 ")));
+
+    // The same defects in MSH 4.1 ASCII: an extra value on a node coordinate line, a node tag
+    // line holding two tags, a tag 0.
+    let good = std::fs::read_to_string(data("bad/repeated_nodes_v41.msh")).unwrap();
+    let good = &good[..good.find("$EndElements").unwrap() + "$EndElements\n".len()];
+    read_msh_bytes(good.as_bytes(), "v41.msh").unwrap();
+    for (from, to, line) in [
+        ("\n1.0 0.0 0.0\n", "\n1.0 0.0 0.0 7\n", 13),
+        ("\n2\n3\n", "\n2 3\n", 8),
+        ("\n5 1 2 3 4\n", "\n0 1 2 3 4\n", 21),
+        ("\n6 2 3 4 5\n", "\n6 2 3 4 5 1\n", 22),
+    ] {
+        let text = good.replacen(from, to, 1);
+        let e = read_msh_bytes(text.as_bytes(), "v41.msh").unwrap_err();
+        assert_eq!(e.location, Location::Line(line), "{to:?}: {e}");
+    }
+}
+
+// Regression: a tetrahedron repeated with its nodes in another order was kept as a second,
+// overlapping element (mass 513 kg read as 642 kg); it is refused naming both elements. Two
+// distinct tetrahedra on the same side of a shared face overlap too: the mesh check names both.
+#[test]
+fn overlapping_tets_are_refused_naming_both_elements() {
+    let e = read_err("bad/permuted_duplicate_tet.msh");
+    assert_eq!(
+        e.kind,
+        MeshErrorKind::DuplicateTet {
+            first: 5,
+            second: 7
+        },
+        "{e}"
+    );
+    assert_located(&e, "bad/permuted_duplicate_tet.msh", Location::Element(7));
+
+    let mut m = read_ok("bad/overlapping_tets.msh");
+    m.orient_tets(DEFAULT_DEGENERATE_REL_TOL).unwrap();
+    let e = m.check_overlaps().unwrap_err();
+    assert_eq!(
+        e.kind,
+        MeshErrorKind::OverlappingTets {
+            first: 5,
+            second: 7
+        },
+        "{e}"
+    );
+    // Valid meshes pass: every interior face is shared once from each side.
+    for form in CUBE_FORMS {
+        read_ok(form).check_overlaps().unwrap();
+    }
+    let mut m = read_ok("bad/inverted_tet.msh");
+    m.orient_tets(DEFAULT_DEGENERATE_REL_TOL).unwrap();
+    m.check_overlaps().unwrap();
+}
+
+// Expectation: gmsh skips sections it does not know wherever they are, also before
+// `$MeshFormat` (it stores `$Comments` as a model attribute); so do the readers.
+#[test]
+fn unknown_sections_are_skipped_anywhere() {
+    let m = read_ok("bad/comments_first.msh");
+    assert_eq!(m.tets.len(), 2);
+    let plain = std::fs::read_to_string(data("bad/comments_first.msh")).unwrap();
+    let plain = &plain[plain.find("$MeshFormat").unwrap()..];
+    assert_eq!(m, read_msh_bytes(plain.as_bytes(), "plain.msh").unwrap());
+    // A known section before `$MeshFormat` is refused.
+    let early = format!("$Nodes\n0\n$EndNodes\n{plain}");
+    let e = read_msh_bytes(early.as_bytes(), "early.msh").unwrap_err();
+    assert_eq!(e.location, Location::Line(1), "{e}");
+}
+
+// Regression: `bake /dev/zero` read 2 GB before failing. Only regular files are read (their
+// size bounds the read); a directory, a device or a FIFO is refused by name, at once.
+#[test]
+fn only_regular_files_are_read() {
+    let dir = tempfile::tempdir().unwrap();
+    let fifo = dir.path().join("pipe.msh");
+    let status = std::process::Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .unwrap();
+    assert!(status.success());
+    for path in [
+        std::path::PathBuf::from("/dev/zero"),
+        dir.path().to_path_buf(),
+        fifo,
+    ] {
+        let e = read_mesh(&path).unwrap_err();
+        assert!(
+            matches!(e.kind, MeshErrorKind::NotARegularFile(_)),
+            "{}: {e}",
+            path.display()
+        );
+        assert!(
+            e.to_string().starts_with(&path.display().to_string()),
+            "{e}"
+        );
+    }
+}
+
+// Regression: one gmsh mesh written as MSH 4.1 ASCII and as MSH 2.2 binary carried coordinates
+// one ulp apart (gmsh prints ASCII with `%.16g`), so the geometry hash differed and `check`
+// called a base stale. The hash keys coordinates at 16 significant digits: both forms hash
+// alike, while the bits really differ.
+#[test]
+fn gmsh_ascii_and_binary_forms_hash_alike() {
+    use modal_bake::bake::geometry_hash;
+    let ascii = read_ok("meshes/cylinder_v41.msh");
+    let binary = read_ok("meshes/cylinder_v22_bin.msh");
+    assert_eq!(ascii.tets, binary.tets);
+    let differ = ascii
+        .nodes
+        .iter()
+        .flatten()
+        .zip(binary.nodes.iter().flatten())
+        .filter(|(a, b)| a.to_bits() != b.to_bits())
+        .count();
+    assert!(differ > 0, "the two forms should differ in some bits");
+    let fixed = ascii.groups["bottom"].clone();
+    assert_eq!(
+        geometry_hash(&ascii, &fixed),
+        geometry_hash(&binary, &fixed)
+    );
+    // A real change of geometry (one coordinate moved by 1e-12 m) still changes the hash.
+    let mut moved = binary.clone();
+    moved.nodes[3][1] += 1e-12;
+    assert_ne!(
+        geometry_hash(&moved, &fixed),
+        geometry_hash(&binary, &fixed)
     );
 }

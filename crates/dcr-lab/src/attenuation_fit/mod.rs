@@ -14,12 +14,12 @@
 //! so fitted parameters plug into `AttenuationLaw::Full` unchanged. (The paper's Fig. 10 uses
 //! peak *velocities* of a high-resolution FEM run; we use displacements because that is what
 //! Eq. 15–16 scale.) The distance r_ab is the heat-method geodesic distance on the surface
-//! (Crane et al. 2013, `dcr_runtime::HeatGeodesic`) from a to b (Euclidean if the surface's heat
+//! (Crane et al. 2013, `dcr_runtime::attenuation::HeatGeodesic`) from a to b (Euclidean if the surface's heat
 //! operators cannot be built).
 //!
 //! # Truth
 //! u is the sum over elastic modes of the exact damped impulse responses (Rayleigh damping,
-//! every damping regime, `dcr_runtime::ModeFilter`), sampled by the exact two-term recursion
+//! every damping regime, `dcr_runtime::filter::ModeFilter`), sampled by the exact two-term recursion
 //! g_k = a1 g_{k−1} − a2 g_{k−2} of each mode:
 //! - [`SurfaceResponse::from_modal_all`]: every mode of a dense eigensolve ([`ModalAll`],
 //!   small meshes), or its lowest `modes`;
@@ -44,8 +44,8 @@ mod surface_response;
 
 use std::time::Instant;
 
+use dcr_runtime::attenuation::HeatGeodesic;
 use dcr_runtime::testing::SplitMix64;
-use dcr_runtime::HeatGeodesic;
 use modal_bake::bake::{bake_mesh, BakeError, BakeParams, MaterialSi, ModeRequest};
 use modal_bake::full_order::{FullOrderError, FullOrderSystem, ModalAll, SystemParams};
 use modal_bake::mesh::TetMesh;
@@ -277,7 +277,7 @@ pub fn sample_attenuation(
             h / dt_req
         )));
     }
-    let steps = dcr_runtime::samples_per_step(h, dt_req);
+    let steps = dcr_runtime::filter::samples_per_step(h, dt_req);
     let dt = h / steps as f64;
     let cand: Vec<usize> = (0..resp.vertices.len())
         .filter(|&v| resp.eligible[v])

@@ -1,7 +1,7 @@
 //! [`SurfaceResponse`]: the normal-displacement rows of every surface vertex in modal
 //! coordinates, and the peaks of the exact modal impulse responses at surface pairs.
 
-use dcr_runtime::{damping_ratio, ModeFilter};
+use dcr_runtime::filter::{damping_ratio, ModeFilter};
 use modal_bake::bake::ModesFile;
 use modal_bake::full_order::{FullOrderSystem, ModalAll};
 use rayon::prelude::*;

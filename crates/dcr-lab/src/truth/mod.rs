@@ -24,7 +24,7 @@
 //!   projected out M-orthogonally (`FullOrderSystem::remove_rigid`), which is what the sum
 //!   over every elastic mode (a base with all modes) gives. Clamped objects: as is.
 //! - `distance_m` is the heat-method geodesic distance on the surface
-//!   (`dcr_runtime::HeatGeodesic`, Crane et al. 2013) from the impact point, interpolated at the
+//!   (`dcr_runtime::attenuation::HeatGeodesic`, Crane et al. 2013) from the impact point, interpolated at the
 //!   contact with its barycentric weights; Euclidean if the geodesic solver cannot be built
 //!   (reported in [`TruthInfo::distance_kind`]).
 
@@ -38,7 +38,9 @@ use modal_bake::full_order::{
 };
 use modal_bake::mesh::{MeshError, TetMesh};
 
-use dcr_runtime::{samples_per_step, HeatGeodesic, SurfacePoint};
+use dcr_runtime::attenuation::HeatGeodesic;
+use dcr_runtime::filter::samples_per_step;
+use dcr_runtime::model::SurfacePoint;
 
 /// Which truth to compute.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]

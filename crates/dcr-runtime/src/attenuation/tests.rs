@@ -68,7 +68,7 @@ fn point_source_is_consistent() {
     let (v, t) = plate_grid(20, 20, 1.0, 1.0);
     let heat = HeatGeodesic::new(&v, &t).unwrap();
     let tri = t[100];
-    let sp = crate::SurfacePoint {
+    let sp = crate::model::SurfacePoint {
         triangle: 100,
         bary: [1.0, 0.0, 0.0],
         point: v[tri[0] as usize],
@@ -208,7 +208,7 @@ fn probe_surface() -> (Vec<[f64; 3]>, Vec<[u32; 3]>, Vec<u32>) {
 }
 
 /// The timing probes' source: inside triangle 7.
-const PROBE_SOURCE: crate::SurfacePoint = crate::SurfacePoint {
+const PROBE_SOURCE: crate::model::SurfacePoint = crate::model::SurfacePoint {
     triangle: 7,
     bary: [0.2, 0.3, 0.5],
     point: [0.0; 3],
@@ -273,7 +273,7 @@ fn heat_timing() {
     }
     let mut spread: Vec<f64> = (0..40)
         .map(|s| {
-            let sp = crate::SurfacePoint {
+            let sp = crate::model::SurfacePoint {
                 triangle: (s * 251 % t.len()) as u32,
                 ..sp
             };
@@ -451,7 +451,7 @@ fn split_queries_match_unsplit_and_threads_agree() {
         let f = t.iter().position(|f| f.contains(&v)).unwrap();
         let mut bary = [0.0; 3];
         bary[t[f].iter().position(|&c| c == v).unwrap()] = 1.0;
-        crate::SurfacePoint {
+        crate::model::SurfacePoint {
             triangle: f as u32,
             bary: if inside { [0.5, 0.3, 0.2] } else { bary },
             point: [0.0; 3],

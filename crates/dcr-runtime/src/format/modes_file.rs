@@ -21,7 +21,7 @@
 //!
 //! Optional: `surface_order` u32 (ns,), a fill-reducing elimination order of the surface
 //! vertices (a permutation of 0..ns) for the heat-geodesic factor, chosen at bake time
-//! ([`crate::HeatGeodesic::plan_ordering`]); without it the runtime orders with AMD at load.
+//! ([`crate::attenuation::HeatGeodesic::plan_ordering`]); without it the runtime orders with AMD at load.
 //!
 //! Optional (all or none): the peak-transfer table ([`TransferTable`]): `transfer_vertices`
 //! u32 (nr,), `transfer_peaks` f32 (np(np+1)/2,) packed upper triangle over np = nr + ne points
@@ -31,11 +31,22 @@
 //! u32 () (1, 2, 3; absent: 2 with edges, else 1) and `transfer_faces` u32 (nf, 3) (order 3).
 //! Readers that predate the table ignore these entries.
 //!
+//! Optional (version ≥ 2, all or none): the mid-edge rows of a second-order (P2) base
+//! ([`QuadraticSurface`]): `surface_edges` u32 (ne, 2), `edge_to_volume` u32 (ne,),
+//! `edge_modes` f64 or f32 (ne, 3, m). A file carries the lowest version that describes it
+//! ([`ModesFile::required_format_version`]): linear bases stay version 1, which every earlier
+//! reader opens; second-order bases are version 2, which version-1 readers refuse rather than
+//! interpolate them linearly.
+//!
 //! Files are written deterministically (fixed zip timestamps, fixed entry order, stored) and
 //! atomically (temporary file in the target directory, then rename).
+//!
+//! Reading distrusts every size in the file: only regular files are opened; each entry's
+//! declared size is checked against the archive's length, each `.npy` header length against
+//! the entry's bytes and each shape against the data present before anything is allocated;
+//! the content is then validated ([`ModesFile::validate`], one table of rules per kind of value).
 
-use std::fs::File;
-use std::io::{Cursor, Read, Seek, Write};
+use std::io::{Cursor, Read, Seek};
 use std::path::{Path, PathBuf};
 
 use ndarray::{Array0, Array1, Array2, Array3, ArrayD};
@@ -43,13 +54,15 @@ use ndarray_npy::npy::header::Header;
 use ndarray_npy::{NpzWriter, ReadNpyExt, ReadableElement};
 use serde::{Deserialize, Serialize};
 
+use super::quadratic_surface::{QuadraticSurface, QUADRATIC_ENTRIES, QUADRATIC_FORMAT_VERSION};
+use super::regular_file::{open_regular_file, OpenError};
 use super::transfer_table::{
     TransferTable, TRANSFER_EDGES_ENTRY, TRANSFER_ENTRIES, TRANSFER_FACES_ENTRY,
     TRANSFER_ORDER_ENTRY,
 };
 
-/// Current `.modes` schema version.
-pub const FORMAT_VERSION: u32 = 1;
+/// Newest `.modes` schema version this build reads and writes (it reads every version from 1).
+pub const FORMAT_VERSION: u32 = 2;
 
 /// Largest `.npy` entry accepted when reading (bytes); guards against hostile headers.
 const MAX_ENTRY_BYTES: u64 = 8 << 30;
@@ -82,7 +95,8 @@ pub struct MaterialSi {
 /// Free-form bake metadata stored as JSON in the `meta` entry.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ModesMeta {
-    /// Schema version (same as the `format_version` entry).
+    /// Schema version (same as the `format_version` entry): 1 to [`FORMAT_VERSION`], at least
+    /// [`ModesFile::required_format_version`].
     pub format_version: u32,
     /// Tool that wrote the file, e.g. `modal-bake 0.1.0`.
     pub tool_version: String,
@@ -178,6 +192,9 @@ pub struct ModesFile {
     /// factor (`order[k]` = the vertex eliminated k-th; a permutation of 0..ns). `None`: the
     /// runtime computes AMD when it first needs the factor.
     pub surface_order: Option<Vec<u32>>,
+    /// Second-order bases: the mid-edge nodes of the 6-node surface triangles and their mode
+    /// rows (`None`: a linear base, modes interpolated linearly in each triangle).
+    pub quadratic: Option<QuadraticSurface>,
 }
 
 /// What went wrong reading or writing a `.modes` file.
@@ -218,8 +235,24 @@ pub enum FormatError {
         /// What is wrong.
         detail: String,
     },
+    /// The path names a directory, device, FIFO or socket, not a regular file.
+    #[error("{path}: not a regular file ({what})")]
+    NotRegular {
+        /// Path concerned.
+        path: PathBuf,
+        /// What it is instead ("a directory", "a FIFO", ...).
+        what: &'static str,
+    },
+    /// A write would replace something that is not a regular file.
+    #[error("{path}: is {what}; refusing to replace it with a file (give the path of a file)")]
+    Clobber {
+        /// Path concerned.
+        path: PathBuf,
+        /// What it is ("a directory", "a character device", ...).
+        what: &'static str,
+    },
     /// The file was written by an incompatible schema version.
-    #[error("{path}: format version {found} is not supported (this build reads version {FORMAT_VERSION})")]
+    #[error("{path}: format version {found} is not supported (this build reads versions 1 to {FORMAT_VERSION})")]
     Version {
         /// File concerned.
         path: PathBuf,
@@ -247,6 +280,16 @@ impl ModesFile {
         self.surface_vertices.len()
     }
 
+    /// The lowest format version that can hold this base: [`QUADRATIC_FORMAT_VERSION`] with a
+    /// second-order surface, else 1.
+    pub fn required_format_version(&self) -> u32 {
+        if self.quadratic.is_some() {
+            QUADRATIC_FORMAT_VERSION
+        } else {
+            1
+        }
+    }
+
     /// Frequencies f_j = √λ_j / 2π (Hz).
     pub fn frequencies_hz(&self) -> Vec<f64> {
         self.eigenvalues
@@ -255,7 +298,12 @@ impl ModesFile {
             .collect()
     }
 
-    /// Checks shapes, index ranges, finiteness and version; `path` is used in messages.
+    /// Checks version, shapes, value ranges and index ranges; `path` is used in messages.
+    ///
+    /// Table-driven: every entry's length, its values' range and its indices' bound are rows of
+    /// three tables (lengths, `RealRule`s, `IndexRule`s), so a new entry is a row in each.
+    /// Messages name the entry, the element (`residuals[3]`, `modes[v][axis][j]`) and the
+    /// range that holds.
     ///
     /// # Errors
     /// [`FormatError::Invalid`] or [`FormatError::Version`] naming what is wrong.
@@ -264,70 +312,91 @@ impl ModesFile {
             path: path.to_path_buf(),
             detail,
         };
-        if self.meta.format_version != FORMAT_VERSION {
+        if !(1..=FORMAT_VERSION).contains(&self.meta.format_version) {
             return Err(FormatError::Version {
                 path: path.to_path_buf(),
                 found: self.meta.format_version,
             });
         }
+        if self.meta.format_version < self.required_format_version() {
+            return Err(inv(format!(
+                "format version {} cannot hold a second-order surface (needs {QUADRATIC_FORMAT_VERSION})",
+                self.meta.format_version
+            )));
+        }
         let m = self.num_modes();
         let ns = self.num_surface_vertices();
+        let nv = self.meta.volume_nodes;
         if m == 0 {
             return Err(inv("no modes".into()));
         }
         if ns == 0 || self.surface_triangles.is_empty() {
             return Err(inv("empty surface".into()));
         }
-        if self.modes.len() != ns * 3 * m {
-            return Err(inv(format!(
-                "modes hold {} values, expected ns×3×m = {ns}×3×{m}",
-                self.modes.len()
-            )));
-        }
-        if self.surface_to_volume.len() != ns {
-            return Err(inv(format!(
-                "surface_to_volume has {} entries for {ns} surface vertices",
-                self.surface_to_volume.len()
-            )));
-        }
-        if self.residuals.len() != m {
-            return Err(inv(format!(
-                "residuals has {} entries for {m} modes",
-                self.residuals.len()
-            )));
-        }
-        for (j, &l) in self.eigenvalues.iter().enumerate() {
-            if !(l.is_finite() && l > 0.0) {
+        // Lengths: (entry, length, expected, expected as a formula).
+        let lengths = [
+            ("modes", self.modes.len(), ns * 3 * m, "ns×3×m"),
+            ("surface_to_volume", self.surface_to_volume.len(), ns, "ns"),
+            ("residuals", self.residuals.len(), m, "m"),
+        ];
+        for (entry, len, expected, formula) in lengths {
+            if len != expected {
                 return Err(inv(format!(
-                    "eigenvalue {j} is {l} (must be finite and > 0)"
+                    "{entry} holds {len} values, expected {formula} = {expected} (ns = {ns} surface vertices, m = {m} modes)"
                 )));
             }
-            if j > 0 && l < self.eigenvalues[j - 1] {
-                return Err(inv(format!("eigenvalues not ascending at mode {j}")));
-            }
         }
-        if let Some(i) = self.modes.iter().position(|x| !x.is_finite()) {
+        let modes_shape = [3, m];
+        let reals = [
+            RealRule::new("eigenvalues", &self.eigenvalues, &[], ValueRule::Positive),
+            RealRule::new("residuals", &self.residuals, &[], ValueRule::NonNegative),
+            RealRule::new("modes", &self.modes, &modes_shape, ValueRule::Finite),
+            RealRule::new(
+                "surface_vertices",
+                self.surface_vertices.as_flattened(),
+                &[3],
+                ValueRule::Coordinate,
+            ),
+            RealRule::new("rayleigh", &self.rayleigh, &[], ValueRule::NonNegative),
+        ];
+        const VOLUME_NODES: &str = "volume nodes (meta.volume_nodes)";
+        let indices = [
+            IndexRule {
+                entry: "surface_triangles",
+                values: self.surface_triangles.as_flattened(),
+                shape: &[3],
+                bound: ns,
+                counts: "surface vertices",
+            },
+            IndexRule {
+                entry: "surface_to_volume",
+                values: &self.surface_to_volume,
+                shape: &[],
+                bound: nv,
+                counts: VOLUME_NODES,
+            },
+            IndexRule {
+                entry: "fixed_nodes",
+                values: &self.fixed_nodes,
+                shape: &[],
+                bound: nv,
+                counts: VOLUME_NODES,
+            },
+        ];
+        for rule in &reals {
+            rule.check().map_err(inv)?;
+        }
+        for rule in &indices {
+            rule.check().map_err(inv)?;
+        }
+        if let Some(j) = (1..m).find(|&j| self.eigenvalues[j] < self.eigenvalues[j - 1]) {
+            return Err(inv(format!("eigenvalues not ascending at mode {j}")));
+        }
+        let extent = surface_extent(&self.surface_vertices);
+        if !(extent >= MIN_EXTENT_M) {
             return Err(inv(format!(
-                "non-finite mode value at vertex {}, axis {}, mode {}",
-                i / (3 * m),
-                (i / m) % 3,
-                i % m
+                "surface extent {extent:.2e} m (bounding-box diagonal) is below the supported {MIN_EXTENT_M:e} m"
             )));
-        }
-        if let Some(v) = self
-            .surface_vertices
-            .iter()
-            .position(|p| p.iter().any(|x| !x.is_finite()))
-        {
-            return Err(inv(format!("non-finite position of surface vertex {v}")));
-        }
-        if let Some((t, _)) = self
-            .surface_triangles
-            .iter()
-            .enumerate()
-            .find(|(_, tri)| tri.iter().any(|&i| i as usize >= ns))
-        {
-            return Err(inv(format!("surface triangle {t} names a vertex ≥ {ns}")));
         }
         let MaterialSi {
             youngs,
@@ -337,17 +406,37 @@ impl ModesFile {
         let positive = |x: f64| x.is_finite() && x > 0.0;
         if !(positive(youngs) && positive(density) && poisson > -1.0 && poisson < 0.5) {
             return Err(inv(format!(
-                "material out of range: E={youngs} ν={poisson} ρ={density}"
+                "material out of range: E={youngs} ν={poisson} ρ={density} (E, ρ finite and > 0, −1 < ν < 0.5)"
             )));
         }
-        if !self.rayleigh.iter().all(|x| x.is_finite() && *x >= 0.0) {
+        let meta = &self.meta;
+        if !positive(meta.mass_kg) {
             return Err(inv(format!(
-                "rayleigh coefficients {:?} must be finite and ≥ 0",
-                self.rayleigh
+                "meta.mass_kg = {} (must be finite and > 0)",
+                meta.mass_kg
+            )));
+        }
+        if nv < ns {
+            return Err(inv(format!(
+                "meta.volume_nodes = {nv} is below the {ns} surface vertices"
+            )));
+        }
+        if !matches!(meta.rigid_modes_excluded, 0 | 6) {
+            return Err(inv(format!(
+                "meta.rigid_modes_excluded = {} (must be 0, fixed, or 6, free-free)",
+                meta.rigid_modes_excluded
             )));
         }
         if let Some(t) = &self.transfer {
             t.check(ns).map_err(inv)?;
+        }
+        if let Some(q) = &self.quadratic {
+            q.check(ns, m, &self.surface_triangles).map_err(inv)?;
+            if self.transfer.is_some() {
+                return Err(inv(
+                    "a peak-transfer table on a second-order base is not supported (the table interpolates P1 midpoint rows)".into(),
+                ));
+            }
         }
         if let Some(order) = &self.surface_order {
             if order.len() != ns {
@@ -370,41 +459,20 @@ impl ModesFile {
 
     /// Writes the base to `path` atomically and deterministically (same content → same bytes).
     ///
-    /// The data is written to a temporary file beside `path`, synced, then renamed over it; on
-    /// any error the temporary file is removed and `path` is left untouched.
+    /// The data is written to a temporary file beside `path`, synced, then renamed over it
+    /// ([`super::AtomicFile`]: unique temporary names, stale temporaries of dead writers
+    /// removed); on any error the temporary file is removed and `path` is left untouched.
     ///
     /// # Errors
-    /// [`FormatError::Invalid`] if the content fails [`ModesFile::validate`]; I/O errors.
+    /// [`FormatError::Invalid`] if the content fails [`ModesFile::validate`];
+    /// [`FormatError::Clobber`] if `path` is a directory, device, FIFO or socket; I/O errors.
     pub fn write_atomic(&self, path: &Path) -> Result<(), FormatError> {
         self.validate(path)?;
-        let io = |source| FormatError::Io {
-            path: path.to_path_buf(),
-            source,
-        };
         let bytes = self.to_bytes().map_err(|detail| FormatError::Archive {
             path: path.to_path_buf(),
             detail,
         })?;
-        let dir = path
-            .parent()
-            .filter(|d| !d.as_os_str().is_empty())
-            .unwrap_or(Path::new("."));
-        let name = path
-            .file_name()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_default();
-        let tmp = dir.join(format!(".{name}.tmp-{}", std::process::id()));
-        let result = (|| {
-            let mut f = File::create(&tmp)?;
-            f.write_all(&bytes)?;
-            f.sync_all()?;
-            std::fs::rename(&tmp, path)
-        })();
-        if let Err(e) = result {
-            let _ = std::fs::remove_file(&tmp);
-            return Err(io(e));
-        }
-        Ok(())
+        super::atomic_file::write_atomic(path, &bytes)
     }
 
     /// Serialises the archive to bytes (deterministic).
@@ -419,8 +487,11 @@ impl ModesFile {
         let tri: Vec<u32> = self.surface_triangles.iter().flatten().copied().collect();
         let pos: Vec<f64> = self.surface_vertices.iter().flatten().copied().collect();
         let meta = serde_json::to_vec(&self.meta).map_err(|err| err.to_string())?;
-        npz.add_array("format_version", &Array0::from_elem((), FORMAT_VERSION))
-            .map_err(e)?;
+        npz.add_array(
+            "format_version",
+            &Array0::from_elem((), self.meta.format_version),
+        )
+        .map_err(e)?;
         npz.add_array("eigenvalues", &Array1::from(self.eigenvalues.clone()))
             .map_err(e)?;
         npz.add_array("frequencies_hz", &Array1::from(self.frequencies_hz()))
@@ -471,6 +542,36 @@ impl ModesFile {
             npz.add_array("surface_order", &Array1::from(order.clone()))
                 .map_err(e)?;
         }
+        if let Some(q) = &self.quadratic {
+            let ne = q.edges.len();
+            let edges: Vec<u32> = q.edges.iter().flatten().copied().collect();
+            npz.add_array(
+                QUADRATIC_ENTRIES[0],
+                &Array2::from_shape_vec((ne, 2), edges).map_err(|x| x.to_string())?,
+            )
+            .map_err(e)?;
+            npz.add_array(
+                QUADRATIC_ENTRIES[1],
+                &Array1::from(q.edge_to_volume.clone()),
+            )
+            .map_err(e)?;
+            match self.precision {
+                ModesPrecision::F64 => npz.add_array(
+                    QUADRATIC_ENTRIES[2],
+                    &Array3::from_shape_vec((ne, 3, m), q.modes.clone())
+                        .map_err(|x| x.to_string())?,
+                ),
+                ModesPrecision::F32 => npz.add_array(
+                    QUADRATIC_ENTRIES[2],
+                    &Array3::from_shape_vec(
+                        (ne, 3, m),
+                        q.modes.iter().map(|&x| x as f32).collect(),
+                    )
+                    .map_err(|x| x.to_string())?,
+                ),
+            }
+            .map_err(e)?;
+        }
         if let Some(t) = &self.transfer {
             npz.add_array("transfer_vertices", &Array1::from(t.vertices.clone()))
                 .map_err(e)?;
@@ -517,9 +618,15 @@ impl ModesFile {
     /// # Errors
     /// A [`FormatError`] naming the file and the entry or value at fault.
     pub fn read(path: &Path) -> Result<ModesFile, FormatError> {
-        let file = File::open(path).map_err(|source| FormatError::Io {
-            path: path.to_path_buf(),
-            source,
+        let (file, _) = open_regular_file(path).map_err(|e| match e {
+            OpenError::Io(source) => FormatError::Io {
+                path: path.to_path_buf(),
+                source,
+            },
+            OpenError::NotRegular(what) => FormatError::NotRegular {
+                path: path.to_path_buf(),
+                what,
+            },
         })?;
         Self::read_from(std::io::BufReader::new(file), path)
     }
@@ -528,7 +635,17 @@ impl ModesFile {
     ///
     /// # Errors
     /// As [`ModesFile::read`].
-    pub fn read_from<R: Read + Seek>(reader: R, path: &Path) -> Result<ModesFile, FormatError> {
+    pub fn read_from<R: Read + Seek>(mut reader: R, path: &Path) -> Result<ModesFile, FormatError> {
+        let io = |source| FormatError::Io {
+            path: path.to_path_buf(),
+            source,
+        };
+        let archive_len = reader.seek(std::io::SeekFrom::End(0)).map_err(io)?;
+        check_zip_directory(&mut reader, archive_len).map_err(|detail| FormatError::Archive {
+            path: path.to_path_buf(),
+            detail,
+        })?;
+        reader.seek(std::io::SeekFrom::Start(0)).map_err(io)?;
         let mut zip = zip::ZipArchive::new(reader).map_err(|err| FormatError::Archive {
             path: path.to_path_buf(),
             detail: err.to_string(),
@@ -536,9 +653,10 @@ impl ModesFile {
         let mut rd = EntryReader {
             zip: &mut zip,
             path,
+            archive_len,
         };
         let version: u32 = rd.scalar("format_version")?;
-        if version != FORMAT_VERSION {
+        if !(1..=FORMAT_VERSION).contains(&version) {
             return Err(FormatError::Version {
                 path: path.to_path_buf(),
                 found: version,
@@ -578,6 +696,7 @@ impl ModesFile {
         } else {
             None
         };
+        let quadratic = rd.quadratic(precision)?;
 
         let inv = |detail: String| FormatError::Invalid {
             path: path.to_path_buf(),
@@ -595,6 +714,15 @@ impl ModesFile {
                 "modes shape {modes_shape:?} does not match (ns, 3, m) = ({ns}, 3, {m})"
             )));
         }
+        if let Some((q, shape)) = &quadratic {
+            let ne = q.edges.len();
+            if shape != &[ne, 3, m] {
+                return Err(inv(format!(
+                    "edge_modes shape {shape:?} does not match (ne, 3, m) = ({ne}, 3, {m})"
+                )));
+            }
+        }
+        let quadratic = quadratic.map(|(q, _)| q);
         if frequencies.len() != m {
             return Err(inv(format!(
                 "frequencies_hz has {} entries for {m} eigenvalues",
@@ -622,7 +750,14 @@ impl ModesFile {
             precision,
             transfer,
             surface_order,
+            quadratic,
         };
+        if out.meta.format_version != version {
+            return Err(inv(format!(
+                "the format_version entry ({version}) and meta.format_version ({}) disagree",
+                out.meta.format_version
+            )));
+        }
         out.validate(path)?;
         for (j, (&f, g)) in frequencies.iter().zip(out.frequencies_hz()).enumerate() {
             if !((f - g).abs() <= 1e-9 * g.abs()) {
@@ -635,10 +770,249 @@ impl ModesFile {
     }
 }
 
+/// Largest |coordinate| (m) of a surface vertex (and, in `modal-bake`, of a mesh node). A
+/// base describes one object of a rigid-body scene; a coordinate beyond 1000 km is a unit or
+/// export error, and far beyond it squared lengths and areas (heat method, BVH) overflow.
+pub const MAX_COORDINATE_M: f64 = 1e6;
+
+/// Smallest bounding-box diagonal (m) of a surface (and of a mesh in `modal-bake`): below a
+/// micrometre, squared lengths and areas approach the floating-point underflow the heat
+/// method and the stiffness assembly cannot work in, and no rigid-body object is that small.
+pub const MIN_EXTENT_M: f64 = 1e-6;
+
+/// The range the values of one entry must lie in (a row of [`ModesFile::validate`]'s table).
+#[derive(Clone, Copy, Debug)]
+enum ValueRule {
+    /// Finite.
+    Finite,
+    /// Finite and > 0.
+    Positive,
+    /// Finite and ≥ 0.
+    NonNegative,
+    /// Finite and within ±[`MAX_COORDINATE_M`] (m).
+    Coordinate,
+}
+
+impl ValueRule {
+    fn holds(self, x: f64) -> bool {
+        match self {
+            ValueRule::Finite => x.is_finite(),
+            ValueRule::Positive => x.is_finite() && x > 0.0,
+            ValueRule::NonNegative => x.is_finite() && x >= 0.0,
+            ValueRule::Coordinate => x.abs() <= MAX_COORDINATE_M,
+        }
+    }
+
+    /// The range in words, for messages.
+    fn range(self) -> String {
+        match self {
+            ValueRule::Finite => "must be finite".into(),
+            ValueRule::Positive => "must be finite and > 0".into(),
+            ValueRule::NonNegative => "must be finite and ≥ 0".into(),
+            ValueRule::Coordinate => format!("must be within ±{MAX_COORDINATE_M:e} m"),
+        }
+    }
+}
+
+/// A row of [`ModesFile::validate`]'s table of real values: every value of `entry` obeys `rule`.
+struct RealRule<'a> {
+    entry: &'static str,
+    values: &'a [f64],
+    /// Trailing dimensions of the entry (for element indices in messages).
+    shape: &'a [usize],
+    rule: ValueRule,
+}
+
+impl<'a> RealRule<'a> {
+    fn new(entry: &'static str, values: &'a [f64], shape: &'a [usize], rule: ValueRule) -> Self {
+        RealRule {
+            entry,
+            values,
+            shape,
+            rule,
+        }
+    }
+
+    fn check(&self) -> Result<(), String> {
+        match self.values.iter().position(|&x| !self.rule.holds(x)) {
+            None => Ok(()),
+            Some(i) => Err(format!(
+                "{}{} = {} ({})",
+                self.entry,
+                element_index(i, self.shape),
+                show(self.values[i]),
+                self.rule.range()
+            )),
+        }
+    }
+}
+
+/// A row of [`ModesFile::validate`]'s table of indices: every value of `entry` is < `bound`.
+struct IndexRule<'a> {
+    entry: &'static str,
+    values: &'a [u32],
+    /// Trailing dimensions of the entry (for element indices in messages).
+    shape: &'a [usize],
+    bound: usize,
+    /// What `bound` counts, for messages.
+    counts: &'static str,
+}
+
+impl IndexRule<'_> {
+    fn check(&self) -> Result<(), String> {
+        match self.values.iter().position(|&v| v as usize >= self.bound) {
+            None => Ok(()),
+            Some(i) => Err(format!(
+                "{}{} = {} (must be < {} {})",
+                self.entry,
+                element_index(i, self.shape),
+                self.values[i],
+                self.bound,
+                self.counts
+            )),
+        }
+    }
+}
+
+/// `x` for a message: plain between 1e-3 and 1e6, else in exponent form (`1e150`, not 151
+/// digits).
+fn show(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() || (1e-3..1e6).contains(&x.abs()) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
+}
+
+/// `[i0][i1]…` of flat index `flat` in an array whose trailing dimensions are `shape`.
+fn element_index(flat: usize, shape: &[usize]) -> String {
+    let mut idx = vec![0; shape.len() + 1];
+    let mut rest = flat;
+    for (k, &d) in shape.iter().enumerate().rev() {
+        idx[k + 1] = rest % d.max(1);
+        rest /= d.max(1);
+    }
+    idx[0] = rest;
+    idx.iter().map(|i| format!("[{i}]")).collect()
+}
+
+/// Bounding-box diagonal (m) of `points`; NaN when empty or not finite.
+fn surface_extent(points: &[[f64; 3]]) -> f64 {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for p in points {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    let d: f64 = (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt();
+    if d.is_finite() {
+        d
+    } else {
+        f64::NAN
+    }
+}
+
 /// Bounded reads of single `.npy` entries from the archive.
 struct EntryReader<'a, R: Read + Seek> {
     zip: &'a mut zip::ZipArchive<R>,
     path: &'a Path,
+    /// Bytes in the whole archive: no entry holds more.
+    archive_len: u64,
+}
+
+/// Most entries a `.modes` archive may declare (it has about 20): the zip reader reserves
+/// memory per declared entry, ~200 bytes each, before reading any.
+const MAX_ARCHIVE_ENTRIES: u64 = 256;
+
+/// Checks the entry counts a zip archive declares (end-of-central-directory record, and its
+/// zip64 form if present) against [`MAX_ARCHIVE_ENTRIES`] and the archive's length before the
+/// zip reader trusts them. Archives without the record are left to the zip reader to refuse.
+fn check_zip_directory<R: Read + Seek>(reader: &mut R, len: u64) -> Result<(), String> {
+    let io = |e: std::io::Error| format!("unreadable: {e}");
+    let tail_len = len.min(22 + 65_535 + 20 + 56);
+    reader
+        .seek(std::io::SeekFrom::Start(len - tail_len))
+        .map_err(io)?;
+    let mut tail = vec![0u8; tail_len as usize];
+    reader.read_exact(&mut tail).map_err(io)?;
+    let Some(eocd) = (0..tail.len().saturating_sub(21))
+        .rev()
+        .find(|&i| &tail[i..i + 4] == b"PK\x05\x06")
+    else {
+        return Ok(());
+    };
+    let u16_at = |i: usize| u64::from(u16::from_le_bytes([tail[i], tail[i + 1]]));
+    let mut counts = vec![u16_at(eocd + 8), u16_at(eocd + 10)];
+    // zip64: the locator just before the record points at the zip64 record with u64 counts.
+    if counts.contains(&0xFFFF) && eocd >= 20 && &tail[eocd - 20..eocd - 16] == b"PK\x06\x07" {
+        let at = u64::from_le_bytes(tail[eocd - 12..eocd - 4].try_into().unwrap_or([0; 8]));
+        let mut rec = [0u8; 56];
+        if at.checked_add(56).is_some_and(|end| end <= len) {
+            reader.seek(std::io::SeekFrom::Start(at)).map_err(io)?;
+            reader.read_exact(&mut rec).map_err(io)?;
+            if &rec[..4] == b"PK\x06\x06" {
+                counts = vec![
+                    u64::from_le_bytes(rec[24..32].try_into().unwrap_or([0; 8])),
+                    u64::from_le_bytes(rec[32..40].try_into().unwrap_or([0; 8])),
+                ];
+            }
+        }
+    }
+    match counts.iter().max() {
+        Some(&n) if n > MAX_ARCHIVE_ENTRIES || n.saturating_mul(46) > len => Err(format!(
+            "the zip directory declares {n} entries (a .modes archive has about 20; at most {MAX_ARCHIVE_ENTRIES}, 46 bytes each, are accepted)"
+        )),
+        _ => Ok(()),
+    }
+}
+
+/// Largest `.npy` header accepted (bytes): numpy's own default (`max_header_size`).
+const MAX_NPY_HEADER: usize = 10_000;
+
+/// Deepest bracket nesting accepted in a `.npy` header (a dict holding a shape tuple is 2).
+const MAX_NPY_NESTING: usize = 8;
+
+/// Checks a `.npy` entry's preamble (magic, version, header length) against the entry's real
+/// size before its header is parsed: the header length field is distrusted (a version-2 length
+/// of 4 GiB would otherwise be allocated), and so is the header's bracket nesting (the header
+/// parser recurses).
+fn check_npy_preamble(buf: &[u8]) -> Result<(), String> {
+    if buf.len() < 10 || &buf[..6] != b"\x93NUMPY" {
+        return Err("not a .npy entry (no \\x93NUMPY magic)".into());
+    }
+    let (len, start) = match buf[6] {
+        1 => (u16::from_le_bytes([buf[8], buf[9]]) as usize, 10),
+        2 | 3 if buf.len() >= 12 => (
+            u32::from_le_bytes([buf[8], buf[9], buf[10], buf[11]]) as usize,
+            12,
+        ),
+        2 | 3 => return Err("truncated .npy preamble".into()),
+        v => return Err(format!("unsupported .npy version {v}.{}", buf[7])),
+    };
+    let present = buf.len() - start;
+    if len > present || len > MAX_NPY_HEADER {
+        return Err(format!(
+            ".npy header of {len} bytes declared, but the entry holds {present} bytes after its preamble (and at most {MAX_NPY_HEADER} are accepted)"
+        ));
+    }
+    let mut depth = 0usize;
+    for &b in &buf[start..start + len] {
+        match b {
+            b'(' | b'[' | b'{' => {
+                depth += 1;
+                if depth > MAX_NPY_NESTING {
+                    return Err(format!(
+                        ".npy header nests brackets deeper than {MAX_NPY_NESTING} levels"
+                    ));
+                }
+            }
+            b')' | b']' | b'}' => depth = depth.saturating_sub(1),
+            _ => {}
+        }
+    }
+    Ok(())
 }
 
 impl<R: Read + Seek> EntryReader<'_, R> {
@@ -667,6 +1041,17 @@ impl<R: Read + Seek> EntryReader<'_, R> {
                 })
             }
         };
+        let declared = f.size().max(f.compressed_size());
+        if declared > self.archive_len {
+            return Err(FormatError::Entry {
+                path,
+                entry,
+                detail: format!(
+                    "declares {declared} bytes, but the whole archive holds {}",
+                    self.archive_len
+                ),
+            });
+        }
         let mut buf = Vec::new();
         // Never trust the declared size: read at most cap + header bytes.
         (&mut f)
@@ -695,6 +1080,7 @@ impl<R: Read + Seek> EntryReader<'_, R> {
         cap: u64,
     ) -> Result<(Vec<A>, Vec<usize>), FormatError> {
         let buf = self.bytes(entry, cap)?;
+        check_npy_preamble(&buf).map_err(|detail| self.err(entry, detail))?;
         let mut cur = Cursor::new(&buf[..]);
         let header = Header::from_reader(&mut cur)
             .map_err(|err| self.err(entry, format!("bad .npy header: {err}")))?;
@@ -847,6 +1233,55 @@ impl<R: Read + Seek> EntryReader<'_, R> {
             faces,
             peaks,
         }))
+    }
+
+    /// The optional second-order surface with the shape of its `edge_modes`: `None` when none
+    /// of its entries is present, an error naming the missing one when only some are.
+    #[allow(clippy::type_complexity)]
+    fn quadratic(
+        &mut self,
+        precision: ModesPrecision,
+    ) -> Result<Option<(QuadraticSurface, Vec<usize>)>, FormatError> {
+        let present = QUADRATIC_ENTRIES
+            .iter()
+            .filter(|e| self.zip.index_for_name(&format!("{e}.npy")).is_some())
+            .count();
+        if present == 0 {
+            return Ok(None);
+        }
+        if let Some(missing) = QUADRATIC_ENTRIES
+            .iter()
+            .find(|e| self.zip.index_for_name(&format!("{e}.npy")).is_none())
+        {
+            return Err(FormatError::Missing {
+                path: self.path.to_path_buf(),
+                entry: missing,
+            });
+        }
+        let (flat, shape) = self.array::<u32>(QUADRATIC_ENTRIES[0], 2)?;
+        if shape[1] != 2 {
+            return Err(self.err(
+                QUADRATIC_ENTRIES[0],
+                format!("expected shape (ne, 2), found {shape:?}"),
+            ));
+        }
+        let edges = flat.chunks_exact(2).map(|c| [c[0], c[1]]).collect();
+        let edge_to_volume: Vec<u32> = self.vector(QUADRATIC_ENTRIES[1], MAX_ENTRY_BYTES)?;
+        let (modes, shape) = match precision {
+            ModesPrecision::F64 => self.array::<f64>(QUADRATIC_ENTRIES[2], 3)?,
+            ModesPrecision::F32 => {
+                let (v, s) = self.array::<f32>(QUADRATIC_ENTRIES[2], 3)?;
+                (v.into_iter().map(f64::from).collect(), s)
+            }
+        };
+        Ok(Some((
+            QuadraticSurface {
+                edges,
+                edge_to_volume,
+                modes,
+            },
+            shape,
+        )))
     }
 
     fn scalar<A: ReadableElement + Copy>(&mut self, entry: &'static str) -> Result<A, FormatError> {

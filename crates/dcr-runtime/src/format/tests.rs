@@ -44,6 +44,7 @@ pub(crate) fn tiny_base() -> ModesFile {
         precision: ModesPrecision::F64,
         transfer: None,
         surface_order: None,
+        quadratic: None,
     }
 }
 
@@ -106,7 +107,7 @@ fn nan_and_mismatch_are_rejected() {
     base.modes[5] = f64::NAN;
     let err = base.write_atomic(&p).unwrap_err().to_string();
     assert!(
-        err.contains("non-finite mode value at vertex 0, axis 2, mode 1"),
+        err.contains("modes[0][2][1] = NaN (must be finite)"),
         "{err}"
     );
     assert!(!p.exists(), "nothing is written for invalid content");
@@ -125,7 +126,7 @@ fn nan_and_mismatch_are_rejected() {
         .write_atomic(&p)
         .unwrap_err()
         .to_string()
-        .contains("triangle 1"));
+        .contains("surface_triangles[1][2] = 9 (must be < 4 surface vertices)"));
 
     let mut base = tiny_base();
     base.meta.format_version = 99;
@@ -401,4 +402,235 @@ fn surface_order_round_trips_and_a_bad_one_is_named() {
         b.surface_order = Some(order);
         assert_refused(&b, needle);
     }
+}
+
+/// `bytes` (a valid archive) with entry `name.npy` replaced by `npy`.
+fn with_entry(bytes: &[u8], name: &str, npy: &[u8]) -> Vec<u8> {
+    let mut zin = zip::ZipArchive::new(Cursor::new(bytes)).unwrap();
+    let opts =
+        zip::write::SimpleFileOptions::default().compression_method(zip::CompressionMethod::Stored);
+    let mut w = zip::ZipWriter::new(Cursor::new(Vec::new()));
+    for i in 0..zin.len() {
+        let mut f = zin.by_index(i).unwrap();
+        let entry = f.name().to_string();
+        w.start_file(entry.as_str(), opts).unwrap();
+        if entry == format!("{name}.npy") {
+            std::io::Write::write_all(&mut w, npy).unwrap();
+        } else {
+            std::io::copy(&mut f, &mut w).unwrap();
+        }
+    }
+    w.finish().unwrap().into_inner()
+}
+
+// Regression: a version-2 `.npy` header declaring a 0xFFFFFFF0-byte header made every reader
+// (info, probe, geodesic, check, ModalModel::load) allocate 4 GiB before failing. The header
+// length is checked against the entry's real size (and numpy's 10,000-byte limit) first.
+#[test]
+fn npy_header_length_is_bounded_by_the_entry() {
+    let good = tiny_base().to_bytes().unwrap();
+    for (version, len) in [(2u8, 0xFFFF_FFF0u32), (3, 0x7FFF_0000), (2, 20_000)] {
+        let mut npy = b"\x93NUMPY".to_vec();
+        npy.extend_from_slice(&[version, 0]);
+        npy.extend_from_slice(&len.to_le_bytes());
+        npy.extend_from_slice(&[b' '; 64]);
+        let bytes = with_entry(&good, "residuals", &npy);
+        let err = ModesFile::read_from(Cursor::new(bytes), Path::new("h.modes")).unwrap_err();
+        let msg = err.to_string();
+        assert!(
+            matches!(
+                err,
+                FormatError::Entry {
+                    entry: "residuals",
+                    ..
+                }
+            ) && msg.contains(&format!("header of {len} bytes")),
+            "{msg}"
+        );
+    }
+    // Deeply nested header text is refused before it reaches the recursive parser.
+    let mut npy = b"\x93NUMPY\x01\x00".to_vec();
+    let h = format!("{}\n", "(".repeat(3000));
+    npy.extend_from_slice(&(h.len() as u16).to_le_bytes());
+    npy.extend_from_slice(h.as_bytes());
+    let bytes = with_entry(&good, "residuals", &npy);
+    let err = ModesFile::read_from(Cursor::new(bytes), Path::new("n.modes")).unwrap_err();
+    assert!(err.to_string().contains("nest"), "{err}");
+}
+
+// Regression: NaN, infinite and negative residuals were accepted although the format says
+// values are validated on read; so were indices past the volume mesh, coordinates far outside
+// any object (a surface scaled by 1e150 made geodesic distances all zero) and meta values
+// that cannot be. Each is refused naming the entry, the index and the range that holds.
+#[test]
+fn content_out_of_range_is_refused_naming_entry_index_and_range() {
+    type Corrupt = fn(&mut ModesFile);
+    let cases: [(Corrupt, &str); 12] = [
+        (|b| b.residuals[1] = f64::NAN, "residuals[1] = NaN"),
+        (|b| b.residuals[0] = f64::INFINITY, "residuals[0] = inf"),
+        (
+            |b| b.residuals[1] = -1e-12,
+            "residuals[1] = -1e-12 (must be finite and ≥ 0)",
+        ),
+        (|b| b.eigenvalues[0] = -1.0, "eigenvalues[0] = -1"),
+        (|b| b.surface_to_volume[2] = 4, "surface_to_volume[2] = 4"),
+        (|b| b.fixed_nodes = vec![1, 7], "fixed_nodes[1] = 7"),
+        (
+            |b| {
+                for p in &mut b.surface_vertices {
+                    *p = p.map(|x| x * 1e150);
+                }
+            },
+            "surface_vertices[1][0] = 1e150 (must be within ±1e6 m)",
+        ),
+        (
+            |b| {
+                for p in &mut b.surface_vertices {
+                    *p = p.map(|x| x * 1e-9);
+                }
+            },
+            "surface extent 1.73e-9 m (bounding-box diagonal) is below the supported 1e-6 m",
+        ),
+        (
+            |b| b.meta.mass_kg = -1.0,
+            "meta.mass_kg = -1 (must be finite and > 0)",
+        ),
+        (|b| b.meta.volume_nodes = 3, "volume_nodes"),
+        (|b| b.meta.rigid_modes_excluded = 5, "rigid_modes_excluded"),
+        (|b| b.modes[5] = f64::NAN, "modes[0][2][1] = NaN"),
+    ];
+    for (corrupt, needle) in cases {
+        let mut b = tiny_base();
+        corrupt(&mut b);
+        assert_refused(&b, needle);
+    }
+    // The ends of the supported coordinate range load.
+    for scale in [1e-5, 3e5] {
+        let mut b = tiny_base();
+        for p in &mut b.surface_vertices {
+            *p = p.map(|x| x * scale);
+        }
+        let bytes = b.to_bytes().unwrap();
+        ModesFile::read_from(Cursor::new(bytes), Path::new("s.modes")).unwrap();
+    }
+}
+
+// Regression: reading a `.modes` path that is a device, FIFO or directory opened it (a FIFO
+// blocks, `/dev/zero` never ends); it is refused by name before opening.
+#[test]
+fn only_regular_files_are_read() {
+    let dir = tempfile::tempdir().unwrap();
+    for path in [Path::new("/dev/zero"), dir.path()] {
+        let err = ModesFile::read(path).unwrap_err().to_string();
+        assert!(
+            err.starts_with(&path.display().to_string()) && err.contains("not a regular file"),
+            "{err}"
+        );
+    }
+}
+
+// Regression: temporaries were named `.NAME.tmp-PID` — two writers with one pid on hosts sharing
+// a file system collided, and a temporary left by a killed writer stayed for ever. Names carry
+// host, pid and random bits; a new write removes the temporaries of writers that are gone.
+#[test]
+fn temporaries_are_unique_and_stale_ones_are_removed() {
+    let dir = tempfile::tempdir().unwrap();
+    let dest = dir.path().join("x.modes");
+    let a = AtomicFile::create(&dest).unwrap();
+    let b = AtomicFile::create(&dest).unwrap();
+    assert_ne!(a.temporary_path(), b.temporary_path());
+    let name = a
+        .temporary_path()
+        .file_name()
+        .unwrap()
+        .to_str()
+        .unwrap()
+        .to_string();
+    let host = atomic_file::this_host_tag();
+    let me = std::process::id();
+    assert!(
+        name.starts_with(&format!(".x.modes.tmp-{host}-{me}-")),
+        "{name}"
+    );
+    // Writers in progress are never stale; dropping one removes its temporary.
+    assert_eq!(atomic_file::stale_removed(dir.path(), "x.modes"), 0);
+    drop(a);
+    drop(b);
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+
+    // A process that has exited: its pid names a dead writer on this host.
+    let mut child = std::process::Command::new("true").spawn().unwrap();
+    let dead = child.id();
+    child.wait().unwrap();
+    let alive = std::os::unix::process::parent_id();
+    let touch = |n: &str| {
+        let p = dir.path().join(n);
+        std::fs::write(&p, b"partial").unwrap();
+        p
+    };
+    let stale = [
+        touch(&format!(".x.modes.tmp-{host}-{dead}-0123456789abcdef")),
+        touch(&format!(".x.modes.tmp-{dead}")),
+    ];
+    let live = touch(&format!(".x.modes.tmp-{host}-{alive}-0123456789abcdef"));
+    let foreign = touch(".x.modes.tmp-otherhost-1-0123456789abcdef");
+    let old_foreign = touch(".x.modes.tmp-otherhost-2-0123456789abcdef");
+    std::fs::File::options()
+        .write(true)
+        .open(&old_foreign)
+        .unwrap()
+        .set_modified(std::time::SystemTime::now() - 2 * STALE_AFTER)
+        .unwrap();
+    let other = touch(".y.modes.tmp-h-1-0");
+    tiny_base().write_atomic(&dest).unwrap();
+    for p in stale.iter().chain([&old_foreign]) {
+        assert!(!p.exists(), "{} should be removed", p.display());
+    }
+    for p in [&live, &foreign, &other] {
+        assert!(p.exists(), "{} should stay", p.display());
+    }
+    assert!(dest.exists());
+}
+
+// Regression: `-o` onto a character device replaced the device node with the base (as root,
+// exit 0). Writes replace regular files only.
+#[test]
+fn writes_never_replace_what_is_not_a_regular_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let fifo = dir.path().join("pipe.modes");
+    assert!(std::process::Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .unwrap()
+        .success());
+    let sub = dir.path().join("sub.modes");
+    std::fs::create_dir(&sub).unwrap();
+    for (path, what) in [(&fifo, "a FIFO"), (&sub, "a directory")] {
+        let err = tiny_base().write_atomic(path).unwrap_err();
+        assert!(
+            matches!(&err, FormatError::Clobber { what: w, .. } if *w == what),
+            "{err}"
+        );
+    }
+    use std::os::unix::fs::FileTypeExt;
+    assert!(std::fs::metadata(&fifo).unwrap().file_type().is_fifo());
+    assert!(sub.is_dir());
+    // Only the FIFO, the folder and nothing else: no temporary left behind.
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 2);
+}
+
+// Regression (found by the fuzz harness): an end-of-central-directory record declaring 65,535
+// entries made the zip reader reserve ~7 MB for a 58 kB archive (~200 bytes per declared
+// entry). Declared counts are checked first.
+#[test]
+fn zip_entry_counts_are_bounded_before_the_zip_reader_trusts_them() {
+    let mut bytes = tiny_base().to_bytes().unwrap();
+    let eocd = bytes.len() - 22;
+    assert_eq!(&bytes[eocd..eocd + 4], b"PK\x05\x06");
+    bytes[eocd + 8..eocd + 12].copy_from_slice(&[0xFF; 4]);
+    let err = ModesFile::read_from(Cursor::new(bytes), Path::new("z.modes")).unwrap_err();
+    assert!(
+        matches!(err, FormatError::Archive { .. }) && err.to_string().contains("65535 entries"),
+        "{err}"
+    );
 }

@@ -62,11 +62,6 @@ impl ContactCache {
         self.map.len()
     }
 
-    /// Whether no contact is cached.
-    pub fn is_empty(&self) -> bool {
-        self.map.is_empty()
-    }
-
     /// The cached contact in `slot`.
     pub fn slot(&self, slot: u32) -> &CachedContact {
         &self.slots[slot as usize]
@@ -78,19 +73,7 @@ impl ContactCache {
     }
 
     /// Finds or maps contact `id` at `point` (m, object frame) for step `step`; returns its slot
-    /// and whether it was (re)mapped now.
-    pub fn lookup(
-        &mut self,
-        model: &ModalModel,
-        id: u64,
-        point: [f64; 3],
-        step: u64,
-        max_distance: f64,
-    ) -> (u32, bool) {
-        self.lookup_with_hint(model, id, point, step, max_distance, u32::MAX)
-    }
-
-    /// As [`ContactCache::lookup`], trying slot `hint` first (e.g. the slot this contact had at
+    /// and whether it was (re)mapped now. Slot `hint` is tried first (e.g. the slot this contact had at
     /// the same position of last step's list): a live slot holding `id` is the one the hash
     /// table would return, so steady-state steps skip the hashing. Same results either way.
     pub fn lookup_with_hint(
@@ -169,17 +152,6 @@ impl ContactCache {
                 self.free.push(s as u32);
                 on_evict(s as u32);
             }
-        }
-    }
-
-    /// Forgets every contact (storage is kept).
-    pub fn clear(&mut self) {
-        self.generation += 1;
-        self.map.clear();
-        self.free.clear();
-        for (s, c) in self.slots.iter_mut().enumerate().rev() {
-            c.live = false;
-            self.free.push(s as u32);
         }
     }
 }

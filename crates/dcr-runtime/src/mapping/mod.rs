@@ -7,4 +7,3 @@ mod id_hasher;
 
 pub use contact_cache::{CachedContact, ContactCache};
 pub(crate) use id_hasher::BuildIdHasher;
-pub use id_hasher::IdHasher;

@@ -1,6 +1,9 @@
 //! The shared, immutable modal model: a validated `.modes` base plus what every query needs
 //! (area-weighted vertex normals, per-vertex normal mode rows nᵀU, ω_j, and a BVH over the
-//! surface for point → surface mapping, paper §4.2).
+//! surface for point → surface mapping, paper §4.2). Second-order bases interpolate the mode
+//! rows with the quadratic shape functions of their 6-node surface triangles
+//! ([`quadratic_triangle_weights`]); mapping, normals and geodesics use the linear triangles
+//! of the corners, which are the exact geometry of straight-sided elements.
 
 mod load_error;
 mod modal_model;
@@ -8,7 +11,7 @@ mod surface_point;
 
 pub use load_error::LoadError;
 pub use modal_model::ModalModel;
-pub use surface_point::SurfacePoint;
+pub use surface_point::{quadratic_triangle_weights, SurfacePoint};
 
 #[cfg(test)]
 mod tests;

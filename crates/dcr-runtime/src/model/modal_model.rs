@@ -7,7 +7,7 @@ use parry3d_f64::math::Vector;
 use parry3d_f64::query::PointQueryWithLocation;
 use parry3d_f64::shape::TriMesh;
 
-use super::{LoadError, SurfacePoint};
+use super::{quadratic_triangle_weights, LoadError, SurfacePoint};
 use crate::attenuation::{GeodesicError, GeodesicTable, HeatGeodesic};
 use crate::format::ModesFile;
 use crate::math::{add, cross, norm, normalize, scale, sub};
@@ -25,6 +25,9 @@ pub struct ModalModel {
     trimesh: TriMesh,
     bbox_diagonal: f64,
     mean_edge_length: f64,
+    /// Second-order bases: per surface triangle, the mid-edge node (index into
+    /// `base.quadratic`) of its edges (v₀,v₁), (v₁,v₂), (v₂,v₀). Empty for a linear base.
+    tri_edges: Vec<[u32; 3]>,
     heat: OnceLock<Result<HeatGeodesic, GeodesicError>>,
     geodesic_table: OnceLock<GeodesicTable>,
 }
@@ -96,6 +99,10 @@ impl ModalModel {
         if trimesh.num_triangles() != base.surface_triangles.len() {
             return Err(invalid("the BVH dropped surface triangles".into()));
         }
+        let tri_edges = match &base.quadratic {
+            Some(q) => q.triangle_edges(&base.surface_triangles).map_err(invalid)?,
+            None => Vec::new(),
+        };
         Ok(ModalModel {
             base,
             omega,
@@ -104,6 +111,7 @@ impl ModalModel {
             trimesh,
             bbox_diagonal,
             mean_edge_length,
+            tri_edges,
             heat: OnceLock::new(),
             geodesic_table: OnceLock::new(),
         })
@@ -210,8 +218,15 @@ impl ModalModel {
         }
     }
 
+    /// Whether the base is second-order (modes interpolated quadratically on 6-node triangles).
+    pub fn is_quadratic(&self) -> bool {
+        self.base.quadratic.is_some()
+    }
+
     /// Reduced impulse `r += Uᵀ H (d·λ)` (paper Eq. 9) of an impulse `lambda` (N·s) along unit
-    /// `direction` (object frame) applied at `sp`; `r` has length m.
+    /// `direction` (object frame) applied at `sp`; `r` has length m. H holds the shape
+    /// functions at `sp`: the barycentric weights (linear base) or the six
+    /// [`quadratic_triangle_weights`] (second-order base).
     pub fn add_reduced_impulse(
         &self,
         sp: &SurfacePoint,
@@ -220,21 +235,40 @@ impl ModalModel {
         r: &mut [f64],
     ) {
         let m = self.num_modes();
-        for (i, v) in self.triangle(sp.triangle).into_iter().enumerate() {
+        let mut add_node = |rows: &[f64], node: usize, weight: f64| {
             for axis in 0..3 {
-                let c = sp.bary[i] * direction[axis] * lambda;
+                let c = weight * direction[axis] * lambda;
                 if c != 0.0 {
-                    let row = &self.base.modes[(v * 3 + axis) * m..(v * 3 + axis + 1) * m];
+                    let row = &rows[(node * 3 + axis) * m..(node * 3 + axis + 1) * m];
                     for (o, u) in r.iter_mut().zip(row) {
                         *o += c * u;
                     }
                 }
             }
+        };
+        let corners = self.triangle(sp.triangle);
+        match &self.base.quadratic {
+            None => {
+                for (i, v) in corners.into_iter().enumerate() {
+                    add_node(&self.base.modes, v, sp.bary[i]);
+                }
+            }
+            Some(q) => {
+                let w = quadratic_triangle_weights(sp.bary);
+                for (i, v) in corners.into_iter().enumerate() {
+                    add_node(&self.base.modes, v, w[i]);
+                }
+                let edges = self.tri_edges[sp.triangle as usize];
+                for (k, e) in edges.into_iter().enumerate() {
+                    add_node(&q.modes, e as usize, w[3 + k]);
+                }
+            }
         }
     }
 
-    /// Contact row `w = nᵀ Σ_i b_i U_i` (m·kg^-1/2, length m) at `sp` with its interpolated
-    /// normal: `w·q` is the normal displacement of the contact point.
+    /// Contact row `w = nᵀ Σ_i N_i U_i` (m·kg^-1/2, length m) at `sp` with its interpolated
+    /// normal (N_i: barycentric weights, or the quadratic shape functions of a second-order
+    /// base): `w·q` is the normal displacement of the contact point.
     pub fn contact_row(&self, sp: &SurfacePoint, w: &mut [f64]) {
         w.iter_mut().for_each(|x| *x = 0.0);
         self.add_reduced_impulse(sp, sp.normal, 1.0, w);

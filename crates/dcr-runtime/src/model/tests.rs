@@ -161,7 +161,7 @@ fn bad_files_are_load_errors_naming_the_file() {
     std::fs::write(&p, nan.to_bytes().unwrap()).unwrap();
     let err = ModalModel::load(&p).unwrap_err().to_string();
     assert!(
-        err.contains("nan.modes") && err.contains("non-finite"),
+        err.contains("nan.modes") && err.contains("modes[0][1][2] = NaN (must be finite)"),
         "{err}"
     );
 

@@ -1,7 +1,9 @@
 //! [`ContactResponse`]: what one resting contact receives this step.
 
-/// The distant response at one resting contact for the step.
+/// The distant response at one resting contact for the step. `#[repr(C)]` (plain data for a C
+/// boundary).
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C)]
 pub struct ContactResponse {
     /// The resting contact's id.
     pub id: u64,
@@ -14,8 +16,6 @@ pub struct ContactResponse {
     pub peak_displacement: f64,
     /// Velocity change along +normal (m/s, Eq. 12 / 13 / 16): `peak_displacement / h`.
     pub delta_v: f64,
-    /// `false`: the contact is farther than `max_map_distance` from the surface: zero response.
-    pub mapped: bool,
     /// Tangential velocity change (m/s, object frame, ⟂ `normal`): the peak tangential
     /// displacement over the step / h, along its direction at the peak (the lateral kick,
     /// paper §5.4). `[0, 0, 0]` unless [`crate::ResponseParams::lateral_kick`].
@@ -23,10 +23,13 @@ pub struct ContactResponse {
     /// Which method produced `peak_displacement` (the modal method also serves the contacts a
     /// [`crate::Method::Transfer`] table cannot: outside its region, forces, h mismatch).
     pub served_by: ServedBy,
+    /// `false`: the contact is farther than `max_map_distance` from the surface: zero response.
+    pub mapped: bool,
 }
 
 /// The method that served one contact's response this step.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[repr(u8)]
 pub enum ServedBy {
     /// The truncated modal base (Eq. 9–13).
     #[default]

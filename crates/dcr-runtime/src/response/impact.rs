@@ -2,6 +2,7 @@
 
 /// A new collision on this object during the step (paper §4.2: "new contacts").
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C)]
 pub struct Impact {
     /// Contact point (m, object frame); mapped to the surface with the BVH.
     pub point: [f64; 3],

@@ -47,9 +47,7 @@ impl LateralKick {
         self.r.iter_mut().for_each(|x| *x = 0.0);
         let mut any = false;
         for imp in impacts {
-            let ok = imp.impulse.is_finite()
-                && imp.impulse > 0.0
-                && imp.impulse >= ctx.params.impact_threshold;
+            let ok = ctx.applies(imp.impulse);
             if !ok {
                 continue;
             }

@@ -23,12 +23,13 @@ pub enum Method {
     /// The base's bake-time peak-transfer table when it has one (many modes, `modal-bake bake
     /// --transfer-h`), else [`Method::Modal`] (default). `d = Σ λ_N max(0, Σ_p Σ_q N_p N_q
     /// T[p][q])` with the P2 weights N over each triangle's vertices and edge midpoints (normal
-    /// impulse component only; several impacts' peaks are summed, an upper bound). Falls back
-    /// to [`Method::Modal`] — per step, reported in `ContactResponse::served_by` — when the base
-    /// has no table, its h or Rayleigh damping differs (relative tolerance 1e-9), `carry_over`
-    /// is on, the step has forces, or an impact (whole step) or a contact (that contact) is
-    /// outside the table's region. `sampling` and `variant` do not apply to table-served
-    /// contacts (the table fixed its own sampling).
+    /// impulse component only; several impacts' peaks are summed, an upper bound). The modal
+    /// method serves instead — reported in `ContactResponse::served_by`, counted with its
+    /// reason in [`crate::StepInfo`] — when the base has no table, its h or Rayleigh damping
+    /// differs (relative tolerance 1e-9) or `carry_over` is on (all decided at set-up, where
+    /// [`TablePolicy::Refuse`] makes them errors instead), the step has forces, or an impact
+    /// (whole step) or a contact (that contact) is outside the table's region. `sampling` and
+    /// `variant` do not apply to table-served contacts (the table fixed its own sampling).
     ///
     /// Why it is the default (docs/accuracy.md, `scripts/accuracy.sh`): wherever a table
     /// exists it is both more accurate and cheaper than the 20-mode modal query — a 640-mode
@@ -132,7 +133,7 @@ pub enum ParamsError {
         detail: String,
     },
     /// The sampling asks for more filter samples per step than supported (10⁶).
-    #[error("{samples} filter samples per step (h/T) exceed the limit of 1000000")]
+    #[error("{samples:.3e} filter samples per step (h/T) exceed the limit of 1e6: use a shorter step h or a longer filter period T")]
     TooManySamples {
         /// S = ⌈h/T⌉.
         samples: f64,

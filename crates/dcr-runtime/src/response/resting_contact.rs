@@ -2,6 +2,7 @@
 
 /// An existing (resting) contact of another body on this object.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C)]
 pub struct RestingContact {
     /// The caller's stable contact id (mapping and rows are cached under it).
     pub id: u64,

@@ -20,10 +20,15 @@ pub(crate) struct StepCtx<'a> {
 }
 
 impl StepCtx<'_> {
+    /// Whether an impact of `impulse` (N·s) is applied: finite, > 0 and ≥ the threshold.
+    pub fn applies(&self, impulse: f64) -> bool {
+        impulse.is_finite() && impulse > 0.0 && impulse >= self.params.impact_threshold
+    }
+
     /// Whether an impact of `impulse` (N·s) is applied: finite, > 0 and ≥ the threshold;
     /// counts it in `impacts_below_threshold` otherwise.
     pub fn accept(&mut self, impulse: f64) -> bool {
-        let ok = impulse.is_finite() && impulse > 0.0 && impulse >= self.params.impact_threshold;
+        let ok = self.applies(impulse);
         if !ok {
             self.info.impacts_below_threshold += 1;
         }

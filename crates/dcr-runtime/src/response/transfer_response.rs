@@ -278,9 +278,7 @@ impl TransferResponse {
         self.hits.clear();
         let (mut below, mut unmapped) = (0u32, 0u32);
         for imp in impacts {
-            let ok = imp.impulse.is_finite()
-                && imp.impulse > 0.0
-                && imp.impulse >= ctx.params.impact_threshold;
+            let ok = ctx.applies(imp.impulse);
             if !ok {
                 below += 1;
                 continue;

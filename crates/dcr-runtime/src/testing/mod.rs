@@ -292,6 +292,7 @@ pub fn synthetic_base(surface: Surface, omega: &[f64], rayleigh: [f64; 2], seed:
         precision: ModesPrecision::F64,
         transfer: None,
         surface_order: None,
+        quadratic: None,
     }
 }
 

@@ -8,6 +8,7 @@
 /// A body id absent from the list is immovable and at rest (static ground, walls); a body with
 /// zero inverse mass and inertia (kinematic) never receives a response.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C)]
 pub struct BodyState {
     /// Engine id of the body (as in [`crate::ContactReport::body1`]).
     pub id: u64,

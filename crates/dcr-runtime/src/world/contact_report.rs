@@ -11,6 +11,7 @@
 /// step's contact impulse acts on `body2` as `+impulse · normal` and on `body1` as
 /// `−impulse · normal`.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C)]
 pub struct ContactReport {
     /// Stable id of this contact point, the same while the engine tracks it from step to step
     /// (e.g. a hash of the collider pair, the sub-shapes and the manifold point index). An id

@@ -116,10 +116,17 @@ struct Touched {
 /// A resting contact's response asks for a normal velocity change `Δv` (m/s) at the contact;
 /// the world issues `j = m_eff (g Δv − a) n` with the gain g, the effective mass of the body at
 /// the point along n (Eq. 17, [`crate::effective_mass`]) and `a` the normal velocity change the
-/// impulses already issued to that body this step produce at that point (tracked from the
+/// impulses already issued to that body this step, by any object, produce at that point (a body
+/// resting on two objects hit at once moves as the larger push asks, not their sum; tracked from the
 /// body's inverse mass and world inverse inertia, so the engine is not re-read); nothing when
 /// `g Δv ≤ a`. A plate on four contacts that all ask for Δv thus gets Δv, not four times it —
 /// one Gauss–Seidel pass, in contact-report order.
+///
+/// # Lateral kick
+/// With [`crate::ResponseParams::lateral_kick`] on an object, its responses also carry the
+/// tangential velocity change of §5.4 ([`crate::ContactResponse::lateral_delta_v`], rotated to
+/// the world); after the normal part the world adds `m_eff,t (g |Δv_t| − a_t) t̂` along its
+/// direction t̂ by the same Gauss–Seidel rule, so the event's impulse gets a tangential part.
 ///
 /// # Chains through dynamic elastic objects
 /// An impulse issued to the body of a dynamic elastic object becomes an impact on that object

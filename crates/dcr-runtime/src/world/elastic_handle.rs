@@ -5,6 +5,7 @@
 /// (0, 1, 2, …) and are never reused (objects are not removed), so a `u32` converts both ways
 /// without a table (e.g. across a C boundary).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[repr(transparent)]
 pub struct ElasticHandle(pub(crate) u32);
 
 impl ElasticHandle {

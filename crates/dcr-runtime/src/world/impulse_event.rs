@@ -11,6 +11,7 @@ use crate::response::ServedBy;
 /// next step; they are ordered by elastic object (processing order, see [`crate::DcrWorld`]),
 /// then by the order of the contact reports.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C)]
 pub struct ImpulseEvent {
     /// Engine id of the body receiving the impulse.
     pub body: u64,
@@ -26,12 +27,12 @@ pub struct ImpulseEvent {
     /// response's Δv × the object's gain, less what earlier impulses of the step already gave
     /// it there (one Gauss–Seidel pass), × the energy-bound scale.
     pub delta_v: f64,
+    /// The resting contact's id ([`crate::ContactReport::id`]).
+    pub contact: u64,
     /// The elastic object whose response this is.
     pub object: ElasticHandle,
     /// Which method computed the response at this contact.
     pub served_by: ServedBy,
-    /// The resting contact's id ([`crate::ContactReport::id`]).
-    pub contact: u64,
     /// Whether the object's response this step was driven (in part) by chained impacts:
     /// impulses this step gave the object's own body through another object's response.
     pub chained: bool,

@@ -5,7 +5,8 @@
 //! resting contacts, converting frames, turning velocity changes into impulses with one
 //! Gauss–Seidel pass per body, chaining responses through dynamic elastic objects in the same
 //! step, counting cache eviction in steps, and bounding the injected energy. Its boundary is
-//! plain data (`[f64; 3]`, `u64` ids, slices), so any engine's math types convert cheaply.
+//! plain data (`[f64; 3]`, `u64` ids, slices; the per-step types are `#[repr(C)]`), so any
+//! engine's math types convert cheaply.
 //! See [`DcrWorld`] for the rules and their reasons.
 
 mod body_state;

@@ -4,11 +4,15 @@
 mod bases;
 mod outcomes;
 mod run;
+mod stress_bench;
 mod table1;
 mod trajectory;
 
 pub use bases::{bake_params, base_path, ensure_base};
 pub use outcomes::{measure_outcome, unit_of};
-pub use run::{run_scene, MethodChoice, ModelReport, RunParams, RunReport};
+pub use run::{
+    run_scene, MethodChoice, ModelReport, ModelStats, ResponseEvent, RunParams, RunReport, StepTime,
+};
+pub use stress_bench::{stress_bench, StressBenchParams};
 pub use table1::{paper_rows, table1, PaperRow, Table1Params};
 pub use trajectory::Trajectory;

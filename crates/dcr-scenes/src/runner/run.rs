@@ -4,18 +4,19 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use crate::adapter::engine::{
-    AmplitudeKind, AttenuationLaw, AttenuationParams, DistanceKind, DistantResponse, Method,
-    ModalModel, ResponseParams,
-};
 use anyhow::{bail, Context, Result};
+use dcr_rapier::f64::{body_handle, AdapterParams, ApplyMode, DcrRapier, StepGate};
+use dcr_rapier::{ElasticHandle, ElasticObjectDesc, WorldParams};
 use dcr_runtime::format::ModesFile;
+use dcr_runtime::{
+    AmplitudeKind, AttenuationLaw, AttenuationParams, DistanceKind, Method, ModalModel,
+    ResponseParams,
+};
 use ndarray::{Array1, Array2};
 use ndarray_npy::NpzWriter;
 use rapier3d_f64::math::Vector;
 use serde::Serialize;
 
-use crate::adapter::{AdapterParams, DcrAdapter, ModelStats};
 use crate::runner::bases::ensure_base;
 use crate::runner::outcomes::{measure_outcome, unit_of};
 use crate::runner::Trajectory;
@@ -52,6 +53,88 @@ pub struct RunParams {
     pub out_dir: Option<PathBuf>,
     /// Progress lines on stderr.
     pub progress: bool,
+    /// How the responses reach the bodies (when `dcr` is on). Default after the step.
+    pub apply: ApplyMode,
+    /// Energy bound η ∈ [0, 1] of the world ([`WorldParams::energy_eta`]); `None`: no bound.
+    pub energy_eta: Option<f64>,
+    /// The lateral kick (paper §5.4) on every elastic object.
+    pub lateral_kick: bool,
+    /// rapier's contact recycling on the elastic objects' colliders
+    /// ([`AdapterParams::contact_recycling`]; always off in the solver path).
+    pub contact_recycling: bool,
+    /// On which steps the contacts are read ([`AdapterParams::gate`]). Default
+    /// [`StepGate::ImpactSteps`].
+    pub gate: StepGate,
+}
+
+impl RunParams {
+    /// Settings for a run of the scene at `root` with the response on or off, bases in
+    /// `out/bases`, nothing written, no progress, the world's default energy bound, responses
+    /// applied after the step, no lateral kick.
+    pub fn new(root: PathBuf, dcr: bool) -> RunParams {
+        RunParams {
+            seconds: None,
+            dcr,
+            method: MethodChoice::Scene,
+            bases_dir: root.join("out").join("bases"),
+            root,
+            out_dir: None,
+            progress: false,
+            apply: ApplyMode::AfterStep,
+            energy_eta: WorldParams::default().energy_eta,
+            lateral_kick: false,
+            contact_recycling: true,
+            gate: StepGate::ImpactSteps,
+        }
+    }
+}
+
+/// What one elastic object saw and did over a run (from the world's per-step counters).
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct ModelStats {
+    /// Model (elastic object) name.
+    pub name: String,
+    /// Wall time (µs) of the object's response call on each step it ran (the world's
+    /// `ObjectStepInfo::response_time_ns`).
+    #[serde(skip)]
+    pub query_us: Vec<f64>,
+    /// Resting contacts at each of those steps.
+    #[serde(skip)]
+    pub query_resting: Vec<usize>,
+    /// Impacts over the run.
+    pub impacts: usize,
+    /// Impacts that came from another model's responses (a dynamic elastic object).
+    pub chained_impacts: usize,
+    /// Impulse events issued (applied, replayed or only measured by the run's mode).
+    pub responses_applied: usize,
+    /// Largest Δv of an event (m/s, after gain, Gauss–Seidel and energy bound).
+    pub max_delta_v: f64,
+    /// Kinetic energy the responses gave the receiving bodies (J, the world's account; 0 in an
+    /// off run, which applies nothing).
+    pub injected_ke: f64,
+    /// Energy the object's impacts dissipated (J, the world's estimate).
+    pub dissipated: f64,
+    /// Kinetic energy chained impulses gave the object's body (J).
+    pub received: f64,
+    /// Steps on which the energy bound scaled the object's responses down.
+    pub energy_limited_steps: usize,
+}
+
+/// One response impulse of a run (what a viewer marks).
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct ResponseEvent {
+    /// Trajectory row at whose time the impulse acts: after the step it is applied right after
+    /// step `row − 1`'s solve, at t = row · h (s); in the solver path it is replayed during step
+    /// `row − 1` (one step after the step that issued it) and acts at its end.
+    pub row: usize,
+    /// Elastic object (index in the scene's `elastic`) whose response it is.
+    pub model: usize,
+    /// Receiving body (index into `BuiltWorld::bodies`, names in `RunReport::bodies_all`).
+    pub body: usize,
+    /// Point of application (m, world frame).
+    pub point: [f64; 3],
+    /// Impulse (N·s, world frame).
+    pub impulse: [f64; 3],
 }
 
 /// One elastic object's figures from a run (a Table 1 row).
@@ -114,9 +197,48 @@ pub struct RunReport {
     pub injected_ke: f64,
     /// Energy dissipated by impacts (J, estimate, all models).
     pub dissipated: f64,
+    /// The energy bound η of the run (`None`: unbounded).
+    pub energy_eta: Option<f64>,
+    /// How responses were applied (`after_step`, `in_solver`; `none` when off).
+    pub apply: String,
+    /// Whether the lateral kick was on.
+    pub lateral_kick: bool,
+    /// Whether rapier's contact recycling was on for the elastic objects' colliders.
+    pub contact_recycling: bool,
+    /// On which steps the contacts were read (`every_step`, `impact_steps`).
+    pub gate: String,
+    /// Steps on which the contacts were read and the world stepped.
+    pub world_steps: usize,
+    /// In-solver path: collider pairs whose replay rapier's hook never saw (applied after the
+    /// step instead).
+    pub replay_missed: usize,
     /// The run's trajectory (not serialised; written as NPZ).
     #[serde(skip)]
     pub trajectory: Trajectory,
+    /// Every response impulse issued, in order, with `body` an index into `bodies_all` (not
+    /// serialised; exported with `--gltf`).
+    #[serde(skip)]
+    pub events: Vec<ResponseEvent>,
+    /// Names of every body of the built world (events' `body` indexes this).
+    #[serde(skip)]
+    pub bodies_all: Vec<String>,
+    /// Per step: wall time of rapier's step and of the adapter (µs), whether the world was
+    /// stepped, and the contact reports it was given (not serialised; `timings.npz`).
+    #[serde(skip)]
+    pub step_times: Vec<StepTime>,
+}
+
+/// One step's timing (see [`RunReport::step_times`]).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct StepTime {
+    /// rapier's `step` (µs).
+    pub rapier_us: f64,
+    /// The adapter's `before_step` + `after_step` (µs).
+    pub adapter_us: f64,
+    /// Whether the contacts were read in full and the world stepped.
+    pub world_stepped: bool,
+    /// Contact reports given to the world (0 on quiet steps).
+    pub reports: u32,
 }
 
 fn percentile(v: &[f64], p: f64) -> Option<f64> {
@@ -180,10 +302,29 @@ pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
     let steps = (seconds / desc.h).round() as usize;
     let mut built = build_world(desc, &params.root)?;
 
-    // Bases and responses.
-    let mut responses = Vec::new();
+    // The world and its elastic objects. Off runs measure only (impacts, what the responses
+    // would have been) and apply nothing.
+    let apply = if params.dcr {
+        params.apply
+    } else {
+        ApplyMode::MeasureOnly
+    };
+    let mut dcr = DcrRapier::new(
+        WorldParams {
+            h: desc.h,
+            energy_eta: params.energy_eta,
+            ..WorldParams::default()
+        },
+        AdapterParams {
+            apply,
+            contact_recycling: params.contact_recycling,
+            gate: params.gate,
+        },
+    )
+    .map_err(|err| anyhow::anyhow!("scene {}: {err}", desc.name))?;
     let mut infos = Vec::new();
-    for e in &desc.elastic {
+    let mut handles: Vec<ElasticHandle> = Vec::new();
+    for (i, e) in desc.elastic.iter().enumerate() {
         let (path, _) = ensure_base(&params.root, &params.bases_dir, e)?;
         let base =
             ModesFile::read(&path).with_context(|| format!("reading base {}", path.display()))?;
@@ -193,7 +334,12 @@ pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
             Some((c, beta, distance, amplitude)) => {
                 let distance = match distance.as_str() {
                     "euclidean" => DistanceKind::Euclidean,
-                    _ => DistanceKind::Heat,
+                    "heat" => DistanceKind::Heat,
+                    "heat_table" => DistanceKind::HeatTable,
+                    other => bail!(
+                        "elastic object {}: distance {other:?} (expected heat, heat_table or euclidean)",
+                        e.name
+                    ),
                 };
                 let amplitude = match amplitude.as_str() {
                     "per_vertex" => AmplitudeKind::PerVertex,
@@ -217,52 +363,53 @@ pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
             None => "modal".to_string(),
             Some((c, b, d, a)) => format!("attenuation C={c} beta={b} {d} {a}"),
         };
-        let response = if params.dcr {
-            let model = ModalModel::load(&path)
-                .map_err(|err| anyhow::anyhow!("loading {}: {err}", path.display()))?;
-            let rp = ResponseParams {
-                h: desc.h,
-                impact_threshold: e.impact_threshold,
-                max_map_distance: 0.1,
-                method,
-                ..ResponseParams::default()
-            };
-            Some(
-                DistantResponse::new(model, rp)
-                    .map_err(|err| anyhow::anyhow!("response of {}: {err}", e.name))?,
+        let model = ModalModel::load(&path)
+            .map_err(|err| anyhow::anyhow!("loading {}: {err}", path.display()))?;
+        let mut object = ElasticObjectDesc::new(model, 0);
+        object.response = ResponseParams {
+            h: desc.h,
+            impact_threshold: e.impact_threshold,
+            max_map_distance: 0.1,
+            method,
+            lateral_kick: params.lateral_kick,
+            ..ResponseParams::default()
+        };
+        object.gain = e.gain;
+        let body = built.bodies[built.elastic_body[i]].handle;
+        let handle = dcr
+            .add_object(
+                &built.world.bodies,
+                &mut built.world.colliders,
+                body,
+                object,
             )
-        } else {
-            None
-        };
-        let (t, sps) = match &response {
-            Some(r) => (Some(r.substep()), Some(r.samples_per_step())),
-            None => (None, None),
-        };
+            .map_err(|err| anyhow::anyhow!("elastic object {}: {err}", e.name))?;
+        let response = dcr.world().response(handle);
         infos.push((
             base.num_surface_vertices(),
             base.surface_triangles.len(),
             base.num_modes(),
             method_name,
-            t,
-            sps,
+            params.dcr.then(|| response.substep()),
+            params.dcr.then(|| response.samples_per_step()),
         ));
-        responses.push(response);
+        handles.push(handle);
     }
-    let thresholds: Vec<f64> = desc.elastic.iter().map(|e| e.impact_threshold).collect();
-    let gains: Vec<f64> = desc.elastic.iter().map(|e| e.gain).collect();
-    let names: Vec<String> = desc.elastic.iter().map(|e| e.name.clone()).collect();
-    let mut adapter = DcrAdapter::new(
-        &built,
-        responses,
-        &thresholds,
-        &gains,
-        &names,
-        AdapterParams {
-            enabled: params.dcr,
-            restitution: desc.restitution,
-            ..AdapterParams::default()
-        },
-    );
+    let mut stats: Vec<ModelStats> = desc
+        .elastic
+        .iter()
+        .map(|e| ModelStats {
+            name: e.name.clone(),
+            ..Default::default()
+        })
+        .collect();
+    // Receiving body id → index into `built.bodies` (events name bodies by rapier handle).
+    let body_index: BTreeMap<u64, usize> = built
+        .bodies
+        .iter()
+        .enumerate()
+        .map(|(i, b)| (dcr_rapier::f64::body_id(b.handle), i))
+        .collect();
 
     // Drivers.
     let mut drivers = Vec::new();
@@ -295,6 +442,10 @@ pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
 
     let mut rapier_us = Vec::with_capacity(steps);
     let mut adapter_us = Vec::with_capacity(steps);
+    let mut events = Vec::new();
+    let mut world_steps = 0;
+    let mut replay_missed = 0;
+    let mut step_times = Vec::with_capacity(steps);
     let wall = Instant::now();
     let mut last_progress = Instant::now();
     for k in 0..steps {
@@ -325,12 +476,70 @@ pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
                 None => rb.apply_impulse(j, true),
             }
         }
-        adapter.before_step(&built);
+        let ta = Instant::now();
+        dcr.before_step(&mut built.world.bodies);
+        let before_us = ta.elapsed().as_secs_f64() * 1e6;
         let ts = Instant::now();
-        built.world.step();
+        built.world.step_with_events(dcr.hooks(), &());
         rapier_us.push(ts.elapsed().as_secs_f64() * 1e6);
-        let st = adapter.after_step(&mut built);
-        adapter_us.push(st.adapter_us);
+        let ta = Instant::now();
+        dcr.after_step(
+            &mut built.world.bodies,
+            &built.world.colliders,
+            &built.world.narrow_phase,
+        );
+        let us = before_us + ta.elapsed().as_secs_f64() * 1e6;
+        adapter_us.push(us);
+        world_steps += usize::from(dcr.step_info().world_stepped);
+        replay_missed += dcr.step_info().replay_missed as usize;
+        step_times.push(StepTime {
+            rapier_us: *rapier_us.last().unwrap_or(&0.0),
+            adapter_us: us,
+            world_stepped: dcr.step_info().world_stepped,
+            reports: dcr.step_info().reports,
+        });
+        // The world's counters describe its last `step`: read them only when it stepped.
+        let stepped = dcr.step_info().world_stepped;
+        for (i, &h) in handles.iter().enumerate().filter(|_| stepped) {
+            let info = dcr.world().object_info(h);
+            let s = &mut stats[i];
+            s.impacts += info.impacts as usize;
+            s.chained_impacts += info.chained_impacts as usize;
+            s.responses_applied += info.events as usize;
+            // An off run applies nothing: the world's account is what would have been injected.
+            if apply != ApplyMode::MeasureOnly {
+                s.injected_ke = info.energy.total_injected;
+            }
+            s.dissipated = info.energy.total_dissipated;
+            s.received = info.energy.total_received;
+            s.energy_limited_steps += usize::from(info.energy.scale < 1.0);
+            if info.queried {
+                s.query_us.push(info.response_time_ns as f64 / 1e3);
+                s.query_resting.push(info.resting as usize);
+            }
+        }
+        for e in dcr.events() {
+            let i = handles
+                .iter()
+                .position(|&h| h == e.object)
+                .unwrap_or_default();
+            stats[i].max_delta_v = stats[i].max_delta_v.max(e.delta_v);
+            // Off runs apply nothing: no events to show.
+            if apply == ApplyMode::MeasureOnly {
+                continue;
+            }
+            if let Some(&body) = body_index.get(&e.body) {
+                events.push(ResponseEvent {
+                    row: k + if apply == ApplyMode::InSolver { 2 } else { 1 },
+                    model: i,
+                    body,
+                    point: e.point,
+                    impulse: e.impulse,
+                });
+            } else {
+                debug_assert!(false, "event for unknown body {:?}", body_handle(e.body));
+            }
+        }
         record(&built, &mut traj, (k + 1) as f64 * desc.h);
         if params.progress && last_progress.elapsed().as_secs_f64() > 5.0 {
             last_progress = Instant::now();
@@ -345,7 +554,6 @@ pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
         }
     }
 
-    let stats = adapter.stats();
     let models: Vec<ModelReport> = stats
         .into_iter()
         .zip(infos)
@@ -391,7 +599,26 @@ pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
         } else {
             0.0
         },
+        energy_eta: params.energy_eta,
+        apply: match apply {
+            ApplyMode::AfterStep => "after_step",
+            ApplyMode::InSolver => "in_solver",
+            _ => "none",
+        }
+        .to_string(),
+        lateral_kick: params.lateral_kick,
+        contact_recycling: params.contact_recycling && apply != ApplyMode::InSolver,
+        gate: match params.gate {
+            StepGate::EveryStep => "every_step",
+            _ => "impact_steps",
+        }
+        .to_string(),
+        world_steps,
+        replay_missed,
         trajectory: traj,
+        events,
+        bodies_all: built.bodies.iter().map(|b| b.name.clone()).collect(),
+        step_times,
     };
 
     if let Some(dir) = &params.out_dir {
@@ -401,6 +628,16 @@ pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
         let mut npz = NpzWriter::new(f);
         npz.add_array("rapier_us", &Array1::from(rapier_us.clone()))?;
         npz.add_array("adapter_us", &Array1::from(adapter_us.clone()))?;
+        npz.add_array(
+            "world_stepped",
+            &Array1::from(
+                report
+                    .step_times
+                    .iter()
+                    .map(|t| u8::from(t.world_stepped))
+                    .collect::<Vec<u8>>(),
+            ),
+        )?;
         for m in &report.models {
             let q = &m.stats.query_us;
             let arr = Array2::from_shape_vec(

@@ -6,6 +6,8 @@ use std::path::PathBuf;
 use anyhow::Result;
 use serde_json::{json, Value};
 
+use dcr_rapier::f64::{ApplyMode, StepGate};
+
 use crate::runner::{run_scene, MethodChoice, RunParams, RunReport};
 use crate::scene::SceneDesc;
 
@@ -69,6 +71,29 @@ pub struct Table1Params {
     pub bases_dir: PathBuf,
     /// Also run the scaffold with attenuation at these β.
     pub scaffold_betas: Vec<f64>,
+    /// How the "on" runs apply the responses.
+    pub apply: ApplyMode,
+    /// Energy bound η of the "on" runs (`None`: unbounded).
+    pub energy_eta: Option<f64>,
+    /// Lateral kick in the "on" runs.
+    pub lateral_kick: bool,
+    /// rapier's contact recycling on the elastic objects' colliders.
+    pub contact_recycling: bool,
+    /// On which steps the contacts are read.
+    pub gate: StepGate,
+    /// Energy-bound sweep: also run every scene unbounded and at each of these η, and report
+    /// which outcomes move by more than 5 % from the unbounded run.
+    pub eta_sweep: Vec<f64>,
+    /// If set, write each scene's on and off runs side by side as `DIR/SCENE.glb`.
+    pub gltf_dir: Option<PathBuf>,
+}
+
+/// An outcome "changes" when it moves by more than this fraction of the reference value (or of
+/// 1e-3 of the unit, whichever is larger).
+const CHANGE_REL: f64 = 0.05;
+
+fn changed(v: f64, reference: f64) -> bool {
+    (v - reference).abs() > CHANGE_REL * reference.abs().max(1e-3)
 }
 
 fn fmt_opt(x: Option<f64>, scale: f64, prec: usize) -> String {
@@ -112,26 +137,98 @@ pub fn table1(p: &Table1Params) -> Result<(String, Value)> {
     let mut outcome_lines = String::new();
     for name in &p.scenes {
         let desc = SceneDesc::read(&p.root.join("scenes").join(format!("{name}.json")))?;
-        let run = |dcr: bool, method: MethodChoice| -> Result<RunReport> {
+        let run_eta = |dcr: bool, method: MethodChoice, eta: Option<f64>| -> Result<RunReport> {
             eprintln!(
-                "[dcr-scenes] table1: {name} dcr {}",
-                if dcr { "on" } else { "off" }
+                "[dcr-scenes] table1: {name} dcr {}{}",
+                if dcr { "on" } else { "off" },
+                match (dcr, eta) {
+                    (false, _) => String::new(),
+                    (true, None) => " (no energy bound)".into(),
+                    (true, Some(e)) => format!(" (eta {e})"),
+                }
             );
             run_scene(
                 &desc,
                 &RunParams {
                     seconds: p.seconds,
-                    dcr,
                     method,
-                    root: p.root.clone(),
-                    bases_dir: p.bases_dir.clone(),
                     out_dir: None,
                     progress: true,
+                    bases_dir: p.bases_dir.clone(),
+                    apply: p.apply,
+                    energy_eta: eta,
+                    lateral_kick: p.lateral_kick,
+                    contact_recycling: p.contact_recycling,
+                    gate: p.gate,
+                    ..RunParams::new(p.root.clone(), dcr)
                 },
             )
         };
+        let run = |dcr: bool, method: MethodChoice| run_eta(dcr, method, p.energy_eta);
         let on = run(true, MethodChoice::Scene)?;
         let off = run(false, MethodChoice::Scene)?;
+        if let Some(dir) = &p.gltf_dir {
+            std::fs::create_dir_all(dir)?;
+            let path = dir.join(format!("{name}.glb"));
+            let sides = [&on, &off].map(|r| crate::export::Side {
+                label: crate::export::side_label(r),
+                report: r,
+            });
+            crate::export::write_scene_glb(&desc, &p.root, &p.bases_dir, &sides, &path)?;
+            eprintln!(
+                "[dcr-scenes] table1: {name} on/off glTF: {}",
+                path.display()
+            );
+        }
+        // Energy-bound sweep: the unbounded run, then each η.
+        let mut sweep = Vec::new();
+        if !p.eta_sweep.is_empty() {
+            let free = if p.energy_eta.is_none() {
+                on.clone()
+            } else {
+                run_eta(true, MethodChoice::Scene, None)?
+            };
+            let mut rows = vec![(None, free)];
+            for &eta in &p.eta_sweep {
+                let r = if p.energy_eta == Some(eta) {
+                    on.clone()
+                } else {
+                    run_eta(true, MethodChoice::Scene, Some(eta))?
+                };
+                rows.push((Some(eta), r));
+            }
+            let reference = rows[0].1.outcomes.clone();
+            for (eta, r) in &rows {
+                let label = eta.map_or("none".to_string(), |e| e.to_string());
+                let mut outs = serde_json::Map::new();
+                let mut moved = Vec::new();
+                for (k, (v, unit)) in &r.outcomes {
+                    let base = reference.get(k).map_or(*v, |x| x.0);
+                    let ch = changed(*v, base);
+                    if ch {
+                        moved.push(k.clone());
+                    }
+                    outs.insert(k.clone(), json!({"value": v, "unit": unit, "changed": ch}));
+                }
+                outcome_lines.push_str(&format!(
+                    "  {:9} {:28} eta {:>5}: injected {:.4e} J, dissipated {:.4e} J, limited steps {}; changed: {}\n",
+                    name,
+                    "energy bound",
+                    label,
+                    r.injected_ke,
+                    r.dissipated,
+                    r.models.iter().map(|m| m.stats.energy_limited_steps).sum::<usize>(),
+                    if moved.is_empty() { "none".to_string() } else { moved.join(", ") }
+                ));
+                sweep.push(json!({
+                    "energy_eta": eta,
+                    "outcomes": outs,
+                    "injected_ke_j": r.injected_ke,
+                    "dissipated_j": r.dissipated,
+                    "energy_limited_steps": r.models.iter().map(|m| m.stats.energy_limited_steps).sum::<usize>(),
+                }));
+            }
+        }
         let mut outcomes = serde_json::Map::new();
         for (k, (v, unit)) in &on.outcomes {
             let off_v = off.outcomes.get(k).map(|x| x.0);
@@ -218,7 +315,16 @@ pub fn table1(p: &Table1Params) -> Result<(String, Value)> {
                 "adapter_ms": on.adapter_ms,
                 "seconds": on.seconds,
                 "outcomes": outcomes,
-                "energy": {"injected_ke_j": m.stats.injected_ke, "dissipated_j": m.stats.dissipated},
+                "energy": {"injected_ke_j": m.stats.injected_ke, "dissipated_j": m.stats.dissipated, "received_j": m.stats.received, "energy_limited_steps": m.stats.energy_limited_steps},
+                "energy_eta": on.energy_eta,
+                "apply": on.apply,
+                "lateral_kick": on.lateral_kick,
+                "contact_recycling": on.contact_recycling,
+                "gate": on.gate,
+                "world_steps": on.world_steps,
+                "replay_missed": on.replay_missed,
+                "steps": on.steps,
+                "energy_sweep": sweep,
                 "attenuation_runs": extra,
                 "trajectory_hash_on": on.trajectory_hash,
                 "trajectory_hash_off": off.trajectory_hash,

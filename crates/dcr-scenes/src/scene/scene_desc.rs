@@ -111,7 +111,9 @@ pub enum MethodDesc {
         c: f64,
         /// β.
         beta: f64,
-        /// `heat` (geodesic, heat method) or `euclidean`.
+        /// `heat` (geodesics by the heat method, one solve per new resting contact),
+        /// `heat_table` (the same distances precomputed for all surface vertex pairs at set-up,
+        /// read bilinearly) or `euclidean`.
         #[serde(default = "default_distance")]
         distance: String,
         /// Amplitude: `per_vertex`, `mean`, or the name of a physical group of the mesh whose

@@ -6,11 +6,15 @@ use std::time::Duration;
 use anyhow::Context;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
-use modal_bake::bake::{self, BakeParams, BakeReport, BakeStage, ModeRequest, ModesPrecision};
+use modal_bake::bake::{
+    self, BakeParams, BakeReport, BakeStage, FixedBelow, ModeRequest, ModesPrecision,
+};
 use modal_bake::transfer::{TableOrder, TransferModes, TransferParams};
 
+use super::mesh::AssetOptions;
 use super::parse;
 pub use modal_bake::args::ModelOptions;
+use modal_bake::mesh::surface::is_surface_asset;
 
 /// Options that determine a base (shared by `bake` and `check`).
 #[derive(Args, Clone, Debug)]
@@ -26,6 +30,14 @@ pub struct BakeOptions {
     /// Store the surface mode shapes as 32-bit floats (half the file size).
     #[arg(long)]
     pub f32: bool,
+    /// Fix every node at or below a coordinate, e.g. `y=0.01` (m, object frame; repeatable;
+    /// combines with --fixed and --fixed-box). A selector that fixes no node is an error.
+    #[arg(long, value_name = "AXIS=VALUE", value_parser = parse::axis_value, allow_hyphen_values = true)]
+    pub fixed_below: Vec<FixedBelow>,
+    /// Fix every node inside a box X0,Y0,Z0,X1,Y1,Z1 (m, object frame, bounds included;
+    /// repeatable; combines with --fixed and --fixed-below).
+    #[arg(long, value_name = "X0,Y0,Z0,X1,Y1,Z1", value_parser = parse::aabb, allow_hyphen_values = true)]
+    pub fixed_box: Vec<[f64; 6]>,
 }
 
 impl BakeOptions {
@@ -37,6 +49,8 @@ impl BakeOptions {
                 None => ModeRequest::Count(self.modes.unwrap_or(20)),
             },
             fixed: self.model.fixed.clone(),
+            fixed_below: self.fixed_below.clone(),
+            fixed_boxes: self.fixed_box.clone(),
             rayleigh: self.model.rayleigh,
             lumped: self.model.lumped,
             precision: if self.f32 {
@@ -50,7 +64,9 @@ impl BakeOptions {
 
 #[derive(Args)]
 pub struct BakeArgs {
-    /// Tetrahedral mesh: gmsh .msh (2.2 or 4.1, ASCII or binary) or meshio-style .json.
+    /// Tetrahedral mesh: gmsh .msh (2.2 or 4.1, ASCII or binary, 4- or 10-node tetrahedra) or
+    /// meshio-style .json; or a closed surface asset .obj / .stl / .ply (in metres), meshed
+    /// with gmsh first (--size, --order, --gmsh).
     pub mesh: PathBuf,
     /// Output base (written atomically: nothing is left behind on failure).
     #[arg(short = 'o', long = "out", value_name = "OUT.modes")]
@@ -65,6 +81,8 @@ pub struct BakeArgs {
     pub json: bool,
     #[command(flatten)]
     pub transfer: TransferOptions,
+    #[command(flatten)]
+    pub asset: AssetOptions,
     /// Choose the cheapest representation (modes; a transfer table, its modes and order) whose
     /// worst peak error against the bake's own converged full-order truth, at seeded pairs of
     /// the table region (--transfer-up / --transfer-region), is at most PCT percent; needs
@@ -77,6 +95,27 @@ pub struct BakeArgs {
         conflicts_with = "max_freq"
     )]
     pub target_error: Option<f64>,
+}
+
+/// The tetrahedral mesh of `path`: read, or (a surface asset) meshed with gmsh; with the
+/// seconds it took. Meshing options given with a volume mesh are an error.
+pub fn load_mesh(
+    path: &std::path::Path,
+    asset: &AssetOptions,
+) -> anyhow::Result<(modal_bake::mesh::TetMesh, f64)> {
+    let t = std::time::Instant::now();
+    if is_surface_asset(path) {
+        let (out, _) = super::mesh::mesh_asset(path, 1.0, asset)?;
+        return Ok((out.mesh, t.elapsed().as_secs_f64()));
+    }
+    if asset.any_set() {
+        anyhow::bail!(
+            "--size, --order, --gmsh and --keep-surface apply to surface assets (.obj, .stl, .ply), not to the volume mesh {}",
+            path.display()
+        );
+    }
+    let mesh = modal_bake::mesh::read_mesh(path).map_err(anyhow::Error::new)?;
+    Ok((mesh, t.elapsed().as_secs_f64()))
 }
 
 /// The optional bake-time peak-transfer table (`dcr_runtime::Method::Transfer`).
@@ -104,8 +143,8 @@ pub struct TransferOptions {
     #[arg(long, value_name = "K", requires = "transfer_h")]
     pub transfer_oversample: Option<f64>,
     /// Interpolation order over each region triangle: 1 (vertices), 2 (+ edge midpoints), 3
-    /// (+ two points per edge and face centroids: exact-looking inside triangles, ≈ 5× the
-    /// size of 2), or auto (3 when its table has at most 5792 points, else 2).
+    /// (+ two points per edge and face centroids, ≈ 5× the size of 2), or auto (3 when its
+    /// table has at most 5792 points, else 2).
     #[arg(long, value_name = "auto|1|2|3", requires = "transfer_h", value_parser = parse_order)]
     pub transfer_order: Option<TableOrder>,
 }
@@ -152,22 +191,118 @@ impl TransferOptions {
     }
 }
 
-/// A spinner per stage, a bar for the eigensolve; hidden when stderr is not a terminal.
+/// Progress of a bake on stderr: on a terminal a spinner per stage and a bar for the
+/// eigensolve and the transfer table; otherwise (CI logs, redirected stderr) plain lines for the
+/// stages longer than [`PLAIN_EVERY`]: one every `PLAIN_EVERY` while a stage that reports
+/// progress runs, and one with its duration when it ends. Short bakes print nothing.
 pub(super) struct Progress {
     pub(super) bar: ProgressBar,
+    pub(super) plain: Option<Plain>,
+}
+
+/// Interval between plain progress lines, and the shortest stage that gets one (seconds;
+/// `MODAL_BAKE_PROGRESS_EVERY` overrides it, e.g. 0 for every event).
+const PLAIN_EVERY: Duration = Duration::from_secs(5);
+
+/// State of the plain-line progress.
+pub(super) struct Plain {
+    every: Duration,
+    start: std::time::Instant,
+    stage: &'static str,
+    label: String,
+    stage_start: std::time::Instant,
+    last: std::time::Instant,
+}
+
+impl Plain {
+    fn line(&self, text: &str) {
+        eprintln!("bake [{:7.1} s] {text}", self.start.elapsed().as_secs_f64());
+    }
+
+    /// Ends the current stage (a line with its duration if it was long).
+    pub(super) fn end_stage(&mut self) {
+        let took = self.stage_start.elapsed();
+        if !self.stage.is_empty() && took >= self.every {
+            self.line(&format!(
+                "{}: done in {:.1} s",
+                self.label,
+                took.as_secs_f64()
+            ));
+        }
+    }
+
+    /// Records progress of `stage` described by `label`.
+    fn report(&mut self, stage: &'static str, label: impl FnOnce() -> String) {
+        let now = std::time::Instant::now();
+        if stage != self.stage {
+            self.end_stage();
+            self.stage = stage;
+            self.label = label();
+            self.stage_start = now;
+            self.last = now;
+        } else if now.duration_since(self.last) >= self.every {
+            self.label = label();
+            self.line(&self.label);
+            self.last = now;
+        }
+    }
 }
 
 impl Progress {
     pub(super) fn new() -> Progress {
-        let bar = ProgressBar::new_spinner();
-        bar.enable_steady_tick(Duration::from_millis(120));
-        Progress { bar }
+        use std::io::IsTerminal;
+        if std::io::stderr().is_terminal() {
+            let bar = ProgressBar::new_spinner();
+            bar.enable_steady_tick(Duration::from_millis(120));
+            Progress { bar, plain: None }
+        } else {
+            let now = std::time::Instant::now();
+            Progress {
+                bar: ProgressBar::hidden(),
+                plain: Some(Plain {
+                    every: std::env::var("MODAL_BAKE_PROGRESS_EVERY")
+                        .ok()
+                        .and_then(|s| s.parse::<f64>().ok())
+                        .filter(|s| s.is_finite() && *s >= 0.0)
+                        .map_or(PLAIN_EVERY, Duration::from_secs_f64),
+                    start: now,
+                    stage: "",
+                    label: String::new(),
+                    stage_start: now,
+                    last: now,
+                }),
+            }
+        }
     }
 
     pub(super) fn update(&mut self, stage: BakeStage) {
+        if let Some(plain) = &mut self.plain {
+            match stage {
+                BakeStage::Read => plain.report("read", || "reading mesh".into()),
+                BakeStage::Assemble => plain.report("assemble", || "assembling K and M".into()),
+                BakeStage::Factor => plain.report("factor", || "factoring K − σM".into()),
+                BakeStage::Eigensolve(p) => plain.report("eigensolve", || {
+                    format!(
+                        "eigensolve: {}/{} modes converged, Lanczos step {}",
+                        p.converged.min(p.requested),
+                        p.requested,
+                        p.iteration
+                    )
+                }),
+                BakeStage::TransferModes => plain.report("transfer modes", || {
+                    "solving for the transfer table's modes".into()
+                }),
+                BakeStage::Transfer(p) => plain.report("transfer", || {
+                    format!("transfer table: {}/{} rows", p.done, p.total)
+                }),
+                BakeStage::Write => plain.report("write", || "writing".into()),
+            }
+            return;
+        }
         match stage {
             BakeStage::Read => self.bar.set_message("reading mesh"),
             BakeStage::Assemble => self.bar.set_message("assembling K and M"),
+            BakeStage::Factor => self.bar.set_message("factoring K − σM"),
             BakeStage::Eigensolve(p) => {
                 if self.bar.length().is_none() {
                     self.bar.set_style(
@@ -179,6 +314,7 @@ impl Progress {
                     );
                     self.bar.set_length(p.requested as u64);
                 }
+                self.bar.set_length(p.requested as u64);
                 self.bar.set_position(p.converged.min(p.requested) as u64);
                 self.bar
                     .set_message(format!("Lanczos step {}", p.iteration));
@@ -210,22 +346,57 @@ impl Progress {
 }
 
 pub fn run(args: &BakeArgs) -> anyhow::Result<()> {
+    super::check_output(&args.out, "-o", &[&args.mesh])?;
+    args.options.model.check_ranges()?;
     if let Some(target) = args.target_error {
         return super::target::run(args, target);
     }
     let params = args.options.params();
     let mut progress = Progress::new();
     let transfer = args.transfer.params();
-    let report = bake::bake_file_with_transfer(
-        &args.mesh,
-        &params,
-        transfer.as_ref(),
-        &args.out,
-        &mut |s| progress.update(s),
-    );
+    let report = if is_surface_asset(&args.mesh) || args.asset.any_set() {
+        progress.bar.finish_and_clear();
+        let (mesh, read_s) = load_mesh(&args.mesh, &args.asset)?;
+        progress = Progress::new();
+        let file = args.mesh.display().to_string();
+        bake::bake_mesh_with_transfer(mesh, &params, transfer.as_ref(), &file, &mut |s| {
+            progress.update(s)
+        })
+        .and_then(|(base, mut report)| {
+            report.read_s = read_s;
+            progress.update(BakeStage::Write);
+            let t = std::time::Instant::now();
+            base.write_atomic(&args.out)?;
+            report.write_s = t.elapsed().as_secs_f64();
+            Ok(report)
+        })
+    } else {
+        bake::bake_file_with_transfer(
+            &args.mesh,
+            &params,
+            transfer.as_ref(),
+            &args.out,
+            &mut |s| progress.update(s),
+        )
+    };
     progress.bar.finish_and_clear();
+    if let Some(plain) = &mut progress.plain {
+        plain.end_stage();
+    }
     let report = report
         .with_context(|| format!("baking {} failed; nothing was written", args.mesh.display()))?;
+    if let Some(dir) = &report.created_folder {
+        eprintln!("note: created folder {dir}");
+    }
+    if report.extent_m > 100.0 {
+        eprintln!(
+            "warning: {} is {:.4e} m across and weighs {:.4e} kg (plausible objects: 0.01 … 100 m); \
+             bake expects metres: if the mesh is in millimetres, coordinates are 1000× too large",
+            args.mesh.display(),
+            report.extent_m,
+            report.mass_kg
+        );
+    }
     if args.json {
         outln!("{}", serde_json::to_string_pretty(&report)?);
     } else {
@@ -256,9 +427,10 @@ pub fn run(args: &BakeArgs) -> anyhow::Result<()> {
 pub(super) fn print_report(out: &std::path::Path, r: &BakeReport) {
     outln!("wrote {}", out.display());
     outln!(
-        "  mesh: {} nodes, {} tets, {} free dofs, mass {:.6} kg",
+        "  mesh: {} nodes, {} {}-node tets, {} free dofs, mass {:.6} kg",
         r.nodes,
         r.tets,
+        if r.order == 2 { 10 } else { 4 },
         r.free_dofs,
         r.mass_kg
     );
@@ -278,12 +450,24 @@ pub(super) fn print_report(out: &std::path::Path, r: &BakeReport) {
         );
     } else {
         outln!("  fixed nodes: {}", r.fixed_nodes);
+        for (what, n) in &r.fixed_by {
+            outln!("    {what}: {n} nodes");
+        }
     }
-    outln!(
-        "  surface: {} vertices, {} triangles",
-        r.surface_vertices,
-        r.surface_triangles
-    );
+    if r.surface_edge_nodes > 0 {
+        outln!(
+            "  surface: {} vertices + {} mid-edge nodes, {} 6-node triangles",
+            r.surface_vertices,
+            r.surface_edge_nodes,
+            r.surface_triangles
+        );
+    } else {
+        outln!(
+            "  surface: {} vertices, {} triangles",
+            r.surface_vertices,
+            r.surface_triangles
+        );
+    }
     let worst = r.residuals.iter().fold(0.0f64, |a, &b| a.max(b));
     outln!(
         "  {} modes, {:.3} Hz … {:.3} Hz, worst relative residual {:.1e}",

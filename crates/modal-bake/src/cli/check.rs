@@ -4,9 +4,10 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::Args;
-use modal_bake::bake;
+use modal_bake::bake::{self, BaseStatus};
 
 use super::bake::{BakeOptions, TransferOptions};
+use super::mesh::AssetOptions;
 
 #[derive(Args)]
 pub struct CheckArgs {
@@ -20,26 +21,73 @@ pub struct CheckArgs {
     /// table when none is asked for, is stale).
     #[command(flatten)]
     pub transfer: TransferOptions,
+    /// How a surface asset was meshed (it is meshed again with gmsh and compared).
+    #[command(flatten)]
+    pub asset: AssetOptions,
+    /// Print one JSON object: {"base", "mesh", "up_to_date", "reason" (up_to_date, missing,
+    /// unreadable, tool_changed, geometry_changed, parameters_changed, transfer_table_changed),
+    /// "detail"} (or {"error"} with exit 2).
+    #[arg(long)]
+    pub json: bool,
 }
 
 pub fn run(args: &CheckArgs) -> ExitCode {
     let transfer = args.transfer.params();
-    match bake::is_up_to_date_with_transfer(
-        &args.mesh,
-        &args.options.params(),
-        transfer.as_ref(),
-        &args.out,
-    ) {
-        Ok(true) => {
-            outln!("{}: up to date", args.out.display());
-            ExitCode::SUCCESS
-        }
-        Ok(false) => {
-            outln!("{}: stale or missing", args.out.display());
-            ExitCode::from(1)
+    let file = args.mesh.display().to_string();
+    let status = super::bake::load_mesh(&args.mesh, &args.asset).and_then(|(mesh, _)| {
+        Ok(bake::mesh_base_status(
+            mesh,
+            &file,
+            &args.options.params(),
+            transfer.as_ref(),
+            &args.out,
+        )?)
+    });
+    match status {
+        Ok(status) => {
+            let fresh = status == BaseStatus::UpToDate;
+            if args.json {
+                let detail = match &status {
+                    BaseStatus::Unreadable(d) => Some(d.clone()),
+                    _ => None,
+                };
+                outln!(
+                    "{}",
+                    serde_json::json!({
+                        "base": args.out.display().to_string(),
+                        "mesh": args.mesh.display().to_string(),
+                        "up_to_date": fresh,
+                        "reason": status.reason(),
+                        "detail": detail,
+                    })
+                );
+            } else if fresh {
+                outln!("{}: up to date", args.out.display());
+            } else {
+                outln!(
+                    "{}: stale ({})",
+                    args.out.display(),
+                    status.reason().replace('_', " ")
+                );
+            }
+            if fresh {
+                ExitCode::SUCCESS
+            } else {
+                ExitCode::from(1)
+            }
         }
         Err(e) => {
-            eprintln!("error: {e}");
+            if args.json {
+                outln!(
+                    "{}",
+                    serde_json::json!({
+                        "base": args.out.display().to_string(),
+                        "mesh": args.mesh.display().to_string(),
+                        "error": super::one_line(&e),
+                    })
+                );
+            }
+            eprintln!("error: {}", super::one_line(&e));
             ExitCode::from(2)
         }
     }

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use anyhow::{bail, Context};
 use dcr_runtime::ModalModel;
-use ndarray_npy::write_npy;
+use ndarray_npy::WriteNpyExt;
 
 /// Arguments of `modal-bake geodesic`.
 #[derive(clap::Args, Debug, Clone)]
@@ -35,6 +35,9 @@ pub struct GeodesicArgs {
 /// Unreadable or invalid file, vertex out of range, a surface the heat method cannot factor, or
 /// an unwritable output (one-line messages).
 pub fn run(args: &GeodesicArgs) -> anyhow::Result<()> {
+    if let Some(path) = &args.npy {
+        super::check_output(path, "--npy", &[&args.file])?;
+    }
     // LoadError messages already name the file and the cause: one line, no repeated chain.
     let model = ModalModel::load(&args.file).map_err(|e| anyhow::anyhow!("{e}"))?;
     let ns = model.num_vertices();
@@ -51,8 +54,12 @@ pub fn run(args: &GeodesicArgs) -> anyhow::Result<()> {
     let mut d = vec![0.0; ns];
     heat.distances_from_vertex(args.from_vertex, &mut d);
     if let Some(path) = &args.npy {
-        write_npy(path, &ndarray::Array1::from(d.clone()))
-            .with_context(|| format!("writing {}", path.display()))?;
+        let mut bytes = Vec::new();
+        ndarray::Array1::from(d.clone())
+            .write_npy(&mut bytes)
+            .context("encoding the distances as .npy")?;
+        super::create_parent(path)?;
+        dcr_runtime::format::write_atomic(path, &bytes)?;
     }
     if args.json {
         outln!(

@@ -3,7 +3,6 @@
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
-use anyhow::Context;
 use clap::Args;
 use dcr_runtime::format::ModesFile;
 
@@ -17,8 +16,8 @@ pub struct InfoArgs {
 }
 
 pub fn run(args: &InfoArgs) -> anyhow::Result<()> {
-    let base = ModesFile::read(&args.file)
-        .with_context(|| format!("cannot read {}", args.file.display()))?;
+    // FormatError messages name the file and the entry at fault.
+    let base = ModesFile::read(&args.file)?;
     let freqs = base.frequencies_hz();
     if args.json {
         let v = serde_json::json!({
@@ -33,6 +32,8 @@ pub fn run(args: &InfoArgs) -> anyhow::Result<()> {
             "residuals": base.residuals,
             "surface_vertices": base.num_surface_vertices(),
             "surface_triangles": base.surface_triangles.len(),
+            "order": if base.quadratic.is_some() { 2 } else { 1 },
+            "surface_mid_edge_nodes": base.quadratic.as_ref().map_or(0, |q| q.edges.len()),
             "volume_nodes": base.meta.volume_nodes,
             "volume_tets": base.meta.volume_tets,
             "fixed_nodes": base.fixed_nodes.len(),
@@ -89,13 +90,23 @@ pub fn run(args: &InfoArgs) -> anyhow::Result<()> {
             format!("{} fixed nodes", base.fixed_nodes.len())
         }
     )?;
-    writeln!(
-        out,
-        "  surface: {} vertices, {} triangles; mode shapes stored as {:?}",
-        base.num_surface_vertices(),
-        base.surface_triangles.len(),
-        base.precision
-    )?;
+    match &base.quadratic {
+        Some(q) => writeln!(
+            out,
+            "  surface: {} vertices + {} mid-edge nodes, {} 6-node triangles (second order: quadratic interpolation); mode shapes stored as {:?}",
+            base.num_surface_vertices(),
+            q.edges.len(),
+            base.surface_triangles.len(),
+            base.precision
+        )?,
+        None => writeln!(
+            out,
+            "  surface: {} vertices, {} triangles; mode shapes stored as {:?}",
+            base.num_surface_vertices(),
+            base.surface_triangles.len(),
+            base.precision
+        )?,
+    }
     writeln!(
         out,
         "  Rayleigh damping: α0 {} 1/s, α1 {} s",

@@ -1,22 +1,25 @@
 //! Command-line front end: one file per subcommand.
 
-/// `println!` that ignores a closed stdout (`modal-bake info x.modes | head` must not panic).
+/// `println!` through [`write_stdout`]: a failed write is remembered and turned into an error
+/// exit by `main` (a closed pipe, `modal-bake info x.modes | head`, ends output quietly).
 macro_rules! outln {
-    ($($t:tt)*) => {{
-        use std::io::Write as _;
-        let _ = writeln!(std::io::stdout().lock(), $($t)*);
-    }};
+    ($($t:tt)*) => {
+        $crate::cli::write_stdout(format_args!("{}\n", format_args!($($t)*)))
+    };
 }
 
 mod bake;
 mod check;
+mod export;
 mod geodesic;
 mod info;
 mod lab_alias;
+mod mesh;
 mod parse;
 mod probe;
 mod target;
 
+use std::path::Path;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
@@ -33,9 +36,12 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Bake MESH (gmsh MSH 2.2/4.1 ASCII or binary, or meshio JSON) into OUT.modes.
+    /// Bake MESH (gmsh MSH 2.2/4.1 ASCII or binary, meshio JSON, or a surface asset .obj /
+    /// .stl / .ply meshed with gmsh) into OUT.modes.
     #[command(allow_negative_numbers = true)]
     Bake(bake::BakeArgs),
+    /// Tetrahedralize a surface asset (OBJ, STL, PLY) with gmsh into a .msh mesh.
+    Mesh(mesh::MeshArgs),
     /// Print a readable summary of a .modes file (or one JSON object with --json).
     Info(info::InfoArgs),
     /// Exit 0 if OUT.modes is up to date for MESH and the options, 1 if stale or missing,
@@ -45,6 +51,9 @@ enum Command {
     /// Distant response of one impulse at the contacts of a base (runtime conventions).
     #[command(allow_negative_numbers = true)]
     Probe(probe::ProbeArgs),
+    /// Mode shapes as VTU (ParaView, meshio), GLB (Blender, three.js) and a PNG contact sheet.
+    #[command(allow_negative_numbers = true)]
+    Export(export::ExportArgs),
     /// Heat-method geodesic distances (m) from one surface vertex of a base.
     Geodesic(geodesic::GeodesicArgs),
     /// Alias of `dcr-lab truth` (full-order reference response): runs the `dcr-lab` binary.
@@ -56,18 +65,139 @@ enum Command {
     FitAttenuation(lab_alias::LabArgs),
 }
 
-/// Writes `s` to stdout; a closed pipe (`modal-bake info x | head`) is not an error.
-pub fn emit(s: &str) {
+/// The first failure writing stdout, if any (checked once by `main`).
+static STDOUT_ERROR: std::sync::OnceLock<std::io::Error> = std::sync::OnceLock::new();
+
+/// Writes to stdout. The first failure is remembered and later writes are skipped; `main`
+/// turns it into an error exit, except a closed pipe (`| head`), which ends output quietly.
+pub fn write_stdout(args: std::fmt::Arguments<'_>) {
     use std::io::Write;
-    let _ = std::io::stdout().lock().write_all(s.as_bytes());
+    if STDOUT_ERROR.get().is_some() {
+        return;
+    }
+    if let Err(e) = std::io::stdout().lock().write_fmt(args) {
+        let _ = STDOUT_ERROR.set(e);
+    }
+}
+
+/// Writes `s` to stdout ([`write_stdout`]).
+pub fn emit(s: &str) {
+    write_stdout(format_args!("{s}"));
+}
+
+/// Flushes stdout and returns the first write failure, a closed pipe excepted.
+fn stdout_failure() -> Option<&'static std::io::Error> {
+    use std::io::Write;
+    if let Err(e) = std::io::stdout().lock().flush() {
+        let _ = STDOUT_ERROR.set(e);
+    }
+    STDOUT_ERROR
+        .get()
+        .filter(|e| e.kind() != std::io::ErrorKind::BrokenPipe)
+}
+
+/// Refuses an output path before any long work: `out` must not be one of `inputs` (same
+/// device and inode: a hard link or another spelling counts), must not exist as anything but a
+/// regular file, and its nearest existing ancestor must be a folder.
+///
+/// # Errors
+/// A one-line message naming `option` and the path.
+pub fn check_output(out: &Path, option: &str, inputs: &[&Path]) -> anyhow::Result<()> {
+    use dcr_runtime::format::{describe_file_type, same_file};
+    for input in inputs {
+        if same_file(out, input) {
+            anyhow::bail!(
+                "{option} {} is the input {}; refusing to overwrite an input (choose another output path)",
+                out.display(),
+                input.display()
+            );
+        }
+    }
+    if let Ok(meta) = std::fs::metadata(out) {
+        if !meta.is_file() {
+            anyhow::bail!(
+                "{option} {} is {}; give the path of a file to write",
+                out.display(),
+                describe_file_type(meta.file_type())
+            );
+        }
+    }
+    let mut ancestor = out.parent();
+    while let Some(dir) = ancestor.filter(|d| !d.as_os_str().is_empty()) {
+        match std::fs::metadata(dir) {
+            Ok(meta) if meta.is_dir() => return Ok(()),
+            Ok(meta) => anyhow::bail!(
+                "{option} {}: {} is {}, not a folder",
+                out.display(),
+                dir.display(),
+                describe_file_type(meta.file_type())
+            ),
+            Err(_) => ancestor = dir.parent(),
+        }
+    }
+    Ok(())
+}
+
+/// Creates the missing folders of `out`'s parent, saying so on stderr.
+///
+/// # Errors
+/// When a folder cannot be created (message names it).
+pub fn create_parent(out: &Path) -> anyhow::Result<()> {
+    if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
+        if !dir.exists() {
+            std::fs::create_dir_all(dir)
+                .map_err(|e| anyhow::anyhow!("cannot create folder {}: {e}", dir.display()))?;
+            eprintln!("note: created folder {}", dir.display());
+        }
+    }
+    Ok(())
 }
 
 pub fn main() -> ExitCode {
     let cli = Cli::parse();
-    let result = match cli.command {
+    if let Err(e) = modal_bake::signals::remove_temporaries_on_signals() {
+        eprintln!("warning: cannot watch for signals ({e}); an interrupted write may leave a temporary file");
+    }
+    // `check` exits 2 on an error (0 and 1 say up to date / stale); the others exit 1.
+    let error_code = if matches!(cli.command, Command::Check(_)) {
+        2
+    } else {
+        1
+    };
+    let code = run_command(cli.command);
+    match stdout_failure() {
+        Some(e) => {
+            eprintln!("error: cannot write to standard output: {e}");
+            ExitCode::from(error_code)
+        }
+        None => code,
+    }
+}
+
+/// An error and its causes on one line, each cause once: a cause whose text the line already
+/// holds (a wrapper that prints its source, as `path: error` does) is not repeated.
+pub fn one_line(e: &anyhow::Error) -> String {
+    let mut line = String::new();
+    for cause in e.chain() {
+        let text = cause.to_string();
+        if line.contains(&text) {
+            continue;
+        }
+        if !line.is_empty() {
+            line.push_str(": ");
+        }
+        line.push_str(&text);
+    }
+    line
+}
+
+fn run_command(command: Command) -> ExitCode {
+    let result = match command {
         Command::Bake(a) => bake::run(&a).map(|()| ExitCode::SUCCESS),
+        Command::Mesh(a) => mesh::run(&a).map(|()| ExitCode::SUCCESS),
         Command::Info(a) => info::run(&a).map(|()| ExitCode::SUCCESS),
         Command::Probe(a) => probe::run(&a).map(|()| ExitCode::SUCCESS),
+        Command::Export(a) => export::run(&a).map(|()| ExitCode::SUCCESS),
         Command::Geodesic(a) => geodesic::run(&a).map(|()| ExitCode::SUCCESS),
         Command::Truth(a) => lab_alias::run("truth", &a),
         Command::FitAttenuation(a) => lab_alias::run("fit-attenuation", &a),
@@ -76,8 +206,31 @@ pub fn main() -> ExitCode {
     match result {
         Ok(code) => code,
         Err(e) => {
-            eprintln!("error: {e:#}");
+            eprintln!("error: {}", one_line(&e));
             ExitCode::FAILURE
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    // Regression: an I/O error under a context printed its cause twice ("…: out/x.modes: No
+    // such file or directory (os error 2): No such file or directory (os error 2)").
+    #[test]
+    fn one_line_prints_each_cause_once() {
+        let io = std::io::Error::from(std::io::ErrorKind::NotFound);
+        let err = dcr_runtime::format::FormatError::Io {
+            path: "out/x.modes".into(),
+            source: io,
+        };
+        let e = anyhow::Error::new(err).context("baking m.msh failed; nothing was written");
+        let line = one_line(&e);
+        assert_eq!(
+            line,
+            "baking m.msh failed; nothing was written: out/x.modes: entity not found"
+        );
+        assert_ne!(format!("{e:#}"), line, "anyhow's chain repeats the cause");
     }
 }

@@ -10,9 +10,10 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 use anyhow::{bail, Context};
+use dcr_runtime::model::SurfacePoint;
 use dcr_runtime::{
     AttenuationParams, DistantResponse, Impact, Method, ModalModel, ResponseParams, RestingContact,
-    Sampling, ServedBy, SurfacePoint, Variant,
+    Sampling, ServedBy, Variant,
 };
 
 /// Distant-response model selectable from the command line.
@@ -112,6 +113,18 @@ pub fn parse_vec2(s: &str) -> Result<[f64; 2], String> {
     parse_floats::<2>(s)
 }
 
+/// `d` scaled to unit length, for any finite non-zero `d`: scaled by its largest component
+/// first, so that neither 1e308 nor 1e-320 components overflow or underflow the length.
+fn unit_direction(d: [f64; 3]) -> Option<[f64; 3]> {
+    let big = d.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    if !(big > 0.0 && big.is_finite()) {
+        return None;
+    }
+    let s = d.map(|x| x / big);
+    let n = (s[0] * s[0] + s[1] * s[1] + s[2] * s[2]).sqrt();
+    Some(s.map(|x| x / n))
+}
+
 /// Runs `modal-bake probe`.
 ///
 /// # Errors
@@ -163,13 +176,9 @@ pub fn run(args: &ProbeArgs) -> anyhow::Result<()> {
         )
     })?;
     let direction = match args.direction {
-        Some(d) => {
-            let n = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
-            if !(n > 0.0) {
-                bail!("--direction must be a non-zero vector");
-            }
-            d.map(|x| x / n)
-        }
+        Some(d) => unit_direction(d).with_context(|| {
+            format!("--direction {d:?} must be a non-zero vector (any finite length)")
+        })?,
         None => impact_sp.normal.map(|x| 0.0 - x),
     };
     let mut mapped: Vec<SurfacePoint> = Vec::with_capacity(args.contacts.len());

@@ -21,8 +21,7 @@ pub fn run(args: &BakeArgs, target: f64) -> anyhow::Result<()> {
         .params()
         .context("--target-error needs --transfer-h (the scene's step)")?;
     let mut progress = Progress::new();
-    let mesh = modal_bake::mesh::read_mesh(&args.mesh)
-        .with_context(|| format!("reading {} failed", args.mesh.display()))?;
+    let (mesh, _) = super::bake::load_mesh(&args.mesh, &args.asset)?;
     let file = args.mesh.display().to_string();
     let res = bake_to_target(
         mesh,
@@ -34,6 +33,9 @@ pub fn run(args: &BakeArgs, target: f64) -> anyhow::Result<()> {
         &mut |s| progress.update(s),
     );
     progress.bar.finish_and_clear();
+    if let Some(plain) = &mut progress.plain {
+        plain.end_stage();
+    }
     let (base, report, tried) =
         res.with_context(|| format!("baking {} failed; nothing was written", args.mesh.display()))?;
     base.write_atomic(&args.out)

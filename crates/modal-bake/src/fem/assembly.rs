@@ -1,4 +1,12 @@
-//! P1 (linear tetrahedron) stiffness and mass assembly with a deterministic summation order.
+//! P1 (4-node) and P2 (10-node, straight-sided) tetrahedron stiffness and mass assembly with a
+//! deterministic summation order.
+//!
+//! P2 element matrices are integrated exactly: the stiffness integrand (products of linear
+//! shape-function gradients, degree 2) with the symmetric 4-point rule (degree 2), the
+//! consistent mass (products of quadratic shape functions, degree 4) in closed form from
+//! ∫ L₀^a L₁^b L₂^c L₃^d dV = 6V a! b! c! d! / (a+b+c+d+3)! (`p2_mass_ref`). The lumped P2
+//! mass is the HRZ diagonal (the consistent diagonal scaled to the element mass: corners
+//! 6/216, mid-edge nodes 32/216 of ρV), because row-sum lumping gives corners negative mass.
 //!
 //! The sparsity pattern is built once from the node graph (two nodes are adjacent when they
 //! share a tetrahedron). Column block `3a..3a+3` of node `a` is one contiguous slice of the value
@@ -11,7 +19,7 @@ use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 use rayon::prelude::*;
 
 use super::{DofMap, DofMapError, Material};
-use crate::mesh::TetMesh;
+use crate::mesh::{TetMesh, TET10_EDGES};
 
 /// Node adjacency and node → tetrahedron incidence of a mesh.
 pub(crate) struct NodeGraph {
@@ -33,9 +41,10 @@ const UNMARKED: u32 = u32::MAX;
 impl NodeGraph {
     pub fn new(mesh: &TetMesh) -> NodeGraph {
         let n = mesh.nodes.len();
+        let npe = mesh.nodes_per_tet();
         let mut inc_ptr = vec![0usize; n + 1];
-        for t in &mesh.tets {
-            for &v in t {
+        for t in 0..mesh.tets.len() {
+            for &v in &mesh.tet_nodes(t)[..npe] {
                 inc_ptr[v + 1] += 1;
             }
         }
@@ -44,8 +53,8 @@ impl NodeGraph {
         }
         let mut fill = inc_ptr.clone();
         let mut inc = vec![(0u32, 0u8); inc_ptr[n]];
-        for (ti, t) in mesh.tets.iter().enumerate() {
-            for (p, &v) in t.iter().enumerate() {
+        for ti in 0..mesh.tets.len() {
+            for (p, &v) in mesh.tet_nodes(ti)[..npe].iter().enumerate() {
                 inc[fill[v]] = (ti as u32, p as u8);
                 fill[v] += 1;
             }
@@ -62,7 +71,7 @@ impl NodeGraph {
                     seen[a] = true;
                     l.push(a);
                     for &(t, _) in &inc[inc_ptr[a]..inc_ptr[a + 1]] {
-                        for &b in &mesh.tets[t as usize] {
+                        for &b in &mesh.tet_nodes(t as usize)[..npe] {
                             if !seen[b] {
                                 seen[b] = true;
                                 l.push(b);
@@ -251,8 +260,66 @@ fn element_geometry(mesh: &TetMesh, t: &[usize; 4]) -> ([[f64; 3]; 4], f64) {
     ([g0, g1, g2, g3], det.abs() / 6.0)
 }
 
-/// Assembles the P1 linear-elastic stiffness matrix K (N/m), `3n × 3n`, node-major dofs
-/// (`3·node + axis`), both triangles stored, rows sorted in every column.
+/// The symmetric 4-point rule on a tetrahedron (degree 2): point q has barycentric coordinate
+/// `P2_QA` at corner q and `P2_QB` at the other three, weight V/4.
+const P2_QA: f64 = 0.585_410_196_624_968_5; // (5 + 3√5)/20
+const P2_QB: f64 = 0.138_196_601_125_010_5; // (5 − √5)/20
+
+/// Gradients (1/m) of the ten P2 shape functions at the four points of the 4-point rule, from
+/// the barycentric gradients `g` of the corners: corner i, N = Lᵢ(2Lᵢ − 1), ∇N = (4Lᵢ − 1)∇Lᵢ;
+/// mid-edge node of edge (a, b) ([`TET10_EDGES`]), N = 4 L_a L_b, ∇N = 4(L_b ∇L_a + L_a ∇L_b).
+fn p2_gradients(g: &[[f64; 3]; 4]) -> [[[f64; 3]; 10]; 4] {
+    let mut out = [[[0.0; 3]; 10]; 4];
+    for (q, at) in out.iter_mut().enumerate() {
+        let l = |i: usize| if i == q { P2_QA } else { P2_QB };
+        for i in 0..4 {
+            let c = 4.0 * l(i) - 1.0;
+            at[i] = g[i].map(|x| c * x);
+        }
+        for (e, &[a, b]) in TET10_EDGES.iter().enumerate() {
+            at[4 + e] = [0, 1, 2].map(|c| 4.0 * (l(b) * g[a][c] + l(a) * g[b][c]));
+        }
+    }
+    out
+}
+
+/// `420/V ∫ N_a N_b dV` of the P2 tetrahedron (local nodes: corners 0–3, then the mid-edge
+/// nodes of [`TET10_EDGES`]): corner–corner 6 (same) or 1; corner–edge −4 (the corner is on the
+/// edge) or −6; edge–edge 32 (same), 16 (sharing a corner) or 8 (opposite). Rows sum to
+/// 420/V ∫ N_a: −21 (corners) and 84 (mid-edge nodes).
+pub(crate) fn p2_mass_ref(a: usize, b: usize) -> f64 {
+    let (a, b) = (a.min(b), a.max(b));
+    match (a < 4, b < 4) {
+        (true, true) => {
+            if a == b {
+                6.0
+            } else {
+                1.0
+            }
+        }
+        (true, false) => {
+            if TET10_EDGES[b - 4].contains(&a) {
+                -4.0
+            } else {
+                -6.0
+            }
+        }
+        _ => {
+            let (ea, eb) = (TET10_EDGES[a - 4], TET10_EDGES[b - 4]);
+            if a == b {
+                32.0
+            } else if ea.iter().any(|c| eb.contains(c)) {
+                16.0
+            } else {
+                8.0
+            }
+        }
+    }
+}
+
+/// Assembles the linear-elastic stiffness matrix K (N/m), `3n × 3n`, node-major dofs
+/// (`3·node + axis`), both triangles stored, rows sorted in every column: P1 for a linear
+/// mesh, P2 (4-point rule, exact on straight-sided elements) for a second-order one.
 ///
 /// Element matrix: K_ab^{ij} = V (λ ∂_i N_a ∂_j N_b + μ ∂_j N_a ∂_i N_b + μ δ_ij ∇N_a·∇N_b), with
 /// the Lamé parameters of `mat` and V = |signed volume|, so either orientation gives the same
@@ -293,6 +360,51 @@ fn stiffness(
     let sym = pattern.dof_pattern(true);
     let mut values = vec![0.0f64; sym.row_idx().len()];
     let slices = pattern.node_slices(&mut values, 9);
+    if mesh.is_quadratic() {
+        pattern.for_each_node(slices, |a, d, marks, out| {
+            for &(t, p) in graph.incidences(a) {
+                let (g, v) = &geo[t as usize];
+                if *v == 0.0 {
+                    continue;
+                }
+                let grads = p2_gradients(g);
+                let w = 0.25 * v;
+                let p = p as usize;
+                for (q, &b) in mesh.tet_nodes(t as usize).iter().enumerate() {
+                    let k = marks[b];
+                    if k == UNMARKED {
+                        continue; // a fixed node: its rows are not stored
+                    }
+                    let k = k as usize;
+                    // s = Σ_qp ∇N_a ∇N_bᵀ over the 4 points: the (a,b) and (b,a) blocks see
+                    // the same products (commuted) in the same order, so K stays bit-exactly
+                    // symmetric.
+                    let mut s = [[0.0f64; 3]; 3];
+                    let mut dot = 0.0;
+                    for gq in &grads {
+                        let (ga, gb) = (gq[p], gq[q]);
+                        for i in 0..3 {
+                            for j in 0..3 {
+                                s[i][j] += ga[i] * gb[j];
+                            }
+                        }
+                        dot += ga[0] * gb[0] + ga[1] * gb[1] + ga[2] * gb[2];
+                    }
+                    for i in 0..3 {
+                        let col = &mut out[3 * d * i + 3 * k..3 * d * i + 3 * k + 3];
+                        for j in 0..3 {
+                            let mut e = lam * s[i][j] + mu * s[j][i];
+                            if i == j {
+                                e += mu * dot;
+                            }
+                            col[j] += w * e;
+                        }
+                    }
+                }
+            }
+        });
+        return SparseColMat::new(sym, values);
+    }
     pattern.for_each_node(slices, |a, d, marks, out| {
         for &(t, p) in graph.incidences(a) {
             let (g, v) = &geo[t as usize];
@@ -327,10 +439,13 @@ fn stiffness(
     SparseColMat::new(sym, values)
 }
 
-/// Assembles the P1 mass matrix M (kg), `3n × 3n`, node-major dofs, both triangles stored.
+/// Assembles the mass matrix M (kg), `3n × 3n`, node-major dofs, both triangles stored.
 ///
-/// `lumped == false`: consistent mass, ρV/20·(1+δ_ab) between nodes a, b of a tetrahedron, per
-/// axis (no coupling between axes). `lumped == true`: diagonal, ρV/4 per node and axis.
+/// P1, `lumped == false`: consistent mass, ρV/20·(1+δ_ab) between nodes a, b of a
+/// tetrahedron, per axis (no coupling between axes). `lumped == true`: diagonal, ρV/4 per node
+/// and axis. P2: consistent ρV/420 × (6, 1; −4, −6; 32, 16, 8) between corners, corner and
+/// mid-edge node, and mid-edge nodes (exact; see the module docs), or its HRZ diagonal when
+/// lumped.
 /// Either way 1ᵀ M_axis 1 = ρ·(total volume). Deterministic like [`assemble_stiffness`].
 ///
 /// ```
@@ -356,13 +471,19 @@ fn mass(
     geo: &[([[f64; 3]; 4], f64)],
 ) -> SparseColMat<usize, f64> {
     let rho = mat.density;
+    let quadratic = mesh.is_quadratic();
     if lumped {
         let n = pattern.kept.len();
         let mut values = vec![0.0f64; 3 * n];
         values.par_chunks_mut(3).enumerate().for_each(|(k, out)| {
             let mut m = 0.0;
-            for &(t, _) in graph.incidences(pattern.kept[k]) {
-                m += rho * geo[t as usize].1 / 4.0;
+            for &(t, p) in graph.incidences(pattern.kept[k]) {
+                m += if quadratic {
+                    // HRZ: the consistent diagonal (6 or 32 per 420) scaled to ρV.
+                    rho * geo[t as usize].1 * p2_mass_ref(p as usize, p as usize) / 216.0
+                } else {
+                    rho * geo[t as usize].1 / 4.0
+                };
             }
             out.fill(m);
         });
@@ -378,6 +499,24 @@ fn mass(
     let sym = pattern.dof_pattern(false);
     let mut values = vec![0.0f64; sym.row_idx().len()];
     let slices = pattern.node_slices(&mut values, 3);
+    if quadratic {
+        pattern.for_each_node(slices, |a, d, marks, out| {
+            for &(t, p) in graph.incidences(a) {
+                let rv = rho * geo[t as usize].1 / 420.0;
+                for (q, &b) in mesh.tet_nodes(t as usize).iter().enumerate() {
+                    let k = marks[b];
+                    if k == UNMARKED {
+                        continue; // a fixed node: its rows are not stored
+                    }
+                    let w = rv * p2_mass_ref(p as usize, q);
+                    for i in 0..3 {
+                        out[d * i + k as usize] += w;
+                    }
+                }
+            }
+        });
+        return SparseColMat::new(sym, values);
+    }
     pattern.for_each_node(slices, |a, d, marks, out| {
         for &(t, _) in graph.incidences(a) {
             let m = rho * geo[t as usize].1 / 20.0;

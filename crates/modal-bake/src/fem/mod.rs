@@ -1,4 +1,5 @@
-//! Linear FEM assembly: P1 (4-node tetrahedron) isotropic linear elasticity, SI units
+//! FEM assembly: P1 (4-node) and P2 (10-node, straight-sided) tetrahedra, isotropic linear
+//! elasticity, SI units
 //! (paper §4.1, Eq. 5: the K and M of M ü + D u̇ + K u = f).
 //!
 //! - [`assemble_stiffness`]: K (N/m), [`assemble_mass`]: M (kg), consistent or lumped.
@@ -9,7 +10,8 @@
 //!   the bake uses: bit-identical, without the full matrices).
 //! - [`rigid_body_modes`]: the 6-dimensional null space of the free-free K.
 //!
-//! Unsupported: anisotropic or heterogeneous materials, quadratic (tet10) elements.
+//! Unsupported: anisotropic or heterogeneous materials, curved (non-affine) 10-node
+//! tetrahedra (refused by [`crate::mesh::TetMesh::check_straight`] before assembly).
 
 mod assembly;
 mod dof_map;

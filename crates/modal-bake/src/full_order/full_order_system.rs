@@ -4,7 +4,7 @@
 use faer::sparse::SparseColMat;
 use faer::Mat;
 
-use dcr_runtime::SurfacePoint;
+use dcr_runtime::model::SurfacePoint;
 
 use super::surface_map::SurfaceMap;
 use super::{FullOrderError, SystemParams};
@@ -64,6 +64,11 @@ impl FullOrderSystem {
         if mesh.tets.is_empty() {
             return Err(FullOrderError::Params(format!(
                 "{file}: the mesh has no tetrahedra"
+            )));
+        }
+        if mesh.is_quadratic() {
+            return Err(FullOrderError::Params(format!(
+                "{file}: the full-order reference supports 4-node tetrahedra only (its surface map is linear); use a linear mesh"
             )));
         }
         mesh.orient_tets(DEFAULT_DEGENERATE_REL_TOL)

@@ -5,7 +5,7 @@
 //! (faer `self_adjoint_eigen`), Φ = L⁻ᵀ Q, so Φᵀ M Φ = I. With Rayleigh damping every mode
 //! decouples (paper Eq. 8) and an impulse f at t = 0 gives the exact displacement
 //! u(t) = Σ_j φ_j (φ_jᵀ f) g_j(t), with g_j the mass-normalised impulse response for
-//! ξ_j = ½(α0/ω_j + α1 ω_j) in every regime (ξ < 1, = 1, > 1) — `dcr_runtime::ModeFilter`.
+//! ξ_j = ½(α0/ω_j + α1 ω_j) in every regime (ξ < 1, = 1, > 1) — `dcr_runtime::filter::ModeFilter`.
 //!
 //! Free-free: the six lowest eigenpairs (λ ≈ 0) are the rigid modes; they are dropped (the load
 //! and the rows are also M-orthogonally stripped of their rigid part by
@@ -13,7 +13,7 @@
 
 use std::time::Instant;
 
-use dcr_runtime::{damping_ratio, ModeFilter};
+use dcr_runtime::filter::{damping_ratio, ModeFilter};
 use std::num::NonZeroUsize;
 
 use faer::diag::Diag;

@@ -3,7 +3,7 @@
 //! barycentric weights in triangle order, area-weighted vertex normals interpolated with the
 //! weights and normalised).
 
-use dcr_runtime::SurfacePoint;
+use dcr_runtime::model::SurfacePoint;
 
 use crate::bake::extract_surface;
 use crate::mesh::TetMesh;

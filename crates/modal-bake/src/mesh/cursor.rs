@@ -1,5 +1,12 @@
 //! A byte cursor over an MSH file that reads ASCII tokens and binary values, and reports
 //! errors with a line number (ASCII) or byte offset (binary).
+//!
+//! ASCII data is read line by line, as gmsh writes it: a record (a node, an element, a
+//! section or block header) opens with [`Cursor::mark`] or [`Cursor::line`], its values are
+//! tokens that never cross a line break ([`MeshErrorKind::ShortLine`] otherwise), and
+//! [`Cursor::end_record`] / [`Cursor::end_line`] require the rest of the line to be blank
+//! ([`MeshErrorKind::ExtraValue`] otherwise). A value too many or too few is thus refused at
+//! its line instead of shifting every later record.
 
 use super::mesh_error::{shorten, Location, MeshError, MeshErrorKind};
 
@@ -14,10 +21,17 @@ pub(crate) struct Cursor<'a> {
     big_endian: bool,
     /// Width in bytes of `size_t` values in binary MSH 4.1 (the data-size field).
     size_width: usize,
+    /// Inside an ASCII record: tokens stop at the end of the line.
+    in_line: bool,
 }
 
 fn is_space(b: u8) -> bool {
     b.is_ascii_whitespace()
+}
+
+/// Blank space within a line (a `\r` before the line break included).
+fn is_line_space(b: u8) -> bool {
+    b != b'\n' && b.is_ascii_whitespace()
 }
 
 impl<'a> Cursor<'a> {
@@ -29,6 +43,7 @@ impl<'a> Cursor<'a> {
             binary: false,
             big_endian: false,
             size_width: 8,
+            in_line: false,
         }
     }
 
@@ -47,7 +62,7 @@ impl<'a> Cursor<'a> {
     }
 
     /// 1-based line of byte `pos`.
-    fn line_at(&self, pos: usize) -> usize {
+    pub fn line_at(&self, pos: usize) -> usize {
         let end = pos.min(self.data.len());
         1 + self.data[..end].iter().filter(|&&b| b == b'\n').count()
     }
@@ -67,12 +82,75 @@ impl<'a> Cursor<'a> {
         self.error_at(pos, self.binary, kind)
     }
 
-    /// Start of the next data record (skips whitespace in ASCII files).
+    /// Start of the next data record: in ASCII files, skips blank space and opens a line
+    /// record (close it with [`Cursor::end_record`]).
+    ///
+    /// Inside an open record, the start of its next value on the same line.
     pub fn mark(&mut self) -> usize {
         if !self.binary {
-            self.skip_space();
+            self.line();
         }
         self.pos
+    }
+
+    /// Opens an ASCII line record even in a binary file (the count lines of MSH 2.2 binary
+    /// sections, `$PhysicalNames`); close it with [`Cursor::end_line`]. Inside an open
+    /// record, the start of its next value on the same line.
+    pub fn line(&mut self) -> usize {
+        if self.in_line {
+            while self.pos < self.data.len() && is_line_space(self.data[self.pos]) {
+                self.pos += 1;
+            }
+        } else {
+            self.skip_space();
+            self.in_line = true;
+        }
+        self.pos
+    }
+
+    /// Closes an ASCII line record: the rest of the line must be blank.
+    ///
+    /// # Errors
+    /// [`MeshErrorKind::ExtraValue`] at the line, naming `record`.
+    pub fn end_line(&mut self, record: &'static str) -> Result<(), MeshError> {
+        self.in_line = false;
+        while self.pos < self.data.len() && is_line_space(self.data[self.pos]) {
+            self.pos += 1;
+        }
+        match self.data.get(self.pos) {
+            None => Ok(()),
+            Some(b'\n') => {
+                self.pos += 1;
+                Ok(())
+            }
+            Some(_) => {
+                let start = self.pos;
+                while self.pos < self.data.len() && !is_space(self.data[self.pos]) {
+                    self.pos += 1;
+                }
+                Err(self.error_at(
+                    start,
+                    false,
+                    MeshErrorKind::ExtraValue {
+                        record,
+                        found: shorten(&self.data[start..self.pos]),
+                    },
+                ))
+            }
+        }
+    }
+
+    /// Closes a data record opened by [`Cursor::mark`]: [`Cursor::end_line`] in ASCII files,
+    /// nothing in binary ones.
+    ///
+    /// # Errors
+    /// As [`Cursor::end_line`].
+    pub fn end_record(&mut self, record: &'static str) -> Result<(), MeshError> {
+        if self.binary {
+            Ok(())
+        } else {
+            self.end_line(record)
+        }
     }
 
     pub fn skip_space(&mut self) {
@@ -86,9 +164,19 @@ impl<'a> Cursor<'a> {
         self.pos >= self.data.len()
     }
 
-    /// The next whitespace-separated token and its start.
+    /// The next whitespace-separated token and its start; inside a line record, on the
+    /// same line.
     pub fn token(&mut self, expected: &'static str) -> Result<(usize, &'a [u8]), MeshError> {
-        self.skip_space();
+        if self.in_line {
+            while self.pos < self.data.len() && is_line_space(self.data[self.pos]) {
+                self.pos += 1;
+            }
+            if self.data.get(self.pos) == Some(&b'\n') {
+                return Err(self.error_at(self.pos, false, MeshErrorKind::ShortLine(expected)));
+            }
+        } else {
+            self.skip_space();
+        }
         let start = self.pos;
         while self.pos < self.data.len() && !is_space(self.data[self.pos]) {
             self.pos += 1;
@@ -99,8 +187,10 @@ impl<'a> Cursor<'a> {
         Ok((start, &self.data[start..self.pos]))
     }
 
-    /// The rest of the current line (without the line break), consuming the line break.
+    /// The rest of the current line (without the line break), consuming the line break; closes
+    /// a line record.
     pub fn rest_of_line(&mut self) -> &'a [u8] {
+        self.in_line = false;
         let start = self.pos;
         while self.pos < self.data.len() && self.data[self.pos] != b'\n' {
             self.pos += 1;

@@ -2,9 +2,16 @@
 //!
 //! Layout (meshio's JSON-compatible form): `points` (n×3 numbers, m), `cells` a list of
 //! `{"type", "data"}` blocks with 0-based point indices (`tetra` for 4-node tetrahedra,
-//! `triangle`; other types skipped with a note), and optional named groups as meshio
+//! `tetra10` for 10-node ones in meshio's (VTK's) node order, `triangle` / `triangle6`; other
+//! types skipped with a note), and optional named groups as meshio
 //! `cell_sets` (`{name: [per-block lists of cell indices]}`) or gmsh-style
 //! `cell_data["gmsh:physical"]` (per-block tag lists) with `field_data` (`{name: [tag, dim]}`).
+//!
+//! Cell types: `cell_info` gives each known type's node count (the width every row of its
+//! block must have) and dimension (for `gmsh:physical` names); `CellFiler` decides what a
+//! block becomes (`tetra` → tetrahedra, `triangle` → triangles, anything else a note). Both
+//! readers below go through these two, so a new cell type is a row in `cell_info` and an arm
+//! in `CellFiler::file`.
 
 use std::collections::BTreeMap;
 
@@ -34,6 +41,61 @@ fn cell_info(ty: &str) -> Option<(usize, i32)> {
         "pyramid" => (5, 3),
         _ => return None,
     })
+}
+
+/// Files cell blocks into a [`MeshBuilder`] by type — the one place a meshio cell type is
+/// dispatched (both readers use it): `tetra` → `MeshBuilder::push_tet` (ids are 1-based
+/// positions across `tetra` blocks), `triangle` → `MeshBuilder::push_triangle`, every other
+/// type counted, one note per type in order of first appearance. Rows have the width
+/// [`cell_info`] gives their type (checked by the readers).
+#[derive(Default)]
+struct CellFiler {
+    tet_id: u64,
+    skipped: Vec<(String, u64)>,
+}
+
+impl CellFiler {
+    fn file<'r>(
+        &mut self,
+        builder: &mut MeshBuilder,
+        ty: &str,
+        rows: impl ExactSizeIterator<Item = &'r [usize]>,
+    ) {
+        match ty {
+            "tetra" => {
+                for row in rows {
+                    self.tet_id += 1;
+                    builder.push_tet(self.tet_id, [row[0], row[1], row[2], row[3]]);
+                }
+            }
+            "tetra10" => {
+                for row in rows {
+                    self.tet_id += 1;
+                    builder.push_tet10(self.tet_id, tetra10_to_gmsh(row));
+                }
+            }
+            "triangle" | "triangle6" => {
+                for row in rows {
+                    builder.push_triangle([row[0], row[1], row[2]]);
+                }
+            }
+            other => {
+                let what = format!("cells of type {other:?}");
+                let n = rows.len() as u64;
+                match self.skipped.iter_mut().find(|s| s.0 == what) {
+                    Some(s) => s.1 += n,
+                    None => self.skipped.push((what, n)),
+                }
+            }
+        }
+    }
+
+    /// Records the skipped types as notes.
+    fn finish(self, builder: &mut MeshBuilder) {
+        for (what, n) in &self.skipped {
+            builder.skip(what, *n);
+        }
+    }
 }
 
 /// One cell block as read: its type and rows of point indices.
@@ -365,36 +427,26 @@ pub(crate) fn parse_json_dom(data: &[u8], file: &str) -> Result<TetMesh, MeshErr
         .set_nodes(nodes)
         .map_err(|kind| r.err("points", kind))?;
     let blocks = r.blocks(&root, npoints)?;
-    let mut tet_id = 0u64;
-    let mut skipped: Vec<(String, u64)> = Vec::new();
+    let mut cells = CellFiler::default();
     for block in &blocks {
-        match block.ty.as_str() {
-            "tetra" => {
-                for row in &block.rows {
-                    tet_id += 1;
-                    builder.push_tet(tet_id, [row[0], row[1], row[2], row[3]]);
-                }
-            }
-            "triangle" => {
-                for row in &block.rows {
-                    builder.push_triangle([row[0], row[1], row[2]]);
-                }
-            }
-            other => {
-                let what = format!("cells of type {other:?}");
-                match skipped.iter_mut().find(|s| s.0 == what) {
-                    Some(s) => s.1 += block.rows.len() as u64,
-                    None => skipped.push((what, block.rows.len() as u64)),
-                }
-            }
-        }
+        cells.file(
+            &mut builder,
+            &block.ty,
+            block.rows.iter().map(Vec::as_slice),
+        );
     }
-    for (what, n) in &skipped {
-        builder.skip(what, *n);
-    }
+    cells.finish(&mut builder);
     r.cell_sets(&root, &blocks, &mut builder)?;
     r.gmsh_physical(&root, &blocks, &mut builder)?;
     builder.finish(file)
+}
+
+/// A meshio `tetra10` row (VTK order: corners, then edges (0,1), (1,2), (0,2), (0,3), (1,3),
+/// (2,3)) in gmsh's type-11 order (its last two mid-edge nodes swapped: (2,3) then (1,3)).
+fn tetra10_to_gmsh(row: &[usize]) -> [usize; 10] {
+    [
+        row[0], row[1], row[2], row[3], row[4], row[5], row[6], row[7], row[9], row[8],
+    ]
 }
 
 /// The typed reader: serde visitors that write points and cell rows straight into flat
@@ -411,7 +463,7 @@ mod fast {
     use serde::de::{self, DeserializeSeed, Deserializer, MapAccess, SeqAccess, Visitor};
     use serde_json::Value;
 
-    use super::{cell_info, JsonReader, MeshBuilder, TetMesh};
+    use super::{cell_info, CellFiler, JsonReader, MeshBuilder, TetMesh};
 
     /// One `cells` block: its type and `width` node indices per row, row after row.
     struct Block {
@@ -773,36 +825,11 @@ mod fast {
                     .collect(),
             )
             .ok()?;
-        // As the document reader: tetrahedra numbered across `tetra` blocks, one note per
-        // skipped cell type in order of first appearance.
-        let mut tet_id = 0u64;
-        let mut skipped: Vec<(String, u64)> = Vec::new();
+        let mut cells = CellFiler::default();
         for block in &blocks {
-            match block.ty.as_str() {
-                "tetra" => {
-                    for row in block.rows() {
-                        tet_id += 1;
-                        builder.push_tet(tet_id, [row[0], row[1], row[2], row[3]]);
-                    }
-                }
-                "triangle" => {
-                    for row in block.rows() {
-                        builder.push_triangle([row[0], row[1], row[2]]);
-                    }
-                }
-                other => {
-                    let what = format!("cells of type {other:?}");
-                    let n = block.rows().len() as u64;
-                    match skipped.iter_mut().find(|s| s.0 == what) {
-                        Some(s) => s.1 += n,
-                        None => skipped.push((what, n)),
-                    }
-                }
-            }
+            cells.file(&mut builder, &block.ty, block.rows());
         }
-        for (what, n) in &skipped {
-            builder.skip(what, *n);
-        }
+        cells.finish(&mut builder);
 
         for (name, per_block) in doc.cell_sets.unwrap_or_default() {
             if per_block.len() != blocks.len() {

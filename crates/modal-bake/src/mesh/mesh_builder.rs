@@ -15,6 +15,8 @@ pub(crate) struct MeshBuilder {
     /// `Some(first)` when the sorted tags are exactly `first, first+1, ...`.
     dense_first: Option<u64>,
     tets: Vec<(u64, [usize; 4])>,
+    /// 10-node tetrahedra: 4 corners, then the mid-edge nodes in `TET10_EDGES` order.
+    tets10: Vec<(u64, [usize; 10])>,
     triangles: Vec<[usize; 3]>,
     groups: BTreeMap<String, Vec<usize>>,
     skipped: Vec<(String, u64)>,
@@ -59,6 +61,12 @@ impl MeshBuilder {
         self.tets.push((id, nodes));
     }
 
+    /// Adds a 10-node tetrahedron with element id `id` (node table indices, gmsh order: 4
+    /// corners, then the mid-edge nodes of edges (0,1), (1,2), (2,0), (3,0), (3,2), (3,1)).
+    pub fn push_tet10(&mut self, id: u64, nodes: [usize; 10]) {
+        self.tets10.push((id, nodes));
+    }
+
     /// Adds a triangle (node table indices).
     pub fn push_triangle(&mut self, nodes: [usize; 3]) {
         self.triangles.push(nodes);
@@ -90,10 +98,40 @@ impl MeshBuilder {
     /// deduplicated. Element order in the file therefore does not matter.
     ///
     /// # Errors
-    /// [`MeshErrorKind::NoTets`] when there is no tetrahedron.
+    /// [`MeshErrorKind::NoTets`] when there is no tetrahedron;
+    /// [`MeshErrorKind::DuplicateTet`] (at the later element) when two tetrahedra have the
+    /// same nodes in different orders: one would count twice.
     pub fn finish(mut self, file: &str) -> Result<TetMesh, MeshError> {
-        if self.tets.is_empty() {
+        if self.tets.is_empty() && self.tets10.is_empty() {
             return Err(MeshError::new(file, Location::None, MeshErrorKind::NoTets));
+        }
+        if !self.tets.is_empty() && !self.tets10.is_empty() {
+            return Err(MeshError::new(
+                file,
+                Location::None,
+                MeshErrorKind::MixedOrder {
+                    linear: self.tets.len(),
+                    quadratic: self.tets10.len(),
+                },
+            ));
+        }
+        let quadratic = !self.tets10.is_empty();
+        let corners: Vec<(u64, [usize; 4])> = self
+            .tets10
+            .iter()
+            .map(|&(id, t)| (id, [t[0], t[1], t[2], t[3]]))
+            .collect();
+        let dup = if quadratic {
+            same_nodes_reordered(&corners)
+        } else {
+            same_nodes_reordered(&self.tets)
+        };
+        if let Some((first, second)) = dup {
+            return Err(MeshError::new(
+                file,
+                Location::Element(second),
+                MeshErrorKind::DuplicateTet { first, second },
+            ));
         }
         let mut notes = Vec::new();
         for (what, n) in &self.skipped {
@@ -102,12 +140,14 @@ impl MeshBuilder {
         // Canonical element order: by node indices (which follow node tags), so the order in
         // which a file lists its elements does not matter; ties by element id.
         self.tets.sort_unstable_by_key(|&(id, t)| (t, id));
-        let before = self.tets.len();
+        self.tets10.sort_unstable_by_key(|&(id, t)| (t, id));
+        let before = self.tets.len() + self.tets10.len();
         self.tets.dedup_by_key(|t| t.1);
-        if self.tets.len() < before {
+        self.tets10.dedup_by_key(|t| t.1);
+        if self.tets.len() + self.tets10.len() < before {
             notes.push(format!(
                 "removed {} duplicated tetrahedra (same nodes in the same order)",
-                before - self.tets.len()
+                before - self.tets.len() - self.tets10.len()
             ));
         }
         self.triangles.sort_unstable();
@@ -116,6 +156,11 @@ impl MeshBuilder {
         const UNUSED: usize = usize::MAX;
         let mut new_index = vec![UNUSED; self.tags.len()];
         for (_, t) in &self.tets {
+            for &v in t {
+                new_index[v] = 0;
+            }
+        }
+        for (_, t) in &self.tets10 {
             for &v in t {
                 new_index[v] = 0;
             }
@@ -133,12 +178,24 @@ impl MeshBuilder {
                 "dropped {dropped} nodes not referenced by any tetrahedron"
             ));
         }
-        let tets = self
-            .tets
-            .iter()
-            .map(|(_, t)| t.map(|v| new_index[v]))
-            .collect();
-        let tet_ids = self.tets.iter().map(|(id, _)| *id).collect();
+        let (tets, tet_ids, mid_edges) = if quadratic {
+            let corner = |t: &[usize; 10]| [t[0], t[1], t[2], t[3]].map(|v| new_index[v]);
+            let mid = |t: &[usize; 10]| [t[4], t[5], t[6], t[7], t[8], t[9]].map(|v| new_index[v]);
+            (
+                self.tets10.iter().map(|(_, t)| corner(t)).collect(),
+                self.tets10.iter().map(|(id, _)| *id).collect(),
+                self.tets10.iter().map(|(_, t)| mid(t)).collect(),
+            )
+        } else {
+            (
+                self.tets
+                    .iter()
+                    .map(|(_, t)| t.map(|v| new_index[v]))
+                    .collect(),
+                self.tets.iter().map(|(id, _)| *id).collect(),
+                Vec::new(),
+            )
+        };
 
         let mut triangles = Vec::with_capacity(self.triangles.len());
         for tri in &self.triangles {
@@ -177,6 +234,38 @@ impl MeshBuilder {
             triangles,
             groups,
             notes,
+            mid_edges,
         })
     }
+}
+
+/// The ids (smaller first) of two tetrahedra with the same node set in different orders, if
+/// any (exact repeats are the same element listed twice and are not reported). Sorted node
+/// sets are packed into one `u128` (node indices < 2^32, as any mesh that fits in memory has)
+/// to sort fast.
+fn same_nodes_reordered(tets: &[(u64, [usize; 4])]) -> Option<(u64, u64)> {
+    let mut keys: Vec<(u128, usize)> = tets
+        .iter()
+        .enumerate()
+        .map(|(i, (_, t))| {
+            let mut k = *t;
+            k.sort_unstable();
+            let packed = k
+                .iter()
+                .fold(0u128, |acc, &v| (acc << 32) | (v as u32 as u128));
+            (packed, i)
+        })
+        .collect();
+    keys.sort_unstable();
+    keys.windows(2).find_map(|w| {
+        let (a, b) = (&tets[w[0].1], &tets[w[1].1]);
+        // Equal packed keys are equal sets when every index fits in 32 bits.
+        let same_set = w[0].0 == w[1].0 && {
+            let (mut x, mut y) = (a.1, b.1);
+            x.sort_unstable();
+            y.sort_unstable();
+            x == y
+        };
+        (same_set && a.1 != b.1).then(|| (a.0.min(b.0), a.0.max(b.0)))
+    })
 }

@@ -16,6 +16,8 @@ pub enum Location {
     Element(u64),
     /// A path into a JSON document, e.g. `cells[1].data[3]`.
     Path(String),
+    /// A 1-based node in canonical order (ascending file tag), for checks on positions.
+    Node(u64),
 }
 
 /// A mesh that could not be read or fails a check, with the file name and a location.
@@ -39,6 +41,10 @@ pub enum MeshErrorKind {
     /// The file could not be read.
     #[error("cannot read file: {0}")]
     Io(String),
+    /// The path is not a regular file (a directory, device, FIFO or socket): meshes are read
+    /// from regular files only, whose size bounds the read.
+    #[error("not a regular file ({0}); give the path of a mesh file")]
+    NotARegularFile(&'static str),
     /// Neither `$MeshFormat` nor a JSON object, and no known extension.
     #[error("unrecognised mesh format (expected gmsh .msh or meshio-style .json)")]
     UnknownFormat,
@@ -114,9 +120,72 @@ pub enum MeshErrorKind {
     /// A required section is absent (or out of order).
     #[error("missing section {0}")]
     MissingSection(&'static str),
-    /// The file holds no 4-node tetrahedra.
-    #[error("no 4-node tetrahedra in the mesh (tet4 only; second-order elements are skipped)")]
+    /// A section a file holds once appears again.
+    #[error("section ${section} appears a second time (the first is at line {first}); a mesh file holds it once")]
+    DuplicateSection {
+        /// The section name without `$`.
+        section: &'static str,
+        /// 1-based line of its first header.
+        first: usize,
+    },
+    /// A section that must come after another one comes before it.
+    #[error("section ${section} comes before ${before}, which it depends on")]
+    SectionOrder {
+        /// The section found too early.
+        section: &'static str,
+        /// The section that must precede it.
+        before: &'static str,
+    },
+    /// A node or element tag that is zero or negative (gmsh tags start at 1).
+    #[error("{what} {found} is not a positive tag (gmsh tags start at 1)")]
+    InvalidTag {
+        /// What the tag names ("node tag", "element tag", "element node tag").
+        what: &'static str,
+        /// The value found.
+        found: String,
+    },
+    /// An ASCII record with more values than its layout has.
+    #[error("extra value {found:?} at the end of {record} (expected the end of the line)")]
+    ExtraValue {
+        /// The record ("an element line", "the $Nodes header", ...).
+        record: &'static str,
+        /// The first extra token (shortened).
+        found: String,
+    },
+    /// An ASCII record that ends (line break) before all its values.
+    #[error("the line ends before its {0}")]
+    ShortLine(&'static str),
+    /// Two elements with the same four nodes in another order (one would count twice).
+    #[error("elements {first} and {second} have the same four nodes (overlapping tetrahedra); remove one")]
+    DuplicateTet {
+        /// The first element's id (MSH tag, JSON 1-based position).
+        first: u64,
+        /// The second element's id.
+        second: u64,
+    },
+    /// Two positively oriented tetrahedra share a face and lie on the same side of it.
+    #[error(
+        "elements {first} and {second} overlap: they share a face and lie on the same side of it"
+    )]
+    OverlappingTets {
+        /// One element id.
+        first: u64,
+        /// The other element id.
+        second: u64,
+    },
+    /// The file holds no 4-node or 10-node tetrahedra.
+    #[error("no 4-node or 10-node tetrahedra in the mesh (other element types are skipped)")]
     NoTets,
+    /// The file mixes 4-node and 10-node tetrahedra.
+    #[error(
+        "the mesh mixes {linear} 4-node and {quadratic} 10-node tetrahedra; use one element order"
+    )]
+    MixedOrder {
+        /// 4-node tetrahedra found.
+        linear: usize,
+        /// 10-node tetrahedra found.
+        quadratic: usize,
+    },
     /// The JSON text does not parse.
     #[error("invalid JSON: {0}")]
     Json(String),
@@ -126,6 +195,24 @@ pub enum MeshErrorKind {
     /// A negative node index in JSON cells.
     #[error("negative node index {0}")]
     NegativeIndex(i64),
+    /// A node coordinate outside ±[`dcr_runtime::format::MAX_COORDINATE_M`].
+    #[error(
+        "coordinate {value:e} m is outside the supported ±{max:e} m (bake expects metres: is the mesh in other units, or is this node misplaced?)"
+    )]
+    CoordinateOutOfRange {
+        /// The coordinate (m).
+        value: f64,
+        /// The limit (m).
+        max: f64,
+    },
+    /// A mesh smaller than [`dcr_runtime::format::MIN_EXTENT_M`].
+    #[error("the mesh is {extent:e} m across (bounding-box diagonal); at least {min:e} m is supported (bake expects metres)")]
+    TooSmall {
+        /// Bounding-box diagonal (m).
+        extent: f64,
+        /// The limit (m).
+        min: f64,
+    },
     /// A tetrahedron of (near-)zero or NaN volume.
     #[error(
         "degenerate tetrahedron {element}: |volume| {volume:e} m³ below {threshold:e} m³ \
@@ -138,6 +225,29 @@ pub enum MeshErrorKind {
         volume: f64,
         /// The threshold it fell below (m³).
         threshold: f64,
+    },
+    /// A second-order tetrahedron with a mid-edge node off its edge's midpoint.
+    #[error(
+        "curved 10-node tetrahedron {element}: a mid-edge node is {offset:e} m off its edge's \
+         midpoint (edge length {edge_length:e} m); only straight-sided second-order elements are \
+         supported: mesh with gmsh's `Mesh.SecondOrderLinear = 1` (what `modal-bake mesh \
+         --order 2` does) or bake the linear mesh"
+    )]
+    CurvedTet {
+        /// The element id (see [`crate::mesh::TetMesh::tet_ids`]).
+        element: u64,
+        /// Distance of the mid-edge node from the midpoint (m).
+        offset: f64,
+        /// Length of the edge (m).
+        edge_length: f64,
+    },
+    /// Second-order tetrahedra that disagree on their shared edges' mid-edge nodes.
+    #[error("non-conforming 10-node tetrahedron {element}: {detail}")]
+    NonConforming {
+        /// The element id (see [`crate::mesh::TetMesh::tet_ids`]).
+        element: u64,
+        /// What disagrees.
+        detail: String,
     },
     /// A group name the mesh does not have.
     #[error(
@@ -192,6 +302,7 @@ impl fmt::Display for MeshError {
             Location::Byte(offset) => write!(f, "{sep}byte {offset}")?,
             Location::Element(id) => write!(f, "{sep}element {id}")?,
             Location::Path(path) => write!(f, "{sep}{path}")?,
+            Location::Node(n) => write!(f, "{sep}node {n}")?,
         }
         if self.file.is_empty() && self.location == Location::None {
             write!(f, "{}", self.kind)

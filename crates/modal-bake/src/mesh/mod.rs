@@ -5,37 +5,58 @@
 //! positions) and elements give equal meshes, whatever their format or element order.
 //!
 //! Caveat: gmsh writes ASCII MSH coordinates with `%.16g`, which does not round-trip every
-//! `f64`; an ASCII and a binary file of one gmsh mesh can differ by 1 ulp per coordinate.
+//! `f64`; an ASCII and a binary file of one gmsh mesh can differ by 1 ulp per coordinate
+//! (the geometry hash, [`crate::bake::geometry_hash`], rounds to 16 digits and sees them as one).
 //!
 //! Supported: 4-node tetrahedra (volume), 3-node triangles (informational) and physical
 //! groups of any dimension (as node sets, for boundary conditions). Unsupported: every other
 //! element type, including second-order tetrahedra, which are skipped with a note in
-//! [`TetMesh::notes`]; MSH versions other than 2.2 and 4.1.
+//! [`TetMesh::notes`]; MSH versions other than 2.2 and 4.1. How an element type is dispatched
+//! is in the `msh` and `json` module docs: one table of node counts per format, one function
+//! that files each element by type.
+//!
+//! Hostile input: files are read only when they are regular files (a device or FIFO is refused
+//! before it is opened), and no more than their size; declared counts are checked against the
+//! bytes left before allocating; repeated or misplaced sections, non-positive tags, short or
+//! long ASCII records and tetrahedra listed twice in different node orders are refused with
+//! their line, byte offset or element ids. Every error is a [`MeshError`] naming the file.
 
+mod asset;
 mod cursor;
+pub mod gmsh;
 mod json;
 mod mesh_builder;
 mod mesh_error;
 mod msh;
+pub mod surface;
 mod tet_mesh;
 mod validate;
 
 use std::path::Path;
 
+pub use asset::{mesh_asset, AssetError};
 pub use mesh_error::{Location, MeshError, MeshErrorKind};
-pub use tet_mesh::{signed_volume, TetMesh};
-pub use validate::DEFAULT_DEGENERATE_REL_TOL;
+pub(crate) use tet_mesh::tet_faces;
+pub use tet_mesh::{signed_volume, TetMesh, TET10_EDGES};
+pub use validate::{DEFAULT_DEGENERATE_REL_TOL, DEFAULT_STRAIGHT_REL_TOL};
 
+/// Reads a whole regular file, at most as many bytes as its size when opened. A directory,
+/// device, FIFO or socket is refused before it is opened for reading (a FIFO would block, a
+/// device like `/dev/zero` never ends).
 fn read_file(path: &Path) -> Result<(Vec<u8>, String), MeshError> {
+    use dcr_runtime::format::{open_regular_file, OpenError};
+    use std::io::Read;
     let name = path.display().to_string();
-    match std::fs::read(path) {
-        Ok(data) => Ok((data, name)),
-        Err(e) => Err(MeshError::new(
-            name,
-            Location::None,
-            MeshErrorKind::Io(e.to_string()),
-        )),
-    }
+    let error = |kind| MeshError::new(&name, Location::None, kind);
+    let (file, len) = open_regular_file(path).map_err(|e| match e {
+        OpenError::NotRegular(what) => error(MeshErrorKind::NotARegularFile(what)),
+        OpenError::Io(e) => error(MeshErrorKind::Io(e.to_string())),
+    })?;
+    let mut data = Vec::with_capacity(usize::try_from(len).unwrap_or(0));
+    file.take(len)
+        .read_to_end(&mut data)
+        .map_err(|e| error(MeshErrorKind::Io(e.to_string())))?;
+    Ok((data, name))
 }
 
 /// Reads a mesh file (positions in m), choosing the format from its content (`$MeshFormat`

@@ -1,10 +1,31 @@
 //! gmsh MSH reader: versions 2.2 and 4.1, ASCII and binary.
 //!
 //! Format reference: gmsh manual §10 "Gmsh file formats" (MSH 4.1) and the legacy MSH 2.2
-//! description. Only 4-node tetrahedra (type 4) make the volume mesh; triangles (type 2) are
-//! kept for information; every element of a physical group (any dimension) contributes its
-//! nodes to that group. Other element types, including second-order ones, are skipped with a
-//! note.
+//! description.
+//!
+//! **Sections.** Read front to back. `$MeshFormat`, `$PhysicalNames`, `$Entities` (4.1),
+//! `$Nodes` and `$Elements` are read, each at most once
+//! ([`MeshErrorKind::DuplicateSection`]), `$MeshFormat` before the others
+//! ([`MeshErrorKind::SectionOrder`]) and `$Nodes` before `$Elements`. Every other section
+//! (`$Comments`, `$NodeData`, `$Periodic`, ...) is skipped wherever it is, also before
+//! `$MeshFormat`, as gmsh does.
+//!
+//! **Records.** ASCII data is read line by line (a node, an element, a block header per line,
+//! as gmsh writes them): a missing or extra value is refused at its line
+//! ([`MeshErrorKind::ShortLine`], [`MeshErrorKind::ExtraValue`]). Node and element tags must be
+//! positive ([`MeshErrorKind::InvalidTag`]). Declared counts are checked against the bytes
+//! left before anything is allocated ([`MeshErrorKind::CountTooLarge`]).
+//!
+//! **Element types.** One table, `element_info`, gives each gmsh element type's node count
+//! and dimension: how many node tags a record carries, so a type the mesh does not use is
+//! still read exactly (its nodes join its physical groups) and then skipped. What a record
+//! becomes is decided in one place, `MshReader::add_element`: type 4 (4-node tetrahedron) →
+//! `MeshBuilder::push_tet`, type 11 (10-node tetrahedron, gmsh node order: corners, then the
+//! mid-edge nodes of edges (0,1), (1,2), (2,0), (3,0), (3,2), (3,1)) → `MeshBuilder::push_tet10`,
+//! types 2 and 9 (3- and 6-node triangles, corners) → `MeshBuilder::push_triangle`, every
+//! other type is counted and reported in [`TetMesh::notes`]. Supporting another type is an arm
+//! there and a `MeshBuilder` method; binary MSH 2.2 and 4.1 element blocks of a type missing
+//! from `element_info` cannot be skipped (their record size is unknown) and are refused.
 
 use std::collections::BTreeMap;
 
@@ -60,14 +81,26 @@ enum Version {
     V41,
 }
 
+/// The sections this reader reads (each at most once); `None` for sections it skips.
+fn known_section(name: &[u8]) -> Option<&'static str> {
+    Some(match name {
+        b"MeshFormat" => "MeshFormat",
+        b"PhysicalNames" => "PhysicalNames",
+        b"Entities" => "Entities",
+        b"Nodes" => "Nodes",
+        b"Elements" => "Elements",
+        _ => return None,
+    })
+}
+
 /// Reader state shared by both versions.
 struct MshReader<'a> {
     c: Cursor<'a>,
     file: &'a str,
     version: Version,
     builder: MeshBuilder,
-    nodes_read: bool,
-    elements_read: bool,
+    /// Sections read so far and the byte offset of each header.
+    seen: Vec<(&'static str, usize)>,
     /// `$PhysicalNames`: (dim, tag) → name.
     names: BTreeMap<(i32, i64), String>,
     /// MSH 4.1 `$Entities`: (dim, entity tag) → physical tags.
@@ -83,14 +116,13 @@ struct MshReader<'a> {
 /// Reads a gmsh MSH 2.2 or 4.1 file (ASCII or binary) from memory; `file` names it in errors.
 pub(crate) fn parse_msh(data: &[u8], file: &str) -> Result<TetMesh, MeshError> {
     let mut c = Cursor::new(data, file);
-    let version = read_header(&mut c)?;
+    let (version, format_pos) = read_header(&mut c)?;
     let mut r = MshReader {
         c,
         file,
         version,
         builder: MeshBuilder::default(),
-        nodes_read: false,
-        elements_read: false,
+        seen: vec![("MeshFormat", format_pos)],
         names: BTreeMap::new(),
         entity_physicals: BTreeMap::new(),
         members: BTreeMap::new(),
@@ -101,17 +133,39 @@ pub(crate) fn parse_msh(data: &[u8], file: &str) -> Result<TetMesh, MeshError> {
     r.finish()
 }
 
-/// Reads `$MeshFormat`, sets the cursor's binary mode, returns the version.
-fn read_header(c: &mut Cursor<'_>) -> Result<Version, MeshError> {
-    let (start, tok) = c.token("$MeshFormat")?;
-    if tok != b"$MeshFormat" {
-        return Err(c.error_at(
-            start,
-            false,
-            MeshErrorKind::MissingSection("$MeshFormat (at the start of the file)"),
-        ));
-    }
-    let (vpos, vtok) = c.token("MSH version")?;
+/// Skips unknown sections up to `$MeshFormat`, reads it, sets the cursor's binary mode and
+/// returns the version and the byte offset of the `$MeshFormat` header.
+fn read_header(c: &mut Cursor<'_>) -> Result<(Version, usize), MeshError> {
+    let format_pos = loop {
+        let (start, tok) = c.token("$MeshFormat")?;
+        match tok.strip_prefix(b"$") {
+            Some(b"MeshFormat") => break start,
+            Some(name) if !name.is_empty() && !name.starts_with(b"End") => {
+                if let Some(section) = known_section(name) {
+                    return Err(c.error_at(
+                        start,
+                        false,
+                        MeshErrorKind::SectionOrder {
+                            section,
+                            before: "MeshFormat",
+                        },
+                    ));
+                }
+                c.rest_of_line();
+                c.skip_section(name)?;
+            }
+            _ => {
+                return Err(c.error_at(
+                    start,
+                    false,
+                    MeshErrorKind::MissingSection("$MeshFormat (at the start of the file)"),
+                ))
+            }
+        }
+    };
+    c.rest_of_line();
+    let vpos = c.line();
+    let (_, vtok) = c.token("MSH version")?;
     let version = match vtok {
         b"2.2" => Version::V22,
         b"4.1" => Version::V41,
@@ -123,11 +177,11 @@ fn read_header(c: &mut Cursor<'_>) -> Result<Version, MeshError> {
             ))
         }
     };
-    let tpos = c.mark();
+    let tpos = c.line();
     let file_type = c.ascii_u64("file-type")?;
-    let dpos = c.mark();
+    let dpos = c.line();
     let data_size = c.ascii_u64("data-size")?;
-    c.rest_of_line();
+    c.end_line("the $MeshFormat line")?;
     let supported = match version {
         Version::V22 => data_size == 8,
         Version::V41 => data_size == 4 || data_size == 8,
@@ -168,7 +222,7 @@ fn read_header(c: &mut Cursor<'_>) -> Result<Version, MeshError> {
         }
     }
     c.expect("$EndMeshFormat")?;
-    Ok(version)
+    Ok((version, format_pos))
 }
 
 impl MshReader<'_> {
@@ -186,47 +240,57 @@ impl MshReader<'_> {
                 ));
             };
             self.c.rest_of_line();
-            match name {
-                b"PhysicalNames" => self.read_physical_names()?,
-                b"Entities" if self.version == Version::V41 => self.read_entities()?,
-                b"Nodes" => {
-                    match self.version {
-                        Version::V22 => self.read_nodes_v22()?,
-                        Version::V41 => self.read_nodes_v41()?,
-                    }
-                    self.nodes_read = true;
-                }
-                b"Elements" => {
-                    if !self.nodes_read {
+            let Some(section) = known_section(name) else {
+                self.c.skip_section(name)?;
+                continue;
+            };
+            if let Some(&(_, first)) = self.seen.iter().find(|s| s.0 == section) {
+                let first = self.c.line_at(first);
+                return Err(self.c.error_at(
+                    start,
+                    false,
+                    MeshErrorKind::DuplicateSection { section, first },
+                ));
+            }
+            self.seen.push((section, start));
+            // `$MeshFormat` is in `seen` from the start: only the four data sections get here.
+            match (section, self.version) {
+                ("PhysicalNames", _) => self.read_physical_names()?,
+                ("Entities", Version::V41) => self.read_entities()?,
+                ("Entities", Version::V22) => self.c.skip_section(name)?,
+                ("Nodes", Version::V22) => self.read_nodes_v22()?,
+                ("Nodes", Version::V41) => self.read_nodes_v41()?,
+                (_, version) => {
+                    if !self.has("Nodes") {
                         return Err(self.c.error_at(
                             start,
                             false,
                             MeshErrorKind::MissingSection("$Nodes (before $Elements)"),
                         ));
                     }
-                    match self.version {
+                    match version {
                         Version::V22 => self.read_elements_v22()?,
                         Version::V41 => self.read_elements_v41()?,
                     }
-                    self.elements_read = true;
                 }
-                other => self.c.skip_section(other)?,
             }
         }
         Ok(())
     }
 
+    /// Whether section `name` has been read.
+    fn has(&self, name: &str) -> bool {
+        self.seen.iter().any(|s| s.0 == name)
+    }
+
     fn finish(mut self) -> Result<TetMesh, MeshError> {
         let end = self.c.pos();
-        if !self.nodes_read {
-            return Err(self
-                .c
-                .error_at(end, false, MeshErrorKind::MissingSection("$Nodes")));
-        }
-        if !self.elements_read {
-            return Err(self
-                .c
-                .error_at(end, false, MeshErrorKind::MissingSection("$Elements")));
+        for required in ["$Nodes", "$Elements"] {
+            if !self.has(&required[1..]) {
+                return Err(self
+                    .c
+                    .error_at(end, false, MeshErrorKind::MissingSection(required)));
+            }
         }
         for &(ty, n) in &self.skipped {
             let what = match element_info(ty) {
@@ -265,11 +329,12 @@ impl MshReader<'_> {
 
     /// `$PhysicalNames` (ASCII in every file type): `dim tag "name"` per line.
     fn read_physical_names(&mut self) -> Result<(), MeshError> {
-        let pos = self.c.mark();
+        let pos = self.c.line();
         let n = self.c.ascii_u64("number of physical names")?;
+        self.c.end_line("the physical-name count")?;
         let n = self.c.check_count(pos, false, n, 6, "physical names")?;
         for _ in 0..n {
-            let dpos = self.c.mark();
+            let dpos = self.c.line();
             let dim = self.c.ascii_i64("physical group dimension")?;
             let tag = self.c.ascii_i64("physical tag")?;
             let name = self.c.rest_of_line();
@@ -301,6 +366,7 @@ impl MshReader<'_> {
         let iw = if binary { 4 } else { 2 };
         let sw = if binary { self.c.size_width() } else { 2 };
         let mut counts = [0usize; 4];
+        self.c.mark();
         for count in &mut counts {
             let pos = self.c.mark();
             let n = self.c.size("number of entities")?;
@@ -309,8 +375,10 @@ impl MshReader<'_> {
                 .c
                 .check_count(pos, binary, n, iw + 3 * iw + sw, "entities")?;
         }
+        self.c.end_record("the $Entities header")?;
         for (dim, &count) in counts.iter().enumerate() {
             for _ in 0..count {
+                self.c.mark();
                 let tag = self.c.int("entity tag")?;
                 for _ in 0..if dim == 0 { 3 } else { 6 } {
                     self.c.float("entity bounding box")?;
@@ -332,12 +400,34 @@ impl MshReader<'_> {
                         self.c.int("bounding entity tag")?;
                     }
                 }
+                self.c.end_record("an entity line")?;
                 if !phys.is_empty() {
                     self.entity_physicals.insert((dim as i32, tag), phys);
                 }
             }
         }
         self.c.expect("$EndEntities")
+    }
+
+    /// A node or element tag of the record at `pos`: a C `int` (2.2) or `size_t` (4.1), and
+    /// positive.
+    fn read_tag(&mut self, pos: usize, what: &'static str) -> Result<u64, MeshError> {
+        let (value, found) = match self.version {
+            Version::V22 => {
+                let v = self.c.int(what)?;
+                (u64::try_from(v).unwrap_or(0), v.to_string())
+            }
+            Version::V41 => {
+                let v = self.c.size(what)?;
+                (v, v.to_string())
+            }
+        };
+        if value == 0 {
+            return Err(self
+                .c
+                .data_error(pos, MeshErrorKind::InvalidTag { what, found }));
+        }
+        Ok(value)
     }
 
     /// Reads x y z of node `tag` (record starting at `pos`), rejecting non-finite values.
@@ -360,26 +450,11 @@ impl MshReader<'_> {
             .map_err(|kind| self.c.error_at(pos, false, kind))
     }
 
-    /// A node tag from a C `int` (2.2) — must be positive.
-    fn positive(&self, pos: usize, v: i64, what: &'static str) -> Result<u64, MeshError> {
-        u64::try_from(v).ok().filter(|&v| v > 0).ok_or_else(|| {
-            self.c.data_error(
-                pos,
-                MeshErrorKind::Unexpected {
-                    expected: format!("positive {what}"),
-                    found: v.to_string(),
-                },
-            )
-        })
-    }
-
-    /// MSH 2.2 `$Nodes`: count (ASCII), then `tag x y z` per node.
+    /// MSH 2.2 `$Nodes`: count (ASCII line), then `tag x y z` per node.
     fn read_nodes_v22(&mut self) -> Result<(), MeshError> {
-        let section = self.c.mark();
+        let section = self.c.line();
         let n = self.c.ascii_u64("number of nodes")?;
-        if self.c.binary {
-            self.c.rest_of_line();
-        }
+        self.c.end_line("the node count")?;
         let n = self.c.check_count(
             section,
             false,
@@ -390,13 +465,9 @@ impl MshReader<'_> {
         let mut nodes = Vec::with_capacity(n);
         for _ in 0..n {
             let pos = self.c.mark();
-            let tag = if self.c.binary {
-                let t = self.c.int("node tag")?;
-                self.positive(pos, t, "node tag")?
-            } else {
-                self.c.ascii_u64("node tag")?
-            };
+            let tag = self.read_tag(pos, "node tag")?;
             let x = self.read_xyz(pos, tag)?;
+            self.c.end_record("a node line")?;
             nodes.push((tag, x));
         }
         self.c.expect("$EndNodes")?;
@@ -414,6 +485,7 @@ impl MshReader<'_> {
         let total = self.c.size("number of nodes")?;
         self.c.size("minimum node tag")?;
         self.c.size("maximum node tag")?;
+        self.c.end_record("the $Nodes header")?;
         let nblocks = self
             .c
             .check_count(section, binary, nblocks, 3 * iw + sw, "node blocks")?;
@@ -428,6 +500,7 @@ impl MshReader<'_> {
             self.c.int("entity tag")?;
             let parametric = self.c.int("parametric flag")?;
             let n = self.c.size("number of nodes in block")?;
+            self.c.end_record("a node block header")?;
             let n = self
                 .c
                 .check_count(bpos, binary, n, sw + 3 * fw, "nodes in block")?;
@@ -444,7 +517,9 @@ impl MshReader<'_> {
             let extra = if parametric != 0 { dim.clamp(0, 3) } else { 0 };
             tags.clear();
             for _ in 0..n {
-                tags.push(self.c.size("node tag")?);
+                let pos = self.c.mark();
+                tags.push(self.read_tag(pos, "node tag")?);
+                self.c.end_record("a node tag line")?;
             }
             for &tag in &tags {
                 let pos = self.c.mark();
@@ -452,6 +527,7 @@ impl MshReader<'_> {
                 for _ in 0..extra {
                     self.c.float("parametric coordinate")?;
                 }
+                self.c.end_record("a node coordinate line")?;
                 nodes.push((tag, x));
             }
         }
@@ -474,13 +550,7 @@ impl MshReader<'_> {
     fn read_element_nodes(&mut self, pos: usize, tag: u64, count: usize) -> Result<(), MeshError> {
         self.scratch.clear();
         for _ in 0..count {
-            let node = match self.version {
-                Version::V22 => {
-                    let v = self.c.int("element node tag")?;
-                    u64::try_from(v).unwrap_or(0)
-                }
-                Version::V41 => self.c.size("element node tag")?,
-            };
+            let node = self.read_tag(pos, "element node tag")?;
             let index = self.builder.node_index(node).ok_or_else(|| {
                 self.c
                     .data_error(pos, MeshErrorKind::MissingNode { element: tag, node })
@@ -495,7 +565,11 @@ impl MshReader<'_> {
         let v = &self.scratch;
         match ty {
             4 => self.builder.push_tet(tag, [v[0], v[1], v[2], v[3]]),
-            2 => self.builder.push_triangle([v[0], v[1], v[2]]),
+            11 => self.builder.push_tet10(
+                tag,
+                [v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7], v[8], v[9]],
+            ),
+            2 | 9 => self.builder.push_triangle([v[0], v[1], v[2]]),
             _ => self.count_skipped(ty, 1),
         }
         if let Some(key) = group {
@@ -516,18 +590,16 @@ impl MshReader<'_> {
     /// MSH 2.2 `$Elements`. ASCII: `tag type ntags tags... nodes...` per line. Binary: blocks
     /// of `type count ntags` headers, each followed by `tag tags... nodes...` as `int`s.
     fn read_elements_v22(&mut self) -> Result<(), MeshError> {
-        let section = self.c.mark();
+        let section = self.c.line();
         let n = self.c.ascii_u64("number of elements")?;
+        self.c.end_line("the element count")?;
         let binary = self.c.binary;
-        if binary {
-            self.c.rest_of_line();
-        }
         let n = self.c.check_count(section, false, n, 8, "elements")?;
         let mut tags: Vec<i64> = Vec::new();
         if !binary {
             for _ in 0..n {
                 let pos = self.c.mark();
-                let tag = self.c.ascii_u64("element tag")?;
+                let tag = self.read_tag(pos, "element tag")?;
                 let ty = self.c.ascii_i64("element type")?;
                 let tpos = self.c.mark();
                 let ntags = self.c.ascii_u64("number of element tags")?;
@@ -542,6 +614,7 @@ impl MshReader<'_> {
                     continue;
                 };
                 self.read_element_nodes(pos, tag, nn)?;
+                self.c.end_record("an element line")?;
                 let group = tags.first().filter(|&&p| p != 0).map(|&p| (dim, p));
                 self.add_element(ty, tag, group);
             }
@@ -595,8 +668,7 @@ impl MshReader<'_> {
                 }
                 for _ in 0..follow {
                     let pos = self.c.pos();
-                    let t = self.c.int("element tag")?;
-                    let tag = self.positive(pos, t, "element tag")?;
+                    let tag = self.read_tag(pos, "element tag")?;
                     tags.clear();
                     for _ in 0..ntags {
                         tags.push(self.c.int("element tag")?);
@@ -621,6 +693,7 @@ impl MshReader<'_> {
         let total = self.c.size("number of elements")?;
         self.c.size("minimum element tag")?;
         self.c.size("maximum element tag")?;
+        self.c.end_record("the $Elements header")?;
         let nblocks =
             self.c
                 .check_count(section, binary, nblocks, 3 * iw + sw, "element blocks")?;
@@ -634,6 +707,7 @@ impl MshReader<'_> {
             let entity = self.c.int("entity tag")?;
             let ty = self.c.int("element type")?;
             let n = self.c.size("number of elements in block")?;
+            self.c.end_record("an element block header")?;
             let info = element_info(ty);
             let per = info.map_or(2, |(nn, _, _)| (nn + 1) * sw);
             let n = self
@@ -656,7 +730,6 @@ impl MshReader<'_> {
                         .c
                         .data_error(bpos, MeshErrorKind::UnsupportedElementType(ty)));
                 }
-                self.c.rest_of_line();
                 for _ in 0..n {
                     self.c.mark();
                     self.c.rest_of_line();
@@ -667,8 +740,9 @@ impl MshReader<'_> {
             let group = i32::try_from(dim).ok().map(|d| (d, entity));
             for _ in 0..n {
                 let pos = self.c.mark();
-                let tag = self.c.size("element tag")?;
+                let tag = self.read_tag(pos, "element tag")?;
                 self.read_element_nodes(pos, tag, nn)?;
+                self.c.end_record("an element line")?;
                 self.add_element(ty, tag, group);
             }
         }

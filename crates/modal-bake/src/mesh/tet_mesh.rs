@@ -7,9 +7,14 @@
 
 use std::collections::BTreeMap;
 
-/// A linear (4-node) tetrahedral mesh with its boundary triangles and named node groups.
+/// A tetrahedral mesh, linear (4-node) or second-order (10-node), with its boundary triangles
+/// and named node groups.
 ///
-/// Positions are in metres, in the object's local frame.
+/// Positions are in metres, in the object's local frame. A second-order mesh keeps its corner
+/// connectivity in [`TetMesh::tets`] and the mid-edge nodes of each tetrahedron in
+/// [`TetMesh::mid_edges`] (local edge order [`TET10_EDGES`], gmsh's for its 10-node
+/// tetrahedron); only straight-sided elements (mid-edge nodes at the edge midpoints) are
+/// accepted by [`TetMesh::check_straight`].
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct TetMesh {
     /// Node positions (m, object frame), canonical order (ascending file node tag).
@@ -25,7 +30,16 @@ pub struct TetMesh {
     pub groups: BTreeMap<String, Vec<usize>>,
     /// Human-readable notes from reading (skipped element types, dropped nodes, ...).
     pub notes: Vec<String>,
+    /// Second-order meshes: the mid-edge node of each tetrahedron's local edge
+    /// `TET10_EDGES[k]` at `mid_edges[t][k]` (0-based node indices). Empty for a linear mesh;
+    /// otherwise exactly one entry per tetrahedron.
+    pub mid_edges: Vec<[usize; 6]>,
 }
+
+/// The local corner pairs of a tetrahedron's six edges, in the order of the mid-edge nodes
+/// 5–10 of gmsh's 10-node tetrahedron (element type 11): (0,1), (1,2), (2,0), (3,0), (3,2),
+/// (3,1), written here with the smaller corner first.
+pub const TET10_EDGES: [[usize; 2]; 6] = [[0, 1], [1, 2], [0, 2], [0, 3], [2, 3], [1, 3]];
 
 /// Signed volume (m³) of the tetrahedron `a b c d`, `(b−a)×(c−a)·(d−a)/6`: positive when `d`
 /// lies on the side of triangle `a b c` its right-hand normal points to.
@@ -34,6 +48,12 @@ pub fn signed_volume(a: [f64; 3], b: [f64; 3], c: [f64; 3], d: [f64; 3]) -> f64 
     let v = sub(c, a);
     let w = sub(d, a);
     dot(cross(u, v), w) / 6.0
+}
+
+/// The faces of a positively oriented tetrahedron (a, b, c, d), each ordered so that its
+/// right-hand normal points out of the tetrahedron.
+pub(crate) fn tet_faces([a, b, c, d]: [usize; 4]) -> [[usize; 3]; 4] {
+    [[a, c, b], [a, b, d], [a, d, c], [b, c, d]]
 }
 
 pub(crate) fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
@@ -149,6 +169,102 @@ impl TetMesh {
             triangles: Vec::new(),
             groups,
             notes: Vec::new(),
+            mid_edges: Vec::new(),
+        }
+    }
+
+    /// Whether the mesh is second-order (10-node tetrahedra, [`TetMesh::mid_edges`] set).
+    pub fn is_quadratic(&self) -> bool {
+        !self.mid_edges.is_empty()
+    }
+
+    /// Nodes per element: 4 (linear) or 10 (second-order).
+    pub fn nodes_per_tet(&self) -> usize {
+        if self.is_quadratic() {
+            10
+        } else {
+            4
+        }
+    }
+
+    /// The nodes of tetrahedron `t`: its 4 corners, then (second-order meshes) its 6 mid-edge
+    /// nodes in [`TET10_EDGES`] order. Only the first [`TetMesh::nodes_per_tet`] entries are
+    /// nodes; the rest (linear meshes) are `usize::MAX`.
+    pub fn tet_nodes(&self, t: usize) -> [usize; 10] {
+        let mut out = [usize::MAX; 10];
+        out[..4].copy_from_slice(&self.tets[t]);
+        if let Some(e) = self.mid_edges.get(t) {
+            out[4..].copy_from_slice(e);
+        }
+        out
+    }
+
+    /// The second-order version of a linear mesh: a mid-edge node at the midpoint of every
+    /// edge (m), appended after the corner nodes in the order of the sorted corner pairs.
+    /// Groups gain the mid-edge nodes of edges whose two corners are both in the group. A
+    /// mesh that is already second-order is returned unchanged.
+    ///
+    /// ```
+    /// use modal_bake::mesh::TetMesh;
+    /// let p1 = TetMesh::structured_box([1, 1, 1], [1.0, 1.0, 1.0]);
+    /// let p2 = p1.to_quadratic();
+    /// assert_eq!(p2.nodes.len(), 8 + 19); // 12 box edges, 6 face diagonals, 1 main diagonal
+    /// assert!(p2.is_quadratic());
+    /// ```
+    pub fn to_quadratic(&self) -> TetMesh {
+        if self.is_quadratic() {
+            return self.clone();
+        }
+        let mut edges: Vec<[usize; 2]> = Vec::with_capacity(self.tets.len() * 6);
+        for t in &self.tets {
+            for [a, b] in TET10_EDGES {
+                let (p, q) = (t[a].min(t[b]), t[a].max(t[b]));
+                edges.push([p, q]);
+            }
+        }
+        edges.sort_unstable();
+        edges.dedup();
+        let n0 = self.nodes.len();
+        let mut nodes = self.nodes.clone();
+        nodes.extend(edges.iter().map(|&[a, b]| {
+            let (x, y) = (self.nodes[a], self.nodes[b]);
+            [
+                0.5 * (x[0] + y[0]),
+                0.5 * (x[1] + y[1]),
+                0.5 * (x[2] + y[2]),
+            ]
+        }));
+        let node_of = |a: usize, b: usize| {
+            let key = [a.min(b), a.max(b)];
+            n0 + edges.binary_search(&key).expect("every tet edge is listed")
+        };
+        let mid_edges = self
+            .tets
+            .iter()
+            .map(|t| TET10_EDGES.map(|[a, b]| node_of(t[a], t[b])))
+            .collect();
+        let mut groups = self.groups.clone();
+        for set in groups.values_mut() {
+            let mut member = vec![false; n0];
+            for &v in set.iter() {
+                member[v] = true;
+            }
+            set.extend(
+                edges
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, &[a, b])| member[a] && member[b])
+                    .map(|(i, _)| n0 + i),
+            );
+        }
+        TetMesh {
+            nodes,
+            tets: self.tets.clone(),
+            tet_ids: self.tet_ids.clone(),
+            triangles: self.triangles.clone(),
+            groups,
+            notes: self.notes.clone(),
+            mid_edges,
         }
     }
 

@@ -21,8 +21,9 @@ pub use reference_pairs::{sample_points, PairsParams, ReferencePairs, SamplePoin
 
 use std::sync::Arc;
 
+use dcr_runtime::filter::{samples_per_step, Sampling};
 use dcr_runtime::format::{AccuracyRecord, ModesFile};
-use dcr_runtime::{samples_per_step, Method, ModalModel, Sampling};
+use dcr_runtime::{Method, ModalModel};
 
 use crate::bake::{bake_mesh, BakeError, BakeParams, BakeReport, BakeStage, ModeRequest};
 use crate::full_order::{FullOrderSystem, ModalAll, SystemParams};

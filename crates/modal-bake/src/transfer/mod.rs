@@ -2,7 +2,7 @@
 //! Lagrange interpolant on its triangles (vertices; edge midpoints for P2; two points per edge
 //! and face centroids for P3), `T[i][j]` = peak over one step h of `|n_jᵀ u_j(t)|` at point j
 //! after a unit inward-normal impulse (1 N·s along −n_i) at point i, summed over MANY modes
-//! (Rayleigh damping of the base, exact impulse responses `g_l(t)` of `dcr_runtime::ModeFilter`,
+//! (Rayleigh damping of the base, exact impulse responses `g_l(t)` of `dcr_runtime::filter::ModeFilter`,
 //! samples t = k·h/S, k = 1..S). A point's normal row is the barycentric blend of its vertices'.
 //!
 //! With `w_il = n_iᵀ U_il` (the runtime's area-weighted vertex normals) the response is

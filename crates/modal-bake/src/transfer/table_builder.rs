@@ -27,8 +27,9 @@
 
 use std::collections::HashMap;
 
+use dcr_runtime::filter::{damping_ratio, samples_per_step, ModeFilter};
 use dcr_runtime::format::{ModesFile, TransferTable, MAX_TRANSFER_POINTS};
-use dcr_runtime::{damping_ratio, samples_per_step, ModalModel, ModeFilter, Sampling};
+use dcr_runtime::{ModalModel, Sampling};
 use faer::linalg::matmul::matmul;
 use faer::{Accum, Mat, Par};
 use rayon::prelude::*;

@@ -1,0 +1,325 @@
+//! Atomic file replacement: a file is written under a temporary name beside its destination
+//! and renamed over it only when complete, so a reader sees the old file or the new one, never
+//! a part, and a failed write leaves nothing behind.
+//!
+//! Temporary names are `.NAME.tmp-HOST-PID-UNIQUE`: the host (sanitised) and process id of the
+//! writer, and 64 random bits, so two writers never collide — not two threads of one process,
+//! not two processes with one pid on two hosts sharing a file system. The name says who wrote
+//! it, which is how temporaries of writers that died (SIGKILL, power loss) are found: every new
+//! [`AtomicFile`] for a destination first removes its stale temporaries — those of a process
+//! on this host that no longer runs, and any older than [`STALE_AFTER`] (a writer on another
+//! host, whose liveness cannot be seen, or a pid since reused).
+//!
+//! Signals: the temporaries being written are registered process-wide; a signal handler (the
+//! `modal-bake` binary installs one for SIGINT, SIGTERM and SIGHUP) calls
+//! [`remove_pending_temporaries`] before the process ends. SIGKILL cannot be caught: its
+//! temporary is removed by the next write of the same destination.
+//!
+//! Why not `tempfile::NamedTempFile::persist`: its random names do not say which process wrote
+//! them, so temporaries of dead writers could not be told from those being written.
+
+use std::fs::{File, OpenOptions};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Mutex;
+use std::time::Duration;
+
+use super::modes_file::FormatError;
+use super::regular_file::describe_file_type;
+
+/// Age after which a temporary is stale whoever wrote it (a write takes seconds, not hours).
+pub const STALE_AFTER: Duration = Duration::from_secs(3600);
+
+/// Temporaries being written by this process (removed by [`remove_pending_temporaries`]).
+static PENDING: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+/// Per-process counter mixed into the random part of temporary names.
+static COUNTER: AtomicU64 = AtomicU64::new(0);
+
+/// Removes every temporary this process is writing; for signal handlers before the process
+/// ends (the writes in progress are lost, their destinations untouched). Returns how many were
+/// removed.
+pub fn remove_pending_temporaries() -> usize {
+    let pending = match PENDING.lock() {
+        Ok(p) => p,
+        Err(poisoned) => poisoned.into_inner(),
+    };
+    pending
+        .iter()
+        .filter(|p| std::fs::remove_file(p).is_ok())
+        .count()
+}
+
+fn register(path: &Path) {
+    if let Ok(mut p) = PENDING.lock() {
+        p.push(path.to_path_buf());
+    }
+}
+
+fn deregister(path: &Path) {
+    if let Ok(mut p) = PENDING.lock() {
+        p.retain(|q| q != path);
+    }
+}
+
+fn is_pending(path: &Path) -> bool {
+    PENDING.lock().is_ok_and(|p| p.iter().any(|q| q == path))
+}
+
+/// This host's name reduced to `[A-Za-z0-9_]` (at most 32 characters; `host` if unknown).
+fn host_tag() -> String {
+    let raw = std::fs::read_to_string("/proc/sys/kernel/hostname")
+        .or_else(|_| std::env::var("HOSTNAME"))
+        .unwrap_or_default();
+    let tag: String = raw
+        .trim()
+        .chars()
+        .take(32)
+        .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
+        .collect();
+    if tag.is_empty() {
+        "host".into()
+    } else {
+        tag
+    }
+}
+
+/// 64 bits that differ between calls and between processes.
+fn unique_bits() -> u64 {
+    use std::hash::BuildHasher;
+    let n = COUNTER.fetch_add(1, Ordering::Relaxed);
+    let nanos = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_nanos() as u64);
+    // `RandomState` keys are random per process.
+    std::collections::hash_map::RandomState::new().hash_one((n, nanos, std::process::id()))
+}
+
+/// The prefix every temporary of `name` starts with.
+fn temp_prefix(name: &str) -> String {
+    format!(".{name}.tmp-")
+}
+
+/// Who wrote a temporary, from its name: (host, pid); the host is `None` in the older
+/// `.NAME.tmp-PID` form.
+fn parse_temp(suffix: &str) -> Option<(Option<&str>, u32)> {
+    let parts: Vec<&str> = suffix.rsplitn(3, '-').collect();
+    match parts.as_slice() {
+        [pid] => Some((None, pid.parse().ok()?)),
+        [_unique, pid, host] => Some((Some(host), pid.parse().ok()?)),
+        _ => None,
+    }
+}
+
+/// Whether process `pid` runs on this host (unknown: assumed running).
+fn process_alive(pid: u32) -> bool {
+    let proc = Path::new("/proc");
+    if proc.join("self").exists() {
+        proc.join(pid.to_string()).exists()
+    } else {
+        true
+    }
+}
+
+/// Removes the stale temporaries of `name` in `dir` (see the module docs); returns how many.
+fn remove_stale(dir: &Path, name: &str) -> usize {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return 0;
+    };
+    let prefix = temp_prefix(name);
+    let host = host_tag();
+    let me = std::process::id();
+    let mut removed = 0;
+    for entry in entries.flatten() {
+        let file_name = entry.file_name();
+        let Some(suffix) = file_name.to_str().and_then(|f| f.strip_prefix(&prefix)) else {
+            continue;
+        };
+        let path = entry.path();
+        if is_pending(&path) {
+            continue;
+        }
+        let dead_here = match parse_temp(suffix) {
+            Some((h, pid)) if h.is_none_or(|h| h == host) => pid == me || !process_alive(pid),
+            _ => false,
+        };
+        let old = entry
+            .metadata()
+            .and_then(|m| m.modified())
+            .ok()
+            .and_then(|t| t.elapsed().ok())
+            .is_some_and(|age| age > STALE_AFTER);
+        if (dead_here || old) && std::fs::remove_file(&path).is_ok() {
+            removed += 1;
+        }
+    }
+    removed
+}
+
+/// A file being written under a temporary name beside `dest`; [`AtomicFile::commit`] renames
+/// it over `dest`, dropping it uncommitted removes it.
+///
+/// ```
+/// use std::io::Write;
+/// let dir = tempfile::tempdir().unwrap();
+/// let dest = dir.path().join("out.bin");
+/// let mut f = dcr_runtime::format::AtomicFile::create(&dest).unwrap();
+/// f.write_all(b"complete").unwrap();
+/// f.commit().unwrap();
+/// assert_eq!(std::fs::read(&dest).unwrap(), b"complete");
+/// ```
+#[derive(Debug)]
+pub struct AtomicFile {
+    file: Option<File>,
+    tmp: PathBuf,
+    dest: PathBuf,
+}
+
+impl AtomicFile {
+    /// Starts writing `dest`: removes its stale temporaries, then creates a new temporary
+    /// beside it (never an existing file).
+    ///
+    /// # Errors
+    /// [`FormatError::Clobber`] when `dest` exists and is not a regular file (a directory,
+    /// device, FIFO or socket: renaming over it would replace it); [`FormatError::Io`] when
+    /// the temporary cannot be created (missing folder, permissions, ...).
+    pub fn create(dest: &Path) -> Result<AtomicFile, FormatError> {
+        let io = |source| FormatError::Io {
+            path: dest.to_path_buf(),
+            source,
+        };
+        check_replaceable(dest)?;
+        let dir = dest
+            .parent()
+            .filter(|d| !d.as_os_str().is_empty())
+            .unwrap_or(Path::new("."));
+        let name = dest
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .ok_or_else(|| {
+                io(std::io::Error::new(
+                    std::io::ErrorKind::InvalidInput,
+                    "the path names no file",
+                ))
+            })?;
+        remove_stale(dir, &name);
+        let tmp = dir.join(format!(
+            "{}{}-{}-{:016x}",
+            temp_prefix(&name),
+            host_tag(),
+            std::process::id(),
+            unique_bits()
+        ));
+        register(&tmp);
+        match OpenOptions::new().write(true).create_new(true).open(&tmp) {
+            Ok(file) => Ok(AtomicFile {
+                file: Some(file),
+                tmp,
+                dest: dest.to_path_buf(),
+            }),
+            Err(e) => {
+                deregister(&tmp);
+                Err(io(e))
+            }
+        }
+    }
+
+    /// The temporary's path (for tests and messages).
+    pub fn temporary_path(&self) -> &Path {
+        &self.tmp
+    }
+
+    /// Syncs the temporary to disk and renames it over the destination.
+    ///
+    /// # Errors
+    /// [`FormatError::Io`]; the temporary is removed and the destination left untouched.
+    pub fn commit(mut self) -> Result<(), FormatError> {
+        let result = (|| {
+            let file = self
+                .file
+                .take()
+                .ok_or_else(|| std::io::Error::other("the temporary was already closed"))?;
+            file.sync_all()?;
+            drop(file);
+            check_replaceable(&self.dest).map_err(|e| std::io::Error::other(e.to_string()))?;
+            std::fs::rename(&self.tmp, &self.dest)
+        })();
+        match result {
+            Ok(()) => {
+                deregister(&self.tmp);
+                // Make the rename itself durable (best effort: not every platform can).
+                if let Some(dir) = self.dest.parent().filter(|d| !d.as_os_str().is_empty()) {
+                    let _ = File::open(dir).and_then(|d| d.sync_all());
+                }
+                Ok(())
+            }
+            Err(source) => Err(FormatError::Io {
+                path: self.dest.clone(),
+                source,
+            }),
+        }
+    }
+}
+
+impl Write for AtomicFile {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        match &mut self.file {
+            Some(f) => f.write(buf),
+            None => Err(std::io::Error::other("the temporary was already closed")),
+        }
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        match &mut self.file {
+            Some(f) => f.flush(),
+            None => Ok(()),
+        }
+    }
+}
+
+impl Drop for AtomicFile {
+    fn drop(&mut self) {
+        // Uncommitted (or a failed commit): the temporary goes.
+        drop(self.file.take());
+        if is_pending(&self.tmp) {
+            let _ = std::fs::remove_file(&self.tmp);
+            deregister(&self.tmp);
+        }
+    }
+}
+
+/// `dest` may be replaced by a file: it does not exist or is a regular file (a symbolic link
+/// to one is replaced by the file).
+fn check_replaceable(dest: &Path) -> Result<(), FormatError> {
+    match std::fs::metadata(dest) {
+        Ok(meta) if !meta.is_file() => Err(FormatError::Clobber {
+            path: dest.to_path_buf(),
+            what: describe_file_type(meta.file_type()),
+        }),
+        _ => Ok(()),
+    }
+}
+
+/// Writes `bytes` to `dest` atomically ([`AtomicFile`]).
+///
+/// # Errors
+/// As [`AtomicFile::create`] and [`AtomicFile::commit`].
+pub fn write_atomic(dest: &Path, bytes: &[u8]) -> Result<(), FormatError> {
+    let mut f = AtomicFile::create(dest)?;
+    f.write_all(bytes).map_err(|source| FormatError::Io {
+        path: dest.to_path_buf(),
+        source,
+    })?;
+    f.commit()
+}
+
+#[cfg(test)]
+pub(crate) fn stale_removed(dir: &Path, name: &str) -> usize {
+    remove_stale(dir, name)
+}
+
+#[cfg(test)]
+pub(crate) fn this_host_tag() -> String {
+    host_tag()
+}

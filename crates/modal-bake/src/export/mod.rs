@@ -1,0 +1,209 @@
+//! Mode shapes out of a `.modes` base, in the formats artists and viewers open:
+//!
+//! - [`write_modes_vtu`]: the surface as a VTK XML unstructured grid (`.vtu`, ParaView,
+//!   meshio) with one point-data vector array per mode (m, object frame);
+//! - [`write_modes_glb`]: the surface as binary glTF 2.0 (`.glb`, Blender, three.js) with one
+//!   morph target and one animation per mode;
+//! - [`render_contact_sheet`] / [`write_modes_png`]: a PNG contact sheet of the lowest modes
+//!   (displacement magnitude as colour, fixed camera from the bounding box; the paper's Fig. 2),
+//!   rendered on the CPU.
+//!
+//! [`GltfBuilder`] is the small glTF/GLB assembler both this module and `dcr-scenes` use.
+//!
+//! A mode shape is a column of the M-orthonormal basis U (m·kg^-½): vertex v moves by
+//! `U[v, :, j] · q_j` for a modal coordinate q_j (kg^½·m). Exports show each mode with q_j
+//! chosen so that its largest vertex displacement is a stated length (see each writer).
+//!
+//! Every writer draws the same surface (`ExportSurface`): the base's vertices and outward linear
+//! triangles.
+
+mod contact_sheet;
+mod gltf_builder;
+mod mode_gltf;
+mod mode_vtu;
+mod raster;
+
+use std::path::{Path, PathBuf};
+
+use dcr_runtime::format::ModesFile;
+
+pub use contact_sheet::{render_contact_sheet, write_modes_png, SheetParams};
+pub use gltf_builder::{extras_of, GltfBuilder, GLTF_GENERATOR};
+pub use mode_gltf::{write_modes_glb, ModeGltfParams};
+pub use mode_vtu::write_modes_vtu;
+
+/// What went wrong writing an export.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum ExportError {
+    /// Operating-system I/O error on `path`.
+    #[error("{path}: {source}")]
+    Io {
+        /// File concerned.
+        path: PathBuf,
+        /// Underlying error.
+        source: std::io::Error,
+    },
+    /// The encoder refused the content (VTK XML, PNG).
+    #[error("{path}: cannot encode: {detail}")]
+    Encode {
+        /// File concerned.
+        path: PathBuf,
+        /// What the encoder said.
+        detail: String,
+    },
+    /// Options that cannot be honoured (no modes selected, a mode index out of range, a
+    /// non-positive scale...).
+    #[error("{0}")]
+    Invalid(String),
+}
+
+/// The selected modes' label, e.g. `mode_01_12.3Hz`: 1-based mode number (two digits at
+/// least) and frequency (Hz, one decimal; three significant digits below 1 Hz).
+///
+/// ```
+/// assert_eq!(modal_bake::export::mode_label(0, 12.34), "mode_01_12.3Hz");
+/// assert_eq!(modal_bake::export::mode_label(11, 0.0432), "mode_12_0.0432Hz");
+/// ```
+pub fn mode_label(j: usize, hz: f64) -> String {
+    if hz >= 1.0 {
+        format!("mode_{:02}_{:.1}Hz", j + 1, hz)
+    } else {
+        format!("mode_{:02}_{}Hz", j + 1, format_sig(hz, 3))
+    }
+}
+
+fn format_sig(x: f64, digits: i32) -> String {
+    if x == 0.0 {
+        return "0".into();
+    }
+    let e = x.abs().log10().floor() as i32;
+    let decimals = (digits - 1 - e).max(0) as usize;
+    format!("{:.*}", decimals, x)
+}
+
+/// The default number of exported modes: every mode of the base up to 20.
+pub const DEFAULT_EXPORT_MODES: usize = 20;
+
+/// Checks a mode count against the base: `Some(n)` must be in 1..=m; `None` gives
+/// min(m, [`DEFAULT_EXPORT_MODES`]). Returns the count (the lowest n modes are exported).
+///
+/// # Errors
+/// [`ExportError::Invalid`] when the base has no modes or `n` is 0 or above m.
+pub fn select_modes(base: &ModesFile, n: Option<usize>) -> Result<usize, ExportError> {
+    let m = base.num_modes();
+    if m == 0 {
+        return Err(ExportError::Invalid("the base has no modes".into()));
+    }
+    match n {
+        None => Ok(m.min(DEFAULT_EXPORT_MODES)),
+        Some(0) => Err(ExportError::Invalid("--modes must be at least 1".into())),
+        Some(n) if n > m => Err(ExportError::Invalid(format!(
+            "--modes {n}: the base has only {m} modes"
+        ))),
+        Some(n) => Ok(n),
+    }
+}
+
+/// The surface an export shows: vertices, linear triangles and per-vertex mode rows.
+///
+/// Built once per export by [`ExportSurface::of`] from the base's corner vertices and linear
+/// triangles (the one place to split second-order 6-node triangles into four linear ones
+/// through their mid-edge nodes; bases carrying mid-edge rows are shown by their corners).
+pub(crate) struct ExportSurface {
+    /// Vertex positions (m, object frame).
+    pub positions: Vec<[f64; 3]>,
+    /// Outward triangles (indices into `positions`).
+    pub triangles: Vec<[u32; 3]>,
+    /// Volume-mesh node of each vertex.
+    pub volume_node: Vec<u32>,
+    /// Mode rows (v, 3, m) row-major, m·kg^-½.
+    modes: Vec<f64>,
+    m: usize,
+}
+
+impl ExportSurface {
+    pub fn of(base: &ModesFile) -> ExportSurface {
+        ExportSurface {
+            positions: base.surface_vertices.clone(),
+            triangles: base.surface_triangles.clone(),
+            volume_node: base.surface_to_volume.clone(),
+            modes: base.modes.clone(),
+            m: base.num_modes(),
+        }
+    }
+
+    /// Number of vertices.
+    pub fn len(&self) -> usize {
+        self.positions.len()
+    }
+
+    /// Mode j's displacement of vertex v (m per unit modal coordinate, object frame).
+    pub fn mode_vec(&self, v: usize, j: usize) -> [f64; 3] {
+        let (m, r) = (self.m, v * 3 * self.m);
+        [
+            self.modes[r + j],
+            self.modes[r + m + j],
+            self.modes[r + 2 * m + j],
+        ]
+    }
+
+    /// Largest vertex displacement norm of mode j (m per unit modal coordinate).
+    pub fn mode_max_norm(&self, j: usize) -> f64 {
+        (0..self.len())
+            .map(|v| {
+                let u = self.mode_vec(v, j);
+                (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt()
+            })
+            .fold(0.0, f64::max)
+    }
+}
+
+/// Axis-aligned bounding box (min, max) of the surface (m, object frame).
+pub(crate) fn bounding_box(points: &[[f64; 3]]) -> ([f64; 3], [f64; 3]) {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for p in points {
+        for a in 0..3 {
+            lo[a] = lo[a].min(p[a]);
+            hi[a] = hi[a].max(p[a]);
+        }
+    }
+    (lo, hi)
+}
+
+/// Length of the bounding-box diagonal (m).
+pub(crate) fn diagonal(points: &[[f64; 3]]) -> f64 {
+    let (lo, hi) = bounding_box(points);
+    ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2) + (hi[2] - lo[2]).powi(2)).sqrt()
+}
+
+/// Writes `bytes` to `path` through a temporary file beside it (`tempfile`) and a rename: on
+/// failure nothing is left behind and an existing `path` is untouched.
+///
+/// # Errors
+/// I/O errors, naming `path`.
+pub fn write_file_atomic(path: &Path, bytes: &[u8]) -> Result<(), ExportError> {
+    use std::io::Write;
+    let io = |source| ExportError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let dir = path
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(".export-");
+    // Readable like any file the user creates (tempfile's default is owner-only).
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        builder.permissions(std::fs::Permissions::from_mode(0o644));
+    }
+    let mut tmp = builder.tempfile_in(dir).map_err(io)?;
+    tmp.write_all(bytes).map_err(io)?;
+    tmp.as_file().sync_all().map_err(io)?;
+    tmp.persist(path).map_err(|e| io(e.error))?;
+    Ok(())
+}

@@ -1,0 +1,365 @@
+//! Tetrahedralization of a checked surface ([`crate::mesh::surface`]) with the real gmsh.
+//!
+//! gmsh is run as a program: the `gmsh` binary (Debian package `gmsh`, or the launcher the PyPI
+//! `gmsh` package installs) or the PyPI package's Python module (`python3` importing `gmsh`),
+//! found on `PATH` or given explicitly. The surface is handed over as an MSH 2.2 file of
+//! triangles (exact decimal coordinates) with a `.geo` script that, by default, classifies it
+//! into patches (feature angle 40°), rebuilds a geometry and remeshes it at the requested size
+//! (gmsh tutorial t13), or keeps the asset's triangles as the boundary (`keep_surface`), then
+//! fills the volume (Frontal-Delaunay 2D, Delaunay 3D). Second order uses straight-sided
+//! elements (`Mesh.SecondOrderLinear = 1`), which the P2 assembly requires.
+//!
+//! Determinism: one thread (`General.NumThreads = 1`), fixed algorithms and `Mesh.RandomSeed`;
+//! the same surface, size, order and gmsh version give the same mesh.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::time::Instant;
+
+use super::surface::SurfaceMesh;
+use super::{MeshError, TetMesh};
+
+/// How to install gmsh, for the error when none is found.
+pub const INSTALL_HINT: &str = "install it with `pip install gmsh` (PyPI, ships the gmsh library and a `gmsh` launcher) \
+     or `apt-get install gmsh` (Debian), or pass --gmsh PATH (a gmsh executable, or the PyPI package's gmsh.py)";
+
+/// Meshing parameters (SI).
+#[derive(Clone, Debug, PartialEq)]
+pub struct GmshParams {
+    /// Target element size (m); `None`: [`default_size`] of the surface's bounding box.
+    pub size: Option<f64>,
+    /// Element order: 1 (4-node tetrahedra) or 2 (10-node, straight-sided). Default 1.
+    pub order: u8,
+    /// The gmsh to run: an executable, or a `gmsh.py` (or the folder holding it) run with
+    /// `python3`; `None`: `gmsh` on `PATH`, else `python3 -c "import gmsh"`.
+    pub gmsh: Option<PathBuf>,
+    /// Keep the asset's triangles as the boundary mesh instead of remeshing it at `size`
+    /// (for surfaces gmsh cannot reparametrize; the tetrahedra then follow the asset's
+    /// triangle sizes near the surface). Default false.
+    pub keep_surface: bool,
+}
+
+impl Default for GmshParams {
+    fn default() -> Self {
+        GmshParams {
+            size: None,
+            order: 1,
+            gmsh: None,
+            keep_surface: false,
+        }
+    }
+}
+
+/// What a gmsh run reports.
+#[derive(Clone, Debug, Default, serde::Serialize)]
+pub struct GmshInfo {
+    /// How gmsh was run (`gmsh` path, or `python3 + gmsh module`).
+    pub program: String,
+    /// gmsh's version string.
+    pub version: String,
+    /// Element size used (m).
+    pub size_m: f64,
+    /// Element order.
+    pub order: u8,
+    /// Wall-clock seconds in gmsh.
+    pub seconds: f64,
+}
+
+/// A gmsh result: the mesh, gmsh's MSH 4.1 binary file as written, and the run's facts.
+#[derive(Clone, Debug)]
+pub struct GmshOutput {
+    /// The tetrahedral mesh read back (m).
+    pub mesh: TetMesh,
+    /// The `.msh` bytes gmsh wrote (what `modal-bake mesh` saves).
+    pub msh: Vec<u8>,
+    /// Version, size, time.
+    pub info: GmshInfo,
+}
+
+/// Why meshing failed.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum GmshError {
+    /// No gmsh could be found or started.
+    #[error("gmsh not found ({detail}); {INSTALL_HINT}")]
+    NotFound {
+        /// What was tried.
+        detail: String,
+    },
+    /// Invalid parameters.
+    #[error("{0}")]
+    Params(String),
+    /// Writing the input or reading the output failed.
+    #[error("gmsh work files: {0}")]
+    Io(String),
+    /// gmsh ran but produced no mesh.
+    #[error("gmsh {version} failed to mesh {file}: {detail}")]
+    Failed {
+        /// The surface file.
+        file: String,
+        /// gmsh's version.
+        version: String,
+        /// gmsh's error lines (or exit status).
+        detail: String,
+    },
+    /// gmsh's output could not be read.
+    #[error(transparent)]
+    Mesh(#[from] MeshError),
+}
+
+/// Default element size (m): 1/20 of the bounding-box diagonal.
+pub fn default_size(bbox: [[f64; 3]; 2]) -> f64 {
+    let d: f64 = (0..3).map(|k| (bbox[1][k] - bbox[0][k]).powi(2)).sum();
+    d.sqrt() / 20.0
+}
+
+/// A way to run gmsh.
+#[derive(Clone, Debug)]
+enum Launcher {
+    /// A gmsh executable taking gmsh's command line.
+    Binary(PathBuf),
+    /// `python3` importing the `gmsh` module (from `dir` when given).
+    Python(Option<PathBuf>),
+}
+
+const PY_RUN: &str = "import sys\nif sys.argv[1]: sys.path.insert(0, sys.argv[1])\nimport gmsh\n\
+     gmsh.initialize(['gmsh'] + sys.argv[2:], readConfigFiles=False, run=True)\ngmsh.finalize()\n";
+const PY_VERSION: &str =
+    "import sys\nif sys.argv[1]: sys.path.insert(0, sys.argv[1])\nimport gmsh\nprint(gmsh.__version__)\n";
+
+impl Launcher {
+    fn command(&self, script: &str) -> Command {
+        match self {
+            Launcher::Binary(p) => Command::new(p),
+            Launcher::Python(dir) => {
+                let mut c = Command::new("python3");
+                c.arg("-c").arg(script).arg(
+                    dir.as_ref()
+                        .map(|d| d.display().to_string())
+                        .unwrap_or_default(),
+                );
+                c
+            }
+        }
+    }
+
+    fn describe(&self) -> String {
+        match self {
+            Launcher::Binary(p) => p.display().to_string(),
+            Launcher::Python(Some(d)) => format!("python3 + gmsh module in {}", d.display()),
+            Launcher::Python(None) => "python3 + gmsh module".into(),
+        }
+    }
+
+    /// gmsh's version, or `None` when it does not run.
+    fn version(&self) -> Option<String> {
+        let out = match self {
+            Launcher::Binary(_) => self.command("").arg("--version").output().ok()?,
+            Launcher::Python(_) => self.command(PY_VERSION).output().ok()?,
+        };
+        if !out.status.success() {
+            return None;
+        }
+        let text = String::from_utf8_lossy(&out.stdout).to_string()
+            + &String::from_utf8_lossy(&out.stderr);
+        let v = text.split_whitespace().next()?.to_string();
+        v.chars().next()?.is_ascii_digit().then_some(v)
+    }
+}
+
+fn on_path(name: &str) -> Option<PathBuf> {
+    let path = std::env::var_os("PATH")?;
+    std::env::split_paths(&path)
+        .map(|d| d.join(name))
+        .find(|p| p.is_file())
+}
+
+/// Finds gmsh: `explicit` (an executable, a `gmsh.py`, or a folder holding `gmsh.py`), else
+/// `gmsh` on `PATH`, else the `gmsh` Python module. Returns how to run it and its version.
+fn find_gmsh(explicit: Option<&Path>) -> Result<(Launcher, String), GmshError> {
+    let mut tried = Vec::new();
+    let candidates: Vec<Launcher> = match explicit {
+        Some(p) if p.is_dir() => vec![Launcher::Python(Some(p.to_path_buf()))],
+        Some(p) if p.extension().is_some_and(|e| e == "py") => {
+            vec![Launcher::Python(p.parent().map(Path::to_path_buf))]
+        }
+        Some(p) => vec![Launcher::Binary(p.to_path_buf())],
+        None => {
+            let mut c = Vec::new();
+            if let Some(p) = on_path("gmsh") {
+                c.push(Launcher::Binary(p));
+            }
+            c.push(Launcher::Python(None));
+            c
+        }
+    };
+    for l in candidates {
+        match l.version() {
+            Some(v) => return Ok((l, v)),
+            None => tried.push(l.describe()),
+        }
+    }
+    Err(GmshError::NotFound {
+        detail: if tried.is_empty() {
+            "nothing to try".into()
+        } else {
+            format!("tried {}", tried.join(", "))
+        },
+    })
+}
+
+/// The version of the gmsh [`tetrahedralize`] would run.
+///
+/// # Errors
+/// [`GmshError::NotFound`] with installation instructions.
+pub fn gmsh_version(explicit: Option<&Path>) -> Result<String, GmshError> {
+    find_gmsh(explicit).map(|(_, v)| v)
+}
+
+/// The surface as an MSH 2.2 ASCII file of 3-node triangles (shortest round-trip decimals:
+/// gmsh reads back the exact doubles).
+fn surface_msh(surface: &SurfaceMesh) -> String {
+    use std::fmt::Write;
+    let mut s = String::with_capacity(64 * (surface.vertices.len() + surface.triangles.len()));
+    s.push_str("$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n");
+    let _ = writeln!(s, "{}", surface.vertices.len());
+    for (i, p) in surface.vertices.iter().enumerate() {
+        let _ = writeln!(s, "{} {:?} {:?} {:?}", i + 1, p[0], p[1], p[2]);
+    }
+    s.push_str("$EndNodes\n$Elements\n");
+    let _ = writeln!(s, "{}", surface.triangles.len());
+    for (i, t) in surface.triangles.iter().enumerate() {
+        let _ = writeln!(
+            s,
+            "{} 2 2 1 1 {} {} {}",
+            i + 1,
+            t[0] + 1,
+            t[1] + 1,
+            t[2] + 1
+        );
+    }
+    s.push_str("$EndElements\n");
+    s
+}
+
+/// The `.geo` script meshing `surface.msh` into `volume.msh`.
+fn geo_script(size: f64, order: u8, keep_surface: bool) -> String {
+    let remesh = if keep_surface {
+        ""
+    } else {
+        "ClassifySurfaces{40 * Pi / 180, 1, 1, Pi};\nCreateGeometry;\n"
+    };
+    format!(
+        "General.NumThreads = 1;\n\
+         General.Terminal = 1;\n\
+         Mesh.RandomSeed = 1;\n\
+         Mesh.Algorithm = 6;\n\
+         Mesh.Algorithm3D = 1;\n\
+         Mesh.MeshSizeMax = {size:?};\n\
+         Mesh.MeshSizeFromCurvature = 0;\n\
+         Mesh.ElementOrder = {order};\n\
+         Mesh.SecondOrderLinear = 1;\n\
+         Mesh.MshFileVersion = 4.1;\n\
+         Mesh.Binary = 1;\n\
+         Mesh.SaveAll = 0;\n\
+         Merge \"surface.msh\";\n\
+         {remesh}\
+         Surface Loop(1) = Surface{{:}};\n\
+         Volume(1) = {{1}};\n\
+         Physical Volume(\"volume\") = {{1}};\n"
+    )
+}
+
+/// Fills a checked, outward-oriented closed surface (m) with tetrahedra using gmsh, in a
+/// temporary folder that is removed afterwards. `file` names the asset in messages.
+///
+/// # Errors
+/// [`GmshError`]: gmsh missing (with how to install it), invalid size or order, gmsh failing
+/// (its error lines), or an unreadable result.
+pub fn tetrahedralize(
+    surface: &SurfaceMesh,
+    params: &GmshParams,
+    file: &str,
+) -> Result<GmshOutput, GmshError> {
+    if !matches!(params.order, 1 | 2) {
+        return Err(GmshError::Params(format!(
+            "--order must be 1 or 2, got {}",
+            params.order
+        )));
+    }
+    let size = match params.size {
+        Some(s) if !(s.is_finite() && s > 0.0) => {
+            return Err(GmshError::Params(format!(
+                "--size must be a positive length in metres, got {s}"
+            )))
+        }
+        Some(s) => s,
+        None => default_size(surface.bounding_box()),
+    };
+    let (launcher, version) = find_gmsh(params.gmsh.as_deref())?;
+    let io = |e: std::io::Error| GmshError::Io(e.to_string());
+    let dir = tempfile::Builder::new()
+        .prefix("modal-bake-gmsh")
+        .tempdir()
+        .map_err(io)?;
+    std::fs::write(dir.path().join("surface.msh"), surface_msh(surface)).map_err(io)?;
+    std::fs::write(
+        dir.path().join("volume.geo"),
+        geo_script(size, params.order, params.keep_surface),
+    )
+    .map_err(io)?;
+    let args = [
+        "volume.geo",
+        "-3",
+        "-nt",
+        "1",
+        "-o",
+        "volume.msh",
+        "-v",
+        "4",
+    ];
+    let t = Instant::now();
+    let mut cmd = launcher.command(PY_RUN);
+    cmd.args(args).current_dir(dir.path());
+    let out = cmd.output().map_err(|e| GmshError::NotFound {
+        detail: format!("{}: {e}", launcher.describe()),
+    })?;
+    let seconds = t.elapsed().as_secs_f64();
+    let text =
+        String::from_utf8_lossy(&out.stdout).to_string() + &String::from_utf8_lossy(&out.stderr);
+    let errors: Vec<&str> = text
+        .lines()
+        .filter(|l| l.trim_start().starts_with("Error"))
+        .collect();
+    let result = dir.path().join("volume.msh");
+    if !out.status.success() || !errors.is_empty() || !result.is_file() {
+        let detail = if errors.is_empty() {
+            format!("exit status {}, no mesh written", out.status)
+        } else {
+            errors.join("; ")
+        };
+        let hint = if params.keep_surface {
+            ""
+        } else {
+            " (if the surface cannot be reparametrized, try --keep-surface)"
+        };
+        return Err(GmshError::Failed {
+            file: file.to_string(),
+            version,
+            detail: format!("{detail}{hint}"),
+        });
+    }
+    let msh = std::fs::read(&result).map_err(io)?;
+    let mesh = super::read_msh_bytes(&msh, &format!("{file} (meshed by gmsh)"))?;
+    Ok(GmshOutput {
+        mesh,
+        msh,
+        info: GmshInfo {
+            program: launcher.describe(),
+            version,
+            size_m: size,
+            order: params.order,
+            seconds,
+        },
+    })
+}

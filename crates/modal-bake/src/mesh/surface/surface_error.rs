@@ -1,0 +1,132 @@
+//! [`SurfaceError`]: why a surface asset cannot be meshed.
+
+/// Why a surface asset (OBJ, STL, PLY) was refused. Every variant names the file; defects of
+/// the surface give a position in metres (after the unit scaling) so it can be found in a
+/// modelling tool.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum SurfaceError {
+    /// The file could not be read.
+    #[error("{file}: cannot read file: {detail}")]
+    Io {
+        /// The file.
+        file: String,
+        /// What the operating system said.
+        detail: String,
+    },
+    /// The extension is not one of `.obj`, `.stl`, `.ply`.
+    #[error("{file}: unrecognised surface format (expected .obj, .stl or .ply)")]
+    UnknownFormat {
+        /// The file.
+        file: String,
+    },
+    /// The format's parser refused the file.
+    #[error("{file}: invalid {format} file: {detail}")]
+    Parse {
+        /// The file.
+        file: String,
+        /// `OBJ`, `STL` or `PLY`.
+        format: &'static str,
+        /// What the parser said.
+        detail: String,
+    },
+    /// No triangle in the file.
+    #[error("{file}: the file holds no triangles")]
+    Empty {
+        /// The file.
+        file: String,
+    },
+    /// A coordinate is NaN or infinite.
+    #[error("{file}: vertex {vertex} has a non-finite coordinate")]
+    NonFinite {
+        /// The file.
+        file: String,
+        /// 0-based vertex index in the file.
+        vertex: usize,
+    },
+    /// A face names a vertex that does not exist.
+    #[error("{file}: face {face} names vertex {vertex}, but the file has {count} vertices")]
+    BadIndex {
+        /// The file.
+        file: String,
+        /// 0-based face index.
+        face: usize,
+        /// The index named.
+        vertex: i64,
+        /// Vertices in the file.
+        count: usize,
+    },
+    /// A triangle with two equal corners or zero area.
+    #[error("{file}: triangle {triangle} is degenerate (zero area) at ({:.6}, {:.6}, {:.6}) m", at[0], at[1], at[2])]
+    Degenerate {
+        /// The file.
+        file: String,
+        /// 0-based triangle index (after polygon triangulation).
+        triangle: usize,
+        /// Its first corner (m).
+        at: [f64; 3],
+    },
+    /// An edge with one triangle: the surface has a hole.
+    #[error(
+        "{file}: the surface is not closed: open edge from ({:.6}, {:.6}, {:.6}) to ({:.6}, {:.6}, {:.6}) m \
+         ({open_edges} open edges in all); fill the hole in the modelling tool",
+        a[0], a[1], a[2], b[0], b[1], b[2]
+    )]
+    OpenEdge {
+        /// The file.
+        file: String,
+        /// One end of the first open edge (m).
+        a: [f64; 3],
+        /// The other end (m).
+        b: [f64; 3],
+        /// Number of open edges.
+        open_edges: usize,
+    },
+    /// An edge shared by more than two triangles.
+    #[error(
+        "{file}: non-manifold edge from ({:.6}, {:.6}, {:.6}) to ({:.6}, {:.6}, {:.6}) m, shared by {triangles} triangles",
+        a[0], a[1], a[2], b[0], b[1], b[2]
+    )]
+    NonManifoldEdge {
+        /// The file.
+        file: String,
+        /// One end (m).
+        a: [f64; 3],
+        /// The other end (m).
+        b: [f64; 3],
+        /// Triangles on the edge.
+        triangles: usize,
+    },
+    /// A vertex where two separate fans of triangles touch (e.g. two cones tip to tip).
+    #[error("{file}: non-manifold vertex at ({:.6}, {:.6}, {:.6}) m: {fans} separate fans of triangles meet there", at[0], at[1], at[2])]
+    NonManifoldVertex {
+        /// The file.
+        file: String,
+        /// Its position (m).
+        at: [f64; 3],
+        /// Fans meeting at it.
+        fans: usize,
+    },
+    /// Two neighbouring triangles with opposite orientations.
+    #[error(
+        "{file}: inconsistent orientation: the two triangles on the edge from ({:.6}, {:.6}, {:.6}) to ({:.6}, {:.6}, {:.6}) m \
+         run the same way (recalculate normals in the modelling tool)",
+        a[0], a[1], a[2], b[0], b[1], b[2]
+    )]
+    Orientation {
+        /// The file.
+        file: String,
+        /// One end (m).
+        a: [f64; 3],
+        /// The other end (m).
+        b: [f64; 3],
+    },
+    /// Several separate closed shells.
+    #[error("{file}: the surface has {shells} separate closed shells; export and bake each object on its own")]
+    Shells {
+        /// The file.
+        file: String,
+        /// Number of shells.
+        shells: usize,
+    },
+}
