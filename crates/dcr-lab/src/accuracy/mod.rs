@@ -32,6 +32,9 @@ pub struct AccuracyOptions {
     pub only: Vec<String>,
     /// Fewer method rows and no attenuation fit (a pipeline check).
     pub quick: bool,
+    /// Impacts of the objects whose truth is Newmark (its cost grows with them); `None`:
+    /// [`IMPACTS`] like every other object.
+    pub newmark_impacts: Option<usize>,
 }
 
 /// The goal the report checks: median and worst |error| (%) over the pairs.
@@ -54,7 +57,7 @@ pub fn generate(root: &Path, out_dir: &Path, opts: &AccuracyOptions) -> anyhow::
             continue;
         }
         let mesh = load_mesh(&spec, root).map_err(|e| anyhow::anyhow!("{}: {e}", spec.source))?;
-        studies.push(study_object(&spec, mesh, opts.quick));
+        studies.push(study_object(&spec, mesh, opts.quick, opts.newmark_impacts));
     }
     let fits = if opts.quick {
         Vec::new()
@@ -103,9 +106,33 @@ fn header(md: &mut String, date: &str, load: &str, opts: &AccuracyOptions) {
         "# Accuracy of the distant response vs the full-order truth\n"
     );
     let _ = writeln!(md, "Regenerate everything on this page (tables and `docs/accuracy/*.svg`) with\n\n```sh\nscripts/accuracy.sh          # = cargo build --release -p dcr-lab && target/release/dcr-lab accuracy --out docs\n```\n\nDo not edit by hand. Generated {date} on 2 shared cores (load average at the start: {}){}.\n", load.split_whitespace().take(3).collect::<Vec<_>>().join(" "), if opts.quick { " — QUICK RUN, not the full study" } else { "" });
+    if !opts.only.is_empty() || opts.newmark_impacts.is_some() {
+        let all: Vec<&str> = all_objects().iter().map(|o| o.name).collect();
+        let skipped: Vec<&str> = all
+            .iter()
+            .copied()
+            .filter(|n| !opts.only.is_empty() && !opts.only.iter().any(|o| o == n))
+            .collect();
+        let mut cmd = String::from("dcr-lab accuracy --out docs");
+        for o in &opts.only {
+            let _ = write!(cmd, " --only {o}");
+        }
+        if let Some(n) = opts.newmark_impacts {
+            let _ = write!(cmd, " --newmark-impacts {n}");
+        }
+        if opts.quick {
+            cmd.push_str(" --quick");
+        }
+        let _ = writeln!(md, "**This page is a reduced run**: `{cmd}`.{}{}\n",
+            if skipped.is_empty() { String::new() } else { format!(" Objects left out: {}.", skipped.join(", ")) },
+            match opts.newmark_impacts {
+                Some(n) => format!(" Objects whose truth is Newmark (more than {} free dofs) use {n} impacts instead of {IMPACTS}: the truth's cost grows with the impacts, the pairs' contacts and the verdict's rules are unchanged.", modal_bake::transfer::DENSE_MAX_DOFS),
+                None => String::new(),
+            });
+    }
     let _ = writeln!(md, "## Set-up\n");
     let _ = writeln!(md, "- Objects: every elastic object of the six scenes, with the material and fixed groups its scene bakes, and a thick slab (4 × 4 × 0.3 m, E = 10 GPa, ρ = 500 kg/m³, bottom fixed). Each has a **region**: the surface its scene touches (upward faces, or boxes), where its table is built and where the points are drawn.");
-    let _ = writeln!(md, "- Points (seed 2): {IMPACTS} impacts × {CONTACTS} resting contacts in the region, each a third at region vertices, a third at triangle centroids and a third at uniformly random points inside triangles; {IMPULSE} N·s into the surface (−normal) at t = 0; pairs closer than {MIN_DISTANCE} m left out. `at vertices` / `inside triangles`: the contact's kind (impacts of all kinds).");
+    let _ = writeln!(md, "- Points (seed 2): {IMPACTS} impacts (unless the object says fewer) × {CONTACTS} resting contacts in the region, each a third at region vertices, a third at triangle centroids and a third at uniformly random points inside triangles; {IMPULSE} N·s into the surface (−normal) at t = 0; pairs closer than {MIN_DISTANCE} m left out. `at vertices` / `inside triangles`: the contact's kind (impacts of all kinds).");
     let _ = writeln!(md, "- Quantity: the peak |normal displacement| over one rigid-body step h = {H} s (Eq. 11; Δv = peak/h, Eq. 12). Error = (method − truth)/truth in %.");
     let _ = writeln!(md, "- **Truth**: the full-order FEM response (P1 tets, every dof; Rayleigh 10 1/s, 1e-7 s): the exact sum over every elastic mode (dense eigensolve) up to 6000 free dofs, else implicit Newmark (β = ¼, γ = ½). Either way the step starts at {TRUTH_DT0:e} s (the dense sum at 8 samples per period of its top mode, if finer) and is halved until no peak changes by more than 0.5 % over two successive halvings (`dcr-lab truth` does the same); the step reached, the estimated error (the larger of those two changes) and, for the dense sum, its difference from Newmark at that step are given per object.");
     let _ = writeln!(md, "- **Methods**, read and stepped through `DistantResponse` as an engine does (`carry_over = false`): the modal filters over m modes (paper T sampling; 20 = the paper's choice and the cost reference); the paper's spatial attenuation s = C/r with the 20-mode local amplitude and the C that best fits the truth; and the bake-time transfer table (`Method::Transfer`) in a 20-mode base, built from every mode where the dense solve fits and 640 Lanczos modes elsewhere, at the default order (cubic where the table has at most 5792 points, else quadratic) — **the default of `modal-bake bake MESH --transfer-h H --transfer-up AXIS`, marked ★**, which the verdict is about — and variants (quadratic; 160 modes).");
@@ -216,8 +243,8 @@ fn object_section(md: &mut String, s: &ObjectStudy) {
     };
     let _ = writeln!(
         md,
-        "- region: {region}, {} vertices; {} pairs",
-        s.region, s.pairs
+        "- region: {region}, {} vertices; {} impacts × {} contacts, {} pairs",
+        s.region, s.points.0, s.points.1, s.pairs
     );
     let levels: Vec<String> = s
         .truth

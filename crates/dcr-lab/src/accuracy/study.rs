@@ -86,6 +86,8 @@ pub struct ObjectStudy {
     pub cross_check: Option<(String, f64)>,
     /// Seconds of the truth (eigensolve or factorizations, and every level).
     pub truth_s: f64,
+    /// Impacts and resting contacts sampled.
+    pub points: (usize, usize),
     /// Pairs evaluated (distance ≥ [`MIN_DISTANCE`]).
     pub pairs: usize,
     /// Every method, cheapest first.
@@ -184,8 +186,15 @@ impl Bench<'_> {
     }
 }
 
-/// The full study of one object (see the module docs). `quick`: fewer rows.
-pub fn study_object(spec: &ObjectSpec, mesh: TetMesh, quick: bool) -> ObjectStudy {
+/// The full study of one object (see the module docs). `quick`: fewer rows; `newmark_impacts`:
+/// impacts for an object whose truth is Newmark (more than [`DENSE_MAX_DOFS`] free dofs; each
+/// impact is one more Newmark run at every level of the refinement), [`IMPACTS`] when `None`.
+pub fn study_object(
+    spec: &ObjectSpec,
+    mesh: TetMesh,
+    quick: bool,
+    newmark_impacts: Option<usize>,
+) -> ObjectStudy {
     let name = spec.name;
     let file = spec.source.clone();
     let (nodes, tets) = (mesh.nodes.len(), mesh.tets.len());
@@ -215,8 +224,12 @@ pub fn study_object(spec: &ObjectSpec, mesh: TetMesh, quick: bool) -> ObjectStud
     let dense = dofs <= DENSE_MAX_DOFS;
     let ma = dense.then(|| ModalAll::new(&sys, DENSE_MAX_DOFS).expect("dense eigensolve"));
     let dense_s = t.elapsed().as_secs_f64();
+    let impacts = match newmark_impacts {
+        Some(n) if !dense => n,
+        _ => IMPACTS,
+    };
     let pp = PairsParams {
-        impacts: IMPACTS,
+        impacts,
         contacts: CONTACTS,
         seed: 2,
         min_distance: MIN_DISTANCE,
@@ -442,6 +455,7 @@ pub fn study_object(spec: &ObjectSpec, mesh: TetMesh, quick: bool) -> ObjectStud
         truth: pairs.truth.clone(),
         cross_check,
         truth_s,
+        points: (pairs.impacts.len(), pairs.resting.len()),
         pairs: pairs.pairs(),
         rows: out,
         attenuation_c: c_fit,

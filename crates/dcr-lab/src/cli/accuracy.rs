@@ -21,6 +21,11 @@ pub struct AccuracyArgs {
     /// Fewer method rows and no attenuation fit (a pipeline check).
     #[arg(long)]
     pub quick: bool,
+    /// Impacts of the objects whose truth is Newmark (the scaffold and the cliff: more than
+    /// 6000 free dofs; every impact is one more Newmark solve at each step of every level of
+    /// the refinement). Default: the same 6 as every object.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..=6))]
+    pub newmark_impacts: Option<u64>,
 }
 
 pub fn run(args: &AccuracyArgs) -> anyhow::Result<()> {
@@ -33,6 +38,7 @@ pub fn run(args: &AccuracyArgs) -> anyhow::Result<()> {
     let opts = AccuracyOptions {
         only: args.only.clone(),
         quick: args.quick,
+        newmark_impacts: args.newmark_impacts.map(|n| n as usize),
     };
     let md = dcr_lab::accuracy::generate(&args.root, &args.out, &opts)?;
     let path = args.out.join("accuracy.md");
