@@ -671,8 +671,7 @@ fn boundary_faces(tets: &[[usize; 4]]) -> Vec<[usize; 3]> {
 /// [`boundary_faces`] for node indices below 2^[`PACK_BITS`] and fewer than 2^30 tets: the
 /// sorted node triple packed into one u64 (same order as the triples) beside the face's
 /// number: 16-byte elements sort about twice as fast as the 48-byte (triple, face)
-/// pairs (measured on the bake bench beams: 3k 1.1–1.9 vs 2.0–3.0 ms, 15k 4.9–7.4 vs
-/// 8.9–17.8 ms for the whole surface extraction). Same result.
+/// pairs (docs/benchmarks.md, "Design measurements"). Same result.
 fn boundary_faces_packed(tets: &[[usize; 4]]) -> Vec<[usize; 3]> {
     let mut faces: Vec<(u64, u32)> = Vec::with_capacity(tets.len() * 4);
     for (t, &tet) in tets.iter().enumerate() {

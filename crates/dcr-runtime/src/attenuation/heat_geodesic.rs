@@ -160,8 +160,8 @@ impl std::fmt::Debug for HeatGeodesic {
 
 impl HeatGeodesic {
     /// Factor size (stored entries) from which a [`HeatWorkspace::set_parallel`] query forks:
-    /// below it, two `rayon::join`s (≈ 10–30 µs each on the 2-core test machine) cost more
-    /// than half the sweeps save.
+    /// below it, two `rayon::join`s cost more than half the sweeps save
+    /// (docs/benchmarks.md, "Design measurements").
     pub const PARALLEL_MIN_ENTRIES: usize = 20_000;
 
     /// Builds and factors the operators for a surface (vertices in m, any consistent orientation).

@@ -140,10 +140,8 @@ struct PanelRows<'a> {
 }
 
 /// [`PanelRows::run`] under `pulp` dispatch: AVX2 lanes, with the same operations per lane
-/// and no fused products, so the same bits as the portable (SSE2) path. Measured in-process,
-/// interleaved (best of 30 each): 3.5k dofs, M × 8 columns 0.187 vs 0.232 ms, K × 20 columns
-/// with |K||x| 2.05 vs 2.56 ms; at 13.5k dofs, where the panels leave L2, 1.10 vs 1.17 ms and
-/// 8.6–11.4 vs 11.9–12.5 ms.
+/// and no fused products, so the same bits as the portable (SSE2) path, and faster
+/// (docs/benchmarks.md, "Design measurements").
 struct AbsKernel<'a, const ABS: bool>(PanelRows<'a>);
 
 impl PanelRows<'_> {
@@ -196,10 +194,7 @@ const SPMM_SEQ_BELOW: usize = 20_000;
 ///
 /// The Lanczos products are tall and skinny (n × ≤ 100 against n × b, or n × ≤ 100 times a
 /// small matrix), memory-bound, and faer 0.24.4's parallel path is much slower on them than
-/// its sequential one: measured on 2 cores at n = 108 900 (the 100k bake bench beam),
-/// `Vᵀ Z` with V n × 48 and Z n × 6 took 164–200 ms with `Par::rayon(2)` against 9.6–9.8 ms
-/// with `Par::Seq` (n × 20 against n × 20: 64–142 ms vs 4.9–5.8 ms), and `Z − V C` 13–20 ms
-/// against 11.3–11.4 ms.
+/// its sequential one (up to 20× on 2 cores at n = 108 900; docs/benchmarks.md, "Design measurements").
 pub(crate) fn gemm(
     dst: MatMut<'_, f64>,
     accum: Accum,
