@@ -84,7 +84,6 @@ use sha2::{Digest, Sha256};
 use crate::eigen::{self, EigenError, EigenParams, EigenProgress};
 use crate::fem::{self, Material, MaterialError};
 use crate::mesh::{tet_faces, MeshError, DEFAULT_DEGENERATE_REL_TOL, DEFAULT_STRAIGHT_REL_TOL};
-use dcr_runtime::attenuation::HeatGeodesic;
 use dcr_runtime::format::{FormatError, ModesMeta, QuadraticSurface};
 
 /// Version of what `modal-bake` writes for given inputs, stored in every base
@@ -590,7 +589,7 @@ impl Surface {
         }
         let triangles: Vec<[u32; 3]> = tris.iter().map(|t| t.map(|v| local[v])).collect();
         let positions: Vec<[f64; 3]> = nodes.iter().map(|&v| mesh.nodes[v]).collect();
-        let order = HeatGeodesic::plan_ordering(&positions, &triangles).ok();
+        let order = crate::ordering::plan_surface_order(&positions, &triangles).ok();
         let (mut edges, mut edge_nodes) = (Vec::new(), Vec::new());
         if mesh.is_quadratic() {
             edges = QuadraticSurface::edges_of(&triangles);
@@ -1227,7 +1226,8 @@ pub fn mesh_base_status(
     // A base without the stored heat-geodesic order (baked before it existed, or written
     // elsewhere) is stale when this tool would store one.
     let order_matches = base.surface_order.is_some()
-        || HeatGeodesic::plan_ordering(&base.surface_vertices, &base.surface_triangles).is_err();
+        || crate::ordering::plan_surface_order(&base.surface_vertices, &base.surface_triangles)
+            .is_err();
     if output_version != Some(&serde_json::json!(OUTPUT_VERSION)) || !order_matches {
         return Ok(BaseStatus::ToolChanged);
     }
