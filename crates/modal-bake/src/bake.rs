@@ -40,6 +40,12 @@ pub struct BakeParams {
     pub lumped: bool,
     /// Storage precision of the surface mode shapes.
     pub precision: ModesPrecision,
+    /// The bake-time peak-transfer table ([`crate::transfer`]) to build over the base; `None`
+    /// (the default) for none. Not serialized, so not part of [`BakeParams::hash`]: a bake
+    /// records the table's parameters in `meta.bake_params.transfer` and staleness checks
+    /// compare them on their own.
+    #[serde(skip)]
+    pub transfer: Option<crate::transfer::TransferParams>,
 }
 
 /// A half-space selector of fixed nodes: every node whose coordinate `axis` is ≤ `value`.
@@ -73,6 +79,7 @@ impl Default for BakeParams {
             rayleigh: [10.0, 1e-7],
             lumped: false,
             precision: ModesPrecision::F64,
+            transfer: None,
         }
     }
 }
@@ -161,7 +168,7 @@ pub enum BakeError {
     /// Writing or reading the `.modes` file failed.
     #[error(transparent)]
     Format(#[from] FormatError),
-    /// The peak-transfer table could not be built (`--transfer-h`); nothing is written.
+    /// The peak-transfer table ([`BakeParams::transfer`]) could not be built; nothing is written.
     #[error("{file}: {error}")]
     Transfer {
         /// Mesh file.
@@ -223,29 +230,57 @@ pub struct BakeReport {
     pub notes: Vec<String>,
     /// Geometry hash stored in the base.
     pub source_hash: String,
-    /// Seconds computing the transfer table's modes (0 without a table or when the base's own
-    /// modes sufficed).
-    pub transfer_modes_s: f64,
-    /// Seconds building the transfer table (0 without one).
-    pub transfer_s: f64,
-    /// Transfer table: region vertices (0: no table).
-    pub transfer_vertices: usize,
-    /// Transfer table: region edges whose points are tabulated.
-    pub transfer_edges: usize,
-    /// Transfer table: interpolation order (1, 2, 3; 0 without a table).
-    pub transfer_order: u8,
-    /// Transfer table: points (vertices, edge and face points).
-    pub transfer_points: usize,
-    /// Transfer table: modes summed.
-    pub transfer_modes: usize,
-    /// Transfer table: samples per step.
-    pub transfer_samples: usize,
-    /// Transfer table: where its modes came from (`base`, `dense`, `lanczos`).
-    pub transfer_mode_source: String,
+    /// The peak-transfer table's figures (`None` without a table).
+    pub transfer: Option<TransferReport>,
     /// Bounding-box diagonal of the mesh (m).
     pub extent_m: f64,
     /// The output's folder, when the bake had to create it ([`bake_file`]).
     pub created_folder: Option<String>,
+}
+
+/// What a bake reports about the peak-transfer table it built ([`BakeParams::transfer`]).
+#[derive(Clone, Debug, Default, serde::Serialize)]
+pub struct TransferReport {
+    /// Seconds computing the table's modes (0 when the base's own modes sufficed).
+    pub modes_s: f64,
+    /// Seconds building the table.
+    pub build_s: f64,
+    /// Region vertices.
+    pub vertices: usize,
+    /// Region edges whose points are tabulated.
+    pub edges: usize,
+    /// Interpolation order (1, 2, 3).
+    pub order: u8,
+    /// Points (vertices, edge and face points).
+    pub points: usize,
+    /// Modes summed.
+    pub modes: usize,
+    /// Samples per step.
+    pub samples: usize,
+    /// Where its modes came from (`base`, `dense`, `lanczos`).
+    pub mode_source: String,
+}
+
+impl TransferReport {
+    /// The figures of `table`, with the mode source and timings (s) given.
+    pub fn of(
+        table: &dcr_runtime::format::TransferTable,
+        mode_source: &str,
+        modes_s: f64,
+        build_s: f64,
+    ) -> Self {
+        TransferReport {
+            modes_s,
+            build_s,
+            vertices: table.len(),
+            edges: table.edges.len(),
+            order: table.order,
+            points: table.num_points(),
+            modes: table.modes as usize,
+            samples: table.samples as usize,
+            mode_source: mode_source.to_string(),
+        }
+    }
 }
 
 /// Progress of a bake, for a CLI bar.
@@ -284,30 +319,32 @@ impl BakeParams {
         )?;
         match self.modes {
             ModeRequest::Count(0) => {
-                return Err(BakeError::Params("--modes must be at least 1".into()))
+                return Err(BakeError::Params(
+                    "modes: the mode count must be at least 1".into(),
+                ))
             }
             ModeRequest::Count(n) if n > 5000 => {
                 return Err(BakeError::Params(format!(
-                    "--modes {n} is more than the supported 5000"
+                    "modes: {n} modes is more than the supported 5000"
                 )))
             }
             ModeRequest::MaxFreqHz(f) if !(f.is_finite() && f > 0.0) => {
                 return Err(BakeError::Params(format!(
-                    "--max-freq must be a positive frequency in Hz, got {f}"
+                    "modes: the maximum frequency must be positive (Hz), got {f}"
                 )))
             }
             _ => {}
         }
         if !self.rayleigh.iter().all(|x| x.is_finite() && *x >= 0.0) {
             return Err(BakeError::Params(format!(
-                "--rayleigh coefficients must be finite and ≥ 0, got {:?}",
+                "rayleigh: the coefficients must be finite and ≥ 0, got {:?}",
                 self.rayleigh
             )));
         }
         for b in &self.fixed_below {
             if b.axis > 2 || !b.value.is_finite() {
                 return Err(BakeError::Params(format!(
-                    "--fixed-below needs an axis x, y or z and a finite value in m, got axis {} value {}",
+                    "fixed_below: needs an axis 0, 1 or 2 (x, y, z) and a finite value in m, got axis {} value {}",
                     b.axis, b.value
                 )));
             }
@@ -315,7 +352,7 @@ impl BakeParams {
         for b in &self.fixed_boxes {
             if !b.iter().all(|x| x.is_finite()) || (0..3).any(|k| b[k] > b[k + 3]) {
                 return Err(BakeError::Params(format!(
-                    "--fixed-box {b:?}: expected finite X0,Y0,Z0,X1,Y1,Z1 (m) with each minimum ≤ its maximum"
+                    "fixed_boxes: {b:?}: expected finite [x0, y0, z0, x1, y1, z1] (m) with each minimum ≤ its maximum"
                 )));
             }
         }
@@ -436,7 +473,7 @@ fn select_fixed(
         let nodes = mesh.group_nodes(name).map_err(name_file)?.to_vec();
         if nodes.is_empty() {
             return Err(BakeError::Params(format!(
-                "{file}: --fixed {name} fixes no node (the group has no node on the tetrahedra)"
+                "{file}: fixed group {name} fixes no node (the group has no node on the tetrahedra)"
             )));
         }
         out.push((format!("group {name}"), nodes));
@@ -447,7 +484,7 @@ fn select_fixed(
             .collect();
         if nodes.is_empty() {
             return Err(BakeError::Params(format!(
-                "{file}: --fixed-below {b} fixes no node ({})",
+                "{file}: fixed_below {b} fixes no node ({})",
                 extent()
             )));
         }
@@ -459,7 +496,7 @@ fn select_fixed(
             .collect();
         if nodes.is_empty() {
             return Err(BakeError::Params(format!(
-                "{file}: --fixed-box {} fixes no node ({})",
+                "{file}: fixed_boxes {} fixes no node ({})",
                 bx.map(|x| x.to_string()).join(","),
                 extent()
             )));
@@ -517,7 +554,7 @@ fn prepare(mut mesh: TetMesh, params: &BakeParams, file: &str) -> Result<Prepare
     }
     if !fixed.is_empty() && fixed.len() == mesh.nodes.len() {
         return Err(BakeError::Params(format!(
-            "{file}: --fixed fixes every node; nothing can vibrate"
+            "{file}: the fixed-node selectors fix every node; nothing can vibrate"
         )));
     }
     let hash = geometry_hash(&mesh, &fixed);
@@ -694,7 +731,32 @@ fn boundary_faces_packed(tets: &[[usize; 4]]) -> Vec<[usize; 3]> {
     tris
 }
 
-/// Bakes the modal base of an in-memory mesh. `file` names the source in messages.
+/// Bakes the modal base of an in-memory mesh, with the peak-transfer table when
+/// [`BakeParams::transfer`] asks for one. `file` names the source in messages.
+///
+/// The table ([`crate::transfer`]) covers the selected region and is built from the base's own
+/// modes when it keeps enough, else from the dense all-mode eigensolve (≤
+/// [`crate::transfer::DENSE_MAX_DOFS`] free dofs) or a Lanczos bake with that many modes. Its
+/// parameters are recorded in `meta.bake_params.transfer`; `params_hash` does not depend on
+/// them (the table is checked by its own entries: h, Rayleigh, modes).
+///
+/// # Errors
+/// A [`BakeError`] naming the file and what failed; [`BakeError::Transfer`] when the table
+/// cannot be built.
+pub fn bake_mesh(
+    mesh: TetMesh,
+    params: &BakeParams,
+    file: &str,
+    progress: &mut dyn FnMut(BakeStage),
+) -> Result<(ModesFile, BakeReport), BakeError> {
+    match &params.transfer {
+        None => bake_modes(mesh, params, file, progress),
+        Some(tp) => bake_with_table(mesh, params, tp, file, progress),
+    }
+}
+
+/// The modal base of an in-memory mesh, without a transfer table (whatever
+/// [`BakeParams::transfer`] says).
 ///
 /// Steps: orient tetrahedra (inverted ones are flipped and counted, degenerate ones are an
 /// error), refuse disconnected meshes, fix the named groups, assemble K and M, solve
@@ -703,7 +765,7 @@ fn boundary_faces_packed(tets: &[[usize; 4]]) -> Vec<[usize; 3]> {
 ///
 /// # Errors
 /// A [`BakeError`] naming the file and what failed.
-pub fn bake_mesh(
+fn bake_modes(
     mesh: TetMesh,
     params: &BakeParams,
     file: &str,
@@ -744,7 +806,7 @@ pub fn bake_mesh(
     let wanted = params.min_modes() + rigid;
     if wanted > map.n_free() {
         return Err(BakeError::Params(format!(
-            "{file}: --modes {}: at most {} modes for this mesh (3 × {} nodes − {} fixed dofs{} = {})",
+            "{file}: modes = {}: at most {} modes for this mesh (3 × {} nodes − {} fixed dofs{} = {})",
             params.min_modes(),
             map.n_free().saturating_sub(rigid),
             mesh.nodes.len(),
@@ -927,26 +989,15 @@ pub fn bake_mesh(
     Ok((base, report))
 }
 
-/// As [`bake_mesh`], plus (with `transfer`) the bake-time peak-transfer table
-/// ([`crate::transfer`]) over the selected region, built from the base's own modes when it
-/// keeps enough, else from the dense all-mode eigensolve (≤ [`crate::transfer::DENSE_MAX_DOFS`]
-/// free dofs) or a Lanczos bake with that many modes. The table's parameters are recorded in
-/// `meta.bake_params.transfer`; `params_hash` stays that of `params` (the table is checked by
-/// its own entries: h, Rayleigh, modes).
-///
-/// # Errors
-/// As [`bake_mesh`]; [`BakeError::Transfer`] when the table cannot be built.
-pub fn bake_mesh_with_transfer(
+/// The base of `mesh` with the peak-transfer table `tp` (see [`bake_mesh`]).
+fn bake_with_table(
     mesh: TetMesh,
     params: &BakeParams,
-    transfer: Option<&crate::transfer::TransferParams>,
+    tp: &crate::transfer::TransferParams,
     file: &str,
     progress: &mut dyn FnMut(BakeStage),
 ) -> Result<(ModesFile, BakeReport), BakeError> {
     use crate::transfer::{self as tr, TransferModes};
-    let Some(tp) = transfer else {
-        return bake_mesh(mesh, params, file, progress);
-    };
     let terr = |error| BakeError::Transfer {
         file: file.to_string(),
         error: Box::new(error),
@@ -954,36 +1005,35 @@ pub fn bake_mesh_with_transfer(
     tp.check().map_err(terr)?;
     if mesh.is_quadratic() {
         return Err(terr(tr::TransferError::Params(
-            "--transfer-h is not supported for second-order (10-node) meshes: the table interpolates P1 midpoint rows; bake the linear mesh for a table".into(),
+            "transfer: a peak-transfer table is not supported for second-order (10-node) meshes: the table interpolates P1 midpoint rows; bake the linear mesh for a table".into(),
         )));
     }
-    let (mut base, mut report) = bake_mesh(mesh.clone(), params, file, progress)?;
+    let (mut base, mut report) = bake_modes(mesh.clone(), params, file, progress)?;
     let t = Instant::now();
     let tp = &tr::TransferParams {
         modes: tp.modes.resolve(report.free_dofs),
         ..tp.clone()
     };
     let enough = matches!(tp.modes, TransferModes::Count(n) if n <= base.num_modes());
-    let set = if enough {
-        report.transfer_mode_source = "base".into();
-        None
+    let (set, mode_source) = if enough {
+        (None, "base")
     } else if report.free_dofs <= tr::DENSE_MAX_DOFS {
         progress(BakeStage::TransferModes);
-        report.transfer_mode_source = "dense".into();
-        Some(tr::mode_set_dense(&base, &mesh, params, tp.modes, file).map_err(terr)?)
+        let set = tr::mode_set_dense(&base, &mesh, params, tp.modes, file).map_err(terr)?;
+        (Some(set), "dense")
     } else {
         let TransferModes::Count(n) = tp.modes else {
             return Err(terr(tr::TransferError::Params(format!(
-                "--transfer-modes all needs the dense eigensolve, but the mesh has {} free dofs (limit {}); give a count",
+                "transfer.modes = all needs the dense eigensolve, but the mesh has {} free dofs (limit {}); give a count",
                 report.free_dofs,
                 tr::DENSE_MAX_DOFS
             ))));
         };
         progress(BakeStage::TransferModes);
-        report.transfer_mode_source = "lanczos".into();
-        Some(tr::mode_set_lanczos(&mesh, params, n, file).map_err(terr)?)
+        let set = tr::mode_set_lanczos(&mesh, params, n, file).map_err(terr)?;
+        (Some(set), "lanczos")
     };
-    report.transfer_modes_s = t.elapsed().as_secs_f64();
+    let modes_s = t.elapsed().as_secs_f64();
     let t = Instant::now();
     let table = tr::build_transfer_table(
         set.as_ref().unwrap_or(&base),
@@ -992,13 +1042,12 @@ pub fn bake_mesh_with_transfer(
         &mut |p| progress(BakeStage::Transfer(p)),
     )
     .map_err(terr)?;
-    report.transfer_s = t.elapsed().as_secs_f64();
-    report.transfer_vertices = table.len();
-    report.transfer_edges = table.edges.len();
-    report.transfer_order = table.order;
-    report.transfer_points = table.num_points();
-    report.transfer_modes = table.modes as usize;
-    report.transfer_samples = table.samples as usize;
+    report.transfer = Some(TransferReport::of(
+        &table,
+        mode_source,
+        modes_s,
+        t.elapsed().as_secs_f64(),
+    ));
     if let Some(obj) = base.meta.bake_params.as_object_mut() {
         obj.insert("transfer".into(), transfer_meta(tp));
     }
@@ -1007,7 +1056,7 @@ pub fn bake_mesh_with_transfer(
 }
 
 /// The record of a transfer table's parameters in `meta.bake_params.transfer` (what
-/// [`is_up_to_date_with_transfer`] compares).
+/// [`base_status`] compares).
 fn transfer_meta(tp: &crate::transfer::TransferParams) -> serde_json::Value {
     use crate::transfer::TransferModes;
     serde_json::json!({
@@ -1030,8 +1079,9 @@ fn transfer_meta(tp: &crate::transfer::TransferParams) -> serde_json::Value {
     })
 }
 
-/// Reads `mesh_path`, bakes it and writes `out` atomically (nothing is left on failure),
-/// creating `out`'s folder if it is missing ([`BakeReport::created_folder`]).
+/// Reads `mesh_path`, bakes it ([`bake_mesh`], with the transfer table when `params` asks for
+/// one) and writes `out` atomically (nothing is left on failure), creating `out`'s folder if it
+/// is missing ([`BakeReport::created_folder`]).
 ///
 /// # Errors
 /// A [`BakeError`] naming the file and what failed.
@@ -1041,31 +1091,11 @@ pub fn bake_file(
     out: &Path,
     progress: &mut dyn FnMut(BakeStage),
 ) -> Result<BakeReport, BakeError> {
-    bake_file_with_transfer(mesh_path, params, None, out, progress)
-}
-
-/// As [`bake_file`], with an optional peak-transfer table ([`bake_mesh_with_transfer`]).
-///
-/// # Errors
-/// A [`BakeError`] naming the file and what failed.
-pub fn bake_file_with_transfer(
-    mesh_path: &Path,
-    params: &BakeParams,
-    transfer: Option<&crate::transfer::TransferParams>,
-    out: &Path,
-    progress: &mut dyn FnMut(BakeStage),
-) -> Result<BakeReport, BakeError> {
     progress(BakeStage::Read);
     let t = Instant::now();
     let mesh = crate::mesh::read_mesh(mesh_path)?;
     let read_s = t.elapsed().as_secs_f64();
-    let (base, mut report) = bake_mesh_with_transfer(
-        mesh,
-        params,
-        transfer,
-        &mesh_path.display().to_string(),
-        progress,
-    )?;
+    let (base, mut report) = bake_mesh(mesh, params, &mesh_path.display().to_string(), progress)?;
     report.read_s = read_s;
     progress(BakeStage::Write);
     let t = Instant::now();
@@ -1084,8 +1114,9 @@ pub fn bake_file_with_transfer(
 }
 
 /// Whether `modes` is an up-to-date base of `mesh_path` baked with `params`: it exists, reads,
-/// its stored geometry and parameter hashes equal those of this mesh and these parameters, and
-/// it holds the heat-geodesic `surface_order` a bake would store.
+/// its stored geometry and parameter hashes equal those of this mesh and these parameters, it
+/// holds the heat-geodesic `surface_order` a bake would store, and its peak-transfer table
+/// matches [`BakeParams::transfer`] (see [`base_status`]).
 ///
 /// `Ok(false)` when the base is missing, unreadable or stale.
 ///
@@ -1096,23 +1127,7 @@ pub fn is_up_to_date(
     params: &BakeParams,
     modes: &Path,
 ) -> Result<bool, BakeError> {
-    is_up_to_date_with_transfer(mesh_path, params, None, modes)
-}
-
-/// As [`is_up_to_date`], also for the peak-transfer table: `transfer` as passed to
-/// [`bake_file_with_transfer`]. A base is stale when it has a table and none is asked for, has
-/// none and one is asked for, or its table was built with other parameters (step h, modes,
-/// region, up direction, oversampling).
-///
-/// # Errors
-/// As [`is_up_to_date`]; invalid transfer parameters.
-pub fn is_up_to_date_with_transfer(
-    mesh_path: &Path,
-    params: &BakeParams,
-    transfer: Option<&crate::transfer::TransferParams>,
-    modes: &Path,
-) -> Result<bool, BakeError> {
-    Ok(base_status(mesh_path, params, transfer, modes)? == BaseStatus::UpToDate)
+    Ok(base_status(mesh_path, params, modes)? == BaseStatus::UpToDate)
 }
 
 /// Whether a base is up to date, and if not why (what `modal-bake check --json` reports).
@@ -1152,9 +1167,12 @@ impl BaseStatus {
     }
 }
 
-/// Compares the base at `modes` with what a bake of `mesh_path` with `params` (and `transfer`)
-/// would write: by content hashes of the parsed geometry and of the parameters, and the
-/// [`OUTPUT_VERSION`] of the tool that wrote it — never by file times.
+/// Compares the base at `modes` with what a bake of `mesh_path` with `params` would write: by
+/// content hashes of the parsed geometry and of the parameters, the [`OUTPUT_VERSION`] of the
+/// tool that wrote it, and the recorded transfer-table parameters — never by file times. A
+/// base is stale when it has a table and none is asked for, has none and one is asked for, or
+/// its table was built with other parameters (step h, modes, region, up direction,
+/// oversampling, order).
 ///
 /// # Errors
 /// A [`BakeError`] when the mesh itself cannot be read or prepared, or the parameters are
@@ -1162,23 +1180,18 @@ impl BaseStatus {
 pub fn base_status(
     mesh_path: &Path,
     params: &BakeParams,
-    transfer: Option<&crate::transfer::TransferParams>,
     modes: &Path,
 ) -> Result<BaseStatus, BakeError> {
     let file = mesh_path.display().to_string();
-    check_options(params, transfer, &file)?;
+    check_options(params, &file)?;
     let mesh = crate::mesh::read_mesh(mesh_path)?;
-    mesh_base_status(mesh, &file, params, transfer, modes)
+    mesh_base_status(mesh, &file, params, modes)
 }
 
 /// Checks the bake and transfer-table parameters (what `check` exits 2 on before any mesh work).
-fn check_options(
-    params: &BakeParams,
-    transfer: Option<&crate::transfer::TransferParams>,
-    file: &str,
-) -> Result<(), BakeError> {
+fn check_options(params: &BakeParams, file: &str) -> Result<(), BakeError> {
     params.check()?;
-    if let Some(tp) = transfer {
+    if let Some(tp) = &params.transfer {
         tp.check().map_err(|error| BakeError::Transfer {
             file: file.to_string(),
             error: Box::new(error),
@@ -1187,7 +1200,7 @@ fn check_options(
     Ok(())
 }
 
-/// As [`is_up_to_date_with_transfer`] for a mesh already in memory (e.g. one gmsh made from a
+/// As [`is_up_to_date`] for a mesh already in memory (e.g. one gmsh made from a
 /// surface asset); `file` names it in messages.
 ///
 /// # Errors
@@ -1196,10 +1209,9 @@ pub fn is_mesh_up_to_date(
     mesh: TetMesh,
     file: &str,
     params: &BakeParams,
-    transfer: Option<&crate::transfer::TransferParams>,
     modes: &Path,
 ) -> Result<bool, BakeError> {
-    Ok(mesh_base_status(mesh, file, params, transfer, modes)? == BaseStatus::UpToDate)
+    Ok(mesh_base_status(mesh, file, params, modes)? == BaseStatus::UpToDate)
 }
 
 /// As [`base_status`] for a mesh already in memory; `file` names it in messages.
@@ -1210,10 +1222,9 @@ pub fn mesh_base_status(
     mesh: TetMesh,
     file: &str,
     params: &BakeParams,
-    transfer: Option<&crate::transfer::TransferParams>,
     modes: &Path,
 ) -> Result<BaseStatus, BakeError> {
-    check_options(params, transfer, file)?;
+    check_options(params, file)?;
     let prepared = prepare(mesh, params, file)?;
     if std::fs::symlink_metadata(modes).is_err() {
         return Ok(BaseStatus::Missing);
@@ -1237,7 +1248,7 @@ pub fn mesh_base_status(
     if base.meta.params_hash != params.hash() {
         return Ok(BaseStatus::ParametersChanged);
     }
-    let table_matches = match transfer {
+    let table_matches = match &params.transfer {
         None => base.transfer.is_none(),
         Some(tp) => {
             base.transfer.is_some()

@@ -122,6 +122,7 @@ pub fn bake_to_target(
     transfer.check().map_err(terr)?;
     let base_params = BakeParams {
         modes: ModeRequest::Count(TABLE_BASE_MODES),
+        transfer: None,
         ..params.clone()
     };
     let (base20, report20) = bake_mesh(mesh.clone(), &base_params, file, progress)?;
@@ -284,15 +285,10 @@ pub fn bake_to_target(
     report.modes = base.num_modes();
     report.frequencies_hz = base.frequencies_hz();
     report.residuals = base.residuals.clone();
-    if let Some(t) = &base.transfer {
-        report.transfer_vertices = t.len();
-        report.transfer_edges = t.edges.len();
-        report.transfer_order = t.order;
-        report.transfer_points = t.num_points();
-        report.transfer_modes = t.modes as usize;
-        report.transfer_samples = t.samples as usize;
-        report.transfer_mode_source = if dense { "dense" } else { "lanczos" }.into();
-    }
+    report.transfer = base.transfer.as_ref().map(|t| {
+        let source = if dense { "dense" } else { "lanczos" };
+        crate::bake::TransferReport::of(t, source, 0.0, 0.0)
+    });
     Ok((base, report, tried))
 }
 
