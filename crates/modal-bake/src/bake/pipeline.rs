@@ -75,33 +75,65 @@ fn bake_modes(
         notes: mesh.notes.clone(),
         ..Default::default()
     };
-    let Prepared {
-        mesh,
-        fixed,
-        fixed_by,
-        mid_table,
-        reoriented,
-        hash,
-    } = prepare(mesh, params, file)?;
+    let prepared = prepare(mesh, params, file)?;
+    let mesh = &prepared.mesh;
     report.order = if mesh.is_quadratic() { 2 } else { 1 };
-    report.fixed_by = fixed_by;
+    report.fixed_by = prepared.fixed_by.clone();
     report.nodes = mesh.nodes.len();
     report.tets = mesh.tets.len();
     report.extent_m = mesh.extent();
-    report.reoriented_tets = reoriented;
-    report.fixed_nodes = fixed.len();
-    report.source_hash = hash.clone();
+    report.reoriented_tets = prepared.reoriented;
+    report.fixed_nodes = prepared.fixed.len();
+    report.source_hash = prepared.hash.clone();
+    let solved = solve(&prepared, &mat, params, file, progress, &mut report)?;
+    let free_free = prepared.fixed.is_empty();
+    let elastic = elastic_modes(&solved.res, params, free_free, file, &mut report)?;
+    let base = base_of(prepared, solved, &elastic, params, &mut report);
+    Ok((base, report))
+}
 
+/// Rigid-body modes a mesh has: 6 free-free, 0 with fixed nodes.
+fn rigid_count(free_free: bool) -> usize {
+    if free_free {
+        6
+    } else {
+        0
+    }
+}
+
+/// What the eigensolve step yields: the free-dof map, the modes and the surface.
+struct Solved {
+    map: fem::DofMap,
+    res: eigen::EigenResult,
+    surface: Surface,
+}
+
+/// Assembles K and M on the free dofs and solves for the lowest modes (plus the six rigid-body
+/// modes of a free-free object), extracting the surface on a second thread meanwhile.
+fn solve(
+    prepared: &Prepared,
+    mat: &fem::Material,
+    params: &BakeParams,
+    file: &str,
+    progress: &mut dyn FnMut(BakeStage),
+    report: &mut BakeReport,
+) -> Result<Solved, BakeError> {
+    let Prepared {
+        mesh,
+        fixed,
+        mid_table,
+        ..
+    } = prepared;
     progress(BakeStage::Assemble);
     let t = Instant::now();
-    let (map, kf, mf) = fem::assemble_clamped(&mesh, &mat, params.lumped, &fixed)
+    let (map, kf, mf) = fem::assemble_clamped(mesh, mat, params.lumped, fixed)
         .map_err(|e| BakeError::Params(format!("{file}: {e}")))?;
     report.assemble_s = t.elapsed().as_secs_f64();
     report.free_dofs = map.n_free();
     report.mass_kg = mat.density * mesh.volume();
 
     let free_free = fixed.is_empty();
-    let rigid = if free_free { 6 } else { 0 };
+    let rigid = rigid_count(free_free);
     let wanted = params.min_modes() + rigid;
     if wanted > map.n_free() {
         return Err(BakeError::Params(format!(
@@ -121,13 +153,10 @@ fn bake_modes(
             ModeRequest::Count(_) => None,
         },
         shift: if free_free {
-            eigen::default_shift(&mesh, &mat)
+            eigen::default_shift(mesh, mat)
         } else {
             0.0
         },
-        // Ten times stricter than the MAX_RESIDUAL a written mode must meet; 1e-10 is below
-        // the rounding floor of the higher modes of fine meshes (measured: table, 80 modes,
-        // worst 7.4e-10).
         // The MAX_RESIDUAL a written mode must meet: the solver confirms every pair on the
         // same explicit residual, so a stricter tolerance only buys iterations (1e-10 is below
         // the rounding floor of the higher modes of fine meshes).
@@ -139,7 +168,7 @@ fn bake_modes(
     // beams: ≈ 5 / 17 ms, otherwise after it).
     progress(BakeStage::Factor);
     let (res, surface) = std::thread::scope(|scope| {
-        let surface = scope.spawn(|| Surface::of(&mesh, &mid_table));
+        let surface = scope.spawn(|| Surface::of(mesh, mid_table));
         let res = eigen::solve_lowest(&kf, &mf, &eparams, &mut |p| {
             progress(BakeStage::Eigensolve(p))
         });
@@ -154,8 +183,21 @@ fn bake_modes(
     })?;
     report.factor_s = res.info.factor_seconds;
     report.eigensolve_s = res.info.solve_seconds;
+    Ok(Solved { map, res, surface })
+}
 
+/// The indices of the elastic modes to keep: after exactly six rigid-body modes of a
+/// free-free object, the requested count or those below the requested frequency, each with a
+/// residual ≤ [`MAX_RESIDUAL`] (or at its double-precision floor) and λ > 0.
+fn elastic_modes(
+    res: &eigen::EigenResult,
+    params: &BakeParams,
+    free_free: bool,
+    file: &str,
+    report: &mut BakeReport,
+) -> Result<Vec<usize>, BakeError> {
     // Rigid-body modes: exactly six near-zero eigenvalues for a free-free object.
+    let rigid = rigid_count(free_free);
     let mut first = 0;
     if free_free {
         let lam7 = res
@@ -207,7 +249,25 @@ fn bake_modes(
             });
         }
     }
+    Ok(elastic)
+}
 
+/// The base: the surface rows of the `elastic` modes, the surface, material and metadata.
+fn base_of(
+    prepared: Prepared,
+    solved: Solved,
+    elastic: &[usize],
+    params: &BakeParams,
+    report: &mut BakeReport,
+) -> ModesFile {
+    let Prepared {
+        mesh,
+        fixed,
+        reoriented,
+        hash,
+        ..
+    } = prepared;
+    let Solved { map, res, surface } = solved;
     // Surface rows of U.
     let full = map.expand(res.vectors.as_ref());
     let Surface {
@@ -223,7 +283,7 @@ fn bake_modes(
         let mut modes = Vec::with_capacity(nodes.len() * 3 * nm);
         for &v in nodes {
             for axis in 0..3 {
-                for &j in &elastic {
+                for &j in elastic {
                     modes.push(if v < mesh.nodes.len() {
                         full[(3 * v + axis, j)]
                     } else {
@@ -266,7 +326,7 @@ fn bake_modes(
             },
             volume_nodes: mesh.nodes.len(),
             volume_tets: mesh.tets.len(),
-            rigid_modes_excluded: first,
+            rigid_modes_excluded: report.rigid_modes_excluded,
             mass_kg: report.mass_kg,
             reoriented_tets: reoriented,
             accuracy: None,
@@ -285,7 +345,7 @@ fn bake_modes(
     report.residual_floors = elastic.iter().map(|&j| res.residual_floors[j]).collect();
     report.surface_vertices = base.surface_vertices.len();
     report.surface_triangles = base.surface_triangles.len();
-    Ok((base, report))
+    base
 }
 
 /// The base of `mesh` with the peak-transfer table `tp` (see [`bake_mesh`]).
