@@ -12,8 +12,8 @@ use super::contact_id::{body_handle, body_id, collider_pair_key, NO_BODY};
 use super::contact_reader::{read_pair, scan_pair, LoadMemory, ReportSource};
 use super::rapier::math::Vector;
 use super::rapier::prelude::{
-    ActiveHooks, ColliderHandle, ColliderSet, NarrowPhase, PhysicsWorld, RigidBodyHandle,
-    RigidBodySet,
+    ActiveHooks, ColliderHandle, ColliderSet, NarrowPhase, PhysicsWorld, RigidBody,
+    RigidBodyHandle, RigidBodySet,
 };
 use super::solver_hooks::{DcrSolverHooks, PairMark};
 use super::{arr, to_f64, vector, ApplyMode, StepGate};
@@ -377,8 +377,14 @@ impl DcrRapier {
         self.info.events = n as u32;
         match self.params.apply {
             ApplyMode::AfterStep => {
+                // A body's events come together (its contacts are reported together): look
+                // it up once per run.
+                let mut current: Option<(u64, Option<&mut RigidBody>)> = None;
                 for e in self.world.events() {
-                    if let Some(rb) = bodies.get_mut(body_handle(e.body)) {
+                    if current.as_ref().is_none_or(|(id, _)| *id != e.body) {
+                        current = Some((e.body, bodies.get_mut(body_handle(e.body))));
+                    }
+                    if let Some((_, Some(rb))) = current.as_mut() {
                         rb.apply_impulse_at_point(vector(e.impulse), vector(e.point), true);
                     }
                 }
@@ -445,6 +451,7 @@ impl DcrRapier {
         self.reports.clear();
         self.sources.clear();
         self.states.clear();
+        self.memory.begin_read();
         self.stamp = self.stamp.wrapping_add(1);
         if self.stamp == 0 {
             self.stamps.iter_mut().for_each(|s| *s = 0);
@@ -480,7 +487,7 @@ impl DcrRapier {
                     [co1, co2],
                     [id1, id2],
                     key,
-                    &self.memory,
+                    &mut self.memory,
                     &mut self.reports,
                     &mut self.sources,
                 );

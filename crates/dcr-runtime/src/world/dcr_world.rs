@@ -490,6 +490,9 @@ impl DcrWorld {
     fn classify(&mut self, contacts: &[ContactReport], bodies: &[BodyState]) {
         let step = self.step - 1;
         let cp = self.params.classify;
+        // The last body looked up on each side: consecutive reports usually share their bodies
+        // (an engine reports a pair's points together).
+        let mut memo: [Option<(u64, Option<u32>)>; 2] = [None; 2];
         for c in contacts {
             let objs = [self.object_at(c.body1), self.object_at(c.body2)];
             if objs == [None, None] || c.body1 == c.body2 {
@@ -519,7 +522,17 @@ impl DcrWorld {
                 fired_before = Some(&mut age.fired);
                 f
             };
-            let bidx = [c.body1, c.body2].map(|b| self.body_index.get(&b).copied());
+            let mut bidx = [None; 2];
+            for (side, b) in [c.body1, c.body2].into_iter().enumerate() {
+                bidx[side] = match memo[side] {
+                    Some((id, i)) if id == b => i,
+                    _ => {
+                        let i = self.body_index.get(&b).copied();
+                        memo[side] = Some((b, i));
+                        i
+                    }
+                };
+            }
             let mut fired = [false; 2];
             for side in 0..2 {
                 let Some(o) = objs[side] else { continue };
