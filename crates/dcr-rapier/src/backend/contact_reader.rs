@@ -89,6 +89,7 @@ impl LoadMemory {
     }
 
     /// The pair's masks for this step, its previous-step mask rolled into `before`.
+    #[inline(always)]
     fn pair(&mut self, key: u64) -> &mut PairLoad {
         let at = match self.entries.get(self.cursor) {
             Some(p) if p.key == key => self.cursor,
@@ -238,6 +239,7 @@ pub(super) fn read_pair(
 
 /// The light pass over one pair: records its loaded points in `memory` and returns whether one
 /// of them is an impact candidate — new with impulse ≥ `threshold` (N·s).
+#[inline(always)]
 pub(super) fn scan_pair(
     pair: &ContactPair,
     pair_key: u64,
