@@ -8,7 +8,8 @@
 #    and the median of the per-run shares (`dcr_share_of_step`);
 # 2. instructions (valgrind callgrind, independent of the machine's load): rapier's
 #    `step_with_events` and `DcrRapier::after_step` (+ `before_step`) per scene, for the default
-#    impact-step gate and for reading every step;
+#    impact-step gate and for reading every step; the same for the stress scene cut to 100, 300
+#    and 1000 boxes (default gate only);
 # 3. `dcr-scenes bench-stress --props 100,300,1000`.
 # Writes out/bench/{table1_*.json,callgrind.txt,stress.json,summary.txt}; prints the summary.
 set -euo pipefail
@@ -59,6 +60,26 @@ if command -v valgrind >/dev/null; then
       w=$(count "DcrWorld::step")
       echo "$s $g ${r:-0} ${a:-0} ${b:-0} ${w:-0}" >> "$OUT/callgrind.txt"
     done
+  done
+  # The stress scene cut to N boxes (as bench-stress does), default gate.
+  for n in 100 300 1000; do
+    s="stress_$n"
+    python3 - "$n" "$OUT/$s.json" <<'EOF'
+import json, sys
+d = json.load(open("scenes/stress.json"))
+for p in d["props"]:
+    if p["name"] == "box":
+        p["copies"] = p["copies"][: int(sys.argv[1])]
+json.dump(d, open(sys.argv[2], "w"))
+EOF
+    f="$OUT/cg.$s.out"
+    valgrind --tool=callgrind --callgrind-out-file="$f" "$BIN" run "$OUT/$s.json" --out "$OUT/run_$s" >/dev/null 2>&1
+    callgrind_annotate --inclusive=yes "$f" 2>/dev/null > "$f.txt"
+    r=$(count "PhysicsWorld::step_with_events")
+    a=$(count "DcrRapier::after_step")
+    b=$(count "DcrRapier::before_step")
+    w=$(count "DcrWorld::step")
+    echo "$s impact-steps ${r:-0} ${a:-0} ${b:-0} ${w:-0}" >> "$OUT/callgrind.txt"
   done
   python3 - "$OUT" >> "$OUT/summary.txt" <<'EOF'
 import sys

@@ -24,7 +24,7 @@
 use dcr_runtime::ContactReport;
 
 use super::arr;
-use super::contact_id::{manifold_seed, point_id};
+use super::contact_id::{collider_pair_key, manifold_seed, point_id};
 use super::rapier::geometry::NEW_CONTACT_BIT;
 use super::rapier::prelude::{Collider, ColliderHandle, ContactPair};
 use std::collections::{HashMap, HashSet};
@@ -62,9 +62,12 @@ pub(super) struct LoadMemory {
 }
 
 /// One pair's loaded-point masks.
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Copy, Debug)]
 struct PairLoad {
     key: u64,
+    /// The pair's colliders in rapier's order: the cursor compares them, so the key is
+    /// computed only when the pair is not under the cursor.
+    colliders: [ColliderHandle; 2],
     /// Step of `now`.
     step: u64,
     before: [u64; 2],
@@ -88,22 +91,32 @@ impl LoadMemory {
         }
     }
 
-    /// The pair's masks for this step, its previous-step mask rolled into `before`.
+    /// The masks of the pair of colliders `colliders` (rapier's order) for this step, its
+    /// previous-step mask rolled into `before`.
     #[inline(always)]
-    fn pair(&mut self, key: u64) -> &mut PairLoad {
+    fn pair(&mut self, colliders: [ColliderHandle; 2]) -> &mut PairLoad {
         let at = match self.entries.get(self.cursor) {
-            Some(p) if p.key == key => self.cursor,
-            _ => match self.index.get(&key) {
-                Some(&i) => i as usize,
-                None => {
-                    self.index.insert(key, self.entries.len() as u32);
-                    self.entries.push(PairLoad {
-                        key,
-                        ..PairLoad::default()
-                    });
-                    self.entries.len() - 1
+            Some(p) if p.colliders == colliders => self.cursor,
+            _ => {
+                let key = collider_pair_key(colliders[0], colliders[1]);
+                match self.index.get(&key) {
+                    Some(&i) => {
+                        self.entries[i as usize].colliders = colliders;
+                        i as usize
+                    }
+                    None => {
+                        self.index.insert(key, self.entries.len() as u32);
+                        self.entries.push(PairLoad {
+                            key,
+                            colliders,
+                            step: 0,
+                            before: [0; 2],
+                            now: [0; 2],
+                        });
+                        self.entries.len() - 1
+                    }
                 }
-            },
+            }
         };
         self.cursor = at + 1;
         let step = self.step;
@@ -240,15 +253,10 @@ pub(super) fn read_pair(
 /// The light pass over one pair: records its loaded points in `memory` and returns whether one
 /// of them is an impact candidate — new with impulse ≥ `threshold` (N·s).
 #[inline(always)]
-pub(super) fn scan_pair(
-    pair: &ContactPair,
-    pair_key: u64,
-    threshold: f64,
-    memory: &mut LoadMemory,
-) -> bool {
+pub(super) fn scan_pair(pair: &ContactPair, threshold: f64, memory: &mut LoadMemory) -> bool {
     let mut hot = false;
     let mut overflow = false;
-    let load = memory.pair(pair_key);
+    let load = memory.pair([pair.collider1, pair.collider2]);
     for (mi, m) in pair.solver_manifolds().iter().enumerate() {
         // The slot's word and the manifold's first bit in it (see `slot`).
         let (fits, word, base) = (mi < 16, (mi >> 3) & 1, (mi & 7) * 8);
@@ -271,6 +279,7 @@ pub(super) fn scan_pair(
         }
     }
     if overflow {
+        let pair_key = collider_pair_key(pair.collider1, pair.collider2);
         for (mi, m) in pair.solver_manifolds().iter().enumerate() {
             for sc in m.data.solver_contacts.iter() {
                 let idx = (sc.contact_id[0] & !NEW_CONTACT_BIT) as usize;

@@ -467,8 +467,7 @@ impl DcrRapier {
                     }
                     threshold = threshold.min(self.objects[self.colliders[j].1 as usize].threshold);
                 }
-                let key = collider_pair_key(pair.collider1, pair.collider2);
-                hot |= scan_pair(pair, key, threshold, &mut self.memory);
+                hot |= scan_pair(pair, threshold, &mut self.memory);
             }
         }
         hot
