@@ -214,6 +214,9 @@ pub(super) fn read_pair(
     let before = memory.before(pair_key);
     let mut n = 0;
     for (mi, m) in pair.solver_manifolds().iter().enumerate() {
+        if m.data.solver_contacts.is_empty() {
+            continue;
+        }
         let normal = arr(m.data.normal);
         let sub1 = m.subshape_pos1();
         let sub2 = m.subshape_pos2();
