@@ -45,26 +45,34 @@ for j, s in enumerate(runs[0]["scenes"]):
           f"world steps {s['world_steps']}/{s['steps']}")
 EOF
 
+# One callgrind run: `callgrind NAME GATE SCENE` appends "NAME GATE rapier after before world"
+# (inclusive instruction counts at the call sites, "=> … (Nx)"; a function inlined everywhere
+# has none) to callgrind.txt.
+callgrind() {
+  local name="$1" gate="$2" scene="$3"
+  local f="$OUT/cg.$name.$gate.out"
+  valgrind --tool=callgrind --callgrind-out-file="$f" "$BIN" run "$scene" --gate "$gate" \
+    --out "$OUT/run_$name" >/dev/null 2>&1
+  callgrind_annotate --inclusive=yes "$f" 2>/dev/null > "$f.txt"
+  count() { { grep -E "=> .*$1 \(" "$f.txt" || true; } | head -1 | awk '{print $1}' | tr -d ,; }
+  local r a b w
+  r=$(count "PhysicsWorld::step_with_events")
+  a=$(count "DcrRapier::after_step")
+  b=$(count "DcrRapier::before_step")
+  w=$(count "DcrWorld::step")
+  echo "$name $gate ${r:-0} ${a:-0} ${b:-0} ${w:-0}" >> "$OUT/callgrind.txt"
+}
+
 if command -v valgrind >/dev/null; then
   : > "$OUT/callgrind.txt"
   for s in dinner roof scaffold lowrider rockfall washing; do
     for g in impact-steps every-step; do
-      f="$OUT/cg.$s.$g.out"
-      valgrind --tool=callgrind --callgrind-out-file="$f" "$BIN" run "$s" --gate "$g" --out "$OUT/run_$s" >/dev/null 2>&1
-      callgrind_annotate --inclusive=yes "$f" 2>/dev/null > "$f.txt"
-      # Inclusive counts at the call sites ("=> … (Nx)"); a function inlined everywhere has none.
-      count() { { grep -E "=> .*$1 \(" "$f.txt" || true; } | head -1 | awk '{print $1}' | tr -d ,; }
-      r=$(count "PhysicsWorld::step_with_events")
-      a=$(count "DcrRapier::after_step")
-      b=$(count "DcrRapier::before_step")
-      w=$(count "DcrWorld::step")
-      echo "$s $g ${r:-0} ${a:-0} ${b:-0} ${w:-0}" >> "$OUT/callgrind.txt"
+      callgrind "$s" "$g" "$s"
     done
   done
   # The stress scene cut to N boxes (as bench-stress does), default gate.
   for n in 100 300 1000; do
-    s="stress_$n"
-    python3 - "$n" "$OUT/$s.json" <<'EOF'
+    python3 - "$n" "$OUT/stress_$n.json" <<'EOF'
 import json, sys
 d = json.load(open("scenes/stress.json"))
 for p in d["props"]:
@@ -72,14 +80,7 @@ for p in d["props"]:
         p["copies"] = p["copies"][: int(sys.argv[1])]
 json.dump(d, open(sys.argv[2], "w"))
 EOF
-    f="$OUT/cg.$s.out"
-    valgrind --tool=callgrind --callgrind-out-file="$f" "$BIN" run "$OUT/$s.json" --out "$OUT/run_$s" >/dev/null 2>&1
-    callgrind_annotate --inclusive=yes "$f" 2>/dev/null > "$f.txt"
-    r=$(count "PhysicsWorld::step_with_events")
-    a=$(count "DcrRapier::after_step")
-    b=$(count "DcrRapier::before_step")
-    w=$(count "DcrWorld::step")
-    echo "$s impact-steps ${r:-0} ${a:-0} ${b:-0} ${w:-0}" >> "$OUT/callgrind.txt"
+    callgrind "stress_$n" impact-steps "$OUT/stress_$n.json"
   done
   python3 - "$OUT" >> "$OUT/summary.txt" <<'EOF'
 import sys
