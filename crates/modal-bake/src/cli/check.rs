@@ -38,8 +38,8 @@ pub fn run(args: &CheckArgs) -> ExitCode {
         Ok(bake::mesh_base_status(
             mesh,
             &file,
-        &args.options.params(),
-        transfer.as_ref(),
+            &args.options.params(),
+            transfer.as_ref(),
             &args.out,
         )?)
     });
