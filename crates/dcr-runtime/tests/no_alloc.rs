@@ -94,7 +94,9 @@ fn steps_do_not_allocate_after_warm_up() {
         modes: 40,
         samples: 100,
         vertices,
+        order: 2,
         edges,
+        faces: Vec::new(),
         peaks: (0..np * (np + 1) / 2)
             .map(|k| 1e-5 * (1 + k % 5) as f32)
             .collect(),

@@ -194,7 +194,9 @@ fn version_2_round_trip_and_refusals() {
         modes: 2,
         samples: 4,
         vertices: vec![0, 1],
+        order: 1,
         edges: vec![],
+        faces: vec![],
         peaks: vec![1e-6; 3],
     });
     let err = table.write_atomic(&p).unwrap_err().to_string();

@@ -41,7 +41,9 @@ fn base_with_table() -> ModesFile {
         modes: 100,
         samples: 400,
         vertices,
+        order: 1,
         edges: Vec::new(),
+        faces: Vec::new(),
         peaks,
     });
     b
@@ -293,6 +295,18 @@ fn mismatched_h_rayleigh_or_carry_over_use_the_modal_method() {
     assert!(dr.transfer_active());
 }
 
+/// Position (m) of table point `p`: the blend of its region vertices.
+fn table_point(t: &TransferTable, x: &[[f64; 3]], p: usize) -> [f64; 3] {
+    let (vs, ws) = t.point_support(p);
+    let mut q = [0.0; 3];
+    for k in 0..3 {
+        for c in 0..3 {
+            q[c] += ws[k] * x[t.vertices[vs[k] as usize] as usize][c];
+        }
+    }
+    q
+}
+
 /// A symmetric kernel quadratic in each argument's (x, y) (m): P2 interpolation on flat
 /// triangles reproduces it exactly. Positive on the plate; units m per N·s.
 fn quadratic_kernel(a: [f64; 3], b: [f64; 3]) -> f64 {
@@ -305,17 +319,10 @@ fn with_midpoints_the_lookup_reproduces_a_quadratic_table() {
     let mut b = base_with_table();
     let x = b.surface_vertices.clone();
     let t = b.transfer.as_mut().unwrap();
+    t.order = 2;
     t.edges = TransferTable::region_edges(&b.surface_triangles, &t.vertices);
     assert!(!t.edges.is_empty());
-    let point = |p: usize| -> [f64; 3] {
-        let nr = t.vertices.len();
-        if p < nr {
-            x[t.vertices[p] as usize]
-        } else {
-            let [i, j] = t.edges[p - nr].map(|k| x[t.vertices[k as usize] as usize]);
-            [0, 1, 2].map(|k| 0.5 * (i[k] + j[k]))
-        }
-    };
+    let point = |p: usize| table_point(t, &x, p);
     let np = t.num_points();
     let mut peaks = Vec::with_capacity(TransferTable::packed_len(np));
     for p in 0..np {
@@ -369,4 +376,88 @@ fn with_midpoints_the_lookup_reproduces_a_quadratic_table() {
             "linear blend unexpectedly exact: {linear_off:e}"
         );
     }
+}
+
+/// A symmetric kernel cubic in each argument's (x, y) (m): P3 interpolation on flat triangles
+/// reproduces it exactly, P2 does not. Positive on the plate; units m per N·s.
+fn cubic_kernel(a: [f64; 3], b: [f64; 3]) -> f64 {
+    // In units of 0.25 m, so the cubic terms matter on the 0.5 m × 0.6 m region.
+    let f = |p: [f64; 3]| {
+        let (x, y) = (4.0 * p[0], 4.0 * p[1]);
+        2.0 + x * x * y - 0.2 * y * y * y + 0.5 * x * x * x + 3.0
+    };
+    let g = |p: [f64; 3]| {
+        let (x, y) = (4.0 * p[0], 4.0 * p[1]);
+        1.0 + x * y * y + x
+    };
+    1e-5 * (f(a) * f(b) + g(a) * g(b))
+}
+
+/// An order-3 table (two points per edge, face centroids) of a cubic kernel is reproduced
+/// exactly at random interior impacts and contacts, including points on the region's edge;
+/// the same kernel on an order-2 table is not (so the test sees the cubic nodes).
+#[test]
+fn order_three_lookup_reproduces_a_cubic_table() {
+    let table_for = |order: u8| {
+        let mut b = base_with_table();
+        let x = b.surface_vertices.clone();
+        let t = b.transfer.as_mut().unwrap();
+        t.order = order;
+        t.edges = TransferTable::region_edges(&b.surface_triangles, &t.vertices);
+        t.faces = if order == 3 {
+            TransferTable::region_faces(&b.surface_triangles, &t.vertices)
+        } else {
+            Vec::new()
+        };
+        let np = t.num_points();
+        let mut peaks = Vec::with_capacity(TransferTable::packed_len(np));
+        for p in 0..np {
+            for q in p..np {
+                peaks.push(cubic_kernel(table_point(t, &x, p), table_point(t, &x, q)) as f32);
+            }
+        }
+        t.peaks = peaks;
+        assert_eq!(t.check(x.len()), Ok(()));
+        Arc::new(ModalModel::from_base(b).unwrap())
+    };
+    let (m3, m2) = (table_for(3), table_for(2));
+    let mut rng = SplitMix64(5);
+    let mut pt = || [rng.range(0.0, 0.5), rng.range(0.0, 0.6), 0.0];
+    let mut resting: Vec<RestingContact> = (0..16)
+        .map(|i| RestingContact { id: i, point: pt() })
+        .collect();
+    // On the region's boundary edge x = 0.5 (its triangles outside have weight 0 there).
+    resting.push(RestingContact {
+        id: 99,
+        point: [0.5, 0.37, 0.0],
+    });
+    let mut worst2 = 0.0f64;
+    for _ in 0..4 {
+        let imp = Impact {
+            point: pt(),
+            direction: [0.0, 0.0, -1.0],
+            impulse: 1.5,
+        };
+        let mut d3 = DistantResponse::new(m3.clone(), params(Method::Transfer)).unwrap();
+        let mut d2 = DistantResponse::new(m2.clone(), params(Method::Transfer)).unwrap();
+        let o3 = d3.step(&[imp], &resting).to_vec();
+        let o2 = d2.step(&[imp], &resting).to_vec();
+        for ((a, b), rc) in o3.iter().zip(&o2).zip(&resting) {
+            assert_eq!(a.served_by, ServedBy::TransferTable);
+            let want = 1.5 * cubic_kernel(imp.point, rc.point);
+            let rel = (a.peak_displacement - want).abs() / want;
+            assert!(
+                rel < 1e-6,
+                "{:?}→{:?}: {} vs {want}",
+                imp.point,
+                rc.point,
+                a.peak_displacement
+            );
+            worst2 = worst2.max((b.peak_displacement - want).abs() / want);
+        }
+    }
+    assert!(
+        worst2 > 1e-4,
+        "P2 unexpectedly exact on a cubic kernel: {worst2:e}"
+    );
 }

@@ -519,7 +519,9 @@ fn base_with_table() -> ModesFile {
         modes: 40,
         samples: 100,
         vertices,
+        order: 1,
         edges: Vec::new(),
+        faces: Vec::new(),
         peaks: (0..TransferTable::packed_len(np))
             .map(|k| 1e-5 * (1 + k % 5) as f32)
             .collect(),

@@ -231,8 +231,12 @@ pub struct BakeReport {
     pub transfer_s: f64,
     /// Transfer table: region vertices (0: no table).
     pub transfer_vertices: usize,
-    /// Transfer table: region edges whose midpoints are tabulated.
+    /// Transfer table: region edges whose points are tabulated.
     pub transfer_edges: usize,
+    /// Transfer table: interpolation order (1, 2, 3; 0 without a table).
+    pub transfer_order: u8,
+    /// Transfer table: points (vertices, edge and face points).
+    pub transfer_points: usize,
     /// Transfer table: modes summed.
     pub transfer_modes: usize,
     /// Transfer table: samples per step.
@@ -906,6 +910,7 @@ pub fn bake_mesh(
             rigid_modes_excluded: first,
             mass_kg: report.mass_kg,
             reoriented_tets: reoriented,
+            accuracy: None,
         },
         precision: params.precision,
         transfer: None,
@@ -956,6 +961,10 @@ pub fn bake_mesh_with_transfer(
     }
     let (mut base, mut report) = bake_mesh(mesh.clone(), params, file, progress)?;
     let t = Instant::now();
+    let tp = &tr::TransferParams {
+        modes: tp.modes.resolve(report.free_dofs),
+        ..tp.clone()
+    };
     let enough = matches!(tp.modes, TransferModes::Count(n) if n <= base.num_modes());
     let set = if enough {
         report.transfer_mode_source = "base".into();
@@ -988,6 +997,8 @@ pub fn bake_mesh_with_transfer(
     report.transfer_s = t.elapsed().as_secs_f64();
     report.transfer_vertices = table.len();
     report.transfer_edges = table.edges.len();
+    report.transfer_order = table.order;
+    report.transfer_points = table.num_points();
     report.transfer_modes = table.modes as usize;
     report.transfer_samples = table.samples as usize;
     if let Some(obj) = base.meta.bake_params.as_object_mut() {
@@ -1005,12 +1016,19 @@ fn transfer_meta(tp: &crate::transfer::TransferParams) -> serde_json::Value {
         "h": tp.h,
         "modes": match tp.modes {
             TransferModes::All => serde_json::json!("all"),
+            TransferModes::Auto => serde_json::json!("auto"),
             TransferModes::Count(n) => serde_json::json!(n),
         },
         "regions": tp.boxes,
         "up": tp.up,
         "up_min_cos": tp.up_min_cos,
         "oversample": tp.oversample,
+        "order": match tp.order {
+            crate::transfer::TableOrder::Auto => serde_json::json!("auto"),
+            crate::transfer::TableOrder::Linear => serde_json::json!(1),
+            crate::transfer::TableOrder::Quadratic => serde_json::json!(2),
+            crate::transfer::TableOrder::Cubic => serde_json::json!(3),
+        },
     })
 }
 

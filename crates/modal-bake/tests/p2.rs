@@ -527,13 +527,13 @@ fn meshio_tetra10_reads_in_vtk_order() {
 }
 
 /// The P1-only consumers refuse a second-order mesh instead of treating its mid-edge nodes as
-/// loose nodes: the full-order truth, and a transfer table.
+/// loose nodes: the full-order system, and a transfer table.
 #[test]
 fn p1_only_paths_refuse_second_order() {
     let p2 = TetMesh::structured_box([2, 1, 1], [0.2, 0.1, 0.1]).to_quadratic();
-    let Err(err) = modal_bake::truth::TruthSystem::new(
+    let Err(err) = modal_bake::full_order::FullOrderSystem::new(
         p2.clone(),
-        &modal_bake::truth::TruthParams::default(),
+        &modal_bake::full_order::SystemParams::default(),
         "p2.msh",
     ) else {
         panic!("the truth accepted a second-order mesh")

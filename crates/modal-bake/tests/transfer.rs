@@ -160,60 +160,117 @@ fn probe_point(
     v["contacts"][0]["peak_displacement_m"].as_f64().unwrap()
 }
 
+/// Every kind of table point (vertex, edge point, face centroid) holds the peak the modal probe
+/// gives at that point, for order 2 (midpoints) and order 3 (two points per edge, centroids):
+/// point → point, vertex → point and point → vertex, on flat faces (where an impulse along one
+/// vertex's inward normal is the table's blend of the corners' normals).
 #[test]
-fn midpoint_entries_equal_the_probe_at_the_midpoint() {
+fn every_point_kind_equals_the_probe_at_that_point() {
     let dir = tempfile::tempdir().unwrap();
-    let (with, base, t) = beam_with_own_mode_table(dir.path(), "beam_m.modes");
-    let nr = t.len();
-    assert_eq!(
-        t.edges,
-        dcr_runtime::format::TransferTable::region_edges(&base.surface_triangles, &t.vertices)
-    );
-    let model = ModalModel::from_base(base.clone()).unwrap();
-    let (x, n) = (&base.surface_vertices, model.vertex_normals());
-    let vert = |k: u32| t.vertices[k as usize] as usize;
-    // Edges inside flat faces (equal vertex normals, so a midpoint impulse along −n is the
-    // table's ½(−n_a) + ½(−n_b)) with no clamped end.
-    let fixed = |v: usize| base.fixed_nodes.contains(&base.surface_to_volume[v]);
-    let flat: Vec<usize> = (0..t.edges.len())
-        .filter(|&e| {
-            let [a, b] = t.edges[e].map(vert);
-            !fixed(a) && !fixed(b) && (0..3).all(|k| (n[a][k] - n[b][k]).abs() < 1e-12)
-        })
-        .collect();
-    assert!(flat.len() > 10, "{} flat edges", flat.len());
-    let mid = |e: usize| {
-        let [a, b] = t.edges[e].map(vert);
-        [0, 1, 2].map(|k| 0.5 * (x[a][k] + x[b][k]))
-    };
-    let (e1, e2) = (flat[2], flat[flat.len() - 3]);
-    let a = vert(t.edges[e1][0]);
-    let inward = |v: usize| n[v].map(|c| -c);
-    // midpoint → midpoint, vertex → midpoint, midpoint → vertex.
-    for (imp, dir, con, p, q) in [
-        (mid(e1), inward(a), mid(e2), nr + e1, nr + e2),
-        (x[a], inward(a), mid(e2), t.edges[e1][0] as usize, nr + e2),
-        (
-            mid(e2),
-            inward(vert(t.edges[e2][0])),
-            x[a],
-            nr + e2,
-            t.edges[e1][0] as usize,
-        ),
-    ] {
-        let got = probe_point(&with, &t, imp, dir, con, "modal");
-        let table = t.peak(p, q);
-        let rel = (got - table).abs() / table;
-        // `probe --method transfer` serves the point from the table itself (P2 node: exact).
-        let looked_up = probe_point(&with, &t, imp, dir, con, "transfer");
-        assert!(
-            (looked_up - table).abs() <= 1e-12 * table,
-            "points ({p}, {q}): lookup {looked_up:e} vs table {table:e}"
+    for order in ["2", "3"] {
+        let path = dir.path().join(format!("beam_o{order}.modes"));
+        let o = bake_beam_with(&path, "8", &["--transfer-order", order]);
+        assert!(o.status.success(), "{}", text(&o));
+        let base = ModesFile::read(&path).unwrap();
+        let t = base.transfer.clone().expect("table stored");
+        assert_eq!(t.order.to_string(), order);
+        assert_eq!(
+            t.edges,
+            dcr_runtime::format::TransferTable::region_edges(&base.surface_triangles, &t.vertices)
         );
-        assert!(
-            table > 0.0 && rel < 1e-6,
-            "points ({p}, {q}): probe {got:e} vs table {table:e}"
-        );
+        let model = ModalModel::from_base(base.clone()).unwrap();
+        let (x, n) = (&base.surface_vertices, model.vertex_normals());
+        let vert = |k: u32| t.vertices[k as usize] as usize;
+        let fixed = |v: usize| base.fixed_nodes.contains(&base.surface_to_volume[v]);
+        // Points whose corners share one normal and are free, by kind.
+        let flat_points = |range: std::ops::Range<usize>| -> Vec<usize> {
+            range
+                .filter(|&p| {
+                    let (vs, ws) = t.point_support(p);
+                    let vs: Vec<usize> = (0..3)
+                        .filter(|&k| ws[k] != 0.0)
+                        .map(|k| vert(vs[k]))
+                        .collect();
+                    vs.iter().all(|&v| !fixed(v))
+                        && vs
+                            .iter()
+                            .all(|&v| (0..3).all(|k| (n[v][k] - n[vs[0]][k]).abs() < 1e-12))
+                })
+                .collect()
+        };
+        let nr = t.len();
+        let ne = t.edges.len();
+        let edge_pts = flat_points(nr..nr + if order == "3" { 2 * ne } else { ne });
+        let face_pts = flat_points(nr + 2 * ne..t.num_points());
+        assert!(edge_pts.len() > 10, "{} flat edge points", edge_pts.len());
+        assert_eq!(face_pts.is_empty(), order == "2");
+        let pos = |p: usize| {
+            let (vs, ws) = t.point_support(p);
+            let mut q = [0.0; 3];
+            for k in 0..3 {
+                for c in 0..3 {
+                    q[c] += ws[k] * x[vert(vs[k])][c];
+                }
+            }
+            q
+        };
+        let inward = |p: usize| n[vert(t.point_support(p).0[0])].map(|c| -c);
+        let (e1, e2) = (edge_pts[2], edge_pts[edge_pts.len() - 3]);
+        let v1 = t.point_support(e1).0[0] as usize;
+        let mut cases = vec![(e1, e2), (v1, e2), (e2, v1)];
+        if let (Some(&f1), Some(&f2)) = (face_pts.first(), face_pts.last()) {
+            cases.extend([(f1, f2), (f1, e2), (v1, f2)]);
+        }
+        // Points next to the beam's edges, whose corners' normals differ: the table holds the
+        // response along their interpolated normal (the runtime's and the probe's).
+        let blended = |p: usize| {
+            let (vs, ws) = t.point_support(p);
+            let mut q = [0.0; 3];
+            for k in 0..3 {
+                for c in 0..3 {
+                    q[c] += ws[k] * n[vert(vs[k])][c];
+                }
+            }
+            let l = (q[0] * q[0] + q[1] * q[1] + q[2] * q[2]).sqrt();
+            q.map(|x| x / l)
+        };
+        let bent: Vec<usize> = (nr..t.num_points())
+            .filter(|&p| {
+                let (vs, ws) = t.point_support(p);
+                let vs: Vec<usize> = (0..3)
+                    .filter(|&k| ws[k] != 0.0)
+                    .map(|k| vert(vs[k]))
+                    .collect();
+                vs.iter().all(|&v| !fixed(v))
+                    && vs
+                        .iter()
+                        .any(|&v| (0..3).any(|k| (n[v][k] - n[vs[0]][k]).abs() > 1e-3))
+            })
+            .collect();
+        assert!(bent.len() > 10, "{} bent points", bent.len());
+        let (b1, b2) = (bent[1], bent[bent.len() - 2]);
+        cases.extend([(b1, b2), (b1, e2), (e1, b2), (v1, b2), (b2, v1)]);
+        let inward = |p: usize| {
+            if bent.contains(&p) {
+                blended(p).map(|c| -c)
+            } else {
+                inward(p)
+            }
+        };
+        for (p, q) in cases {
+            let got = probe_point(&path, &t, pos(p), inward(p), pos(q), "modal");
+            let table = t.peak(p, q);
+            // `probe --method transfer` serves a node from the table itself (exact there).
+            let looked_up = probe_point(&path, &t, pos(p), inward(p), pos(q), "transfer");
+            assert!(
+                (looked_up - table).abs() <= 1e-9 * table,
+                "order {order}, points ({p}, {q}): lookup {looked_up:e} vs table {table:e}"
+            );
+            assert!(
+                table > 0.0 && (got - table).abs() / table < 1e-6,
+                "order {order}, points ({p}, {q}): probe {got:e} vs table {table:e}"
+            );
+        }
     }
 }
 
@@ -243,6 +300,33 @@ fn baking_twice_is_bit_identical_and_info_shows_the_table() {
     let o = run(&["info", a.to_str().unwrap(), "--json"]);
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(v["transfer"]["modes"], 60);
+}
+
+/// The same inputs give the same bytes on any thread count: a table whose 100 modes come from
+/// the dense all-mode eigensolve (the base keeps 8), baked with RAYON_NUM_THREADS = 1, 2 and 4.
+#[test]
+fn table_is_bit_identical_on_any_thread_count() {
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = data("data/meshes/beam.msh");
+    let bytes: Vec<Vec<u8>> = [1, 2, 4]
+        .iter()
+        .map(|threads| {
+            let out = dir.path().join(format!("t{threads}.modes"));
+            let o = bin()
+                .env("RAYON_NUM_THREADS", threads.to_string())
+                .args(["bake", mesh.to_str().unwrap(), "-o", out.to_str().unwrap()])
+                .args(["--fixed", "clamp", "--modes", "8", "--transfer-h", "0.01"])
+                .args(["--transfer-modes", "100", "--json"])
+                .output()
+                .unwrap();
+            assert!(o.status.success(), "{}", text(&o));
+            let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+            assert_eq!(v["transfer_mode_source"], "dense", "{v}");
+            std::fs::read(&out).unwrap()
+        })
+        .collect();
+    assert!(bytes[0] == bytes[1], "1 vs 2 threads differ");
+    assert!(bytes[0] == bytes[2], "1 vs 4 threads differ");
 }
 
 #[test]

@@ -8,7 +8,7 @@ mod transfer_table;
 
 pub use atomic_file::{remove_pending_temporaries, write_atomic, AtomicFile, STALE_AFTER};
 pub use modes_file::{
-    FormatError, MaterialSi, ModesFile, ModesMeta, ModesPrecision, FORMAT_VERSION,
+    AccuracyRecord, FormatError, MaterialSi, ModesFile, ModesMeta, ModesPrecision, FORMAT_VERSION,
     MAX_COORDINATE_M, MIN_EXTENT_M,
 };
 pub use quadratic_surface::{QuadraticSurface, QUADRATIC_FORMAT_VERSION};

@@ -27,8 +27,9 @@
 //! u32 (nr,), `transfer_peaks` f32 (np(np+1)/2,) packed upper triangle over np = nr + ne points
 //! (m per N·s),
 //! `transfer_h` f64 () (s), `transfer_rayleigh` f64 (2,), `transfer_modes` u32 (),
-//! `transfer_samples` u32 (), and `transfer_edges` u32 (ne, 2) (absent in tables written
-//! before it: vertex points only). Readers that predate the table ignore these entries.
+//! `transfer_samples` u32 (), and optionally `transfer_edges` u32 (ne, 2), `transfer_order`
+//! u32 () (1, 2, 3; absent: 2 with edges, else 1) and `transfer_faces` u32 (nf, 3) (order 3).
+//! Readers that predate the table ignore these entries.
 //!
 //! Optional (version ≥ 2, all or none): the mid-edge rows of a second-order (P2) base
 //! ([`QuadraticSurface`]): `surface_edges` u32 (ne, 2), `edge_to_volume` u32 (ne,),
@@ -55,7 +56,10 @@ use serde::{Deserialize, Serialize};
 
 use super::quadratic_surface::{QuadraticSurface, QUADRATIC_ENTRIES, QUADRATIC_FORMAT_VERSION};
 use super::regular_file::{open_regular_file, OpenError};
-use super::transfer_table::{TransferTable, TRANSFER_EDGES_ENTRY, TRANSFER_ENTRIES};
+use super::transfer_table::{
+    TransferTable, TRANSFER_EDGES_ENTRY, TRANSFER_ENTRIES, TRANSFER_FACES_ENTRY,
+    TRANSFER_ORDER_ENTRY,
+};
 
 /// Newest `.modes` schema version this build reads and writes (it reads every version from 1).
 pub const FORMAT_VERSION: u32 = 2;
@@ -112,6 +116,48 @@ pub struct ModesMeta {
     pub mass_kg: f64,
     /// Inverted tetrahedra that were reoriented while baking.
     pub reoriented_tets: usize,
+    /// What `modal-bake bake --target-error` chose and its measured error (absent otherwise;
+    /// files without it read as `None` and are written byte for byte as before).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub accuracy: Option<AccuracyRecord>,
+}
+
+/// The accuracy a base was chosen for (`modal-bake bake --target-error PCT`): its error against
+/// the bake's own converged full-order truth at seeded pairs of the region, and its cost. Every
+/// figure is deterministic (no timings), so the file stays bit-identical.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct AccuracyRecord {
+    /// Target: worst |error| allowed over the pairs (%).
+    pub target_pct: f64,
+    /// Whether the chosen representation meets it (else it is the most accurate tried).
+    pub met: bool,
+    /// Median |error| over the pairs (%).
+    pub median_pct: f64,
+    /// Worst |error| over the pairs (%).
+    pub worst_pct: f64,
+    /// Pairs measured (impact, resting contact; vertices and points inside triangles).
+    pub pairs: usize,
+    /// Rigid-body step h the peaks are taken over (s).
+    pub h: f64,
+    /// The truth: `all-modes` (dense sum) or `newmark`.
+    pub truth: String,
+    /// The truth's step after refinement (s).
+    pub truth_dt: f64,
+    /// The truth's estimated error (%), see `modal_bake::full_order::converged_peaks`.
+    pub truth_error_pct: f64,
+    /// Runtime modes kept in the base.
+    pub modes: usize,
+    /// Modes summed by its transfer table (`None`: no table).
+    pub table_modes: Option<usize>,
+    /// Interpolation order of its table (`None`: no table).
+    pub table_order: Option<u8>,
+    /// Query cost model: multiply-adds per (impact, resting contact) pair — m·S for m modal
+    /// filters sampled S times per step, (nodes per triangle)² table lookups for a table.
+    pub query_cost: f64,
+    /// The same for the paper's 20 modes, for comparison.
+    pub query_cost_20: f64,
+    /// Bytes of the numeric payload (mode rows and table entries; the file adds a few KiB).
+    pub payload_bytes: u64,
 }
 
 /// A modal base in memory: exactly what a `.modes` file holds.
@@ -545,6 +591,22 @@ impl ModesFile {
                 &Array2::from_shape_vec((t.edges.len(), 2), edges).map_err(|x| x.to_string())?,
             )
             .map_err(e)?;
+            // Only when it differs from what a reader infers (2 with edges, else 1), so that
+            // order-1 and order-2 files keep the bytes of readers that predate the entry.
+            if t.order != if t.edges.is_empty() { 1 } else { 2 } {
+                npz.add_array(
+                    TRANSFER_ORDER_ENTRY,
+                    &Array0::from_elem((), u32::from(t.order)),
+                )
+                .map_err(e)?;
+                let faces: Vec<u32> = t.faces.iter().flatten().copied().collect();
+                npz.add_array(
+                    TRANSFER_FACES_ENTRY,
+                    &Array2::from_shape_vec((t.faces.len(), 3), faces)
+                        .map_err(|x| x.to_string())?,
+                )
+                .map_err(e)?;
+            }
         }
         Ok(npz.finish().map_err(e)?.into_inner())
     }
@@ -1133,6 +1195,27 @@ impl<R: Read + Seek> EntryReader<'_, R> {
         } else {
             Vec::new()
         };
+        let has = |rd: &Self, e: &str| rd.zip.index_for_name(&format!("{e}.npy")).is_some();
+        let order = if has(self, TRANSFER_ORDER_ENTRY) {
+            let o: u32 = self.scalar(TRANSFER_ORDER_ENTRY)?;
+            u8::try_from(o).unwrap_or(u8::MAX)
+        } else if edges.is_empty() {
+            1
+        } else {
+            2
+        };
+        let faces = if has(self, TRANSFER_FACES_ENTRY) {
+            let (flat, shape) = self.array::<u32>(TRANSFER_FACES_ENTRY, 2)?;
+            if shape[1] != 3 {
+                return Err(self.err(
+                    TRANSFER_FACES_ENTRY,
+                    format!("expected shape (nf, 3), found {shape:?}"),
+                ));
+            }
+            flat.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect()
+        } else {
+            Vec::new()
+        };
         if rayleigh.len() != 2 {
             return Err(self.err(
                 "transfer_rayleigh",
@@ -1145,7 +1228,9 @@ impl<R: Read + Seek> EntryReader<'_, R> {
             modes,
             samples,
             vertices,
+            order,
             edges,
+            faces,
             peaks,
         }))
     }

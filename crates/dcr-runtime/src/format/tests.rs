@@ -39,6 +39,7 @@ pub(crate) fn tiny_base() -> ModesFile {
             rigid_modes_excluded: 6,
             mass_kg: 700.0 / 6.0,
             reoriented_tets: 0,
+            accuracy: None,
         },
         precision: ModesPrecision::F64,
         transfer: None,
@@ -203,7 +204,9 @@ fn tiny_with_table() -> ModesFile {
         modes: 40,
         samples: 123,
         vertices: vec![0, 1, 3],
+        order: 1,
         edges: Vec::new(),
+        faces: Vec::new(),
         peaks: vec![1e-4, 2e-5, 3e-6, 4e-4, 5e-5, 6e-4],
     });
     b
@@ -247,6 +250,7 @@ fn transfer_table_round_trips_exactly_and_deterministically() {
     // entry absent) reads as a vertex-only table.
     let mut with_edges = tiny_with_table();
     let t = with_edges.transfer.as_mut().unwrap();
+    t.order = 2;
     t.edges = vec![[0, 1], [1, 2]];
     t.peaks = (0..TransferTable::packed_len(5))
         .map(|k| 1e-5 * (1 + k) as f32)
@@ -254,6 +258,29 @@ fn transfer_table_round_trips_exactly_and_deterministically() {
     let bytes = with_edges.to_bytes().unwrap();
     let r = ModesFile::read_from(Cursor::new(bytes), Path::new("e.modes")).unwrap();
     assert_eq!(r, with_edges);
+    // Order 3: two points per edge and face centroids round-trip; order-2 files carry no
+    // `transfer_order` entry (their bytes are those of a reader that predates it).
+    let mut cubic = tiny_with_table();
+    let t = cubic.transfer.as_mut().unwrap();
+    t.order = 3;
+    t.edges = vec![[0, 1], [0, 2], [1, 2]];
+    t.faces = vec![[0, 1, 2]];
+    t.peaks = (0..TransferTable::packed_len(3 + 6 + 1))
+        .map(|k| 1e-5 * (1 + k) as f32)
+        .collect();
+    assert_eq!(t.point_support(3), ([0, 1, 0], [2.0 / 3.0, 1.0 / 3.0, 0.0]));
+    assert_eq!(t.point_support(4), ([0, 1, 0], [1.0 / 3.0, 2.0 / 3.0, 0.0]));
+    assert_eq!(t.point_support(9), ([0, 1, 2], [1.0 / 3.0; 3]));
+    let bytes = cubic.to_bytes().unwrap();
+    let r = ModesFile::read_from(Cursor::new(bytes), Path::new("c.modes")).unwrap();
+    assert_eq!(r, cubic);
+    let names = |b: &ModesFile| -> Vec<String> {
+        let bytes = b.to_bytes().unwrap();
+        let z = zip::ZipArchive::new(Cursor::new(bytes)).unwrap();
+        z.file_names().map(str::to_string).collect()
+    };
+    assert!(names(&cubic).contains(&"transfer_order.npy".to_string()));
+    assert!(!names(&with_edges).contains(&"transfer_order.npy".to_string()));
     let bytes = without_entries(&base.to_bytes().unwrap(), &["transfer_edges"]);
     let r = ModesFile::read_from(Cursor::new(bytes), Path::new("o.modes")).unwrap();
     assert_eq!(r, base);
@@ -284,13 +311,46 @@ fn partial_transfer_table_names_the_missing_entry() {
 #[test]
 fn corrupted_transfer_table_is_rejected_with_a_clear_error() {
     type Corrupt = fn(&mut TransferTable);
-    let cases: [(Corrupt, &str); 10] = [
+    let cases: [(Corrupt, &str); 14] = [
+        (|t| t.order = 4, "transfer_order = 4"),
+        (
+            |t| {
+                t.order = 2;
+                t.faces = vec![[0, 1, 2]];
+            },
+            "transfer_faces is not empty",
+        ),
+        (
+            |t| {
+                t.order = 3;
+                t.edges = vec![[0, 1], [0, 2], [1, 2]];
+                t.faces = vec![[0, 2, 1]];
+                t.peaks = vec![1e-5; TransferTable::packed_len(10)];
+            },
+            "transfer_faces row 0",
+        ),
         (|t| t.peaks[2] = f32::NAN, "transfer_peaks[2]"),
         (|t| t.peaks[4] = -1e-6, "transfer_peaks[4]"),
         (|t| t.peaks[1] = f32::INFINITY, "transfer_peaks[1]"),
         (|t| t.peaks.truncate(5), "expected np(np+1)/2 = 6"),
-        (|t| t.edges = vec![[0, 3]], "transfer_edges row 0"),
-        (|t| t.edges = vec![[0, 2], [0, 1]], "transfer_edges row 1"),
+        (
+            |t| {
+                t.order = 2;
+                t.edges = vec![[0, 3]];
+            },
+            "transfer_edges row 0",
+        ),
+        (
+            |t| {
+                t.order = 2;
+                t.edges = vec![[0, 2], [0, 1]];
+            },
+            "transfer_edges row 1",
+        ),
+        (
+            |t| t.edges = vec![[0, 1]],
+            "transfer_order = 1 but transfer_edges",
+        ),
         (|t| t.vertices[2] = 4, "names vertex 4"),
         (|t| t.vertices = vec![0, 3, 1], "not strictly ascending"),
         (|t| t.h = 0.0, "transfer_h"),

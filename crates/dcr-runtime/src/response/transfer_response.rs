@@ -2,22 +2,26 @@
 //! distant peaks looked up in the base's bake-time peak-transfer table ([`crate::format::TransferTable`]) instead of
 //! filtering the truncated modal base.
 //!
-//! The table's points are the region's vertices and its edge midpoints
-//! ([`crate::format::TransferTable`]). A mapped point with barycentric weights β in triangle
-//! (v₀, v₁, v₂) is spread over the triangle's six P2 nodes with the quadratic Lagrange weights
-//! `N_k = β_k(2β_k − 1)` at vertex k and `N_jk = 4β_jβ_k` at the midpoint of edge (j, k); the
-//! peak normal displacement at a resting contact is
+//! The table's points are the nodes of a Lagrange interpolant of its order on every region
+//! triangle ([`crate::format::TransferTable`]). A mapped point with barycentric weights β in
+//! triangle (v₀, v₁, v₂) is spread over the triangle's nodes with the Lagrange weights N:
+//! - order 3 (ten nodes): `½β_k(3β_k − 1)(3β_k − 2)` at vertex k, `(9/2)β_jβ_k(3β_j − 1)` at the
+//!   point of edge (j, k) at a third of the way from j, `27β₀β₁β₂` at the centroid;
+//! - order 2 (six nodes): `β_k(2β_k − 1)` at vertex k, `4β_jβ_k` at the midpoint of edge (j, k);
+//! - order 1: `β_k` at vertex k.
+//!
+//! The peak normal displacement at a resting contact is
 //! `d = Σ_impacts λ_N max(0, Σ_p Σ_q N_p(β_impact) N_q(β_contact) T[p][q])`, where
 //! λ_N = λ·|d̂·n| is the normal component of the impulse (N·s; the tangential part is ignored).
 //! T is the peak for a unit inward-normal impulse at one table point seen at another, computed
 //! at bake time with many modes. The weights sum to 1 and reproduce T exactly at the nodes.
 //!
-//! Why quadratic: the exact peak is a convex function of β on each side (a maximum of absolute
-//! values of linear functions), so the linear blend of vertex peaks overestimates inside
-//! triangles where the vertex responses are out of phase (by up to +214 % on the ground slab);
-//! the P2 interpolant, which also sees the midpoints, is measured in `docs/accuracy.md`. It may
-//! undershoot, hence the clamp at 0. A table without midpoints (written before they existed)
-//! is blended linearly, as is any triangle one of whose needed midpoints is missing. With
+//! Why not the linear blend: the exact peak is a convex function of β on each side (a maximum
+//! of absolute values of linear functions), so blending vertex peaks overestimates inside
+//! triangles where the vertex responses are out of phase (by up to +214 % on the ground slab,
+//! whose waves are a few triangles long); the higher-order interpolants, which see points
+//! inside the triangle, are measured in `docs/accuracy.md`. They may undershoot, hence the
+//! clamp at 0. A triangle one of whose needed points is missing is blended linearly. With
 //! several impacts in one step their peaks are summed, an upper bound of the peak of the summed
 //! response.
 //!
@@ -45,16 +49,17 @@ const MATCH_REL_TOL: f64 = 1e-9;
 /// this (a point at a region vertex may map to a neighbouring triangle outside the region).
 const NEGLIGIBLE_WEIGHT: f64 = 1e-9;
 
-/// Table nodes of a mapped point (vertices and edge midpoints) with their interpolation
+/// Table nodes of a mapped point (vertices, edge points, centroid) with their interpolation
 /// weights; unused slots have weight 0.
-type Nodes = ([u32; 6], [f64; 6]);
+type Nodes = ([u32; 10], [f64; 10]);
 
-/// The P2 (or, lacking midpoints, P1) nodes and weights of a point with barycentric weights
-/// `bary` in surface triangle `t` (corners `tri`), or `None` when a corner with a weight above
-/// [`NEGLIGIBLE_WEIGHT`] is outside the region (negligible ones get weight 0).
+/// The nodes and weights of a point with barycentric weights `bary` in surface triangle `t`
+/// (corners `tri`) at the table's order (linear where a needed point is missing), or `None`
+/// when a corner with a weight above [`NEGLIGIBLE_WEIGHT`] is outside the region (negligible
+/// ones get weight 0).
 #[inline]
 fn table_nodes(ts: &TransferResponse, t: u32, tri: [usize; 3], bary: [f64; 3]) -> Option<Nodes> {
-    let mut idx = [0u32; 6];
+    let mut idx = [0u32; 10];
     let mut w = bary;
     for k in 0..3 {
         let l = ts.local[tri[k]];
@@ -67,13 +72,53 @@ fn table_nodes(ts: &TransferResponse, t: u32, tri: [usize; 3], bary: [f64; 3]) -
             idx[k] = l;
         }
     }
-    let mids = ts.tri_mids[t as usize];
+    let linear = |idx: [u32; 10]| {
+        let mut nw = [0.0; 10];
+        nw[..3].copy_from_slice(&w);
+        Some((idx, nw))
+    };
+    if ts.order != 3 {
+        return table_nodes_quadratic(ts, t, idx, w, linear);
+    }
+    let pts = &ts.tri_pts[t as usize];
+    let mut nw = [0.0; 10];
+    for k in 0..3 {
+        nw[k] = 0.5 * w[k] * (3.0 * w[k] - 1.0) * (3.0 * w[k] - 2.0);
+        // Edge opposite corner k, from corner j = k+1 to corner l = k+2: the point nearer j,
+        // then the point nearer l.
+        let (j, l) = ((k + 1) % 3, (k + 2) % 3);
+        nw[3 + 2 * k] = 4.5 * w[j] * w[l] * (3.0 * w[j] - 1.0);
+        nw[4 + 2 * k] = 4.5 * w[j] * w[l] * (3.0 * w[l] - 1.0);
+    }
+    nw[9] = 27.0 * w[0] * w[1] * w[2];
+    for s in 3..10 {
+        if nw[s] != 0.0 {
+            if pts[s - 3] == UNMAPPED {
+                return linear(idx);
+            }
+            idx[s] = pts[s - 3];
+        }
+    }
+    Some((idx, nw))
+}
+
+/// Order 1 or 2: the P2 nodes and weights, or the linear blend when a needed midpoint is
+/// missing (`idx`: the corners' table points, `w`: their weights).
+#[inline]
+fn table_nodes_quadratic(
+    ts: &TransferResponse,
+    t: u32,
+    mut idx: [u32; 10],
+    w: [f64; 3],
+    linear: impl Fn([u32; 10]) -> Option<Nodes>,
+) -> Option<Nodes> {
+    let mids = ts.tri_pts[t as usize];
     // Midpoint k sits on the edge opposite corner k.
     let mid_w = [0, 1, 2].map(|k| 4.0 * w[(k + 1) % 3] * w[(k + 2) % 3]);
-    if (0..3).any(|k| mid_w[k] > 0.0 && mids[k] == UNMAPPED) {
-        return Some((idx, [w[0], w[1], w[2], 0.0, 0.0, 0.0]));
+    if ts.order == 1 || (0..3).any(|k| mid_w[k] > 0.0 && mids[k] == UNMAPPED) {
+        return linear(idx);
     }
-    let mut nw = [0.0; 6];
+    let mut nw = [0.0; 10];
     for k in 0..3 {
         nw[k] = w[k] * (2.0 * w[k] - 1.0);
         if mid_w[k] > 0.0 {
@@ -90,15 +135,58 @@ fn table_nodes(ts: &TransferResponse, t: u32, tri: [usize; 3], bary: [f64; 3]) -
 pub(crate) struct TransferResponse {
     /// Region index (= table point) of each surface vertex ([`UNMAPPED`]: outside the region).
     local: Vec<u32>,
-    /// Per surface triangle: the table point of the midpoint of the edge opposite each corner
-    /// ([`UNMAPPED`]: not tabulated).
-    tri_mids: Vec<[u32; 3]>,
+    /// The table's interpolation order (1, 2, 3).
+    order: u8,
+    /// Per surface triangle, its table points ([`UNMAPPED`]: not tabulated): order 2, slot k
+    /// the midpoint of the edge opposite corner k; order 3, slots 2k and 2k + 1 the points of
+    /// the edge opposite corner k (from corner k+1 to k+2) nearer k+1 and nearer k+2, slot 6
+    /// the centroid.
+    tri_pts: Vec<[u32; 7]>,
     /// This step's applied impacts: table nodes and weights, λ_N (N·s).
     hits: Vec<(Nodes, f64)>,
     /// Table peak per resting contact this step (m); NaN: not served by the table.
     peaks: Vec<f64>,
     /// The modal method: serves the steps and contacts the table cannot.
     modal: ModalResponse,
+}
+
+/// The table points of a triangle whose corners have region indices `tri` ([`UNMAPPED`]:
+/// outside), in the slot layout of `TransferResponse::tri_pts`.
+fn triangle_points(t: &crate::format::TransferTable, tri: [u32; 3]) -> [u32; 7] {
+    let nr = t.vertices.len();
+    let ne = t.edges.len();
+    let mut pts = [UNMAPPED; 7];
+    let edge = |a: u32, b: u32| {
+        if a == UNMAPPED || b == UNMAPPED {
+            return None;
+        }
+        t.edges.binary_search(&[a.min(b), a.max(b)]).ok()
+    };
+    for k in 0..3 {
+        let (a, b) = (tri[(k + 1) % 3], tri[(k + 2) % 3]);
+        let Some(e) = edge(a, b) else { continue };
+        match t.order {
+            2 => pts[k] = (nr + e) as u32,
+            3 => {
+                // Point nr + 2e is nearer the edge's smaller region index.
+                let (near_a, near_b) = ((nr + 2 * e) as u32, (nr + 2 * e + 1) as u32);
+                (pts[2 * k], pts[2 * k + 1]) = if a < b {
+                    (near_a, near_b)
+                } else {
+                    (near_b, near_a)
+                };
+            }
+            _ => {}
+        }
+    }
+    if t.order == 3 && tri.iter().all(|&v| v != UNMAPPED) {
+        let mut f = tri;
+        f.sort_unstable();
+        if let Ok(c) = t.faces.binary_search(&f) {
+            pts[6] = (nr + 2 * ne + c) as u32;
+        }
+    }
+    pts
 }
 
 fn close(a: f64, b: f64) -> bool {
@@ -144,24 +232,13 @@ impl TransferResponse {
         for (k, &v) in t.vertices.iter().enumerate() {
             local[v as usize] = k as u32;
         }
-        let nr = t.vertices.len();
-        let tri_mids = (0..model.base().surface_triangles.len())
-            .map(|f| {
-                let tri = model.triangle(f as u32).map(|v| local[v]);
-                [0, 1, 2].map(|k| {
-                    let (a, b) = (tri[(k + 1) % 3], tri[(k + 2) % 3]);
-                    if a == UNMAPPED || b == UNMAPPED {
-                        return UNMAPPED;
-                    }
-                    t.edges
-                        .binary_search(&[a.min(b), a.max(b)])
-                        .map_or(UNMAPPED, |e| (nr + e) as u32)
-                })
-            })
+        let tri_pts = (0..model.base().surface_triangles.len())
+            .map(|f| triangle_points(t, model.triangle(f as u32).map(|v| local[v])))
             .collect();
         TransferResponse {
             local,
-            tri_mids,
+            order: t.order,
+            tri_pts,
             hits: Vec::new(),
             peaks: Vec::new(),
             modal,

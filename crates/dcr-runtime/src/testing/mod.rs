@@ -32,6 +32,11 @@ impl SplitMix64 {
     pub fn range(&mut self, lo: f64, hi: f64) -> f64 {
         lo + (hi - lo) * self.next_f64()
     }
+
+    /// Uniform integer in 0..n (n > 0), by the high half of a 64 × 64-bit product (Lemire).
+    pub fn below(&mut self, n: usize) -> usize {
+        ((self.next_u64() as u128 * n as u128) >> 64) as usize
+    }
 }
 
 /// A nested-dissection-like vertex order of a connected surface, for tests of split solves: the
@@ -282,6 +287,7 @@ pub fn synthetic_base(surface: Surface, omega: &[f64], rayleigh: [f64; 2], seed:
             rigid_modes_excluded: 6,
             mass_kg: 1.0,
             reoriented_tets: 0,
+            accuracy: None,
         },
         precision: ModesPrecision::F64,
         transfer: None,

@@ -7,99 +7,14 @@ use anyhow::Context;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use modal_bake::bake::{
-    self, BakeParams, BakeReport, BakeStage, FixedBelow, MaterialSi, ModeRequest, ModesPrecision,
+    self, BakeParams, BakeReport, BakeStage, FixedBelow, ModeRequest, ModesPrecision,
 };
-use modal_bake::transfer::{TransferModes, TransferParams};
+use modal_bake::transfer::{TableOrder, TransferModes, TransferParams};
 
 use super::mesh::AssetOptions;
 use super::parse;
+pub use modal_bake::args::ModelOptions;
 use modal_bake::mesh::surface::is_surface_asset;
-
-/// The object's material, boundary conditions and damping (shared by `bake`, `check`,
-/// `truth` and `fit-attenuation`).
-#[derive(Args, Clone, Debug)]
-pub struct ModelOptions {
-    /// Young's modulus E (Pa).
-    #[arg(long, value_name = "PA", default_value_t = 1.1e9)]
-    pub youngs: f64,
-    /// Poisson ratio ν (−1 < ν < 0.5).
-    #[arg(long, value_name = "NU", default_value_t = 0.3)]
-    pub poisson: f64,
-    /// Density ρ (kg/m³).
-    #[arg(long, value_name = "KG_M3", default_value_t = 770.0)]
-    pub density: f64,
-    /// Fix every node of this named physical group (repeatable). Nothing fixed: free-free (the
-    /// six rigid-body modes, or the rigid-body part of a response, are excluded).
-    #[arg(long, value_name = "NAME")]
-    pub fixed: Vec<String>,
-    /// Rayleigh damping: α0 (1/s), α1 (s); `bake` stores it as the base's default.
-    #[arg(long, value_name = "A0,A1", value_parser = parse::pair, default_value = "10,1e-7")]
-    pub rayleigh: [f64; 2],
-    /// Lumped (diagonal) mass instead of the consistent mass.
-    #[arg(long)]
-    pub lumped: bool,
-}
-
-impl ModelOptions {
-    /// Refuses a Young's modulus or density outside the supported ranges, naming the option,
-    /// and warns (stderr) about values that look like a unit mistake.
-    ///
-    /// # Errors
-    /// A one-line message naming `--youngs` or `--density` and the range that works.
-    pub fn check_ranges(&self) -> anyhow::Result<()> {
-        use modal_bake::fem::Material;
-        let [elo, ehi] = Material::YOUNGS_RANGE;
-        if !(self.youngs >= elo && self.youngs <= ehi) {
-            anyhow::bail!(
-                "--youngs {:e} Pa is outside the supported {elo:e} … {ehi:e} Pa (foams ~1e5, polymers ~1e9, steel 2e11)",
-                self.youngs
-            );
-        }
-        if !(self.poisson > -1.0 && self.poisson < 0.5) {
-            anyhow::bail!(
-                "--poisson {} must satisfy −1 < ν < 0.5 (rubber ~0.49, metals ~0.3, cork ~0)",
-                self.poisson
-            );
-        }
-        let [dlo, dhi] = Material::DENSITY_RANGE;
-        if !(self.density >= dlo && self.density <= dhi) {
-            anyhow::bail!(
-                "--density {:e} kg/m³ is outside the supported {dlo} … {dhi:e} kg/m³ (aerogel ~2, wood ~700, steel 7850)",
-                self.density
-            );
-        }
-        if self.youngs < 1e5 {
-            eprintln!(
-                "warning: --youngs {} Pa is softer than any solid object (plausible: 1e5 Pa foam … 1.2e12 Pa diamond); \
-                 the unit is Pa: did you mean {} GPa = {:e} Pa or {} MPa = {:e} Pa?",
-                self.youngs,
-                self.youngs,
-                self.youngs * 1e9,
-                self.youngs,
-                self.youngs * 1e6
-            );
-        }
-        if self.density < 100.0 {
-            eprintln!(
-                "warning: --density {} kg/m³ is lighter than solids other than foams and aerogels (plausible: 100 … 22600 kg/m³); \
-                 the unit is kg/m³: did you mean {} g/cm³ = {} kg/m³?",
-                self.density,
-                self.density,
-                self.density * 1000.0
-            );
-        }
-        Ok(())
-    }
-
-    /// The material in SI units.
-    pub fn material(&self) -> MaterialSi {
-        MaterialSi {
-            youngs: self.youngs,
-            poisson: self.poisson,
-            density: self.density,
-        }
-    }
-}
 
 /// Options that determine a base (shared by `bake` and `check`).
 #[derive(Args, Clone, Debug)]
@@ -168,6 +83,18 @@ pub struct BakeArgs {
     pub transfer: TransferOptions,
     #[command(flatten)]
     pub asset: AssetOptions,
+    /// Choose the cheapest representation (modes; a transfer table, its modes and order) whose
+    /// worst peak error against the bake's own converged full-order truth, at seeded pairs of
+    /// the table region (--transfer-up / --transfer-region), is at most PCT percent; needs
+    /// --transfer-h (the scene's step). The estimate, query cost and size are stored in the
+    /// base (`info` shows them). Overrides --modes and --transfer-modes / --transfer-order.
+    #[arg(
+        long,
+        value_name = "PCT",
+        requires = "transfer_h",
+        conflicts_with = "max_freq"
+    )]
+    pub target_error: Option<f64>,
 }
 
 /// The tetrahedral mesh of `path`: read, or (a surface asset) meshed with gmsh; with the
@@ -207,8 +134,9 @@ pub struct TransferOptions {
     /// for this h and the base's Rayleigh damping.
     #[arg(long, value_name = "SECONDS", allow_hyphen_values = true)]
     pub transfer_h: Option<f64>,
-    /// Modes the table sums: a count or `all` (dense eigensolve; small meshes) [default: 640].
-    #[arg(long, value_name = "N|all", requires = "transfer_h", value_parser = parse_modes)]
+    /// Modes the table sums: a count, `all` (dense eigensolve; small meshes) or `auto` (all up
+    /// to 6000 free dofs, else 640) [default: auto].
+    #[arg(long, value_name = "N|all|auto", requires = "transfer_h", value_parser = parse_modes)]
     pub transfer_modes: Option<TransferModes>,
     /// Region box (m, object frame), repeatable: surface vertices inside any box [default: the
     /// whole surface].
@@ -218,18 +146,38 @@ pub struct TransferOptions {
     /// `0,0,1` for the top faces).
     #[arg(long, value_name = "DX,DY,DZ", requires = "transfer_h", value_parser = parse::vec3, allow_hyphen_values = true)]
     pub transfer_up: Option<[f64; 3]>,
-    /// Peak-search oversampling of the table: T = π/(2 ω_max)/K for its highest mode [default: 2].
+    /// Peak-search oversampling of the table: T = π/(2 ω_max)/K for its highest mode [default: 1].
     #[arg(long, value_name = "K", requires = "transfer_h")]
     pub transfer_oversample: Option<f64>,
+    /// Interpolation order over each region triangle: 1 (vertices), 2 (+ edge midpoints), 3
+    /// (+ two points per edge and face centroids, ≈ 5× the size of 2), or auto (3 when its
+    /// table has at most 5792 points, else 2).
+    #[arg(long, value_name = "auto|1|2|3", requires = "transfer_h", value_parser = parse_order)]
+    pub transfer_order: Option<TableOrder>,
+}
+
+fn parse_order(s: &str) -> Result<TableOrder, String> {
+    match s.trim() {
+        "auto" => Ok(TableOrder::Auto),
+        "1" => Ok(TableOrder::Linear),
+        "2" => Ok(TableOrder::Quadratic),
+        "3" => Ok(TableOrder::Cubic),
+        _ => Err(format!("expected auto, 1, 2 or 3, got `{s}`")),
+    }
 }
 
 fn parse_modes(s: &str) -> Result<TransferModes, String> {
     if s.eq_ignore_ascii_case("all") {
         return Ok(TransferModes::All);
     }
+    if s.eq_ignore_ascii_case("auto") {
+        return Ok(TransferModes::Auto);
+    }
     match s.trim().parse::<usize>() {
         Ok(n) if n >= 1 => Ok(TransferModes::Count(n)),
-        _ => Err(format!("expected a mode count ≥ 1 or `all`, got `{s}`")),
+        _ => Err(format!(
+            "expected a mode count ≥ 1, `all` or `auto`, got `{s}`"
+        )),
     }
 }
 
@@ -244,6 +192,7 @@ impl TransferOptions {
             boxes: self.transfer_region.clone(),
             up: self.transfer_up,
             oversample: self.transfer_oversample.unwrap_or(d.oversample),
+            order: self.transfer_order.unwrap_or(d.order),
             ..d
         })
     }
@@ -253,9 +202,9 @@ impl TransferOptions {
 /// eigensolve and the transfer table; otherwise (CI logs, redirected stderr) plain lines for the
 /// stages longer than [`PLAIN_EVERY`]: one every `PLAIN_EVERY` while a stage that reports
 /// progress runs, and one with its duration when it ends. Short bakes print nothing.
-struct Progress {
-    bar: ProgressBar,
-    plain: Option<Plain>,
+pub(super) struct Progress {
+    pub(super) bar: ProgressBar,
+    pub(super) plain: Option<Plain>,
 }
 
 /// Interval between plain progress lines, and the shortest stage that gets one (seconds;
@@ -263,7 +212,7 @@ struct Progress {
 const PLAIN_EVERY: Duration = Duration::from_secs(5);
 
 /// State of the plain-line progress.
-struct Plain {
+pub(super) struct Plain {
     every: Duration,
     start: std::time::Instant,
     stage: &'static str,
@@ -278,7 +227,7 @@ impl Plain {
     }
 
     /// Ends the current stage (a line with its duration if it was long).
-    fn end_stage(&mut self) {
+    pub(super) fn end_stage(&mut self) {
         let took = self.stage_start.elapsed();
         if !self.stage.is_empty() && took >= self.every {
             self.line(&format!(
@@ -307,7 +256,7 @@ impl Plain {
 }
 
 impl Progress {
-    fn new() -> Progress {
+    pub(super) fn new() -> Progress {
         use std::io::IsTerminal;
         if std::io::stderr().is_terminal() {
             let bar = ProgressBar::new_spinner();
@@ -333,7 +282,7 @@ impl Progress {
         }
     }
 
-    fn update(&mut self, stage: BakeStage) {
+    pub(super) fn update(&mut self, stage: BakeStage) {
         if let Some(plain) = &mut self.plain {
             match stage {
                 BakeStage::Read => plain.report("read", || "reading mesh".into()),
@@ -406,6 +355,9 @@ impl Progress {
 pub fn run(args: &BakeArgs) -> anyhow::Result<()> {
     super::check_output(&args.out, "-o", &[&args.mesh])?;
     args.options.model.check_ranges()?;
+    if let Some(target) = args.target_error {
+        return super::target::run(args, target);
+    }
     let params = args.options.params();
     let mut progress = Progress::new();
     let transfer = args.transfer.params();
@@ -483,7 +435,7 @@ pub fn run(args: &BakeArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-fn print_report(out: &std::path::Path, r: &BakeReport) {
+pub(super) fn print_report(out: &std::path::Path, r: &BakeReport) {
     outln!("wrote {}", out.display());
     outln!(
         "  mesh: {} nodes, {} {}-node tets, {} free dofs, mass {:.6} kg",
@@ -537,7 +489,9 @@ fn print_report(out: &std::path::Path, r: &BakeReport) {
     );
     if r.transfer_vertices > 0 {
         outln!(
-            "  transfer table: {} region vertices + {} edge midpoints, {} modes ({}), {} samples per step, built in {:.2} s",
+            "  transfer table: order {}, {} points ({} region vertices, {} edges), {} modes ({}), {} samples per step, built in {:.2} s",
+            r.transfer_order,
+            r.transfer_points,
             r.transfer_vertices,
             r.transfer_edges,
             r.transfer_modes,

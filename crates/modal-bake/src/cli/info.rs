@@ -51,9 +51,14 @@ pub fn run(args: &InfoArgs) -> anyhow::Result<()> {
                 "samples": t.samples,
                 "region_vertices": t.len(),
                 "edge_midpoints": t.edges.len(),
+                "order": t.order,
+                "edges": t.edges.len(),
+                "faces": t.faces.len(),
+                "points": t.num_points(),
                 "packed_values": t.peaks.len(),
                 "max_peak_m_per_ns": t.peaks.iter().fold(0.0f32, |a, &b| a.max(b)),
             })),
+            "accuracy": base.meta.accuracy,
         });
         super::emit(&format!("{}\n", serde_json::to_string_pretty(&v)?));
         return Ok(());
@@ -120,9 +125,12 @@ pub fn run(args: &InfoArgs) -> anyhow::Result<()> {
     match &base.transfer {
         Some(t) => writeln!(
             out,
-            "  transfer table: {} region vertices + {} edge midpoints ({} f32 values, {:.1} KiB), h {} s, {} modes, {} samples per step, Rayleigh α0 {} α1 {}, largest peak {:.4e} m per N·s",
+            "  transfer table: {} region vertices, {} edges, {} faces, order {} ({} points; {} f32 values, {:.1} KiB), h {} s, {} modes, {} samples per step, Rayleigh α0 {} α1 {}, largest peak {:.4e} m per N·s",
             t.len(),
             t.edges.len(),
+            t.faces.len(),
+            t.order,
+            t.num_points(),
             t.peaks.len(),
             t.peaks.len() as f64 * 4.0 / 1024.0,
             t.h,
@@ -133,6 +141,24 @@ pub fn run(args: &InfoArgs) -> anyhow::Result<()> {
             t.peaks.iter().fold(0.0f32, |a, &b| a.max(b))
         )?,
         None => writeln!(out, "  transfer table: none")?,
+    }
+    if let Some(a) = &base.meta.accuracy {
+        writeln!(
+            out,
+            "  accuracy target {} %: {} — median {:.2} %, worst {:.2} % over {} pairs at h {} s vs the {} truth (dt {:.2e} s, est. error {:.2} %); query cost {:.0} multiply-adds per pair ({:.2}× 20 modes), payload {:.1} KiB",
+            a.target_pct,
+            if a.met { "met" } else { "not met" },
+            a.median_pct,
+            a.worst_pct,
+            a.pairs,
+            a.h,
+            a.truth,
+            a.truth_dt,
+            a.truth_error_pct,
+            a.query_cost,
+            a.query_cost / a.query_cost_20,
+            a.payload_bytes as f64 / 1024.0
+        )?;
     }
     writeln!(out, "  {} modes:", base.num_modes())?;
     writeln!(out, "     #   freq (Hz)      λ (rad²/s²)    residual")?;

@@ -11,13 +11,13 @@ macro_rules! outln {
 mod bake;
 mod check;
 mod export;
-mod fit_attenuation;
 mod geodesic;
 mod info;
+mod lab_alias;
 mod mesh;
 mod parse;
 mod probe;
-mod truth;
+mod target;
 
 use std::path::Path;
 use std::process::ExitCode;
@@ -56,12 +56,13 @@ enum Command {
     Export(export::ExportArgs),
     /// Heat-method geodesic distances (m) from one surface vertex of a base.
     Geodesic(geodesic::GeodesicArgs),
-    /// Full-order reference response of a mesh to an impulse (Newmark or all modes).
-    #[command(allow_negative_numbers = true)]
-    Truth(truth::TruthArgs),
-    /// Fit the spatial attenuation law (Eq. 14) to the full-order response at random surface pairs.
-    #[command(allow_negative_numbers = true)]
-    FitAttenuation(fit_attenuation::FitAttenuationArgs),
+    /// Alias of `dcr-lab truth` (full-order reference response): runs the `dcr-lab` binary.
+    #[command(disable_help_flag = true)]
+    Truth(lab_alias::LabArgs),
+    /// Alias of `dcr-lab fit-attenuation` (Eq. 14 fitted to the full-order response): runs the
+    /// `dcr-lab` binary.
+    #[command(disable_help_flag = true)]
+    FitAttenuation(lab_alias::LabArgs),
 }
 
 /// The first failure writing stdout, if any (checked once by `main`).
@@ -198,8 +199,8 @@ fn run_command(command: Command) -> ExitCode {
         Command::Probe(a) => probe::run(&a).map(|()| ExitCode::SUCCESS),
         Command::Export(a) => export::run(&a).map(|()| ExitCode::SUCCESS),
         Command::Geodesic(a) => geodesic::run(&a).map(|()| ExitCode::SUCCESS),
-        Command::Truth(a) => truth::run(&a).map(|()| ExitCode::SUCCESS),
-        Command::FitAttenuation(a) => fit_attenuation::run(&a).map(|()| ExitCode::SUCCESS),
+        Command::Truth(a) => lab_alias::run("truth", &a),
+        Command::FitAttenuation(a) => lab_alias::run("fit-attenuation", &a),
         Command::Check(a) => return check::run(&a),
     };
     match result {

@@ -1,40 +1,7 @@
-//! Small value parsers shared by the subcommands.
+//! Small value parsers shared by the subcommands (the general ones are defined once in
+//! [`modal_bake::args`]).
 
-/// Parses `X,Y,Z` (three finite numbers).
-pub fn vec3(s: &str) -> Result<[f64; 3], String> {
-    let v = list(s)?;
-    match v.as_slice() {
-        [x, y, z] => Ok([*x, *y, *z]),
-        _ => Err(format!(
-            "expected three comma-separated numbers X,Y,Z, got `{s}`"
-        )),
-    }
-}
-
-/// Parses `A,B` (two finite numbers).
-pub fn pair(s: &str) -> Result<[f64; 2], String> {
-    let v = list(s)?;
-    match v.as_slice() {
-        [a, b] => Ok([*a, *b]),
-        _ => Err(format!(
-            "expected two comma-separated numbers A,B, got `{s}`"
-        )),
-    }
-}
-
-/// Parses `XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX` (six finite numbers, min ≤ max per axis).
-pub fn aabb(s: &str) -> Result<[f64; 6], String> {
-    let v = list(s)?;
-    match v.as_slice() {
-        [a, b, c, d, e, f] if a <= d && b <= e && c <= f => Ok([*a, *b, *c, *d, *e, *f]),
-        [_, _, _, _, _, _] => Err(format!(
-            "box `{s}`: each minimum must be ≤ its maximum (XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX)"
-        )),
-        _ => Err(format!(
-            "expected six comma-separated numbers XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX, got `{s}`"
-        )),
-    }
-}
+pub use modal_bake::args::{aabb, vec3};
 
 /// Parses `AXIS=VALUE` (`x`, `y` or `z`, then a finite number in m), e.g. `y=0.01`.
 pub fn axis_value(s: &str) -> Result<modal_bake::bake::FixedBelow, String> {
@@ -53,20 +20,4 @@ pub fn axis_value(s: &str) -> Result<modal_bake::bake::FixedBelow, String> {
             "`{value}` is not a finite number of metres (in `{s}`)"
         )),
     }
-}
-
-fn list(s: &str) -> Result<Vec<f64>, String> {
-    s.split(',')
-        .map(|t| {
-            let x: f64 = t
-                .trim()
-                .parse()
-                .map_err(|_| format!("`{t}` is not a number"))?;
-            if x.is_finite() {
-                Ok(x)
-            } else {
-                Err(format!("`{t}` is not finite"))
-            }
-        })
-        .collect()
 }

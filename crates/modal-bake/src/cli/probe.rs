@@ -73,8 +73,8 @@ pub struct ProbeArgs {
     /// Oversampling factor K: T = π/(2 ω_max)/K.
     #[arg(long)]
     pub oversample: Option<f64>,
-    /// Response model.
-    #[arg(long, value_enum, default_value_t = MethodArg::Modal)]
+    /// Response model (default: the base's transfer table where it applies, else modal).
+    #[arg(long, value_enum, default_value_t = MethodArg::Transfer)]
     pub method: MethodArg,
     /// Peak variant (modal method).
     #[arg(long, value_enum, default_value_t = VariantArg::PerContact)]

@@ -295,10 +295,13 @@ pub(crate) fn lower_inverse(l: MatRef<'_, f64>) -> Mat<f64> {
     x
 }
 
-/// splitmix64 (Steele, Lea, Flood 2014): the fixed-seed generator of the start block.
-pub(crate) struct SplitMix64(pub u64);
+/// splitmix64 (Steele, Lea, Flood 2014): the fixed-seed generator of the Lanczos start block
+/// and of the seeded points of an accuracy target (the same bits on every platform).
+#[derive(Clone, Debug)]
+pub struct SplitMix64(pub u64);
 
 impl SplitMix64 {
+    /// Next 64 random bits.
     pub fn next_u64(&mut self) -> u64 {
         self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
         let mut z = self.0;
@@ -310,6 +313,16 @@ impl SplitMix64 {
     /// Uniform in [−1, 1).
     pub fn next_sym(&mut self) -> f64 {
         ((self.next_u64() >> 11) as f64) * (2.0 / (1u64 << 53) as f64) - 1.0
+    }
+
+    /// Uniform in [0, 1).
+    pub fn unit(&mut self) -> f64 {
+        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    /// Uniform integer in 0..n (n > 0), by the high half of a 64 × 64-bit product (Lemire).
+    pub fn below(&mut self, n: usize) -> usize {
+        ((self.next_u64() as u128 * n as u128) >> 64) as usize
     }
 }
 

@@ -89,6 +89,7 @@ use faer::Mat;
 use crate::fem::Material;
 use crate::mesh::TetMesh;
 
+pub use kernels::SplitMix64;
 /// A pair counts as converged within this factor of its double-precision residual floor.
 pub use lanczos::FLOOR_FACTOR;
 pub(crate) use shift_invert::{lin_comb, ShiftInvert};

@@ -5,19 +5,23 @@
 //! (faer `self_adjoint_eigen`), Φ = L⁻ᵀ Q, so Φᵀ M Φ = I. With Rayleigh damping every mode
 //! decouples (paper Eq. 8) and an impulse f at t = 0 gives the exact displacement
 //! u(t) = Σ_j φ_j (φ_jᵀ f) g_j(t), with g_j the mass-normalised impulse response for
-//! ξ_j = ½(α0/ω_j + α1 ω_j) in every regime (ξ < 1, = 1, > 1) — `dcr_runtime::ModeFilter`.
+//! ξ_j = ½(α0/ω_j + α1 ω_j) in every regime (ξ < 1, = 1, > 1) — `dcr_runtime::filter::ModeFilter`.
 //!
 //! Free-free: the six lowest eigenpairs (λ ≈ 0) are the rigid modes; they are dropped (the load
 //! and the rows are also M-orthogonally stripped of their rigid part by
-//! [`super::TruthSystem::remove_rigid`], so their coefficients are ≈ 0 anyway).
+//! [`super::FullOrderSystem::remove_rigid`], so their coefficients are ≈ 0 anyway).
 
 use std::time::Instant;
 
 use dcr_runtime::filter::{damping_ratio, ModeFilter};
-use faer::{Mat, Side};
+use std::num::NonZeroUsize;
+
+use faer::diag::Diag;
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::{Mat, Par};
 use rayon::prelude::*;
 
-use super::{TruthError, TruthSystem};
+use super::{FullOrderError, FullOrderSystem};
 
 /// A near-zero eigenvalue is rigid when |λ| ≤ this × the first elastic λ (as in the bake).
 const RIGID_REL_TOL: f64 = 1e-6;
@@ -39,36 +43,19 @@ impl ModalAll {
     /// Dense generalized eigensolve of the system's (K, M).
     ///
     /// # Errors
-    /// [`TruthError::TooLarge`] above `max_dofs` free dofs; [`TruthError::Eigen`] if M is not
+    /// [`FullOrderError::TooLarge`] above `max_dofs` free dofs; [`FullOrderError::Eigen`] if M is not
     /// positive definite, the eigensolver fails, or a free-free object does not show exactly
     /// six near-zero eigenvalues.
-    pub fn new(sys: &TruthSystem, max_dofs: usize) -> Result<ModalAll, TruthError> {
+    pub fn new(sys: &FullOrderSystem, max_dofs: usize) -> Result<ModalAll, FullOrderError> {
         let n = sys.n();
         if n > max_dofs {
-            return Err(TruthError::TooLarge {
+            return Err(FullOrderError::TooLarge {
                 dofs: n,
                 max: max_dofs,
             });
         }
         let t = Instant::now();
-        let md = sys.m.to_dense();
-        let kd = sys.k.to_dense();
-        let llt = md
-            .llt(Side::Lower)
-            .map_err(|e| TruthError::Eigen(format!("M is not positive definite: {e:?}")))?;
-        let l = llt.L().to_owned();
-        // X = L⁻¹ K, C = L⁻¹ Xᵀ = L⁻¹ K L⁻ᵀ.
-        let mut x = kd;
-        l.solve_lower_triangular_in_place(x.as_mut());
-        let mut c = x.transpose().to_owned();
-        l.solve_lower_triangular_in_place(c.as_mut());
-        let c = Mat::from_fn(n, n, |i, j| 0.5 * (c[(i, j)] + c[(j, i)]));
-        let eig = c
-            .self_adjoint_eigen(Side::Lower)
-            .map_err(|e| TruthError::Eigen(format!("dense eigensolver failed: {e:?}")))?;
-        let vals: Vec<f64> = (0..n).map(|i| eig.S()[i]).collect();
-        let mut phi = eig.U().to_owned();
-        l.transpose().solve_upper_triangular_in_place(phi.as_mut());
+        let (vals, phi) = dense_generalized_eigen(&sys.k.to_dense(), sys.m.to_dense())?;
         let rigid = if sys.free_free() { 6 } else { 0 };
         if rigid > 0 {
             let lam7 = vals.get(rigid).copied().unwrap_or(f64::INFINITY).abs();
@@ -77,13 +64,13 @@ impl ModalAll {
                 .filter(|l| l.abs() <= RIGID_REL_TOL * lam7)
                 .count();
             if near != rigid {
-                return Err(TruthError::Eigen(format!(
+                return Err(FullOrderError::Eigen(format!(
                     "expected 6 rigid-body modes for a free-free object, found {near}"
                 )));
             }
         }
         if !vals.iter().all(|v| v.is_finite()) {
-            return Err(TruthError::Eigen("non-finite eigenvalue".into()));
+            return Err(FullOrderError::Eigen("non-finite eigenvalue".into()));
         }
         let vectors = phi.subcols(rigid, n - rigid).to_owned();
         Ok(ModalAll {
@@ -155,40 +142,37 @@ impl ModalAll {
     ) -> Vec<f64> {
         let m = modes.unwrap_or(usize::MAX).min(self.eigenvalues.len());
         let nc = w.len();
-        // y[c][k] = Σ_j w_cj r_j x_j(kΔt), accumulated per chunk of modes in parallel.
-        let y = (0..m)
-            .into_par_iter()
-            .with_min_len(32)
-            .fold(
-                || vec![0.0f64; nc * steps],
-                |mut acc, j| {
-                    let lam = self.eigenvalues[j];
-                    if lam.is_nan() || lam <= 0.0 || r[j] == 0.0 {
-                        return acc;
-                    }
-                    let omega = lam.sqrt();
-                    let filt = ModeFilter::new(omega, damping_ratio(omega, rayleigh), dt);
-                    let coef: Vec<f64> = w.iter().map(|wc| wc[j] * r[j]).collect();
-                    for k in 0..steps {
-                        let t = (k + 1) as f64 * dt;
+        if nc == 0 || steps == 0 {
+            return vec![0.0; nc];
+        }
+        // y[c][k] = Σ_j w_cj r_j x_j(kΔt), summed over j in order for each sample k; samples are
+        // split over threads (the same bits on any thread count).
+        let active: Vec<(ModeFilter, Vec<f64>)> = (0..m)
+            .filter(|&j| self.eigenvalues[j] > 0.0 && r[j] != 0.0)
+            .map(|j| {
+                let omega = self.eigenvalues[j].sqrt();
+                let filt = ModeFilter::new(omega, damping_ratio(omega, rayleigh), dt);
+                (filt, w.iter().map(|wc| wc[j] * r[j]).collect())
+            })
+            .collect();
+        const BLOCK: usize = 64;
+        let mut y = vec![0.0f64; steps * nc];
+        y.par_chunks_mut(BLOCK * nc)
+            .enumerate()
+            .for_each(|(b, out)| {
+                for (kk, yk) in out.chunks_mut(nc).enumerate() {
+                    let t = (b * BLOCK + kk + 1) as f64 * dt;
+                    for (filt, coef) in &active {
                         let x = match input {
                             ModalInput::Impulse => filt.impulse_response(t),
                             ModalInput::Step => filt.step_response(t),
                         };
-                        for (c, a) in coef.iter().enumerate() {
-                            acc[c * steps + k] += a * x;
+                        for (v, a) in yk.iter_mut().zip(coef) {
+                            *v += a * x;
                         }
                     }
-                    acc
-                },
-            )
-            .reduce(
-                || vec![0.0f64; nc * steps],
-                |mut a, b| {
-                    a.iter_mut().zip(b).for_each(|(x, y)| *x += y);
-                    a
-                },
-            );
+                }
+            });
         let offset: Vec<f64> = if static_correction && input == ModalInput::Step {
             w.iter()
                 .map(|wc| {
@@ -202,13 +186,67 @@ impl ModalAll {
             vec![0.0; nc]
         };
         (0..nc)
-            .map(|c| {
-                y[c * steps..(c + 1) * steps]
-                    .iter()
-                    .fold(0.0f64, |p, v| p.max((v + offset[c]).abs()))
-            })
+            .map(|c| (0..steps).fold(0.0f64, |p, k| p.max((y[k * nc + c] + offset[c]).abs())))
             .collect()
     }
+}
+
+/// The thread split of the dense factorization, triangular solves and eigensolve. Fixed (not the
+/// pool's size): faer's blocked dense kernels partition their work by this count, so a fixed
+/// count gives the same bits whatever `RAYON_NUM_THREADS` is (with fewer threads in the pool
+/// the parts run one after another).
+const DENSE_PAR: Par = Par::Rayon(match NonZeroUsize::new(2) {
+    Some(n) => n,
+    None => unreachable!(),
+});
+
+/// Every eigenpair of K φ = λ M φ (dense, M symmetric positive definite), ascending, with
+/// Φᵀ M Φ = I: M = L Lᵀ, C = L⁻¹ K L⁻ᵀ (symmetrised), C = Q Λ Qᵀ, Φ = L⁻ᵀ Q. Bit-identical on
+/// any thread count ([`DENSE_PAR`]).
+fn dense_generalized_eigen(
+    k: &Mat<f64>,
+    mut l: Mat<f64>,
+) -> Result<(Vec<f64>, Mat<f64>), FullOrderError> {
+    use faer::linalg::cholesky::llt::factor::{cholesky_in_place, cholesky_in_place_scratch};
+    use faer::linalg::evd::{self_adjoint_evd, self_adjoint_evd_scratch, ComputeEigenvectors};
+    use faer::linalg::triangular_solve::{
+        solve_lower_triangular_in_place, solve_upper_triangular_in_place,
+    };
+    let n = l.nrows();
+    let scratch = cholesky_in_place_scratch::<f64>(n, DENSE_PAR, Default::default()).or(
+        self_adjoint_evd_scratch::<f64>(n, ComputeEigenvectors::Yes, DENSE_PAR, Default::default()),
+    );
+    let mut mem = MemBuffer::try_new(scratch)
+        .map_err(|_| FullOrderError::Eigen(format!("no memory for the workspace of {n} dofs")))?;
+    let stack = MemStack::new(&mut mem);
+    cholesky_in_place(
+        l.as_mut(),
+        Default::default(),
+        DENSE_PAR,
+        stack,
+        Default::default(),
+    )
+    .map_err(|e| FullOrderError::Eigen(format!("M is not positive definite: {e:?}")))?;
+    let l = l.as_ref();
+    // X = L⁻¹ K, C = L⁻¹ Xᵀ = L⁻¹ K L⁻ᵀ (only L's lower triangle is read).
+    let mut x = k.clone();
+    solve_lower_triangular_in_place(l, x.as_mut(), DENSE_PAR);
+    let mut c = x.transpose().to_owned();
+    solve_lower_triangular_in_place(l, c.as_mut(), DENSE_PAR);
+    let c = Mat::from_fn(n, n, |i, j| 0.5 * (c[(i, j)] + c[(j, i)]));
+    let mut s = Diag::<f64>::zeros(n);
+    let mut u = Mat::<f64>::zeros(n, n);
+    self_adjoint_evd(
+        c.as_ref(),
+        s.as_mut(),
+        Some(u.as_mut()),
+        DENSE_PAR,
+        stack,
+        Default::default(),
+    )
+    .map_err(|e| FullOrderError::Eigen(format!("dense eigensolver failed: {e:?}")))?;
+    solve_upper_triangular_in_place(l.transpose(), u.as_mut(), DENSE_PAR);
+    Ok(((0..n).map(|i| s[i]).collect(), u))
 }
 
 /// The time profile of the load in [`ModalAll::response_peaks`].

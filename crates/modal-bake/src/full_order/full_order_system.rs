@@ -1,4 +1,4 @@
-//! [`TruthSystem`]: the full-order FEM system of a mesh (free dofs), its surface, and the
+//! [`FullOrderSystem`]: the full-order FEM system of a mesh (free dofs), its surface, and the
 //! M-orthogonal projector that removes rigid-body motion from loads and measurements.
 
 use faer::sparse::SparseColMat;
@@ -7,14 +7,14 @@ use faer::Mat;
 use dcr_runtime::model::SurfacePoint;
 
 use super::surface_map::SurfaceMap;
-use super::{TruthError, TruthParams};
+use super::{FullOrderError, SystemParams};
 use crate::fem::{self, DofMap, Material};
 use crate::mesh::{TetMesh, DEFAULT_DEGENERATE_REL_TOL};
 
 /// A prepared full-order problem: K (N/m) and M (kg) on the free dofs, the dof map, the boundary
 /// surface, and (free-free only) the six rigid-body modes made M-orthonormal.
 #[derive(Clone, Debug)]
-pub struct TruthSystem {
+pub struct FullOrderSystem {
     /// The oriented mesh (m).
     pub mesh: TetMesh,
     /// Full ↔ free dof map (fixed nodes removed).
@@ -33,21 +33,25 @@ pub struct TruthSystem {
     rigid: Option<Mat<f64>>,
 }
 
-impl TruthSystem {
+impl FullOrderSystem {
     /// Orients and checks `mesh`, fixes the groups named in `params.fixed`, assembles K and M.
     ///
     /// # Errors
-    /// [`TruthError`] on an invalid material, a degenerate or disconnected mesh, unknown groups.
-    pub fn new(mut mesh: TetMesh, params: &TruthParams, file: &str) -> Result<Self, TruthError> {
+    /// [`FullOrderError`] on an invalid material, a degenerate or disconnected mesh, unknown groups.
+    pub fn new(
+        mut mesh: TetMesh,
+        params: &SystemParams,
+        file: &str,
+    ) -> Result<Self, FullOrderError> {
         let mat = Material::new(
             params.material.youngs,
             params.material.poisson,
             params.material.density,
         )
-        .map_err(|e| TruthError::Params(format!("invalid material: {e}")))?;
+        .map_err(|e| FullOrderError::Params(format!("invalid material: {e}")))?;
         if !params.rayleigh.iter().all(|x| x.is_finite() && *x >= 0.0) {
-            return Err(TruthError::Params(format!(
-                "--rayleigh coefficients must be finite and ≥ 0, got {:?}",
+            return Err(FullOrderError::Params(format!(
+                "Rayleigh coefficients [α0, α1] must be finite and ≥ 0, got {:?}",
                 params.rayleigh
             )));
         }
@@ -55,15 +59,15 @@ impl TruthSystem {
             if e.file.is_empty() {
                 e.file = file.to_string();
             }
-            TruthError::Mesh(e)
+            FullOrderError::Mesh(e)
         };
         if mesh.tets.is_empty() {
-            return Err(TruthError::Params(format!(
+            return Err(FullOrderError::Params(format!(
                 "{file}: the mesh has no tetrahedra"
             )));
         }
         if mesh.is_quadratic() {
-            return Err(TruthError::Params(format!(
+            return Err(FullOrderError::Params(format!(
                 "{file}: the full-order reference supports 4-node tetrahedra only (its surface map is linear); use a linear mesh"
             )));
         }
@@ -71,7 +75,7 @@ impl TruthSystem {
             .map_err(name_file)?;
         let pieces = mesh.connected_components();
         if pieces != 1 {
-            return Err(TruthError::Params(format!(
+            return Err(FullOrderError::Params(format!(
                 "{file}: the mesh has {pieces} disconnected pieces"
             )));
         }
@@ -82,19 +86,19 @@ impl TruthSystem {
         fixed.sort_unstable();
         fixed.dedup();
         if !fixed.is_empty() && fixed.len() == mesh.nodes.len() {
-            return Err(TruthError::Params(format!(
-                "{file}: --fixed fixes every node; nothing can vibrate"
+            return Err(FullOrderError::Params(format!(
+                "{file}: the fixed groups fix every node; nothing can vibrate"
             )));
         }
         let (map, k, m) = fem::assemble_clamped(&mesh, &mat, params.lumped, &fixed)
-            .map_err(|e| TruthError::Params(format!("{file}: {e}")))?;
+            .map_err(|e| FullOrderError::Params(format!("{file}: {e}")))?;
         let rigid = if fixed.is_empty() {
             Some(m_orthonormal(&m, fem::rigid_body_modes(&mesh)))
         } else {
             None
         };
         let surface = SurfaceMap::new(&mesh);
-        Ok(TruthSystem {
+        Ok(FullOrderSystem {
             mesh,
             map,
             k,
@@ -118,7 +122,7 @@ impl TruthSystem {
 
     /// Nodal impulse vector (N·s, free dofs) of an impulse `impulse` (N·s) along unit `direction`
     /// at `sp`, spread to the triangle's three nodes with the barycentric weights (paper Eq. 9,
-    /// `H_cᵀ n λ`). Free-free: the rigid-body part is removed (see [`TruthSystem::remove_rigid`]).
+    /// `H_cᵀ n λ`). Free-free: the rigid-body part is removed (see [`FullOrderSystem::remove_rigid`]).
     pub fn load_vector(&self, sp: &SurfacePoint, direction: [f64; 3], impulse: f64) -> Vec<f64> {
         let mut f = vec![0.0; self.n()];
         self.scatter(sp, direction, impulse, &mut f);

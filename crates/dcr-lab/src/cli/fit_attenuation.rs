@@ -1,14 +1,15 @@
-//! `modal-bake fit-attenuation`: fit the spatial attenuation law (paper Eq. 14) to the
+//! `dcr-lab fit-attenuation`: fit the spatial attenuation law (paper Eq. 14) to the
 //! full-order response of a mesh at random surface vertex pairs (see
-//! [`modal_bake::truth::fit_eq14`] and the `attenuation_fit` module docs).
+//! [`dcr_lab::attenuation_fit::fit_eq14`] and the `attenuation_fit` module docs).
 
 use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::{Args, ValueEnum};
-use modal_bake::truth::{self, AttenuationFitParams, FitTruth};
+use dcr_lab::attenuation_fit::{self, AttenuationFitParams, FitProgress, FitTruth};
+use modal_bake::args::ModelOptions;
 
-use super::bake::ModelOptions;
+use super::progress::Progress;
 
 /// Truth used for the pairs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -83,11 +84,26 @@ impl FitAttenuationArgs {
 pub fn run(args: &FitAttenuationArgs) -> anyhow::Result<()> {
     let mesh = modal_bake::mesh::read_mesh(&args.mesh)
         .with_context(|| format!("reading {} failed", args.mesh.display()))?;
-    let rep = truth::fit_attenuation_mesh(mesh, &args.params(), &args.mesh.display().to_string())
-        .with_context(|| format!("fit-attenuation for {} failed", args.mesh.display()))?;
+    let mut progress = Progress::new("fit-attenuation");
+    let rep = attenuation_fit::fit_attenuation_mesh(
+        mesh,
+        &args.params(),
+        &args.mesh.display().to_string(),
+        &mut |p| match p {
+            FitProgress::Solve { method } => {
+                progress.stage(&format!("solving for the modes ({method})"))
+            }
+            FitProgress::Distances { done, total } => {
+                progress.count("geodesic distances", done, total)
+            }
+            FitProgress::Pairs { done, total } => progress.count("pair responses", done, total),
+            _ => {}
+        },
+    );
+    progress.finish();
+    let rep = rep.with_context(|| format!("fit-attenuation for {} failed", args.mesh.display()))?;
     if args.json {
-        super::emit(&format!("{}\n", serde_json::to_string_pretty(&rep)?));
-        return Ok(());
+        return super::emit(&format!("{}\n", serde_json::to_string_pretty(&rep)?));
     }
     let (i, f, s) = (&rep.info, &rep.fit, &rep.simplified);
     let (rmin, rmax) = rep
@@ -138,6 +154,5 @@ pub fn run(args: &FitAttenuationArgs) -> anyhow::Result<()> {
         "  seconds: eigensolve {:.3}, pairs {:.3}\n",
         i.eigensolve_s, i.response_s
     );
-    super::emit(&out);
-    Ok(())
+    super::emit(&out)
 }

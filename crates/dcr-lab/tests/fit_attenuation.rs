@@ -3,14 +3,16 @@
 //! (peak at the contact / local peak at the impact) decays with distance (β > 0) and agrees
 //! with `run_truth` at the same points.
 //!
-//! Run with `cargo test --release -p modal-bake --test fit_attenuation`.
+//! Run with `cargo test --release -p dcr-lab --test fit_attenuation`.
 
-use modal_bake::mesh::TetMesh;
-use modal_bake::truth::{
-    fit_attenuation_mesh, fit_eq14, fit_eq14_fixed_r0, fit_simplified, run_truth,
-    sample_attenuation, AttenuationFitParams, FitTruth, ModalAll, SplitMix64, SurfaceResponse,
-    TruthImpact, TruthMethod, TruthParams, TruthSystem,
+use dcr_lab::attenuation_fit::{
+    fit_attenuation_mesh, fit_eq14, fit_eq14_fixed_r0, fit_simplified, sample_attenuation,
+    AttenuationFitParams, FitTruth, SurfaceResponse,
 };
+use dcr_lab::truth::{run_truth, CrossCheck, TruthImpact, TruthMethod, TruthParams};
+use dcr_runtime::testing::SplitMix64;
+use modal_bake::full_order::{FullOrderSystem, ModalAll, RefineParams};
+use modal_bake::mesh::TetMesh;
 
 /// Eq. 14.
 fn eq14(r: f64, alpha: f64, beta: f64, r0: f64) -> f64 {
@@ -19,13 +21,13 @@ fn eq14(r: f64, alpha: f64, beta: f64, r0: f64) -> f64 {
 
 /// Distances 0.05 … 3 m (random, seeded) and s with multiplicative noise e^(σ·N(0,1)).
 fn synthetic(alpha: f64, beta: f64, r0: f64, sigma: f64, n: usize) -> (Vec<f64>, Vec<f64>) {
-    let mut rng = SplitMix64::new(7);
-    let r: Vec<f64> = (0..n).map(|_| 0.05 + 2.95 * rng.unit()).collect();
+    let mut rng = SplitMix64(7);
+    let r: Vec<f64> = (0..n).map(|_| 0.05 + 2.95 * rng.next_f64()).collect();
     let s = r
         .iter()
         .map(|&r| {
             // Box–Muller.
-            let (u1, u2) = (rng.unit().max(1e-300), rng.unit());
+            let (u1, u2) = (rng.next_f64().max(1e-300), rng.next_f64());
             let z = (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos();
             eq14(r, alpha, beta, r0) * (sigma * z).exp()
         })
@@ -117,13 +119,23 @@ fn measured_samples_match_run_truth_at_the_same_points() {
         method: TruthMethod::ModalAll,
         ..Default::default()
     };
-    let sys = TruthSystem::new(slab(), &tp, "slab").unwrap();
+    let sys = FullOrderSystem::new(slab(), &tp.system(), "slab").unwrap();
     let ma = ModalAll::new(&sys, 6000).unwrap();
     let resp = SurfaceResponse::from_modal_all(&sys, &ma, None);
-    let (samples, kind, dt, _) = sample_attenuation(&resp, tp.rayleigh, tp.h, None, 4, 3).unwrap();
+    let (samples, kind, dt, _) =
+        sample_attenuation(&resp, tp.rayleigh, tp.h, None, 4, 3, &mut |_| {}).unwrap();
     assert_eq!(kind, "geodesic");
     for smp in &samples {
-        let p = TruthParams { dt, ..tp.clone() };
+        // One run at exactly the sampler's period (no refinement), to compare like with like.
+        let p = TruthParams {
+            dt,
+            refine: RefineParams {
+                max_refinements: 0,
+                ..RefineParams::default()
+            },
+            cross_check: CrossCheck::Off,
+            ..tp.clone()
+        };
         let imp = TruthImpact {
             point: smp.impact_point,
             impulse: 1.0,
@@ -135,6 +147,7 @@ fn measured_samples_match_run_truth_at_the_same_points() {
             &imp,
             &[smp.impact_point, smp.contact_point],
             "slab",
+            &mut |_| {},
         )
         .unwrap();
         let (local, far) = (
@@ -157,7 +170,7 @@ fn measured_samples_match_run_truth_at_the_same_points() {
 fn small_mesh_fit_is_finite_and_decays_with_distance() {
     let p = AttenuationFitParams {
         fixed: vec!["zmin".into()],
-        material: modal_bake::truth::MaterialSi {
+        material: dcr_lab::truth::MaterialSi {
             youngs: 10e9,
             poisson: 0.3,
             density: 500.0,
@@ -167,7 +180,7 @@ fn small_mesh_fit_is_finite_and_decays_with_distance() {
         seed: 11,
         ..Default::default()
     };
-    let rep = fit_attenuation_mesh(slab(), &p, "slab").unwrap();
+    let rep = fit_attenuation_mesh(slab(), &p, "slab", &mut |_| {}).unwrap();
     let f = rep.fit;
     assert!(
         f.alpha.is_finite() && f.beta.is_finite() && f.r0.is_finite(),
@@ -178,7 +191,7 @@ fn small_mesh_fit_is_finite_and_decays_with_distance() {
     assert_eq!(rep.samples.len(), 60);
     assert_eq!(rep.info.method, "modal-all");
     // Same seed, same samples.
-    let again = fit_attenuation_mesh(slab(), &p, "slab").unwrap();
+    let again = fit_attenuation_mesh(slab(), &p, "slab", &mut |_| {}).unwrap();
     assert_eq!(again.samples, rep.samples);
 }
 
@@ -192,7 +205,7 @@ fn sparse_truth_runs_and_decays_with_distance() {
         modes: Some(60),
         ..Default::default()
     };
-    let rep = fit_attenuation_mesh(slab(), &p, "slab").unwrap();
+    let rep = fit_attenuation_mesh(slab(), &p, "slab", &mut |_| {}).unwrap();
     assert_eq!(rep.info.method, "modes");
     assert_eq!(rep.info.modes, 60);
     assert!(
@@ -202,14 +215,14 @@ fn sparse_truth_runs_and_decays_with_distance() {
     );
 }
 
-/// `modal-bake fit-attenuation` through the binary: text and JSON output, and a clean error.
+/// `dcr-lab fit-attenuation` through the binary: text and JSON output, and a clean error.
 #[test]
 fn cli_runs_on_a_small_mesh() {
     let beam = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/meshes/beam.msh");
     let run = |extra: &[&str]| {
         let mut argv = vec!["fit-attenuation", beam.to_str().unwrap()];
         argv.extend_from_slice(extra);
-        std::process::Command::new(env!("CARGO_BIN_EXE_modal-bake"))
+        std::process::Command::new(env!("CARGO_BIN_EXE_dcr-lab"))
             .args(&argv)
             .output()
             .unwrap()
@@ -227,10 +240,16 @@ fn cli_runs_on_a_small_mesh() {
         "10,1e-7",
     ];
     let text = run(&base);
+    let err = String::from_utf8_lossy(&text.stderr);
+    assert!(text.status.success(), "{err}");
+    // stderr is not a terminal here: progress comes as plain lines, ending with the last pair.
     assert!(
-        text.status.success(),
-        "{}",
-        String::from_utf8_lossy(&text.stderr)
+        err.contains("fit-attenuation: solving for the modes"),
+        "{err}"
+    );
+    assert!(
+        err.contains("fit-attenuation: pair responses 30/30"),
+        "{err}"
     );
     let mut with_json = base.to_vec();
     with_json.push("--json");
@@ -239,6 +258,14 @@ fn cli_runs_on_a_small_mesh() {
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("one JSON object");
     let text = v.to_string();
     assert!(text.contains("beta"), "{text}");
+    // An absurd pair count is refused at once, naming the limit (it would need gigabytes).
+    let absurd = run(&["--fixed", "clamp", "--pairs", "1000000000"]);
+    let err = String::from_utf8_lossy(&absurd.stderr);
+    assert!(!absurd.status.success() && err.contains("100000"), "{err}");
+    assert!(
+        err.contains("1000000000") && !err.contains("panicked"),
+        "{err}"
+    );
     // A user error is a clean error, not a panic.
     let bad = run(&["--fixed", "nope"]);
     let err = String::from_utf8_lossy(&bad.stderr);

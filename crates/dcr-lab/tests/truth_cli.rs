@@ -1,5 +1,4 @@
-//! End-to-end tests of `modal-bake truth` (needs the `Truth` subcommand wired in
-//! `src/cli/mod.rs`): probe's JSON shape, the two methods agree, clear errors on bad input.
+//! End-to-end tests of `dcr-lab truth`: probe's JSON shape, the two methods agree, clear errors on bad input.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -25,16 +24,18 @@ fn truth(extra: &[&str]) -> Output {
         "0.5,0.05,0.1",
         "--contact",
         "0.8,0.0,0.05",
-        "--h",
-        "0.002",
-        "--dt",
-        "5e-7",
     ];
+    // The window and step unless `extra` sets them.
+    for (flag, value) in [("--h", "0.002"), ("--dt", "5e-7")] {
+        if !extra.contains(&flag) {
+            a.extend_from_slice(&[flag, value]);
+        }
+    }
     a.extend_from_slice(extra);
-    Command::new(env!("CARGO_BIN_EXE_modal-bake"))
+    Command::new(env!("CARGO_BIN_EXE_dcr-lab"))
         .args(&a)
         .output()
-        .expect("modal-bake runs")
+        .expect("dcr-lab runs")
 }
 
 fn peaks(out: &Output) -> Vec<f64> {
@@ -82,7 +83,7 @@ fn truth_json_methods_agree() {
 fn truth_rejects_bad_input_with_a_clear_message() {
     for (extra, needle) in [
         (&["--fixed", "nope"][..], "no node group named"),
-        (&["--dt", "0"][..], "--dt"),
+        (&["--dt", "0"][..], "dt = 0"),
         (&["--modes", "5"][..], "--method modal-all"),
         (&["--impulse", "nan"][..], "impulse"),
         (&["--impulse", "-1"][..], "impulse"),
@@ -115,4 +116,44 @@ fn truth_accepts_negative_coordinates() {
     assert_eq!(v["contacts"].as_array().unwrap().len(), 3);
     let d = v["info"]["impact_direction"].as_array().unwrap();
     assert!(d[0].as_f64().unwrap() < 0.0);
+}
+
+/// Exit status 3 and `"converged": false` when the step cannot be refined enough; exit 0 and
+/// the step reached otherwise.
+#[test]
+fn truth_exit_status_says_whether_it_converged() {
+    let out = truth(&[
+        "--json",
+        "--dt",
+        "1e-4",
+        "--tol",
+        "1e-7",
+        "--max-refinements",
+        "1",
+    ]);
+    assert_eq!(
+        out.status.code(),
+        Some(3),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["convergence"]["converged"], false);
+    assert_eq!(v["convergence"]["history"].as_array().unwrap().len(), 2);
+    let out = truth(&["--json", "--dt", "1e-4", "--method", "modal-all"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let c = &v["convergence"];
+    assert_eq!(c["converged"], true);
+    assert!(c["estimated_error_pct"].as_f64().unwrap() < 0.5);
+    assert!(c["history"].as_array().unwrap().len() >= 3);
+    assert_eq!(c["cross_check"]["method"], "newmark");
+    assert_eq!(c["dt_reached"], v["info"]["dt"]);
+    let text = truth(&["--dt", "1e-4", "--method", "modal-all"]);
+    let s = String::from_utf8_lossy(&text.stdout);
+    assert!(s.contains("converged at dt ="), "{s}");
 }

@@ -17,8 +17,8 @@ use std::time::Instant;
 use faer::sparse::SparseColMat;
 use faer::{MatMut, Par};
 
-use super::truth_system::{spmv, TruthSystem};
-use super::TruthError;
+use super::full_order_system::{spmv, FullOrderSystem};
+use super::FullOrderError;
 
 /// What a Newmark run did.
 #[derive(Clone, Debug, Default, serde::Serialize)]
@@ -37,36 +37,61 @@ pub struct NewmarkInfo {
 /// free dofs) at t = 0 from rest. `dt` in s.
 ///
 /// # Errors
-/// [`TruthError::Factorization`] if M or K_eff is not positive definite.
+/// [`FullOrderError::Factorization`] if M or K_eff is not positive definite.
 pub fn newmark_peaks(
-    sys: &TruthSystem,
+    sys: &FullOrderSystem,
     f: &[f64],
     rows: &[Vec<f64>],
     dt: f64,
     steps: usize,
-) -> Result<(Vec<f64>, NewmarkInfo), TruthError> {
-    let mut peaks = vec![0.0f64; rows.len()];
-    let info = newmark_run(sys, f, dt, steps, &mut |_, u| {
-        for (p, w) in peaks.iter_mut().zip(rows) {
-            let y: f64 = w.iter().zip(u).map(|(a, b)| a * b).sum();
-            *p = p.max(y.abs());
+) -> Result<(Vec<f64>, NewmarkInfo), FullOrderError> {
+    let (mut p, info) =
+        newmark_peaks_multi(sys, std::slice::from_ref(&f.to_vec()), rows, dt, steps)?;
+    Ok((p.swap_remove(0), info))
+}
+
+/// As [`newmark_peaks`] for several impulses at once, each on its own (one factorization, block
+/// back-solves): `peaks[i][c]` for impulse `loads[i]` and row `rows[c]`.
+///
+/// # Errors
+/// As [`newmark_peaks`].
+pub fn newmark_peaks_multi(
+    sys: &FullOrderSystem,
+    loads: &[Vec<f64>],
+    rows: &[Vec<f64>],
+    dt: f64,
+    steps: usize,
+) -> Result<(Vec<Vec<f64>>, NewmarkInfo), FullOrderError> {
+    let n = sys.n();
+    let mut peaks = vec![vec![0.0f64; rows.len()]; loads.len()];
+    let info = newmark_run(sys, loads, dt, steps, &mut |_, u| {
+        for (i, pk) in peaks.iter_mut().enumerate() {
+            let ui = &u[i * n..(i + 1) * n];
+            for (p, w) in pk.iter_mut().zip(rows) {
+                let y: f64 = w.iter().zip(ui).map(|(a, b)| a * b).sum();
+                *p = p.max(y.abs());
+            }
         }
     })?;
     Ok((peaks, info))
 }
 
-/// Runs the Newmark integration and calls `sample(k, u)` with u(kΔt) for k = 1 … `steps`.
+/// Runs the Newmark integration of each impulse in `loads` (N·s, free dofs) and calls
+/// `sample(k, u)` with u(kΔt) for k = 1 … `steps`: the displacements of every load, column-major
+/// (`u[i·n..(i+1)·n]` for load i, n = free dofs).
 ///
 /// # Errors
 /// As [`newmark_peaks`].
 pub fn newmark_run(
-    sys: &TruthSystem,
-    f: &[f64],
+    sys: &FullOrderSystem,
+    loads: &[Vec<f64>],
     dt: f64,
     steps: usize,
     sample: &mut dyn FnMut(usize, &[f64]),
-) -> Result<NewmarkInfo, TruthError> {
+) -> Result<NewmarkInfo, FullOrderError> {
     let n = sys.n();
+    let nb = loads.len();
+    let len = n * nb;
     let [a0, a1] = sys.rayleigh;
     let (beta, gamma) = (0.25, 0.5);
     let c0 = 1.0 / (beta * dt * dt);
@@ -74,47 +99,53 @@ pub fn newmark_run(
     let c2 = 1.0 / (beta * dt);
     let t = Instant::now();
     let factor = |a: &SparseColMat<usize, f64>, what: &str| {
-        ShiftInvert::new(a, Par::Seq).map_err(|e| TruthError::Factorization(format!("{what}: {e}")))
+        ShiftInvert::new(a, Par::Seq)
+            .map_err(|e| FullOrderError::Factorization(format!("{what}: {e}")))
     };
     let mfac = factor(&sys.m, "M")?;
     // K_eff = (1 + c1 α1) K + (c0 + c1 α0) M.
     let keff = lin_comb(&sys.k, 1.0 + c1 * a1, &sys.m, c0 + c1 * a0);
     let kfac = factor(&keff, "K_eff")?;
-    let mut mem = kfac.solve_buffer(1);
-    let mut solve = |fac: &ShiftInvert, x: &mut [f64]| {
-        let len = x.len();
-        fac.solve_in_place(MatMut::from_column_major_slice_mut(x, len, 1), &mut mem);
+    // One scratch per factor: their symbolic structures (and solve paths) differ.
+    let (mut mmem, mut kmem) = (mfac.solve_buffer(nb), kfac.solve_buffer(nb));
+    let solve = |fac: &ShiftInvert, mem: &mut _, x: &mut [f64]| {
+        fac.solve_in_place(MatMut::from_column_major_slice_mut(x, n, nb), mem);
     };
     let factor_s = t.elapsed().as_secs_f64();
     let t = Instant::now();
 
-    let mut u = vec![0.0; n];
-    let mut v = f.to_vec();
-    solve(&mfac, &mut v);
+    let mut u = vec![0.0; len];
+    let mut v: Vec<f64> = loads.iter().flat_map(|f| f.iter().copied()).collect();
+    solve(&mfac, &mut mmem, &mut v);
     // ü(0) = −α0 v − α1 M⁻¹ K v.
-    let mut acc = vec![0.0; n];
-    spmv(&sys.k, &v, &mut acc);
-    solve(&mfac, &mut acc);
+    let mut acc = vec![0.0; len];
+    for i in 0..nb {
+        spmv(&sys.k, &v[i * n..(i + 1) * n], &mut acc[i * n..(i + 1) * n]);
+    }
+    solve(&mfac, &mut mmem, &mut acc);
     for (ai, vi) in acc.iter_mut().zip(&v) {
         *ai = -a0 * vi - a1 * *ai;
     }
-    let (mut x, mut y) = (vec![0.0; n], vec![0.0; n]);
+    let (mut x, mut y) = (vec![0.0; len], vec![0.0; len]);
     let (mut mx, mut ky) = (vec![0.0; n], vec![0.0; n]);
-    let mut un = vec![0.0; n];
+    let mut un = vec![0.0; len];
     for k in 1..=steps {
         // rhs = M(c0 u + c2 v + a) + D(c1 u + v), β = ¼, γ = ½.
-        for i in 0..n {
+        for i in 0..len {
             let d = c1 * u[i] + v[i];
             x[i] = c0 * u[i] + c2 * v[i] + acc[i] + a0 * d;
             y[i] = a1 * d;
         }
-        spmv(&sys.m, &x, &mut mx);
-        spmv(&sys.k, &y, &mut ky);
-        for i in 0..n {
-            un[i] = mx[i] + ky[i];
+        for b in 0..nb {
+            let r = b * n..(b + 1) * n;
+            spmv(&sys.m, &x[r.clone()], &mut mx);
+            spmv(&sys.k, &y[r.clone()], &mut ky);
+            for ((o, p), q) in un[r].iter_mut().zip(&mx).zip(&ky) {
+                *o = p + q;
+            }
         }
-        solve(&kfac, &mut un);
-        for i in 0..n {
+        solve(&kfac, &mut kmem, &mut un);
+        for i in 0..len {
             let an = c0 * (un[i] - u[i]) - c2 * v[i] - acc[i];
             v[i] += 0.5 * dt * (acc[i] + an);
             acc[i] = an;

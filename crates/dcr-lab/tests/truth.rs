@@ -2,15 +2,15 @@
 //! equals a baked base read through the runtime (conventions: mapping, normals, weights,
 //! direction, mass normalisation).
 //!
-//! Run with `cargo test --release -p modal-bake --test truth`.
+//! Run with `cargo test --release -p dcr-lab --test truth`.
 
 use std::sync::Arc;
 
-use dcr_runtime::filter::{damping_ratio, samples_per_step, ModeFilter};
+use dcr_lab::truth::{run_truth, TruthImpact, TruthMethod, TruthParams};
+use dcr_runtime::filter::{damping_ratio, ModeFilter};
 use dcr_runtime::ModalModel;
 use modal_bake::bake::{bake_mesh, BakeParams, MaterialSi, ModeRequest};
 use modal_bake::mesh::TetMesh;
-use modal_bake::truth::{run_truth, TruthImpact, TruthMethod, TruthParams};
 
 /// 1 m × 0.2 m × 0.15 m: a rectangular section, so bending pairs are not degenerate and "the
 /// lowest 20 modes" is one well-defined subspace.
@@ -57,6 +57,7 @@ fn newmark_matches_modal_all_clamped() {
         &impact(),
         &CONTACTS,
         "c",
+        &mut |_| {},
     )
     .unwrap();
     let ma = run_truth(
@@ -65,6 +66,7 @@ fn newmark_matches_modal_all_clamped() {
         &impact(),
         &CONTACTS,
         "c",
+        &mut |_| {},
     )
     .unwrap();
     for (a, b) in nm.contacts.iter().zip(&ma.contacts) {
@@ -88,6 +90,7 @@ fn newmark_matches_modal_all_free_free() {
         &impact(),
         &CONTACTS,
         "c",
+        &mut |_| {},
     )
     .unwrap();
     let ma = run_truth(
@@ -96,6 +99,7 @@ fn newmark_matches_modal_all_free_free() {
         &impact(),
         &CONTACTS,
         "c",
+        &mut |_| {},
     )
     .unwrap();
     assert_eq!(ma.info.rigid_modes_dropped, 6);
@@ -115,9 +119,9 @@ fn newmark_matches_modal_all_free_free() {
 fn newmark_matches_modal_all_overdamped() {
     let mut p = params(true, TruthMethod::Newmark);
     p.rayleigh = [200.0, 1e-4];
-    let nm = run_truth(cantilever(), &p, &impact(), &CONTACTS, "c").unwrap();
+    let nm = run_truth(cantilever(), &p, &impact(), &CONTACTS, "c", &mut |_| {}).unwrap();
     p.method = TruthMethod::ModalAll;
-    let ma = run_truth(cantilever(), &p, &impact(), &CONTACTS, "c").unwrap();
+    let ma = run_truth(cantilever(), &p, &impact(), &CONTACTS, "c", &mut |_| {}).unwrap();
     for (a, b) in nm.contacts.iter().zip(&ma.contacts) {
         let e = rel(a.peak_displacement_m, b.peak_displacement_m);
         println!(
@@ -139,7 +143,7 @@ fn modal_all_truncated_equals_baked_base() {
             modes: Some(20),
             ..params(fixed, TruthMethod::ModalAll)
         };
-        let ma = run_truth(cantilever(), &p, &impact(), &CONTACTS, "c").unwrap();
+        let ma = run_truth(cantilever(), &p, &impact(), &CONTACTS, "c", &mut |_| {}).unwrap();
         assert_eq!(ma.info.modes_used, 20);
         let bp = BakeParams {
             material: MaterialSi {
@@ -157,8 +161,9 @@ fn modal_all_truncated_equals_baked_base() {
         let isp = model.project(impact().point, 1.0).unwrap();
         let mut r = vec![0.0; m];
         model.add_reduced_impulse(&isp, isp.normal.map(|x| -x), impact().impulse, &mut r);
-        let steps = samples_per_step(p.h, p.dt);
-        let dt = p.h / steps as f64;
+        // The samples the truth's refinement reached.
+        let (steps, dt) = (ma.info.samples, ma.info.dt);
+        assert!((dt * steps as f64 - p.h).abs() < 1e-12 * p.h);
         for (c, truth) in CONTACTS.iter().zip(&ma.contacts) {
             let sp = model.project(*c, 1.0).unwrap();
             let mut w = vec![0.0; m];
@@ -199,12 +204,12 @@ fn truth_is_linear_in_the_impulse() {
         dt: 1e-5,
         ..params(true, TruthMethod::Newmark)
     };
-    let a = run_truth(cantilever(), &p, &impact(), &CONTACTS, "c").unwrap();
+    let a = run_truth(cantilever(), &p, &impact(), &CONTACTS, "c", &mut |_| {}).unwrap();
     let big = TruthImpact {
         impulse: 2e6,
         ..impact()
     };
-    let b = run_truth(cantilever(), &p, &big, &CONTACTS, "c").unwrap();
+    let b = run_truth(cantilever(), &p, &big, &CONTACTS, "c", &mut |_| {}).unwrap();
     for (x, y) in a.contacts.iter().zip(&b.contacts) {
         assert!(rel(y.peak_displacement_m, 1e6 * x.peak_displacement_m) < 1e-9);
         assert!(rel(x.delta_v_mps, x.peak_displacement_m / p.h) < 1e-15);
@@ -225,9 +230,9 @@ fn truth_extreme_materials_agree() {
         };
         p.h = h;
         p.dt = dt;
-        let nm = run_truth(cantilever(), &p, &impact(), &CONTACTS, "c").unwrap();
+        let nm = run_truth(cantilever(), &p, &impact(), &CONTACTS, "c", &mut |_| {}).unwrap();
         p.method = TruthMethod::ModalAll;
-        let ma = run_truth(cantilever(), &p, &impact(), &CONTACTS, "c").unwrap();
+        let ma = run_truth(cantilever(), &p, &impact(), &CONTACTS, "c", &mut |_| {}).unwrap();
         for (a, b) in nm.contacts.iter().zip(&ma.contacts) {
             assert!(a.peak_displacement_m.is_finite() && b.peak_displacement_m > 0.0);
             let err = rel(a.peak_displacement_m, b.peak_displacement_m);
@@ -245,10 +250,10 @@ fn truth_extreme_materials_agree() {
 /// all-mode peak (= wᵀK⁻¹f) to 1e-4, while 20 modes alone are off by more than that.
 #[test]
 fn static_correction_recovers_static_deflection() {
-    use modal_bake::truth::{ModalAll, ModalInput, TruthSystem};
+    use modal_bake::full_order::{FullOrderSystem, ModalAll, ModalInput};
     let mut p = params(true, TruthMethod::ModalAll);
     p.rayleigh = [2000.0, 0.0];
-    let sys = TruthSystem::new(cantilever(), &p, "c").unwrap();
+    let sys = FullOrderSystem::new(cantilever(), &p.system(), "c").unwrap();
     let ma = ModalAll::new(&sys, 6000).unwrap();
     let isp = sys.surface.project(impact().point).unwrap();
     let f = sys.load_vector(&isp, isp.normal.map(|x| -x), 100.0);
@@ -293,4 +298,137 @@ fn static_correction_recovers_static_deflection() {
         );
     }
     assert!((0..CONTACTS.len()).any(|c| rel(m20[c], all[c]) > 1e-3));
+}
+
+/// The truth checks itself: from a coarse step (1e-4 s, 50 samples over 5 ms) Newmark halves the
+/// step until no peak changes by 0.5 % twice running, each level's step is half the previous one, and the
+/// converged peaks match the all-mode sum at a fine step to well within the tolerance — while
+/// the coarse single run is off by more, so the refinement is what makes them right.
+#[test]
+fn refinement_converges_and_reports_the_step() {
+    use modal_bake::full_order::RefineParams;
+    let coarse = TruthParams {
+        dt: 1e-4,
+        refine: RefineParams {
+            max_refinements: 9,
+            ..RefineParams::default()
+        },
+        ..params(true, TruthMethod::Newmark)
+    };
+    let run = run_truth(
+        cantilever(),
+        &coarse,
+        &impact(),
+        &CONTACTS,
+        "c",
+        &mut |_| {},
+    )
+    .unwrap();
+    let c = &run.convergence;
+    assert!(c.converged, "{c:?}");
+    assert!(c.history.len() >= 3, "{c:?}");
+    for w in c.history.windows(2) {
+        assert!((w[1].dt - 0.5 * w[0].dt).abs() < 1e-12 * w[0].dt, "{c:?}");
+    }
+    // Converged means the last two changes are below the tolerance; the estimate is the larger.
+    let n = c.history.len();
+    let (a, b) = (
+        c.history[n - 2].change_pct.unwrap(),
+        c.history[n - 1].change_pct.unwrap(),
+    );
+    assert!(
+        a < 0.5 && b < 0.5 && c.estimated_error_pct.unwrap() == a.max(b),
+        "{c:?}"
+    );
+    assert!(c.history[1].change_pct.unwrap() >= 0.5);
+    assert_eq!(run.info.dt, c.dt_reached);
+    // The independent check ran (a small mesh) and agrees.
+    let x = c.cross_check.as_ref().expect("cross-check on a small mesh");
+    assert_eq!(x.method, "modal-all");
+    assert!(x.max_diff_pct < 0.5, "{x:?}");
+    let exact = TruthParams {
+        dt: 2.5e-7,
+        refine: RefineParams {
+            max_refinements: 0,
+            ..RefineParams::default()
+        },
+        ..params(true, TruthMethod::ModalAll)
+    };
+    let exact = run_truth(cantilever(), &exact, &impact(), &CONTACTS, "c", &mut |_| {}).unwrap();
+    let single = TruthParams {
+        refine: RefineParams {
+            max_refinements: 0,
+            ..RefineParams::default()
+        },
+        ..coarse
+    };
+    let single = run_truth(
+        cantilever(),
+        &single,
+        &impact(),
+        &CONTACTS,
+        "c",
+        &mut |_| {},
+    )
+    .unwrap();
+    let worst = |r: &dcr_lab::truth::TruthResult| {
+        r.contacts
+            .iter()
+            .zip(&exact.contacts)
+            .map(|(a, b)| rel(a.peak_displacement_m, b.peak_displacement_m))
+            .fold(0.0f64, f64::max)
+    };
+    assert!(worst(&run) < 0.005, "converged vs exact {}", worst(&run));
+    assert!(worst(&single) > 0.005, "coarse vs exact {}", worst(&single));
+}
+
+/// A run that cannot meet its tolerance within its refinements says so: `converged` is false
+/// and the last change is reported.
+#[test]
+fn unconverged_run_is_not_called_converged() {
+    use modal_bake::full_order::RefineParams;
+    let p = TruthParams {
+        dt: 1e-4,
+        refine: RefineParams {
+            tolerance: 1e-9,
+            max_refinements: 2,
+            ..RefineParams::default()
+        },
+        ..params(true, TruthMethod::Newmark)
+    };
+    let run = run_truth(cantilever(), &p, &impact(), &CONTACTS, "c", &mut |_| {}).unwrap();
+    let c = &run.convergence;
+    assert!(!c.converged, "{c:?}");
+    assert_eq!(c.history.len(), 3);
+    assert!(c.last_change_pct.unwrap() > 1e-7);
+}
+
+/// Several impulses in one Newmark run (block back-solves with one factorization each of M and
+/// K_eff) give each impulse's own peaks, free-free (the factors' solve paths differ) and
+/// clamped.
+#[test]
+fn newmark_runs_several_impulses_as_one() {
+    use modal_bake::full_order::{newmark_peaks, newmark_peaks_multi, FullOrderSystem};
+    for fixed in [false, true] {
+        let p = params(fixed, TruthMethod::Newmark);
+        let sys = FullOrderSystem::new(cantilever(), &p.system(), "c").unwrap();
+        let rows: Vec<Vec<f64>> = CONTACTS
+            .iter()
+            .map(|c| sys.contact_row(&sys.surface.project(*c).unwrap()))
+            .collect();
+        let loads: Vec<Vec<f64>> = [[0.9, 0.12, 0.2], [0.2, 0.0, 0.1], [0.6, 0.2, 0.05]]
+            .iter()
+            .map(|x| {
+                let s = sys.surface.project(*x).unwrap();
+                sys.load_vector(&s, s.normal.map(|v| -v), 1.5)
+            })
+            .collect();
+        let (all, _) = newmark_peaks_multi(&sys, &loads, &rows, 2e-6, 600).unwrap();
+        for (f, got) in loads.iter().zip(&all) {
+            let (one, _) = newmark_peaks(&sys, f, &rows, 2e-6, 600).unwrap();
+            for (a, b) in got.iter().zip(&one) {
+                assert!(rel(*a, *b) < 1e-12 && *b > 0.0, "fixed {fixed}: {a} vs {b}");
+            }
+        }
+    }
 }

@@ -1,0 +1,62 @@
+//! Command-line front end: one file per subcommand.
+
+mod accuracy;
+mod fit_attenuation;
+mod progress;
+mod truth;
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+/// Evaluate dcr's bases against the full-order response: reference responses, the attenuation
+/// fit and the accuracy report.
+///
+/// Units are SI throughout: metres, kilograms, seconds, pascals, newton-seconds.
+#[derive(Parser)]
+#[command(name = "dcr-lab", version, about, long_about = None, propagate_version = true)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Full-order reference response of a mesh to an impulse (Newmark or all modes).
+    #[command(allow_negative_numbers = true)]
+    Truth(truth::TruthArgs),
+    /// Fit the spatial attenuation law (Eq. 14) to the full-order response at random surface pairs.
+    #[command(allow_negative_numbers = true)]
+    FitAttenuation(fit_attenuation::FitAttenuationArgs),
+    /// Regenerate the accuracy report (OUT/accuracy.md and OUT/accuracy/*.svg).
+    Accuracy(accuracy::AccuracyArgs),
+}
+
+/// Writes `s` to stdout. A closed pipe (`dcr-lab truth … | head`) is not an error; any other
+/// failed write (a full disk) is.
+pub fn emit(s: &str) -> anyhow::Result<()> {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    match out.write_all(s.as_bytes()).and_then(|()| out.flush()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
+            Err(anyhow::Error::new(e).context("writing to stdout failed"))
+        }
+        _ => Ok(()),
+    }
+}
+
+pub fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Truth(a) => truth::run(&a),
+        Command::FitAttenuation(a) => fit_attenuation::run(&a).map(|()| ExitCode::SUCCESS),
+        Command::Accuracy(a) => accuracy::run(&a).map(|()| ExitCode::SUCCESS),
+    };
+    match result {
+        Ok(code) => code,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}

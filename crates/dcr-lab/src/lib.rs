@@ -1,0 +1,14 @@
+//! `dcr-lab`: evaluation beside the pipeline — how far a baked base or transfer table is from
+//! the full-order response it approximates, and what the attenuation law (Eq. 14) fits.
+//!
+//! Built on the baker's full-order kernel ([`modal_bake::full_order`]: Newmark and the sum over
+//! every mode), not a copy of it:
+//! - [`truth`]: the reference response of a mesh to an impulse at surface points, in
+//!   `modal-bake probe`'s shape (`dcr-lab truth`);
+//! - [`attenuation_fit`]: Eq. 14 and the §4.5 law fitted to the full-order response at random
+//!   surface pairs (`dcr-lab fit-attenuation`);
+//! - [`accuracy`]: the report `docs/accuracy.md` and its plots (`dcr-lab accuracy --out docs`).
+
+pub mod accuracy;
+pub mod attenuation_fit;
+pub mod truth;
