@@ -251,18 +251,15 @@ fn geodesic(c: &mut Criterion) {
     c.bench_function(&format!("heat/setup/{}v", v.len()), |b| {
         b.iter(|| black_box(HeatGeodesic::new(&v, &t).unwrap()))
     });
-    // As a base from `modal-bake bake` loads: under the stored `surface_order` (METIS nested
-    // dissection; needs `--features metis` to plan it here, else the rows below use AMD).
-    #[cfg(feature = "metis")]
+    // As a base from `modal-bake bake` loads: under a stored `surface_order` (a bake stores
+    // METIS nested dissection; here the synthetic bisection order, which splits the same way).
     let heat = {
-        let order = HeatGeodesic::plan_ordering(&v, &t).unwrap();
+        let order = dcr_runtime::testing::bisection_order(v.len(), &t);
         c.bench_function(&format!("heat/setup-stored-order/{}v", v.len()), |b| {
             b.iter(|| black_box(HeatGeodesic::with_ordering(&v, &t, Some(&order)).unwrap()))
         });
         HeatGeodesic::with_ordering(&v, &t, Some(&order)).unwrap()
     };
-    #[cfg(not(feature = "metis"))]
-    let heat = HeatGeodesic::new(&v, &t).unwrap();
     let model = ModalModel::from_base(synthetic_base(
         (v.clone(), t.clone()),
         &[100.0],
@@ -279,8 +276,7 @@ fn geodesic(c: &mut Criterion) {
             black_box(out[17])
         })
     });
-    // The same query on two threads (the stored order splits the elimination tree in two;
-    // without `--features metis` the AMD order does not, and this row is serial).
+    // The same query on two threads (the stored order splits the elimination tree in two).
     let mut ws_par = heat.workspace();
     ws_par.set_parallel(true);
     c.bench_function(&format!("heat/source-2threads/{}v", v.len()), |b| {

@@ -78,8 +78,9 @@
 //! Engine-boundary types are plain data (`[f64; 3]`, `u64` ids, slices).
 //!
 //! Features: `testing` (synthetic bases such as `testing::plate_base`, for tests and
-//! doctests, also of other crates), `bench-internals` (the peak kernels, for benchmarks),
-//! `metis` (bake-time nested-dissection orderings).
+//! doctests, also of other crates), `bench-internals` (the peak kernels, for benchmarks). The
+//! crate is pure Rust: fill-reducing orderings that need METIS are planned by the baker and
+//! stored in the base (`surface_order`).
 
 pub mod attenuation;
 pub mod filter;
@@ -88,6 +89,7 @@ pub(crate) mod mapping;
 mod math;
 pub mod model;
 pub mod response;
+pub mod rng;
 #[cfg(any(test, feature = "testing"))]
 pub mod testing;
 pub mod world;

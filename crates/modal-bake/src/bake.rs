@@ -84,7 +84,6 @@ use sha2::{Digest, Sha256};
 use crate::eigen::{self, EigenError, EigenParams, EigenProgress};
 use crate::fem::{self, Material, MaterialError};
 use crate::mesh::{tet_faces, MeshError, DEFAULT_DEGENERATE_REL_TOL, DEFAULT_STRAIGHT_REL_TOL};
-use dcr_runtime::attenuation::HeatGeodesic;
 use dcr_runtime::format::{FormatError, ModesMeta, QuadraticSurface};
 
 /// Version of what `modal-bake` writes for given inputs, stored in every base
@@ -590,7 +589,7 @@ impl Surface {
         }
         let triangles: Vec<[u32; 3]> = tris.iter().map(|t| t.map(|v| local[v])).collect();
         let positions: Vec<[f64; 3]> = nodes.iter().map(|&v| mesh.nodes[v]).collect();
-        let order = HeatGeodesic::plan_ordering(&positions, &triangles).ok();
+        let order = crate::ordering::plan_surface_order(&positions, &triangles).ok();
         let (mut edges, mut edge_nodes) = (Vec::new(), Vec::new());
         if mesh.is_quadratic() {
             edges = QuadraticSurface::edges_of(&triangles);
@@ -671,8 +670,7 @@ fn boundary_faces(tets: &[[usize; 4]]) -> Vec<[usize; 3]> {
 /// [`boundary_faces`] for node indices below 2^[`PACK_BITS`] and fewer than 2^30 tets: the
 /// sorted node triple packed into one u64 (same order as the triples) beside the face's
 /// number: 16-byte elements sort about twice as fast as the 48-byte (triple, face)
-/// pairs (measured on the bake bench beams: 3k 1.1–1.9 vs 2.0–3.0 ms, 15k 4.9–7.4 vs
-/// 8.9–17.8 ms for the whole surface extraction). Same result.
+/// pairs (docs/benchmarks.md, "Design measurements"). Same result.
 fn boundary_faces_packed(tets: &[[usize; 4]]) -> Vec<[usize; 3]> {
     let mut faces: Vec<(u64, u32)> = Vec::with_capacity(tets.len() * 4);
     for (t, &tet) in tets.iter().enumerate() {
@@ -1228,7 +1226,8 @@ pub fn mesh_base_status(
     // A base without the stored heat-geodesic order (baked before it existed, or written
     // elsewhere) is stale when this tool would store one.
     let order_matches = base.surface_order.is_some()
-        || HeatGeodesic::plan_ordering(&base.surface_vertices, &base.surface_triangles).is_err();
+        || crate::ordering::plan_surface_order(&base.surface_vertices, &base.surface_triangles)
+            .is_err();
     if output_version != Some(&serde_json::json!(OUTPUT_VERSION)) || !order_matches {
         return Ok(BaseStatus::ToolChanged);
     }

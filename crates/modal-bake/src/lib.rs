@@ -15,6 +15,8 @@ pub mod export;
 pub mod fem;
 pub mod full_order;
 pub mod mesh;
+pub mod ordering;
 pub mod signals;
 pub mod target_error;
 pub mod transfer;
+mod vec3;

@@ -674,7 +674,7 @@ fn eigensolve_is_bit_deterministic_across_runs_and_pools() {
 /// Many modes: more than one Lanczos run (48 pairs each, deflated against the ones found), on a
 /// clamped beam of square section (every bending eigenvalue is double, so pairs straddle the
 /// run boundaries), against the dense generalized solve; the same through `max_freq_hz`.
-/// Before deflation, one run for 160 modes ended at residuals ≈ 1e-7 (thick-restart drift).
+/// Guards the deflation: a single run for 160 modes drifts to residuals ≈ 1e-7 (thick restarts).
 #[test]
 fn many_modes_across_lanczos_runs_match_dense() {
     let mat = steelish();

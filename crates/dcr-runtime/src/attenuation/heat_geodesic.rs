@@ -160,8 +160,8 @@ impl std::fmt::Debug for HeatGeodesic {
 
 impl HeatGeodesic {
     /// Factor size (stored entries) from which a [`HeatWorkspace::set_parallel`] query forks:
-    /// below it, two `rayon::join`s (≈ 10–30 µs each on the 2-core test machine) cost more
-    /// than half the sweeps save.
+    /// below it, two `rayon::join`s cost more than half the sweeps save
+    /// (docs/benchmarks.md, "Design measurements").
     pub const PARALLEL_MIN_ENTRIES: usize = 20_000;
 
     /// Builds and factors the operators for a surface (vertices in m, any consistent orientation).
@@ -266,63 +266,68 @@ impl HeatGeodesic {
         })
     }
 
-    /// The fill-reducing vertex order to store with a surface (the base's `surface_order`) for
-    /// [`HeatGeodesic::with_ordering`]: METIS nested dissection or AMD, whichever leaves fewer
-    /// factor entries (ties: AMD). Loading with a stored order skips AMD, 2–3 ms of the
-    /// ≈ 10 ms set-up on a 5k-vertex surface, and nested dissection fills less on large
-    /// surfaces (5,048-vertex box: 93k entries vs AMD's 118k), which shortens every solve.
+    /// The surface Laplacian's sparsity as a symmetric graph, in the layout graph partitioners
+    /// take (METIS `xadj`/`adjncy`): vertex v's neighbours are
+    /// `neighbours[offsets[v]..offsets[v + 1]]`, ascending, without v itself. What a baker
+    /// orders to plan the `surface_order` a base stores for [`HeatGeodesic::with_ordering`].
     ///
     /// # Errors
     /// As [`HeatGeodesic::new`].
-    #[cfg(feature = "metis")]
-    pub fn plan_ordering(
+    pub fn laplacian_graph(
         vertices: &[[f64; 3]],
         triangles: &[[u32; 3]],
-    ) -> Result<Vec<u32>, GeodesicError> {
+    ) -> Result<(Vec<usize>, Vec<usize>), GeodesicError> {
         let asm = Assembly::new(vertices, triangles)?;
-        let amd = Self::symbolic(&asm, None)?;
         let n = vertices.len();
-        let amd_order: Vec<u32> = match amd.perm() {
-            Some(p) => p.arrays().0.to_vec(),
-            None => (0..n as u32).collect(),
-        };
         let col_ptr: Vec<usize> = asm.col_ptr.iter().map(|&p| p as usize).collect();
         let row_idx: Vec<usize> = asm.row_idx.iter().map(|&r| r as usize).collect();
-        // METIS wants both triangles of the adjacency; the assembly holds the lower one.
-        let mut degree = vec![0usize; n + 1];
+        // Both triangles of the adjacency; the assembly holds the lower one.
+        let mut offsets = vec![0usize; n + 1];
         for c in 0..n {
             for &r in &row_idx[col_ptr[c]..col_ptr[c + 1]] {
                 if r != c {
-                    degree[r + 1] += 1;
-                    degree[c + 1] += 1;
+                    offsets[r + 1] += 1;
+                    offsets[c + 1] += 1;
                 }
             }
         }
         for v in 0..n {
-            degree[v + 1] += degree[v];
+            offsets[v + 1] += offsets[v];
         }
-        let mut next = degree.clone();
-        let mut adj = vec![0usize; degree[n]];
+        let mut next = offsets.clone();
+        let mut neighbours = vec![0usize; offsets[n]];
         for c in 0..n {
             for &r in &row_idx[col_ptr[c]..col_ptr[c + 1]] {
                 if r != c {
-                    adj[next[r]] = c;
+                    neighbours[next[r]] = c;
                     next[r] += 1;
-                    adj[next[c]] = r;
+                    neighbours[next[c]] = r;
                     next[c] += 1;
                 }
             }
         }
-        let Some(nd) = super::nested_dissection(&degree, &adj) else {
-            return Ok(amd_order);
+        Ok((offsets, neighbours))
+    }
+
+    /// The elimination order and the number of stored factor entries of the Laplacian's
+    /// Cholesky factor under `order` (`None`: AMD, as [`HeatGeodesic::new`] computes it), from
+    /// the symbolic analysis alone: what a baker compares to choose the stored order.
+    ///
+    /// # Errors
+    /// As [`HeatGeodesic::with_ordering`].
+    pub fn ordering_fill(
+        vertices: &[[f64; 3]],
+        triangles: &[[u32; 3]],
+        order: Option<&[u32]>,
+    ) -> Result<(Vec<u32>, usize), GeodesicError> {
+        let asm = Assembly::new(vertices, triangles)?;
+        let symbolic = Self::symbolic(&asm, order)?;
+        let used: Vec<u32> = match (order, symbolic.perm()) {
+            (Some(o), _) => o.to_vec(),
+            (None, Some(p)) => p.arrays().0.to_vec(),
+            (None, None) => (0..vertices.len() as u32).collect(),
         };
-        let nd: Vec<u32> = nd.into_iter().map(|v| v as u32).collect();
-        let nd_len = Self::symbolic(&asm, Some(&nd))?.len_val();
-        Ok(if nd_len < amd.len_val() {
-            nd
-        } else {
-            amd_order
-        })
+        Ok((used, symbolic.len_val()))
     }
 
     /// Simplicial symbolic Cholesky of the Laplacian's pattern (faer), under `order` or AMD.

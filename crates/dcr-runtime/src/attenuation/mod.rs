@@ -7,16 +7,12 @@ mod attenuation_params;
 mod distance_cache;
 mod geodesic_table;
 mod heat_geodesic;
-#[cfg(feature = "metis")]
-mod ordering;
 mod sparse_llt;
 
 pub use attenuation_params::{AmplitudeKind, AttenuationLaw, AttenuationParams, DistanceKind};
 pub(crate) use distance_cache::DistanceCache;
 pub use geodesic_table::GeodesicTable;
 pub use heat_geodesic::{GeodesicError, HeatGeodesic, HeatWorkspace};
-#[cfg(feature = "metis")]
-pub use ordering::nested_dissection;
 
 #[cfg(test)]
 mod tests;

@@ -4,11 +4,11 @@
 //! splits) so the halves can be solved on two threads.
 //!
 //! Hand-written rather than faer's `factorize_numeric_llt` / `LltRef::solve_in_place_with_conj`
-//! (which these replaced) because faer could not reach the heat-geodesic targets on ~5k-vertex
-//! surfaces (issue #3): its simplicial numeric factor (up-looking, one elimination-tree reach per
-//! row, `usize` indices) took ≈ 8 ms per operator, its solve ≈ 0.3 ms. Here the pattern is known
-//! up front, so the factor is left-looking over a precomputed row pattern (each update a plain
-//! suffix of an earlier column), both operators share every index load (values stored as
+//! because faer's simplicial numeric factor (up-looking, one elimination-tree reach per row,
+//! `usize` indices) misses the heat-geodesic set-up and query budgets on ~5k-vertex surfaces
+//! (≈ 8 ms per operator and ≈ 0.3 ms per solve; docs/benchmarks.md, "Design measurements"). Here the pattern is
+//! known up front, so the factor is left-looking over a precomputed row pattern (each update a
+//! plain suffix of an earlier column), both operators share every index load (values stored as
 //! `[heat, poisson]` pairs), and all indices are `u32`.
 
 use crate::math::fmadd;

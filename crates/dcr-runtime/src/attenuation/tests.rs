@@ -194,16 +194,11 @@ fn own_solve_matches_faer_on(heat: &HeatGeodesic, n: usize) {
 }
 
 /// The timing probes' surface, the 5,048-vertex box, with the order a bake stores for it
-/// (METIS; without the `metis` feature, AMD's order handed in, which only skips the ordering).
+/// (a bake plans METIS nested dissection; here the synthetic bisection order, which splits the
+/// solves the same way).
 fn probe_surface() -> (Vec<[f64; 3]>, Vec<[u32; 3]>, Vec<u32>) {
     let (v, t) = crate::testing::box_surface(29, [1.2, 0.8, 0.6]);
-    #[cfg(feature = "metis")]
-    let order = HeatGeodesic::plan_ordering(&v, &t).unwrap();
-    #[cfg(not(feature = "metis"))]
-    let order = HeatGeodesic::new(&v, &t)
-        .unwrap()
-        .elimination_order()
-        .to_vec();
+    let order = crate::testing::bisection_order(v.len(), &t);
     (v, t, order)
 }
 
@@ -374,11 +369,7 @@ fn stored_orderings_give_the_same_distances() {
     let n = v.len();
     let amd = HeatGeodesic::new(&v, &t).unwrap();
     let reversed: Vec<u32> = (0..n as u32).rev().collect();
-    let orders = [
-        reversed,
-        #[cfg(feature = "metis")]
-        HeatGeodesic::plan_ordering(&v, &t).unwrap(),
-    ];
+    let orders = [reversed, crate::testing::bisection_order(n, &t)];
     let (mut a, mut b) = (vec![0.0; n], vec![0.0; n]);
     for order in &orders {
         let other = HeatGeodesic::with_ordering(&v, &t, Some(order)).unwrap();
@@ -399,29 +390,6 @@ fn stored_orderings_give_the_same_distances() {
             Err(GeodesicError::BadOrdering)
         ));
     }
-}
-
-/// The planned order is a deterministic permutation, and on a 5k-vertex surface nested
-/// dissection is picked and fills clearly less than AMD (measured 93k vs 118k entries).
-#[cfg(feature = "metis")]
-#[test]
-fn planned_ordering_is_deterministic_and_fills_less_than_amd() {
-    let (v, t) = crate::testing::box_surface(29, [1.2, 0.8, 0.6]);
-    let order = HeatGeodesic::plan_ordering(&v, &t).unwrap();
-    assert_eq!(order, HeatGeodesic::plan_ordering(&v, &t).unwrap());
-    let planned = HeatGeodesic::with_ordering(&v, &t, Some(&order)).unwrap();
-    let amd = HeatGeodesic::new(&v, &t).unwrap();
-    assert!(
-        (planned.factor_len() as f64) < 0.9 * amd.factor_len() as f64,
-        "planned {} vs AMD {}",
-        planned.factor_len(),
-        amd.factor_len()
-    );
-    // A tiny surface: whichever fills less, never more than AMD.
-    let (v, t) = crate::testing::box_surface(2, [1.0, 1.0, 1.0]);
-    let order = HeatGeodesic::plan_ordering(&v, &t).unwrap();
-    let planned = HeatGeodesic::with_ordering(&v, &t, Some(&order)).unwrap();
-    assert!(planned.factor_len() <= HeatGeodesic::new(&v, &t).unwrap().factor_len());
 }
 
 /// A split query (two halves, then the top block) equals an unsplit one under AMD to 1e-9 of
@@ -518,7 +486,7 @@ fn long_strip_distances_survive_heat_underflow() {
 /// Timing probe (not a test of speed): per-query times of serial and two-thread queries on the
 /// 5k-vertex box, interleaved in blocks of 50, as percentiles; with `IN_POOL=1` set, from inside
 /// a two-thread rayon pool (joins run in the pool, its idle worker spins between them).
-/// `cargo test --release -p dcr-runtime --features metis --lib heat_query_percentiles --
+/// `cargo test --release -p dcr-runtime --lib heat_query_percentiles --
 /// --ignored --nocapture`. On the 2-vCPU test VM the serial time swings between ≈ 0.44 and
 /// ≈ 0.75 ms by phase (also while the pool's other worker spins: the vCPUs behave like two
 /// hyperthreads of one core), so `heat_timing`'s best-of figures catch the fast phase and the

@@ -2,6 +2,7 @@
 
 mod atomic_file;
 mod modes_file;
+mod npy;
 mod quadratic_surface;
 mod regular_file;
 mod transfer_table;

@@ -21,7 +21,8 @@
 //!
 //! Optional: `surface_order` u32 (ns,), a fill-reducing elimination order of the surface
 //! vertices (a permutation of 0..ns) for the heat-geodesic factor, chosen at bake time
-//! ([`crate::attenuation::HeatGeodesic::plan_ordering`]); without it the runtime orders with AMD at load.
+//! (`modal_bake::ordering::plan_surface_order`: METIS nested dissection or AMD, whichever fills
+//! less); without it the runtime orders with AMD at load.
 //!
 //! Optional (all or none): the peak-transfer table ([`TransferTable`]): `transfer_vertices`
 //! u32 (nr,), `transfer_peaks` f32 (np(np+1)/2,) packed upper triangle over np = nr + ne points
@@ -49,9 +50,7 @@
 use std::io::{Cursor, Read, Seek};
 use std::path::{Path, PathBuf};
 
-use ndarray::{Array0, Array1, Array2, Array3, ArrayD};
-use ndarray_npy::npy::header::Header;
-use ndarray_npy::{NpzWriter, ReadNpyExt, ReadableElement};
+use super::npy::{decode, parse_header_text, write_entry, NpyElement};
 use serde::{Deserialize, Serialize};
 
 use super::quadratic_surface::{QuadraticSurface, QUADRATIC_ENTRIES, QUADRATIC_FORMAT_VERSION};
@@ -475,140 +474,83 @@ impl ModesFile {
         super::atomic_file::write_atomic(path, &bytes)
     }
 
-    /// Serialises the archive to bytes (deterministic).
+    /// Serialises the archive to bytes (deterministic: stored entries, fixed timestamps, the
+    /// entries in a fixed order).
     pub(crate) fn to_bytes(&self) -> Result<Vec<u8>, String> {
         let m = self.num_modes();
         let ns = self.num_surface_vertices();
         let opts = zip::write::SimpleFileOptions::default()
             .compression_method(zip::CompressionMethod::Stored)
             .last_modified_time(zip::DateTime::default());
-        let mut npz = NpzWriter::new_with_options(Cursor::new(Vec::new()), opts);
-        let e = |err: ndarray_npy::WriteNpzError| err.to_string();
+        let mut zip = zip::ZipWriter::new(Cursor::new(Vec::new()));
+        let z = &mut zip;
         let tri: Vec<u32> = self.surface_triangles.iter().flatten().copied().collect();
         let pos: Vec<f64> = self.surface_vertices.iter().flatten().copied().collect();
         let meta = serde_json::to_vec(&self.meta).map_err(|err| err.to_string())?;
-        npz.add_array(
-            "format_version",
-            &Array0::from_elem((), self.meta.format_version),
-        )
-        .map_err(e)?;
-        npz.add_array("eigenvalues", &Array1::from(self.eigenvalues.clone()))
-            .map_err(e)?;
-        npz.add_array("frequencies_hz", &Array1::from(self.frequencies_hz()))
-            .map_err(e)?;
-        npz.add_array(
-            "surface_vertices",
-            &Array2::from_shape_vec((ns, 3), pos).map_err(|x| x.to_string())?,
-        )
-        .map_err(e)?;
-        npz.add_array(
-            "surface_triangles",
-            &Array2::from_shape_vec((self.surface_triangles.len(), 3), tri)
-                .map_err(|x| x.to_string())?,
-        )
-        .map_err(e)?;
-        npz.add_array(
-            "surface_to_volume",
-            &Array1::from(self.surface_to_volume.clone()),
-        )
-        .map_err(e)?;
+        let f32s = |v: &[f64]| -> Vec<f32> { v.iter().map(|&x| x as f32).collect() };
+        write_entry(z, "format_version", opts, &[], &[self.meta.format_version])?;
+        write_entry(z, "eigenvalues", opts, &[m], &self.eigenvalues)?;
+        write_entry(z, "frequencies_hz", opts, &[m], &self.frequencies_hz())?;
+        write_entry(z, "surface_vertices", opts, &[ns, 3], &pos)?;
+        let nt = self.surface_triangles.len();
+        write_entry(z, "surface_triangles", opts, &[nt, 3], &tri)?;
+        let nv = self.surface_to_volume.len();
+        write_entry(z, "surface_to_volume", opts, &[nv], &self.surface_to_volume)?;
         match self.precision {
-            ModesPrecision::F64 => npz.add_array(
-                "modes",
-                &Array3::from_shape_vec((ns, 3, m), self.modes.clone())
-                    .map_err(|x| x.to_string())?,
-            ),
-            ModesPrecision::F32 => npz.add_array(
-                "modes",
-                &Array3::from_shape_vec((ns, 3, m), self.modes.iter().map(|&x| x as f32).collect())
-                    .map_err(|x| x.to_string())?,
-            ),
+            ModesPrecision::F64 => write_entry(z, "modes", opts, &[ns, 3, m], &self.modes)?,
+            ModesPrecision::F32 => write_entry(z, "modes", opts, &[ns, 3, m], &f32s(&self.modes))?,
         }
-        .map_err(e)?;
         let mat = &self.material;
-        npz.add_array(
+        write_entry(
+            z,
             "material",
-            &Array1::from(vec![mat.youngs, mat.poisson, mat.density]),
-        )
-        .map_err(e)?;
-        npz.add_array("rayleigh", &Array1::from(self.rayleigh.to_vec()))
-            .map_err(e)?;
-        npz.add_array("fixed_nodes", &Array1::from(self.fixed_nodes.clone()))
-            .map_err(e)?;
-        npz.add_array("residuals", &Array1::from(self.residuals.clone()))
-            .map_err(e)?;
-        npz.add_array("meta", &Array1::from(meta)).map_err(e)?;
+            opts,
+            &[3],
+            &[mat.youngs, mat.poisson, mat.density],
+        )?;
+        write_entry(z, "rayleigh", opts, &[2], &self.rayleigh)?;
+        let nf = self.fixed_nodes.len();
+        write_entry(z, "fixed_nodes", opts, &[nf], &self.fixed_nodes)?;
+        let nr = self.residuals.len();
+        write_entry(z, "residuals", opts, &[nr], &self.residuals)?;
+        write_entry(z, "meta", opts, &[meta.len()], &meta)?;
         if let Some(order) = &self.surface_order {
-            npz.add_array("surface_order", &Array1::from(order.clone()))
-                .map_err(e)?;
+            write_entry(z, "surface_order", opts, &[order.len()], order)?;
         }
         if let Some(q) = &self.quadratic {
             let ne = q.edges.len();
             let edges: Vec<u32> = q.edges.iter().flatten().copied().collect();
-            npz.add_array(
-                QUADRATIC_ENTRIES[0],
-                &Array2::from_shape_vec((ne, 2), edges).map_err(|x| x.to_string())?,
-            )
-            .map_err(e)?;
-            npz.add_array(
-                QUADRATIC_ENTRIES[1],
-                &Array1::from(q.edge_to_volume.clone()),
-            )
-            .map_err(e)?;
+            write_entry(z, QUADRATIC_ENTRIES[0], opts, &[ne, 2], &edges)?;
+            let nev = q.edge_to_volume.len();
+            write_entry(z, QUADRATIC_ENTRIES[1], opts, &[nev], &q.edge_to_volume)?;
             match self.precision {
-                ModesPrecision::F64 => npz.add_array(
-                    QUADRATIC_ENTRIES[2],
-                    &Array3::from_shape_vec((ne, 3, m), q.modes.clone())
-                        .map_err(|x| x.to_string())?,
-                ),
-                ModesPrecision::F32 => npz.add_array(
-                    QUADRATIC_ENTRIES[2],
-                    &Array3::from_shape_vec(
-                        (ne, 3, m),
-                        q.modes.iter().map(|&x| x as f32).collect(),
-                    )
-                    .map_err(|x| x.to_string())?,
-                ),
+                ModesPrecision::F64 => {
+                    write_entry(z, QUADRATIC_ENTRIES[2], opts, &[ne, 3, m], &q.modes)?
+                }
+                ModesPrecision::F32 => {
+                    write_entry(z, QUADRATIC_ENTRIES[2], opts, &[ne, 3, m], &f32s(&q.modes))?
+                }
             }
-            .map_err(e)?;
         }
         if let Some(t) = &self.transfer {
-            npz.add_array("transfer_vertices", &Array1::from(t.vertices.clone()))
-                .map_err(e)?;
-            npz.add_array("transfer_peaks", &Array1::from(t.peaks.clone()))
-                .map_err(e)?;
-            npz.add_array("transfer_h", &Array0::from_elem((), t.h))
-                .map_err(e)?;
-            npz.add_array("transfer_rayleigh", &Array1::from(t.rayleigh.to_vec()))
-                .map_err(e)?;
-            npz.add_array("transfer_modes", &Array0::from_elem((), t.modes))
-                .map_err(e)?;
-            npz.add_array("transfer_samples", &Array0::from_elem((), t.samples))
-                .map_err(e)?;
+            let nv = t.vertices.len();
+            write_entry(z, "transfer_vertices", opts, &[nv], &t.vertices)?;
+            write_entry(z, "transfer_peaks", opts, &[t.peaks.len()], &t.peaks)?;
+            write_entry(z, "transfer_h", opts, &[], &[t.h])?;
+            write_entry(z, "transfer_rayleigh", opts, &[2], &t.rayleigh)?;
+            write_entry(z, "transfer_modes", opts, &[], &[t.modes])?;
+            write_entry(z, "transfer_samples", opts, &[], &[t.samples])?;
             let edges: Vec<u32> = t.edges.iter().flatten().copied().collect();
-            npz.add_array(
-                TRANSFER_EDGES_ENTRY,
-                &Array2::from_shape_vec((t.edges.len(), 2), edges).map_err(|x| x.to_string())?,
-            )
-            .map_err(e)?;
+            write_entry(z, TRANSFER_EDGES_ENTRY, opts, &[t.edges.len(), 2], &edges)?;
             // Only when it differs from what a reader infers (2 with edges, else 1), so that
             // order-1 and order-2 files keep the bytes of readers that predate the entry.
             if t.order != if t.edges.is_empty() { 1 } else { 2 } {
-                npz.add_array(
-                    TRANSFER_ORDER_ENTRY,
-                    &Array0::from_elem((), u32::from(t.order)),
-                )
-                .map_err(e)?;
+                write_entry(z, TRANSFER_ORDER_ENTRY, opts, &[], &[u32::from(t.order)])?;
                 let faces: Vec<u32> = t.faces.iter().flatten().copied().collect();
-                npz.add_array(
-                    TRANSFER_FACES_ENTRY,
-                    &Array2::from_shape_vec((t.faces.len(), 3), faces)
-                        .map_err(|x| x.to_string())?,
-                )
-                .map_err(e)?;
+                write_entry(z, TRANSFER_FACES_ENTRY, opts, &[t.faces.len(), 3], &faces)?;
             }
         }
-        Ok(npz.finish().map_err(e)?.into_inner())
+        Ok(zip.finish().map_err(|e| e.to_string())?.into_inner())
     }
 
     /// Reads and validates a `.modes` file.
@@ -978,7 +920,7 @@ const MAX_NPY_NESTING: usize = 8;
 /// size before its header is parsed: the header length field is distrusted (a version-2 length
 /// of 4 GiB would otherwise be allocated), and so is the header's bracket nesting (the header
 /// parser recurses).
-fn check_npy_preamble(buf: &[u8]) -> Result<(), String> {
+fn check_npy_preamble(buf: &[u8]) -> Result<std::ops::Range<usize>, String> {
     if buf.len() < 10 || &buf[..6] != b"\x93NUMPY" {
         return Err("not a .npy entry (no \\x93NUMPY magic)".into());
     }
@@ -1012,7 +954,7 @@ fn check_npy_preamble(buf: &[u8]) -> Result<(), String> {
             _ => {}
         }
     }
-    Ok(())
+    Ok(start..start + len)
 }
 
 impl<R: Read + Seek> EntryReader<'_, R> {
@@ -1074,23 +1016,23 @@ impl<R: Read + Seek> EntryReader<'_, R> {
 
     /// Parses an n-d array of element type `A`, checking the header's declared length against the
     /// bytes present before anything is allocated for it.
-    fn parse<A: ReadableElement>(
+    fn parse<A: NpyElement>(
         &mut self,
         entry: &'static str,
         cap: u64,
     ) -> Result<(Vec<A>, Vec<usize>), FormatError> {
         let buf = self.bytes(entry, cap)?;
-        check_npy_preamble(&buf).map_err(|detail| self.err(entry, detail))?;
-        let mut cur = Cursor::new(&buf[..]);
-        let header = Header::from_reader(&mut cur)
-            .map_err(|err| self.err(entry, format!("bad .npy header: {err}")))?;
-        let elem = std::mem::size_of::<A>();
-        let descr = header.type_descriptor.to_string();
-        let descr_size = descr
-            .trim_matches(|c| c == '\'' || c == '"')
+        let text = check_npy_preamble(&buf).map_err(|detail| self.err(entry, detail))?;
+        let header_end = text.end;
+        let header = parse_header_text(&buf[text]).map_err(|detail| self.err(entry, detail))?;
+        let elem = A::SIZE;
+        let descr = format!("'{}'", header.descr);
+        let descr_size = header
+            .descr
             .trim_start_matches(|c: char| !c.is_ascii_digit())
             .parse::<usize>()
-            .ok();
+            .ok()
+            .or((header.descr == "B").then_some(1));
         if descr_size != Some(elem) {
             return Err(self.err(entry, format!("unexpected dtype {descr}")));
         }
@@ -1099,7 +1041,7 @@ impl<R: Read + Seek> EntryReader<'_, R> {
             .iter()
             .try_fold(1usize, |acc, &d| acc.checked_mul(d))
             .and_then(|n| n.checked_mul(elem));
-        let remaining = buf.len() - cur.position() as usize;
+        let remaining = buf.len() - header_end;
         match declared {
             Some(bytes) if bytes == remaining => {}
             Some(bytes) => {
@@ -1113,20 +1055,15 @@ impl<R: Read + Seek> EntryReader<'_, R> {
             }
             None => return Err(self.err(entry, format!("shape {:?} overflows", header.shape))),
         }
-        if header.layout.is_fortran() && header.shape.len() > 1 {
+        if header.fortran_order && header.shape.len() > 1 {
             return Err(self.err(entry, "Fortran-ordered arrays are not supported"));
         }
-        let arr = ArrayD::<A>::read_npy(&buf[..]).map_err(|err| match err {
-            ndarray_npy::ReadNpyError::WrongDescriptor(d) => {
-                self.err(entry, format!("unexpected dtype {d}"))
-            }
-            other => self.err(entry, other.to_string()),
-        })?;
-        let shape = arr.shape().to_vec();
-        Ok((arr.into_raw_vec_and_offset().0, shape))
+        let values = decode::<A>(&header.descr, &buf[header_end..])
+            .map_err(|detail| self.err(entry, detail))?;
+        Ok((values, header.shape))
     }
 
-    fn array<A: ReadableElement>(
+    fn array<A: NpyElement>(
         &mut self,
         entry: &'static str,
         ndim: usize,
@@ -1141,7 +1078,7 @@ impl<R: Read + Seek> EntryReader<'_, R> {
         Ok((v, shape))
     }
 
-    fn vector<A: ReadableElement>(
+    fn vector<A: NpyElement>(
         &mut self,
         entry: &'static str,
         cap: u64,
@@ -1284,7 +1221,7 @@ impl<R: Read + Seek> EntryReader<'_, R> {
         )))
     }
 
-    fn scalar<A: ReadableElement + Copy>(&mut self, entry: &'static str) -> Result<A, FormatError> {
+    fn scalar<A: NpyElement + Copy>(&mut self, entry: &'static str) -> Result<A, FormatError> {
         let (v, shape) = self.parse::<A>(entry, 1024)?;
         match (shape.len(), v.first()) {
             (0, Some(&x)) => Ok(x),

@@ -11,7 +11,9 @@ mod surface_point;
 
 pub use load_error::LoadError;
 pub use modal_model::ModalModel;
-pub use surface_point::{quadratic_triangle_weights, SurfacePoint};
+pub use surface_point::{
+    area_weighted_normals, quadratic_triangle_weights, surface_point_on, SurfacePoint,
+};
 
 #[cfg(test)]
 mod tests;

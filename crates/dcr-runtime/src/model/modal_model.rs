@@ -10,7 +10,7 @@ use parry3d_f64::shape::TriMesh;
 use super::{quadratic_triangle_weights, LoadError, SurfacePoint};
 use crate::attenuation::{GeodesicError, GeodesicTable, HeatGeodesic};
 use crate::format::ModesFile;
-use crate::math::{add, cross, norm, normalize, scale, sub};
+use crate::math::{add, cross, norm, normalize, sub};
 
 /// An immutable modal model shared (via `Arc`) by every object instance that uses the same base.
 ///
@@ -197,25 +197,15 @@ impl ModalModel {
     /// Builds the [`SurfacePoint`] at barycentric `bary` of triangle `tri`; `distance` is measured
     /// from `query` (m).
     pub fn surface_point(&self, tri: u32, bary: [f64; 3], query: [f64; 3]) -> SurfacePoint {
-        let vs = self.triangle(tri);
-        let x = &self.base.surface_vertices;
-        let mut point = [0.0; 3];
-        let mut n = [0.0; 3];
-        for (i, &v) in vs.iter().enumerate() {
-            point = add(point, scale(x[v], bary[i]));
-            n = add(n, scale(self.normals[v], bary[i]));
-        }
-        let mut normal = normalize(n);
-        if normal == [0.0; 3] {
-            normal = normalize(cross(sub(x[vs[1]], x[vs[0]]), sub(x[vs[2]], x[vs[0]])));
-        }
-        SurfacePoint {
-            triangle: tri,
+        let b = &self.base;
+        super::surface_point_on(
+            &b.surface_vertices,
+            &b.surface_triangles,
+            &self.normals,
+            tri,
             bary,
-            point,
-            normal,
-            distance: norm(sub(query, point)),
-        }
+            query,
+        )
     }
 
     /// Whether the base is second-order (modes interpolated quadratically on 6-node triangles).

@@ -9,35 +9,7 @@ use crate::format::{MaterialSi, ModesFile, ModesMeta, ModesPrecision, FORMAT_VER
 /// A surface: vertex positions (m) and outward (counter-clockwise from outside) triangles.
 pub type Surface = (Vec<[f64; 3]>, Vec<[u32; 3]>);
 
-/// SplitMix64: a tiny seeded PRNG (deterministic across platforms).
-#[derive(Clone, Debug)]
-pub struct SplitMix64(pub u64);
-
-impl SplitMix64 {
-    /// Next 64 random bits.
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in [0, 1).
-    pub fn next_f64(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
-    }
-
-    /// Uniform in [lo, hi).
-    pub fn range(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * self.next_f64()
-    }
-
-    /// Uniform integer in 0..n (n > 0), by the high half of a 64 × 64-bit product (Lemire).
-    pub fn below(&mut self, n: usize) -> usize {
-        ((self.next_u64() as u128 * n as u128) >> 64) as usize
-    }
-}
+pub use crate::rng::SplitMix64;
 
 /// A nested-dissection-like vertex order of a connected surface, for tests of split solves: the
 /// vertices nearer (in breadth-first hops from vertex 0) than the median hop count, then those

@@ -140,10 +140,8 @@ struct PanelRows<'a> {
 }
 
 /// [`PanelRows::run`] under `pulp` dispatch: AVX2 lanes, with the same operations per lane
-/// and no fused products, so the same bits as the portable (SSE2) path. Measured in-process,
-/// interleaved (best of 30 each): 3.5k dofs, M × 8 columns 0.187 vs 0.232 ms, K × 20 columns
-/// with |K||x| 2.05 vs 2.56 ms; at 13.5k dofs, where the panels leave L2, 1.10 vs 1.17 ms and
-/// 8.6–11.4 vs 11.9–12.5 ms.
+/// and no fused products, so the same bits as the portable (SSE2) path, and faster
+/// (docs/benchmarks.md, "Design measurements").
 struct AbsKernel<'a, const ABS: bool>(PanelRows<'a>);
 
 impl PanelRows<'_> {
@@ -196,10 +194,7 @@ const SPMM_SEQ_BELOW: usize = 20_000;
 ///
 /// The Lanczos products are tall and skinny (n × ≤ 100 against n × b, or n × ≤ 100 times a
 /// small matrix), memory-bound, and faer 0.24.4's parallel path is much slower on them than
-/// its sequential one: measured on 2 cores at n = 108 900 (the 100k bake bench beam),
-/// `Vᵀ Z` with V n × 48 and Z n × 6 took 164–200 ms with `Par::rayon(2)` against 9.6–9.8 ms
-/// with `Par::Seq` (n × 20 against n × 20: 64–142 ms vs 4.9–5.8 ms), and `Z − V C` 13–20 ms
-/// against 11.3–11.4 ms.
+/// its sequential one (up to 20× on 2 cores at n = 108 900; docs/benchmarks.md, "Design measurements").
 pub(crate) fn gemm(
     dst: MatMut<'_, f64>,
     accum: Accum,
@@ -278,36 +273,9 @@ pub(crate) fn lower_inverse(l: MatRef<'_, f64>) -> Mat<f64> {
     x
 }
 
-/// splitmix64 (Steele, Lea, Flood 2014): the fixed-seed generator of the Lanczos start block
-/// and of the seeded points of an accuracy target (the same bits on every platform).
-#[derive(Clone, Debug)]
-pub struct SplitMix64(pub u64);
-
-impl SplitMix64 {
-    /// Next 64 random bits.
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in [−1, 1).
-    pub fn next_sym(&mut self) -> f64 {
-        ((self.next_u64() >> 11) as f64) * (2.0 / (1u64 << 53) as f64) - 1.0
-    }
-
-    /// Uniform in [0, 1).
-    pub fn unit(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
-    }
-
-    /// Uniform integer in 0..n (n > 0), by the high half of a 64 × 64-bit product (Lemire).
-    pub fn below(&mut self, n: usize) -> usize {
-        ((self.next_u64() as u128 * n as u128) >> 64) as usize
-    }
-}
+/// The fixed-seed generator of the Lanczos start block and of an accuracy target's seeded
+/// points (one definition, in the runtime).
+pub use dcr_runtime::rng::SplitMix64;
 
 #[cfg(test)]
 mod tests {

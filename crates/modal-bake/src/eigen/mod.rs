@@ -101,12 +101,9 @@ pub struct EigenParams {
     pub shift: f64,
     /// Block size b: right-hand sides per factor solve (default 8). With the block solves of
     /// `panel_solve.rs` a block of 8 costs about what a block of 6 does once the factor no
-    /// longer fits in cache (109k dofs: 181–199 ms vs 198–204 ms), and the larger block
-    /// converges in fewer solves (bake bench, 20 modes: 3.5k 19 vs 22, 13.5k 15 vs 18, 109k 11
-    /// vs 13). Interleaved `examples/eigen_timing` runs, eigensolve min/median: 109k 3.9/4.2 s
-    /// vs 5.0/5.5 s (block 6, Krylov dimension 48); 13.5k and 3.5k within the noise of a
-    /// loaded machine (13.5k: 0.50/0.52 s vs 0.50/0.55 s in one series, 0.59/0.79 s vs
-    /// 0.59/0.75 s in another; 3.5k: 0.113/0.121 s vs 0.112/0.132 s).
+    /// longer fits in cache, and the larger block converges in fewer solves (bake bench, 20
+    /// modes: 3.5k 19 vs 22, 13.5k 15 vs 18, 109k 11 vs 13; timings in
+    /// docs/benchmarks.md, "Design measurements").
     pub block: usize,
     /// Maximum Krylov basis size before a thick restart; `None`: nev + max(nev, 4b) + b, plus
     /// 8b between 1 000 and 20 000 dofs, rounded up to a multiple of b (grown automatically in
@@ -122,8 +119,7 @@ pub struct EigenParams {
     /// wider than 8) as `Par::rayon(n)`; 0 (default): sequential below 20 000 dofs, else the
     /// current rayon pool's size. The Lanczos block solves and the split panel sweeps use the
     /// current rayon pool; dense products are sequential. Results do not depend on it
-    /// (measured: bit-identical for 1, 2 and 3 threads on faer 0.24.4; `tests/fem_eigen.rs`
-    /// guards it).
+    /// (bit-identical for 1, 2 and 3 threads on faer 0.24.4; `tests/fem_eigen.rs` guards it).
     pub threads: usize,
     /// Seed of the start block.
     pub seed: u64,

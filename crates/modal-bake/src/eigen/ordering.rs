@@ -4,13 +4,12 @@
 //! Why METIS next to faer's AMD: faer 0.24 offers only AMD (and custom orderings). AMD is
 //! local and on 3-D meshes leaves a factor close to a banded one; nested dissection orders two
 //! halves of the mesh before the nodes that separate them, so the fill of each half stays
-//! inside it. METIS's multilevel vertex separators (`METIS_NodeND`) are much smaller than the
-//! breadth-first level sets this module used before (factor entries of the bake bench's stout
-//! 100 × 18 × 18-cell, 108k-dof beam: AMD 123.6M, level sets 97.2M, METIS 83.5M; see the
-//! tests for a block). The safe `metis` crate does not wrap
-//! `METIS_NodeND`; the runtime's `metis` feature holds the one FFI call
-//! ([`dcr_runtime::attenuation::nested_dissection`]), shared with the surface ordering of the
-//! heat geodesic. Deterministic: METIS reseeds its random generator (fixed seed) on every
+//! inside it. METIS's multilevel vertex separators (`METIS_NodeND`) are much smaller than
+//! breadth-first level sets (factor entries of the bake bench's stout 100 × 18 × 18-cell,
+//! 108k-dof beam: AMD 123.6M, level sets 97.2M, METIS 83.5M; see the tests for a block). The
+//! safe `metis` crate does not wrap `METIS_NodeND`; [`crate::ordering::nested_dissection`]
+//! holds the one FFI call, shared with the surface ordering of the heat geodesic
+//! ([`crate::ordering::plan_surface_order`]). Deterministic: METIS reseeds its random generator (fixed seed) on every
 //! call, but that generator is process-global C state, so calls are serialised by one lock
 //! there (two bakes ordering at once on two threads would otherwise interleave one stream).
 
@@ -67,10 +66,10 @@ pub(crate) fn factor_entries(g: &SymbolicSparseColMat<usize>, fwd: &[usize]) -> 
 /// given by its adjacency lists (column pointers and row indices, both triangles; self loops
 /// allowed and ignored). `fwd[k]`: the vertex placed at position k. `None` when the graph does
 /// not fit METIS's 32-bit indices or METIS fails (out of memory): callers fall back to AMD.
-/// The one METIS call site is the runtime's (it serialises calls: METIS uses libc's global
-/// random state).
+/// The one METIS call site is [`crate::ordering::nested_dissection`] (it serialises calls:
+/// METIS uses libc's global random state).
 pub(crate) fn metis_nested_dissection(g: &SymbolicSparseColMat<usize>) -> Option<Vec<usize>> {
-    dcr_runtime::attenuation::nested_dissection(g.col_ptr(), g.row_idx())
+    crate::ordering::nested_dissection(g.col_ptr(), g.row_idx())
 }
 
 #[cfg(test)]

@@ -1,27 +1,21 @@
 //! Block triangular solves x ← (LLᵀ)⁻¹ x on faer's supernodal Cholesky factor, with the
 //! right-hand sides stored as a row-major *panel* (the w ≤ 8 entries of one row side by side).
 //!
-//! Why not faer's own `solve_in_place` (which the rest of the crate still uses for single
-//! vectors and wide blocks): for a few right-hand sides it runs, per supernode, a dense GEMM
-//! that packs the supernode's rows below and then scatters the product column by column, and
-//! ends up 2–3× above one pass over the factor's memory. Measured on the bake bench beams
-//! (faer 0.24.4), 6 right-hand sides: 13.5k dofs (4.8 M factor entries) faer 21–30 ms, one
-//! right-hand side 11–13 ms; 109k dofs (54 M entries) faer with two threads 250–350 ms, one
-//! right-hand side 120 ms. Here each factor entry is loaded once per solve and multiplies a
-//! row of w values held in SIMD registers; the columns of a supernode are taken in passes of
-//! [`PASS`], so each indexed row of x is loaded and stored once per pass rather than once per
-//! factor column. Same measurements with this solve, one thread: 13.5k 17–18 ms, 109k
-//! 185–205 ms; at 3.5k dofs (0.6 M entries, cache-resident) it only matches faer (2.0 vs
-//! 1.8 ms). In the bake bench's 13.5k eigensolve (interleaved runs, 18 solves): 0.50 s vs
-//! 0.58 s (fastest of 7), 0.55 s vs 0.62 s (median).
+//! Why not faer's own `solve_in_place` (which the crate uses for single vectors and wide
+//! blocks): for a few right-hand sides it runs, per supernode, a dense GEMM that packs the
+//! supernode's rows below and then scatters the product column by column, and ends up 2–3×
+//! above one pass over the factor's memory (6 right-hand sides at 13.5k dofs: faer 21–30 ms,
+//! this solve 17–18 ms on one thread; the figures in docs/benchmarks.md, "Design measurements").
+//! Here each factor entry is loaded once per solve and multiplies a row of w values held in
+//! SIMD registers; the columns of a supernode are taken in passes of [`PASS`], so each indexed
+//! row of x is loaded and stored once per pass rather than once per factor column.
 //!
 //! Two threads: from 20 000 rows on, when the supernodal elimination tree splits into two
 //! groups of whole subtrees holding similar weights below a top of at most 25% of the factor
 //! ([`Split`]), the two groups are swept at the same time. That is the case for nested
 //! dissection orderings (the bake bench's stout 108k-dof beam: groups of 40.8 M and 40.1 M
-//! entries below a top of 2.8%; its eigensolve 14.1/14.9 s vs 16.2/16.6 s min/median of 2
-//! interleaved runs on a machine at load ≈ 3.5), not for the AMD ordering of the slender 109k
-//! beam (a near chain: no split within 25%, swept on one thread).
+//! entries below a top of 2.8%), not for the AMD ordering of the slender 109k beam (a near
+//! chain: no split within 25%, swept on one thread).
 //!
 //! Determinism: every sum in a fixed order that depends on the factor only; each right-hand side (lane) sees the
 //! same operations whatever w or the SIMD width, so the results do not depend on how the
@@ -35,10 +29,8 @@ use faer::sparse::linalg::cholesky::supernodal::{SupernodalLltRef, SymbolicSuper
 /// PASS solved rows of x in registers (2 AVX registers each at w = 8) next to two partial
 /// sums, and 8 rows already fill the 16 AVX2 registers (spills); and FEM supernodes hold
 /// whole 3-dof nodes, so their widths are multiples of 3 and a pass of 6 leaves either
-/// nothing or a pass of [`REM`], which also runs on fixed-size arrays. Measured on the bake
-/// bench beams (w = 8, fastest block solve of an eigensolve, interleaved): 3.5k dofs 1.64–1.95
-/// vs 2.18–3.37 ms with passes of 8 (callgrind: 6.9 M vs 10.6 M instructions per solve),
-/// 13.5k 12.9–13.2 vs 16.2–16.9 ms.
+/// nothing or a pass of [`REM`], which also runs on fixed-size arrays (passes of 8: 6.9 M vs
+/// 10.6 M instructions per solve at 3.5k dofs; docs/benchmarks.md, "Design measurements").
 const PASS: usize = 6;
 
 /// The pass width left over in supernodes of an odd number of 3-dof nodes (specialised like a
@@ -46,8 +38,7 @@ const PASS: usize = 6;
 const REM: usize = 3;
 
 /// Panel widths (right-hand sides per pass over the factor) this solve is used for; wider
-/// blocks go to faer, whose packed GEMM is the faster one there (measured at 13.5k and 109k
-/// dofs: 20 right-hand sides 49 vs 34 ms and 617 vs 464 ms, as two panels of 10).
+/// blocks go to faer, whose packed GEMM is the faster one there (docs/benchmarks.md, "Design measurements").
 pub(crate) const PANEL_WIDTHS: std::ops::RangeInclusive<usize> = 2..=8;
 
 /// One supernode: columns `start..start + ncols` of L, stored column-major with leading

@@ -133,18 +133,14 @@ fn symbolic(
 /// Nested dissection replaces AMD when its factor of the node graph has fewer than this
 /// fraction of AMD's entries, i.e. whenever it fills less. Its balanced elimination tree is
 /// what lets faer's factorization and the panel sweeps (`panel_solve.rs`) use both threads,
-/// which AMD's near-chain tree on a slender beam does not. Measured (`eigen_timing`, 2
-/// interleaved runs each, min/median, level-set dissection then): on the slender 109k-dof
-/// beam, where it filled 4% less, factorization 2.20/2.22 s vs 2.48/2.52 s and eigensolve
-/// 3.27/3.41 s vs 4.44/4.57 s against AMD. METIS (2026-11-22, `eigen_timing --threads 1`,
-/// user CPU seconds, level sets → METIS) fills less still: the stout 108k-dof beam 83.5M vs
-/// 97.2M dof-factor entries (AMD 123.6M), 15.6–18.8 s → 13.3–13.4 s; the slender beam 44.2M
-/// (AMD 54.1M), 7.1–7.7 s → 6.3–6.4 s.
+/// which AMD's near-chain tree on a slender beam does not. METIS fills less than AMD on the
+/// bake bench beams (stout 108k dofs: 83.5M vs 123.6M dof-factor entries; slender 109k: 44.2M
+/// vs 54.1M); timings in docs/benchmarks.md, "Design measurements".
 const ND_FILL_RATIO: f64 = 1.0;
 
 /// Below this many dofs nested dissection is not tried: on the bake bench's 13.5k-dof beam
 /// METIS fills 11% less than AMD (4.30M vs 4.83M entries), but ordering it and comparing the
-/// two fills costs what the smaller factor saves (factor + eigensolve 0.79 s vs 0.78 s).
+/// two fills costs what the smaller factor saves (docs/benchmarks.md, "Design measurements").
 const ND_MIN_DOFS: usize = 30_000;
 
 /// The symbolic factorization of `a` under AMD or, when it fills less ([`ND_FILL_RATIO`],
@@ -197,8 +193,8 @@ pub(crate) struct ShiftInvert {
 
 /// Factors with fewer rows solve blocks wider than 8 columns (the purification of the Ritz
 /// vectors: 20 at once for the bake's 20 modes) as panels of 8 with [`PanelSolve`]; larger
-/// ones use faer's solve, whose packed GEMM (on two threads from 20 000 dofs) measured faster
-/// there (109k dofs: 464 ms vs 617 ms for 20 columns, with passes of 8 factor columns).
+/// ones use faer's solve, whose packed GEMM (on two threads from 20 000 dofs) is faster there
+/// (docs/benchmarks.md, "Design measurements").
 const WIDE_PANEL_MAX_ROWS: usize = 20_000;
 
 /// Scratch of [`ShiftInvert::solve_in_place`].

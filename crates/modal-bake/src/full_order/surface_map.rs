@@ -3,10 +3,11 @@
 //! barycentric weights in triangle order, area-weighted vertex normals interpolated with the
 //! weights and normalised).
 
-use dcr_runtime::model::SurfacePoint;
+use dcr_runtime::model::{area_weighted_normals, surface_point_on, SurfacePoint};
 
 use crate::bake::extract_surface;
 use crate::mesh::TetMesh;
+use crate::vec3::{add, dot, norm2, scale, sub};
 
 /// The boundary surface of a tetrahedral mesh, for mapping points onto it (object frame, m).
 #[derive(Clone, Debug)]
@@ -31,17 +32,7 @@ impl SurfaceMap {
         }
         let vertices: Vec<[f64; 3]> = surf.iter().map(|&v| mesh.nodes[v]).collect();
         let triangles: Vec<[u32; 3]> = tris.iter().map(|t| t.map(|v| local[v])).collect();
-        let mut normals = vec![[0.0; 3]; vertices.len()];
-        for t in &triangles {
-            let [a, b, c] = t.map(|i| i as usize);
-            let n = cross(sub(vertices[b], vertices[a]), sub(vertices[c], vertices[a]));
-            for v in [a, b, c] {
-                normals[v] = add(normals[v], n);
-            }
-        }
-        for n in &mut normals {
-            *n = normalize(*n);
-        }
+        let normals = area_weighted_normals(&vertices, &triangles);
         SurfaceMap {
             surface_to_volume: surf,
             vertices,
@@ -70,25 +61,14 @@ impl SurfaceMap {
 
     /// The [`SurfacePoint`] at `bary` of triangle `tri`, `distance` measured from `query` (m).
     pub fn surface_point(&self, tri: u32, bary: [f64; 3], query: [f64; 3]) -> SurfacePoint {
-        let vs = self.triangles[tri as usize].map(|i| i as usize);
-        let mut point = [0.0; 3];
-        let mut n = [0.0; 3];
-        for (i, &v) in vs.iter().enumerate() {
-            point = add(point, scale(self.vertices[v], bary[i]));
-            n = add(n, scale(self.normals[v], bary[i]));
-        }
-        let mut normal = normalize(n);
-        if normal == [0.0; 3] {
-            let x = &self.vertices;
-            normal = normalize(cross(sub(x[vs[1]], x[vs[0]]), sub(x[vs[2]], x[vs[0]])));
-        }
-        SurfacePoint {
-            triangle: tri,
+        surface_point_on(
+            &self.vertices,
+            &self.triangles,
+            &self.normals,
+            tri,
             bary,
-            point,
-            normal,
-            distance: norm2(sub(query, point)).sqrt(),
-        }
+            query,
+        )
     }
 
     /// Diagonal of the surface's axis-aligned bounding box (m).
@@ -171,38 +151,6 @@ pub(crate) fn closest_point_triangle(
     };
     let q = add(add(scale(a, bary[0]), scale(b, bary[1])), scale(c, bary[2]));
     (q, bary)
-}
-
-pub(crate) fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-pub(crate) fn add(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
-pub(crate) fn scale(a: [f64; 3], s: f64) -> [f64; 3] {
-    [a[0] * s, a[1] * s, a[2] * s]
-}
-pub(crate) fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-pub(crate) fn norm2(a: [f64; 3]) -> f64 {
-    dot(a, a)
-}
-pub(crate) fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-/// `a/|a|`, or zero for a zero (or non-finite-length) vector.
-pub(crate) fn normalize(a: [f64; 3]) -> [f64; 3] {
-    let n = norm2(a).sqrt();
-    if n > 0.0 && n.is_finite() {
-        scale(a, 1.0 / n)
-    } else {
-        [0.0; 3]
-    }
 }
 
 #[cfg(test)]

@@ -56,19 +56,7 @@ pub(crate) fn tet_faces([a, b, c, d]: [usize; 4]) -> [[usize; 3]; 4] {
     [[a, c, b], [a, b, d], [a, d, c], [b, c, d]]
 }
 
-pub(crate) fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-pub(crate) fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-pub(crate) fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
+pub(crate) use crate::vec3::{cross, dot, sub};
 
 impl TetMesh {
     /// This mesh as meshio-style JSON that [`crate::mesh::read_mesh`] reads back: `points`

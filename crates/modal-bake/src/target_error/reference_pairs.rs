@@ -59,7 +59,7 @@ pub fn sample_points(
                 let (mut a, mut b) = if c == 1 {
                     (1.0 / 3.0, 1.0 / 3.0)
                 } else {
-                    (rng.unit(), rng.unit())
+                    (rng.next_f64(), rng.next_f64())
                 };
                 if a + b > 1.0 {
                     (a, b) = (1.0 - a, 1.0 - b);

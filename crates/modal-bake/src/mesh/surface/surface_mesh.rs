@@ -27,16 +27,7 @@ pub struct SurfaceInfo {
     pub flipped: bool,
 }
 
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
+use crate::vec3::{cross, sub};
 
 fn find(parent: &mut [usize], mut v: usize) -> usize {
     while parent[v] != v {

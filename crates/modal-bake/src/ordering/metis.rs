@@ -1,10 +1,10 @@
-//! Nested-dissection orderings (METIS 5 `METIS_NodeND`), for work done ahead of the runtime:
-//! the bake's fill-reducing orderings of the volume stiffness and of the surface Laplacian
-//! ([`super::HeatGeodesic::plan_ordering`], stored in the base as `surface_order`).
+//! Nested-dissection orderings (METIS 5 `METIS_NodeND`): the one FFI call behind the bake's
+//! fill-reducing orderings of the volume stiffness (`eigen/ordering.rs`) and of the surface
+//! Laplacian ([`super::plan_surface_order`], stored in the base as `surface_order`).
 //!
-//! Behind the `metis` feature: engines linking the runtime read stored orders and never build
-//! METIS. METIS (through `metis-sys`, which builds it from vendored C) rather than our own
-//! dissection: a breadth-first level-set dissection filled 205k entries on a 5k-vertex box
+//! Only the baker builds METIS (through `metis-sys`, from vendored C): engines linking
+//! `dcr-runtime` read the stored order and need no C compiler. METIS rather than our own
+//! dissection: a breadth-first level-set dissection fills 205k entries on a 5k-vertex box
 //! surface where AMD fills 117k and METIS 93k.
 
 /// METIS nested-dissection order of the symmetric graph whose adjacency is the CSC pattern

@@ -1,0 +1,10 @@
+//! Fill-reducing orderings computed at bake time: METIS nested dissection (`metis.rs`, the
+//! crate's one C dependency) and the heat-geodesic surface order stored in a base
+//! (`surface_order.rs`). The volume stiffness ordering (AMD or nested dissection, whichever
+//! fills less) lives with the eigensolver in `eigen/ordering.rs` and calls [`nested_dissection`].
+
+mod metis;
+mod surface_order;
+
+pub use metis::nested_dissection;
+pub use surface_order::plan_surface_order;
