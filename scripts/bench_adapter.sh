@@ -8,7 +8,8 @@
 #    and the median of the per-run shares (`dcr_share_of_step`);
 # 2. instructions (valgrind callgrind, independent of the machine's load): rapier's
 #    `step_with_events` and `DcrRapier::after_step` (+ `before_step`) per scene, for the default
-#    impact-step gate and for reading every step;
+#    impact-step gate and for reading every step; the same for the stress scene cut to 100, 300
+#    and 1000 boxes (default gate only);
 # 3. `dcr-scenes bench-stress --props 100,300,1000`.
 # Writes out/bench/{table1_*.json,callgrind.txt,stress.json,summary.txt}; prints the summary.
 set -euo pipefail
@@ -44,21 +45,42 @@ for j, s in enumerate(runs[0]["scenes"]):
           f"world steps {s['world_steps']}/{s['steps']}")
 EOF
 
+# One callgrind run: `callgrind NAME GATE SCENE` appends "NAME GATE rapier after before world"
+# (inclusive instruction counts at the call sites, "=> … (Nx)"; a function inlined everywhere
+# has none) to callgrind.txt.
+callgrind() {
+  local name="$1" gate="$2" scene="$3"
+  local f="$OUT/cg.$name.$gate.out"
+  valgrind --tool=callgrind --callgrind-out-file="$f" "$BIN" run "$scene" --gate "$gate" \
+    --out "$OUT/run_$name" >/dev/null 2>&1
+  callgrind_annotate --inclusive=yes "$f" 2>/dev/null > "$f.txt"
+  count() { { grep -E "=> .*$1 \(" "$f.txt" || true; } | head -1 | awk '{print $1}' | tr -d ,; }
+  local r a b w
+  r=$(count "PhysicsWorld::step_with_events")
+  a=$(count "DcrRapier::after_step")
+  b=$(count "DcrRapier::before_step")
+  w=$(count "DcrWorld::step")
+  echo "$name $gate ${r:-0} ${a:-0} ${b:-0} ${w:-0}" >> "$OUT/callgrind.txt"
+}
+
 if command -v valgrind >/dev/null; then
   : > "$OUT/callgrind.txt"
   for s in dinner roof scaffold lowrider rockfall washing; do
     for g in impact-steps every-step; do
-      f="$OUT/cg.$s.$g.out"
-      valgrind --tool=callgrind --callgrind-out-file="$f" "$BIN" run "$s" --gate "$g" --out "$OUT/run_$s" >/dev/null 2>&1
-      callgrind_annotate --inclusive=yes "$f" 2>/dev/null > "$f.txt"
-      # Inclusive counts at the call sites ("=> … (Nx)"); a function inlined everywhere has none.
-      count() { { grep -E "=> .*$1 \(" "$f.txt" || true; } | head -1 | awk '{print $1}' | tr -d ,; }
-      r=$(count "PhysicsWorld::step_with_events")
-      a=$(count "DcrRapier::after_step")
-      b=$(count "DcrRapier::before_step")
-      w=$(count "DcrWorld::step")
-      echo "$s $g ${r:-0} ${a:-0} ${b:-0} ${w:-0}" >> "$OUT/callgrind.txt"
+      callgrind "$s" "$g" "$s"
     done
+  done
+  # The stress scene cut to N boxes (as bench-stress does), default gate.
+  for n in 100 300 1000; do
+    python3 - "$n" "$OUT/stress_$n.json" <<'EOF'
+import json, sys
+d = json.load(open("scenes/stress.json"))
+for p in d["props"]:
+    if p["name"] == "box":
+        p["copies"] = p["copies"][: int(sys.argv[1])]
+json.dump(d, open(sys.argv[2], "w"))
+EOF
+    callgrind "stress_$n" impact-steps "$OUT/stress_$n.json"
   done
   python3 - "$OUT" >> "$OUT/summary.txt" <<'EOF'
 import sys

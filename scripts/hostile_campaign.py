@@ -12,8 +12,9 @@ every run:
              permuted duplicate tetrahedron, an extra value, a negative tag) with node/tet
              counts or mass other than the unmutated mesh's
   leftover   a failed run left a file in its output folder
-  unlocated  a refusal whose message names no file or no location (line, byte, element,
-             node, entry, option)
+  unlocated  a refusal whose message does not name the file and a location in it (a line,
+             byte, element / node / vertex number, archive entry, JSON index, section or
+             option name; see LOCATED)
   refused    a clean refusal;  ok  exit 0 (a mutation that still reads)
 
 Usage (from the repository root, after `cargo build --release -p modal-bake`):
@@ -34,9 +35,14 @@ import tempfile
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 BIN = os.path.join(ROOT, "target", "release", "modal-bake")
 TIMEOUT = 60
+# Where in the input a refusal points: a line (`file:12:` or `line 12`), a byte offset, an
+# element / node / tetrahedron / triangle / vertex number, an archive entry or JSON key by
+# name (`entry `modes``, `"points"[3]`), a section by name (`$Nodes`), or an option
+# (`--modes`). Every refusal must also name the file (checked separately).
 LOCATED = re.compile(
-    r"(:\d+:|byte \d+|element \d+|node \d+|entry `|\[\d+\]|points|cells|--[a-z]|"
-    r"not a regular file|archive|zip|missing section|no 4-node|modes? |surface|group)")
+    r"(:\d+:|\bline \d+|\bbyte \d+|\boffset \d+|\b(element|node|tetrahedron|tet|"
+    r"triangle|vertex|edge|group|mode) `?[\w.-]+|\bentry `[^`]+`|\[\d+\]|\$[A-Z][A-Za-z]+|"
+    r"--[a-z][a-z-]*)")
 
 MESHES = ["cube_v22.msh", "cube_v41.msh", "cube_v22_bin.msh", "cube_v41_bin.msh",
           "cube_cell_sets.json"]

@@ -402,3 +402,83 @@ fn probe_text_reports_what_served_each_contact() {
         assert!(lines.next().unwrap().ends_with(served), "{method}: {text}");
     }
 }
+
+/// `points` of the meshio JSON `src` replaced by `f(coordinate)`, written to `dst`.
+fn rescaled_json(src: &Path, dst: &Path, f: impl Fn(f64) -> f64) {
+    let mut v: serde_json::Value = serde_json::from_slice(&std::fs::read(src).unwrap()).unwrap();
+    for p in v["points"].as_array_mut().unwrap() {
+        for c in p.as_array_mut().unwrap() {
+            *c = serde_json::json!(f(c.as_f64().unwrap()));
+        }
+    }
+    std::fs::write(dst, serde_json::to_vec(&v).unwrap()).unwrap();
+}
+
+#[test]
+fn units_mm_bakes_the_metre_mesh_and_check_needs_the_same_units() {
+    let dir = tempfile::tempdir().unwrap();
+    let src = data("meshes/cube_cell_sets.json");
+    let args = ["--fixed", "bottom", "--modes", "8"];
+    // Whole millimetres: k/1000 is one correctly rounded division, so the mm mesh read with
+    // --units mm has exactly the coordinates of the metre mesh written in decimal.
+    let (m_mesh, mm_mesh) = (dir.path().join("m.json"), dir.path().join("mm.json"));
+    rescaled_json(&src, &m_mesh, |x| (x * 1000.0).round() / 1000.0);
+    rescaled_json(&src, &mm_mesh, |x| (x * 1000.0).round());
+    let (m_base, mm_base) = (dir.path().join("m.modes"), dir.path().join("mm.modes"));
+    let o = bake(&m_mesh, &m_base, &args);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let mut with_units = args.to_vec();
+    with_units.extend(["--units", "mm"]);
+    let o = bake(&mm_mesh, &mm_base, &with_units);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(!stderr.contains("warning"), "{stderr}");
+    assert!(
+        std::fs::read(&m_base).unwrap() == std::fs::read(&mm_base).unwrap(),
+        "--units mm on a whole-millimetre mesh must give the metre mesh's bits"
+    );
+    // check: fresh with the same --units, stale (geometry changed) without.
+    let check = |units: &[&str]| {
+        let mut a = vec![
+            "check",
+            mm_mesh.to_str().unwrap(),
+            mm_base.to_str().unwrap(),
+        ];
+        a.extend_from_slice(&args);
+        a.extend_from_slice(units);
+        a.push("--json");
+        run(&a)
+    };
+    let o = check(&["--units", "mm"]);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stdout)
+    );
+    let o = check(&[]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("geometry_changed"));
+    // Without --units the millimetre mesh is 1.7 km across: the warning suggests --units mm.
+    let o = bake(&mm_mesh, &dir.path().join("huge.modes"), &args);
+    assert!(o.status.success());
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        stderr.contains("warning") && stderr.contains("--units mm"),
+        "{stderr}"
+    );
+
+    // Arbitrary decimals (1/6 m): x·1000 then /1000 may move a coordinate by one ulp, so
+    // the bits may differ; the frequencies agree to 1e-12 relative.
+    let mm_any = dir.path().join("mm_any.json");
+    rescaled_json(&src, &mm_any, |x| x * 1000.0);
+    let (a, b) = (dir.path().join("a.modes"), dir.path().join("b.modes"));
+    assert!(bake(&src, &a, &args).status.success());
+    assert!(bake(&mm_any, &b, &with_units).status.success());
+    let a = dcr_runtime::format::ModesFile::read(&a).unwrap();
+    let b = dcr_runtime::format::ModesFile::read(&b).unwrap();
+    assert_eq!(a.eigenvalues.len(), 8);
+    for (x, y) in a.eigenvalues.iter().zip(&b.eigenvalues) {
+        assert!((x - y).abs() <= 1e-12 * x.abs(), "{x} vs {y}");
+    }
+}

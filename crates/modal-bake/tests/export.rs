@@ -378,3 +378,130 @@ fn bad_export_options_fail_with_a_clear_message_and_write_nothing() {
         "files left behind: {left:?}"
     );
 }
+
+/// A second-order base exports its 6-node triangles as four linear ones each: the VTU holds
+/// the corners then one point per mid-edge node, at the edge's midpoint, with the stored
+/// edge rows bit-exact as its displacements; the GLB carries the same vertices (its morph
+/// targets are the scaled rows) and passes the Khronos glTF-Validator.
+#[test]
+fn p2_base_exports_mid_edge_points_with_their_rows() {
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = common::gltf_check::repo_root().join("data/meshes/fv32_p2_h1.msh");
+    let base_path = dir.path().join("p2.modes");
+    let o = run(&["bake", s(&mesh), "-o", s(&base_path), "--modes", "3"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let base = ModesFile::read(&base_path).unwrap();
+    let q = base.quadratic.as_ref().expect("a second-order base");
+    let (ns, ne, m) = (base.num_surface_vertices(), q.edges.len(), base.num_modes());
+    let edge_row =
+        |e: usize, j: usize| -> [f64; 3] { std::array::from_fn(|a| q.modes[(e * 3 + a) * m + j]) };
+    let (vtu, glb_path) = (dir.path().join("p2.vtu"), dir.path().join("p2.glb"));
+    let o = run(&[
+        "export",
+        s(&base_path),
+        "--vtu",
+        s(&vtu),
+        "--gltf",
+        s(&glb_path),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+
+    validate_gltf(&glb_path);
+    let glb = Glb::read(&glb_path);
+    let diag = glb.extras()["dcr"]["diagonal_m"].as_f64().unwrap();
+    let prim = &glb.root.meshes[0].primitives[0];
+    let pos = glb.floats(
+        prim.attributes
+            .get(&gltf::json::validation::Checked::Valid(
+                gltf::json::mesh::Semantic::Positions,
+            ))
+            .unwrap()
+            .value(),
+    );
+    assert_eq!(pos.len(), 3 * (ns + ne));
+    let targets = prim.targets.as_ref().unwrap();
+    for (j, t) in targets.iter().enumerate() {
+        let a = glb.extras()["dcr"]["modes"][j]["modal_coordinate"]
+            .as_f64()
+            .unwrap();
+        let d = glb.floats(t.positions.unwrap().value());
+        for e in 0..ne {
+            let u = edge_row(e, j);
+            for k in 0..3 {
+                let got = d[3 * (ns + e) + k] as f64;
+                assert!((got - a * u[k]).abs() <= 1e-6 * diag, "mode {j} edge {e}");
+            }
+        }
+    }
+
+    let script = r#"
+import json, sys
+try:
+    import meshio
+except ImportError:
+    print("NO_MESHIO"); sys.exit(0)
+m = meshio.read(sys.argv[1])
+print(json.dumps({"points": m.points.tolist(),
+                  "triangles": [c.data.tolist() for c in m.cells if c.type == "triangle"][0],
+                  "point_data": {k: v.tolist() for k, v in m.point_data.items()}}))
+"#;
+    let out = Command::new("python3")
+        .args(["-c", script, s(&vtu)])
+        .output()
+        .expect("python3 runs");
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    if text.trim() == "NO_MESHIO" {
+        assert!(
+            std::env::var_os("CI").is_none(),
+            "meshio is not installed under CI"
+        );
+        eprintln!("SKIPPED: meshio not installed (pip install meshio)");
+        return;
+    }
+    let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let pts = v["points"].as_array().unwrap();
+    assert_eq!(pts.len(), ns + ne);
+    assert_eq!(
+        v["triangles"].as_array().unwrap().len(),
+        4 * base.surface_triangles.len()
+    );
+    let freqs = base.frequencies_hz();
+    let pd = v["point_data"].as_object().unwrap();
+    for (e, &[a, b]) in q.edges.iter().enumerate() {
+        let (pa, pb) = (
+            base.surface_vertices[a as usize],
+            base.surface_vertices[b as usize],
+        );
+        for k in 0..3 {
+            assert_eq!(
+                pts[ns + e][k].as_f64().unwrap(),
+                0.5 * (pa[k] + pb[k]),
+                "edge {e}"
+            );
+        }
+        assert_eq!(
+            pd["surface_to_volume"][ns + e].as_u64().unwrap(),
+            q.edge_to_volume[e] as u64
+        );
+        for j in 0..m {
+            let row = &pd[&mode_label(j, freqs[j])][ns + e];
+            let u = edge_row(e, j);
+            for k in 0..3 {
+                assert_eq!(row[k].as_f64().unwrap(), u[k], "mode {j} edge {e}");
+            }
+        }
+    }
+    // Corners keep their rows.
+    for vtx in 0..ns {
+        let row = &pd[&mode_label(0, freqs[0])][vtx];
+        let u = mode(&base, vtx, 0);
+        for k in 0..3 {
+            assert_eq!(row[k].as_f64().unwrap(), u[k]);
+        }
+    }
+}

@@ -598,12 +598,19 @@ fn shift_above_lowest_eigenvalue_is_a_factorization_error() {
         solve_lowest(&k, &m, &p, &mut |_| {}),
         Err(EigenError::Factorization(_))
     ));
+    // On a problem this small, what Lanczos cannot meet in its steps the dense path solves.
     let p = EigenParams {
         nev: 20,
         max_iters: 2,
         ..Default::default()
     };
-    match solve_lowest(&k, &m, &p, &mut |_| {}) {
+    let r = solve(&k, &m, &p);
+    assert!(r.info.dense && r.eigenvalues.len() == 20);
+    // Above the dense path's size (2000 free dofs), the step limit is an error.
+    let big = TetMesh::structured_box([24, 6, 6], [1.0, 0.1, 0.1]);
+    let (_, kb, mb) = clamped(&big, &mat);
+    assert!(kb.nrows() > 2000);
+    match solve_lowest(&kb, &mb, &p, &mut |_| {}) {
         Err(EigenError::NotConverged {
             requested,
             worst_residual,
@@ -732,4 +739,96 @@ fn many_modes_across_lanczos_runs_match_dense() {
         assert!(err <= tol(i), "max-freq mode {i}: {err:.1e}");
     }
     assert!(m_orthonormality_error(&m, res.vectors.as_ref()) <= 1e-10);
+}
+
+/// Bits of the eigenvalues and vectors of a result.
+fn result_bits(r: &EigenResult) -> Vec<u64> {
+    let mut v: Vec<u64> = r.eigenvalues.iter().map(|x| x.to_bits()).collect();
+    for j in 0..r.vectors.ncols() {
+        v.extend(r.vectors.col(j).iter().map(|x| x.to_bits()));
+    }
+    v
+}
+
+/// A frequency cap beyond the highest mode of a small free-free cube returns every mode (the
+/// dense path, after Lanczos gives up): six rigid ones, the rest equal to the dense reference,
+/// every residual within the bake's 1e-8, UᵀMU = I, and the same bits on rayon pools of 1, 2
+/// and 4 threads whatever `threads` says.
+#[test]
+fn a_cap_beyond_the_spectrum_returns_every_mode_deterministically() {
+    let mat = steelish();
+    let mesh = TetMesh::structured_box([4, 4, 4], [0.3, 0.3, 0.3]);
+    let k = assemble_stiffness(&mesh, &mat);
+    let m = assemble_mass(&mesh, &mat, false);
+    let n = k.nrows();
+    let p = EigenParams {
+        nev: 1,
+        max_freq_hz: Some(1e300),
+        shift: default_shift(&mesh, &mat),
+        tol: 1e-8,
+        ..Default::default()
+    };
+    let res = solve(&k, &m, &p);
+    assert!(res.info.dense);
+    assert!(!res.info.capped);
+    assert_eq!(res.eigenvalues.len(), n, "every mode of {n} dofs");
+    let l7 = res.eigenvalues[6];
+    assert!(res.eigenvalues[..6].iter().all(|l| l.abs() < 1e-9 * l7));
+    let reference = dense_generalized_eigenvalues(&k, &m);
+    let slack = 100.0 * f64::EPSILON * reference.last().unwrap();
+    for i in 6..n {
+        let err = (res.eigenvalues[i] - reference[i]).abs();
+        assert!(err <= (1e-9 * reference[i]).max(slack), "mode {i}: {err:e}");
+    }
+    for (r, f) in res.residuals.iter().zip(&res.residual_floors) {
+        assert!(*r <= 1e-8f64.max(8.0 * f), "residual {r:e}");
+    }
+    assert!(m_orthonormality_error(&m, res.vectors.as_ref()) <= 1e-10);
+    let reference_bits = result_bits(&res);
+    for pool_threads in [1, 2, 4] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(pool_threads)
+            .build()
+            .unwrap();
+        for threads in [0, 2] {
+            let p = EigenParams {
+                threads,
+                ..p.clone()
+            };
+            let r = pool.install(|| solve(&k, &m, &p));
+            assert!(
+                reference_bits == result_bits(&r),
+                "pool of {pool_threads}, faer threads {threads}"
+            );
+        }
+    }
+}
+
+/// A count up to the exact limit (every free dof of a clamped beam) is met by the dense path:
+/// n pairs, residuals within 1e-8, and the n − 1 lowest equal to those of the request for
+/// n − 1 (the same dense solve).
+#[test]
+fn a_count_at_the_exact_limit_is_met() {
+    let mat = steelish();
+    let mesh = TetMesh::structured_box([12, 2, 2], [1.0, 0.1, 0.1]);
+    let (_, k, m) = clamped(&mesh, &mat);
+    let n = k.nrows();
+    assert_eq!(n, 3 * mesh.nodes.len() - 3 * mesh.groups["xmin"].len());
+    let p = EigenParams {
+        nev: n,
+        tol: 1e-8,
+        ..Default::default()
+    };
+    let all = solve(&k, &m, &p);
+    assert!(all.info.dense);
+    assert_eq!(all.eigenvalues.len(), n);
+    for (r, f) in all.residuals.iter().zip(&all.residual_floors) {
+        assert!(*r <= 1e-8f64.max(8.0 * f), "residual {r:e}");
+    }
+    let reference = dense_generalized_eigenvalues(&k, &m);
+    let slack = 100.0 * f64::EPSILON * reference.last().unwrap();
+    for i in 0..n {
+        let err = (all.eigenvalues[i] - reference[i]).abs();
+        assert!(err <= (1e-9 * reference[i]).max(slack), "mode {i}: {err:e}");
+    }
 }

@@ -581,3 +581,36 @@ fn a_request_beyond_the_mesh_names_the_exact_limit() {
         stderr(&o)
     );
 }
+
+/// A request for every mode is met, not refused: `--modes` at the exact limit 3n − 6 of the
+/// free-free beam and a `--max-freq` far beyond its highest mode both bake all 564 elastic
+/// modes (the same ones), and a clamped cube bakes its 3n − fixed dofs' worth.
+#[test]
+fn every_mode_of_a_small_mesh_bakes() {
+    let dir = tempfile::tempdir().unwrap();
+    let beam = data("meshes/beam.msh");
+    let limit = 3 * modal_bake::mesh::read_mesh(&beam).unwrap().nodes.len() - 6;
+    let bake = |mesh: &std::path::Path, name: &str, extra: &[&str]| {
+        let out = dir.path().join(name);
+        let mut a = vec!["bake", mesh.to_str().unwrap(), "-o", out.to_str().unwrap()];
+        a.extend_from_slice(extra);
+        let o = run(&a);
+        assert_eq!(o.status.code(), Some(0), "{extra:?}: {}", stderr(&o));
+        dcr_runtime::format::ModesFile::read(&out).unwrap()
+    };
+    let count = bake(&beam, "count.modes", &["--modes", &limit.to_string()]);
+    let capped = bake(&beam, "cap.modes", &["--max-freq", "1e300"]);
+    assert_eq!(count.eigenvalues.len(), limit);
+    assert_eq!(count.eigenvalues, capped.eigenvalues);
+    assert!(count.residuals.iter().all(|&r| r <= 1e-8));
+    let cube = data("meshes/cube_v41.msh");
+    let mesh = modal_bake::mesh::read_mesh(&cube).unwrap();
+    let limit = 3 * (mesh.nodes.len() - mesh.groups["bottom"].len());
+    let clamped = bake(
+        &cube,
+        "cube.modes",
+        &["--fixed", "bottom", "--modes", &limit.to_string()],
+    );
+    assert_eq!(clamped.eigenvalues.len(), limit);
+    assert!(clamped.residuals.iter().all(|&r| r <= 1e-8));
+}

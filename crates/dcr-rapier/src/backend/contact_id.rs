@@ -70,14 +70,34 @@ pub fn contact_id(
     manifold: u32,
     point: u32,
 ) -> u64 {
+    point_id(
+        manifold_seed(collider1, collider2, subshapes),
+        manifold,
+        point,
+    )
+}
+
+/// The part of [`contact_id`] shared by the points of one manifold (the colliders and the
+/// subshape pair), hashed once per manifold; [`point_id`] finishes it per point.
+#[inline]
+pub fn manifold_seed(
+    collider1: ColliderHandle,
+    collider2: ColliderHandle,
+    subshapes: (u32, u32),
+) -> u64 {
     let mut h = 0x243F_6A88_85A3_08D3;
     for x in [
         collider_bits(collider1),
         collider_bits(collider2),
         subshapes.0 as u64 | (subshapes.1 as u64) << 32,
-        point as u64 | (manifold as u64) << 16,
     ] {
         h = mix(h, x);
     }
     h
+}
+
+/// [`contact_id`] from its manifold's [`manifold_seed`].
+#[inline]
+pub fn point_id(seed: u64, manifold: u32, point: u32) -> u64 {
+    mix(seed, point as u64 | (manifold as u64) << 16)
 }

@@ -24,7 +24,7 @@
 use dcr_runtime::ContactReport;
 
 use super::arr;
-use super::contact_id::contact_id;
+use super::contact_id::{collider_pair_key, manifold_seed, point_id};
 use super::rapier::geometry::NEW_CONTACT_BIT;
 use super::rapier::prelude::{Collider, ColliderHandle, ContactPair};
 use std::collections::{HashMap, HashSet};
@@ -40,14 +40,19 @@ pub(super) struct ReportSource {
 }
 
 /// Which contact points carried a normal impulse at the previous step and at this one, for
-/// newness (see [`super::StepGate::ImpactSteps`]): per collider pair, a 128-bit mask over the
-/// point slots (solver manifold < 16, point index < 8), points beyond it in a set.
+/// newness (see [`super::StepGate::ImpactSteps`]): per collider pair, two 64-bit masks over the
+/// point slots (solver manifold < 16, point index < 8; manifolds 0–7 in the first word, 8–15 in
+/// the second), points beyond them in a set.
 ///
 /// The pairs' masks sit in a vector in the order the light pass visits the pairs, which is the
 /// same from step to step (rapier's contact graph), so a pair is found by comparing its key with
-/// the entry under a cursor; a hash index by key catches the pairs that moved. Measured with
-/// callgrind on the dinner scene (19 pairs, ~54 points per step): the light pass costs about 190
-/// instructions per pair, against 330 with a hash set of loaded points.
+/// the entry under a cursor (compared by collider handles, so the pair key is hashed only on a
+/// miss); a hash index by key catches the pairs that moved. Masks are 64-bit words because a
+/// variable shift of a 128-bit mask compiles to a dozen instructions and branches. Measured with
+/// callgrind on the stress scene cut to 300 boxes (300 pairs of four points, 300 steps): the
+/// whole light pass costs about 260 instructions per pair, from 350 with one 128-bit mask,
+/// rapier's `contact_pairs_with` and the key hashed every step (a hash set of loaded points cost
+/// more still).
 #[derive(Debug, Default)]
 pub(super) struct LoadMemory {
     entries: Vec<PairLoad>,
@@ -59,13 +64,16 @@ pub(super) struct LoadMemory {
 }
 
 /// One pair's loaded-point masks.
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Copy, Debug)]
 struct PairLoad {
     key: u64,
+    /// The pair's colliders in rapier's order: the cursor compares them, so the key is
+    /// computed only when the pair is not under the cursor.
+    colliders: [ColliderHandle; 2],
     /// Step of `now`.
     step: u64,
-    before: u128,
-    now: u128,
+    before: [u64; 2],
+    now: [u64; 2],
 }
 
 impl LoadMemory {
@@ -85,41 +93,69 @@ impl LoadMemory {
         }
     }
 
-    /// The pair's masks for this step, its previous-step mask rolled into `before`.
-    fn pair(&mut self, key: u64) -> &mut PairLoad {
+    /// The masks of the pair of colliders `colliders` (rapier's order) for this step, its
+    /// previous-step mask rolled into `before`.
+    #[inline(always)]
+    fn pair(&mut self, colliders: [ColliderHandle; 2]) -> &mut PairLoad {
         let at = match self.entries.get(self.cursor) {
-            Some(p) if p.key == key => self.cursor,
-            _ => match self.index.get(&key) {
-                Some(&i) => i as usize,
-                None => {
-                    self.index.insert(key, self.entries.len() as u32);
-                    self.entries.push(PairLoad {
-                        key,
-                        ..PairLoad::default()
-                    });
-                    self.entries.len() - 1
+            Some(p) if p.colliders == colliders => self.cursor,
+            _ => {
+                let key = collider_pair_key(colliders[0], colliders[1]);
+                match self.index.get(&key) {
+                    Some(&i) => {
+                        self.entries[i as usize].colliders = colliders;
+                        i as usize
+                    }
+                    None => {
+                        self.index.insert(key, self.entries.len() as u32);
+                        self.entries.push(PairLoad {
+                            key,
+                            colliders,
+                            step: 0,
+                            before: [0; 2],
+                            now: [0; 2],
+                        });
+                        self.entries.len() - 1
+                    }
                 }
-            },
+            }
         };
         self.cursor = at + 1;
         let step = self.step;
         let p = &mut self.entries[at];
         if p.step != step {
-            p.before = if p.step + 1 == step { p.now } else { 0 };
-            p.now = 0;
+            p.before = if p.step + 1 == step { p.now } else { [0; 2] };
+            p.now = [0; 2];
             p.step = step;
         }
         p
     }
 
-    /// Whether point (`manifold`, `point`) of pair `key` carried no impulse at the previous
-    /// step, as recorded by the previous step's light pass.
-    pub(super) fn is_new(&self, key: u64, manifold: usize, point: usize) -> bool {
+    /// Starts reading this step's reports (after the light pass): pairs are looked up under a
+    /// cursor again, in the light pass's order.
+    pub(super) fn begin_read(&mut self) {
+        self.cursor = 0;
+    }
+
+    /// The pair's previous-step masks as recorded by this step's light pass (None: the pair
+    /// was not scanned at this step), for [`LoadMemory::is_new`].
+    fn before(&mut self, key: u64) -> Option<[u64; 2]> {
+        let i = match self.entries.get(self.cursor) {
+            Some(p) if p.key == key => self.cursor,
+            _ => *self.index.get(&key)? as usize,
+        };
+        self.cursor = i + 1;
+        let p = &self.entries[i];
+        (p.step == self.step).then_some(p.before)
+    }
+
+    /// Whether point (`manifold`, `point`) of a pair whose [`LoadMemory::before`] is `before`
+    /// (pair key `key`) carried no impulse at the previous step, as recorded by the previous
+    /// step's light pass.
+    #[inline]
+    fn is_new(&self, before: Option<[u64; 2]>, key: u64, manifold: usize, point: usize) -> bool {
         match slot(manifold, point) {
-            Some(bit) => self.index.get(&key).is_none_or(|&i| {
-                let p = &self.entries[i as usize];
-                p.step != self.step || p.before & bit == 0
-            }),
+            Some((word, bit)) => before.is_none_or(|b| b[word] & bit == 0),
             None => !self
                 .overflow_before
                 .contains(&point_key(key, manifold, point)),
@@ -127,10 +163,10 @@ impl LoadMemory {
     }
 }
 
-/// The mask bit of a point slot, if it fits.
+/// The mask word and bit of a point slot, if it fits.
 #[inline]
-fn slot(manifold: usize, point: usize) -> Option<u128> {
-    (manifold < 16 && point < 8).then(|| 1u128 << (manifold * 8 + point))
+fn slot(manifold: usize, point: usize) -> Option<(usize, u64)> {
+    (manifold < 16 && point < 8).then(|| (manifold >> 3, 1u64 << ((manifold & 7) * 8 + point)))
 }
 
 /// Hashes a pair key to itself: the keys are splitmix outputs already, so the standard SipHash
@@ -169,17 +205,22 @@ pub(super) fn read_pair(
     colliders: [&Collider; 2],
     [body1, body2]: [u64; 2],
     pair_key: u64,
-    memory: &LoadMemory,
+    memory: &mut LoadMemory,
     out: &mut Vec<ContactReport>,
     sources: &mut Vec<ReportSource>,
 ) -> usize {
     let pose1 = colliders[0].position();
     let pose2 = colliders[1].position();
+    let before = memory.before(pair_key);
     let mut n = 0;
     for (mi, m) in pair.solver_manifolds().iter().enumerate() {
+        if m.data.solver_contacts.is_empty() {
+            continue;
+        }
         let normal = arr(m.data.normal);
         let sub1 = m.subshape_pos1();
         let sub2 = m.subshape_pos2();
+        let seed = manifold_seed(pair.collider1, pair.collider2, (m.subshape1, m.subshape2));
         for sc in m.data.solver_contacts.iter() {
             let idx = (sc.contact_id[0] & !NEW_CONTACT_BIT) as usize;
             let Some(pt) = m.points.get(idx) else {
@@ -193,13 +234,7 @@ pub(super) fn read_pair(
                 Some(sp) => sp.transform_point(pt.local_p2),
                 None => pt.local_p2,
             };
-            let id = contact_id(
-                pair.collider1,
-                pair.collider2,
-                (m.subshape1, m.subshape2),
-                mi as u32,
-                idx as u32,
-            );
+            let id = point_id(seed, mi as u32, idx as u32);
             out.push(ContactReport {
                 id,
                 body1,
@@ -208,7 +243,7 @@ pub(super) fn read_pair(
                 point2: arr(pose2.transform_point(local2)),
                 normal,
                 impulse: super::to_f64(pt.data.impulse),
-                is_new: memory.is_new(pair_key, mi, idx),
+                is_new: memory.is_new(before, pair_key, mi, idx),
             });
             sources.push(ReportSource {
                 pair: pair_key,
@@ -222,16 +257,14 @@ pub(super) fn read_pair(
 
 /// The light pass over one pair: records its loaded points in `memory` and returns whether one
 /// of them is an impact candidate — new with impulse ≥ `threshold` (N·s).
-pub(super) fn scan_pair(
-    pair: &ContactPair,
-    pair_key: u64,
-    threshold: f64,
-    memory: &mut LoadMemory,
-) -> bool {
+#[inline(always)]
+pub(super) fn scan_pair(pair: &ContactPair, threshold: f64, memory: &mut LoadMemory) -> bool {
     let mut hot = false;
     let mut overflow = false;
-    let load = memory.pair(pair_key);
+    let load = memory.pair([pair.collider1, pair.collider2]);
     for (mi, m) in pair.solver_manifolds().iter().enumerate() {
+        // The slot's word and the manifold's first bit in it (see `slot`).
+        let (fits, word, base) = (mi < 16, (mi >> 3) & 1, (mi & 7) * 8);
         for sc in m.data.solver_contacts.iter() {
             let idx = (sc.contact_id[0] & !NEW_CONTACT_BIT) as usize;
             let Some(pt) = m.points.get(idx) else {
@@ -241,16 +274,17 @@ pub(super) fn scan_pair(
             if !(lambda > 0.0) {
                 continue;
             }
-            match slot(mi, idx) {
-                Some(bit) => {
-                    load.now |= bit;
-                    hot |= lambda >= threshold && load.before & bit == 0;
-                }
-                None => overflow = true,
+            if fits && idx < 8 {
+                let bit = 1u64 << (base + idx);
+                load.now[word] |= bit;
+                hot |= lambda >= threshold && load.before[word] & bit == 0;
+            } else {
+                overflow = true;
             }
         }
     }
     if overflow {
+        let pair_key = collider_pair_key(pair.collider1, pair.collider2);
         for (mi, m) in pair.solver_manifolds().iter().enumerate() {
             for sc in m.data.solver_contacts.iter() {
                 let idx = (sc.contact_id[0] & !NEW_CONTACT_BIT) as usize;

@@ -583,14 +583,18 @@ impl ModesFile {
             source,
         };
         let archive_len = reader.seek(std::io::SeekFrom::End(0)).map_err(io)?;
-        check_zip_directory(&mut reader, archive_len).map_err(|detail| FormatError::Archive {
-            path: path.to_path_buf(),
-            detail,
+        let eocd_at = check_zip_directory(&mut reader, archive_len).map_err(|detail| {
+            FormatError::Archive {
+                path: path.to_path_buf(),
+                detail,
+            }
         })?;
         reader.seek(std::io::SeekFrom::Start(0)).map_err(io)?;
         let mut zip = zip::ZipArchive::new(reader).map_err(|err| FormatError::Archive {
             path: path.to_path_buf(),
-            detail: err.to_string(),
+            detail: format!(
+                "{err} (the end-of-central-directory signature found at byte {eocd_at} of {archive_len} does not lead to a valid zip directory)"
+            ),
         })?;
         let mut rd = EntryReader {
             zip: &mut zip,
@@ -870,8 +874,9 @@ const MAX_ARCHIVE_ENTRIES: u64 = 256;
 
 /// Checks the entry counts a zip archive declares (end-of-central-directory record, and its
 /// zip64 form if present) against [`MAX_ARCHIVE_ENTRIES`] and the archive's length before the
-/// zip reader trusts them. Archives without the record are left to the zip reader to refuse.
-fn check_zip_directory<R: Read + Seek>(reader: &mut R, len: u64) -> Result<(), String> {
+/// zip reader trusts them. An archive without the record is refused here, with the byte range
+/// searched (a truncated file, typically). Returns the record's byte offset.
+fn check_zip_directory<R: Read + Seek>(reader: &mut R, len: u64) -> Result<u64, String> {
     let io = |e: std::io::Error| format!("unreadable: {e}");
     let tail_len = len.min(22 + 65_535 + 20 + 56);
     reader
@@ -883,8 +888,12 @@ fn check_zip_directory<R: Read + Seek>(reader: &mut R, len: u64) -> Result<(), S
         .rev()
         .find(|&i| &tail[i..i + 4] == b"PK\x05\x06")
     else {
-        return Ok(());
+        return Err(format!(
+            "no zip end-of-central-directory record (PK\\x05\\x06) between byte {} and the file's end at byte {len}: truncated, or not a .modes file",
+            len - tail_len
+        ));
     };
+    let eocd_at = len - tail_len + eocd as u64;
     let u16_at = |i: usize| u64::from(u16::from_le_bytes([tail[i], tail[i + 1]]));
     let mut counts = vec![u16_at(eocd + 8), u16_at(eocd + 10)];
     // zip64: the locator just before the record points at the zip64 record with u64 counts.
@@ -904,9 +913,9 @@ fn check_zip_directory<R: Read + Seek>(reader: &mut R, len: u64) -> Result<(), S
     }
     match counts.iter().max() {
         Some(&n) if n > MAX_ARCHIVE_ENTRIES || n.saturating_mul(46) > len => Err(format!(
-            "the zip directory declares {n} entries (a .modes archive has about 20; at most {MAX_ARCHIVE_ENTRIES}, 46 bytes each, are accepted)"
+            "the zip directory (end-of-central-directory record at byte {eocd_at}) declares {n} entries (a .modes archive has about 20; at most {MAX_ARCHIVE_ENTRIES}, 46 bytes each, are accepted)"
         )),
-        _ => Ok(()),
+        _ => Ok(eocd_at),
     }
 }
 

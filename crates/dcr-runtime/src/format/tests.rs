@@ -86,6 +86,14 @@ fn every_truncation_is_a_clean_error() {
         let r = ModesFile::read_from(Cursor::new(&bytes[..cut]), Path::new("cut.modes"));
         let err = r.expect_err("a truncated archive must not read");
         assert!(err.to_string().starts_with("cut.modes"), "{err}");
+        // Cut before the end-of-central-directory record: the message says where it looked.
+        if cut + 22 <= bytes.len() {
+            assert!(
+                err.to_string()
+                    .contains(&format!("the file's end at byte {cut}")),
+                "{err}"
+            );
+        }
     }
 }
 
@@ -630,7 +638,10 @@ fn zip_entry_counts_are_bounded_before_the_zip_reader_trusts_them() {
     bytes[eocd + 8..eocd + 12].copy_from_slice(&[0xFF; 4]);
     let err = ModesFile::read_from(Cursor::new(bytes), Path::new("z.modes")).unwrap_err();
     assert!(
-        matches!(err, FormatError::Archive { .. }) && err.to_string().contains("65535 entries"),
+        matches!(err, FormatError::Archive { .. })
+            && err.to_string().contains(&format!(
+                "end-of-central-directory record at byte {eocd}) declares 65535 entries"
+            )),
         "{err}"
     );
 }

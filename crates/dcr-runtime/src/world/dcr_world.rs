@@ -68,6 +68,8 @@ struct Touched {
     dang0: [f64; 3],
     p_lin: [f64; 3],
     p_ang: [f64; 3],
+    /// The body's (A, B) energy terms (`body_energy_terms`), once its impulses are summed.
+    energy: (f64, f64),
 }
 
 /// The elastic objects of a rigid-body world and their distant collision responses (paper
@@ -207,6 +209,8 @@ pub struct DcrWorld {
     rank: Vec<u32>,
     /// Engine body id of each object (index = object), scanned when there are few objects.
     object_bodies: Vec<u64>,
+    /// Whether any object is dynamic (else no impulse can chain and no chain budget is kept).
+    any_dynamic: bool,
     by_body: HashMap<u64, u32, BuildIdHasher>,
     ages: HashMap<u64, ContactAge, BuildIdHasher>,
     /// This step's `bodies` index by id.
@@ -255,6 +259,7 @@ impl DcrWorld {
             order: Vec::new(),
             rank: Vec::new(),
             object_bodies: Vec::new(),
+            any_dynamic: false,
             by_body: HashMap::default(),
             ages: HashMap::default(),
             body_index: HashMap::default(),
@@ -315,6 +320,7 @@ impl DcrWorld {
             info: ObjectStepInfo::default(),
         });
         self.by_body.insert(desc.body, idx);
+        self.any_dynamic |= desc.dynamic;
         self.object_bodies.push(desc.body);
         self.order = (0..self.objects.len() as u32)
             .filter(|&o| !self.objects[o as usize].dynamic)
@@ -490,6 +496,9 @@ impl DcrWorld {
     fn classify(&mut self, contacts: &[ContactReport], bodies: &[BodyState]) {
         let step = self.step - 1;
         let cp = self.params.classify;
+        // The last body looked up on each side: consecutive reports usually share their bodies
+        // (an engine reports a pair's points together).
+        let mut memo: [Option<(u64, Option<u32>)>; 2] = [None; 2];
         for c in contacts {
             let objs = [self.object_at(c.body1), self.object_at(c.body2)];
             if objs == [None, None] || c.body1 == c.body2 {
@@ -519,7 +528,17 @@ impl DcrWorld {
                 fired_before = Some(&mut age.fired);
                 f
             };
-            let bidx = [c.body1, c.body2].map(|b| self.body_index.get(&b).copied());
+            let mut bidx = [None; 2];
+            for (side, b) in [c.body1, c.body2].into_iter().enumerate() {
+                bidx[side] = match memo[side] {
+                    Some((id, i)) if id == b => i,
+                    _ => {
+                        let i = self.body_index.get(&b).copied();
+                        memo[side] = Some((b, i));
+                        i
+                    }
+                };
+            }
             let mut fired = [false; 2];
             for side in 0..2 {
                 let Some(o) = objs[side] else { continue };
@@ -661,11 +680,11 @@ impl DcrWorld {
         obj.info.response = obj.response.last_step_info();
         // Energy of this object's impulses, E(s) = s A + s² B, and the bound.
         let (mut a, mut bq) = (0.0, 0.0);
-        for tc in &self.touched {
+        for tc in &mut self.touched {
             let b = &bodies[tc.body as usize];
-            let (ea, eb) = body_energy_terms(b, tc);
-            a += ea;
-            bq += eb;
+            tc.energy = body_energy_terms(b, tc);
+            a += tc.energy.0;
+            bq += tc.energy.1;
         }
         let requested = a + bq;
         let budget = self
@@ -698,9 +717,12 @@ impl DcrWorld {
                 t.dang = add(tc.dang0, scale(sub(t.dang, tc.dang0), s));
             }
             t.touch = u32::MAX;
-            let (ea, eb) = body_energy_terms(b, tc);
+            let (ea, eb) = tc.energy;
             let e_b = s * ea + s * s * eb;
             injected += e_b;
+            if !self.any_dynamic {
+                continue;
+            }
             // Energy given to a dynamic elastic object's body: its chain budget.
             if let Some(target) = self.object_at(b.id) {
                 if self.forward(o, target as usize, depth) {

@@ -66,8 +66,8 @@ impl BakeOptions {
 #[derive(Args)]
 pub struct BakeArgs {
     /// Tetrahedral mesh: gmsh .msh (2.2 or 4.1, ASCII or binary, 4- or 10-node tetrahedra) or
-    /// meshio-style .json; or a closed surface asset .obj / .stl / .ply (in metres), meshed
-    /// with gmsh first (--size, --order, --gmsh).
+    /// meshio-style .json; or a closed surface asset .obj / .stl / .ply, meshed with gmsh
+    /// first (--size, --order, --gmsh). Coordinates in metres unless --units says otherwise.
     pub mesh: PathBuf,
     /// Output base (written atomically: nothing is left behind on failure).
     #[arg(short = 'o', long = "out", value_name = "OUT.modes")]
@@ -106,7 +106,7 @@ pub fn load_mesh(
 ) -> anyhow::Result<(modal_bake::mesh::TetMesh, f64)> {
     let t = std::time::Instant::now();
     if is_surface_asset(path) {
-        let (out, _) = super::mesh::mesh_asset(path, 1.0, asset)?;
+        let (out, _) = super::mesh::mesh_asset(path, asset)?;
         return Ok((out.mesh, t.elapsed().as_secs_f64()));
     }
     if asset.any_set() {
@@ -115,7 +115,14 @@ pub fn load_mesh(
             path.display()
         );
     }
-    let mesh = modal_bake::mesh::read_mesh(path).map_err(anyhow::Error::new)?;
+    let mut mesh = modal_bake::mesh::read_mesh(path).map_err(anyhow::Error::new)?;
+    if asset.units != super::mesh::Units::M {
+        for p in &mut mesh.nodes {
+            for c in p.iter_mut() {
+                *c = asset.units.to_metres_of(*c);
+            }
+        }
+    }
     Ok((mesh, t.elapsed().as_secs_f64()))
 }
 
@@ -357,24 +364,28 @@ pub fn run(args: &BakeArgs) -> anyhow::Result<()> {
         ..args.options.params()
     };
     let mut progress = Progress::new();
-    let report = if is_surface_asset(&args.mesh) || args.asset.any_set() {
-        progress.bar.finish_and_clear();
-        let (mesh, read_s) = load_mesh(&args.mesh, &args.asset)?;
-        progress = Progress::new();
-        let file = args.mesh.display().to_string();
-        bake::bake_mesh(mesh, &params, &file, &mut |s| progress.update(s)).and_then(
-            |(base, mut report)| {
-                report.read_s = read_s;
-                progress.update(BakeStage::Write);
-                let t = std::time::Instant::now();
-                base.write_atomic(&args.out)?;
-                report.write_s = t.elapsed().as_secs_f64();
-                Ok(report)
-            },
-        )
-    } else {
-        bake::bake_file(&args.mesh, &params, &args.out, &mut |s| progress.update(s))
-    };
+    let units = args.asset.units;
+    let report =
+        if is_surface_asset(&args.mesh) || args.asset.any_set() || units != super::mesh::Units::M {
+            progress.bar.finish_and_clear();
+            let (mesh, read_s) = load_mesh(&args.mesh, &args.asset)?;
+            progress = Progress::new();
+            let file = args.mesh.display().to_string();
+            bake::bake_mesh(mesh, &params, &file, &mut |s| progress.update(s))
+                .map_err(anyhow::Error::new)
+                .and_then(|(base, mut report)| {
+                    report.read_s = read_s;
+                    progress.update(BakeStage::Write);
+                    let t = std::time::Instant::now();
+                    super::create_parent(&args.out)?;
+                    base.write_atomic(&args.out)?;
+                    report.write_s = t.elapsed().as_secs_f64();
+                    Ok(report)
+                })
+        } else {
+            bake::bake_file(&args.mesh, &params, &args.out, &mut |s| progress.update(s))
+                .map_err(anyhow::Error::new)
+        };
     progress.bar.finish_and_clear();
     if let Some(plain) = &mut progress.plain {
         plain.end_stage();
@@ -384,13 +395,12 @@ pub fn run(args: &BakeArgs) -> anyhow::Result<()> {
     if let Some(dir) = &report.created_folder {
         eprintln!("note: created folder {dir}");
     }
-    if report.extent_m > 100.0 {
-        eprintln!(
-            "warning: {} is {:.4e} m across and weighs {:.4e} kg (plausible objects: 0.01 … 100 m); \
-             bake expects metres: if the mesh is in millimetres, coordinates are 1000× too large",
-            args.mesh.display(),
+    if !is_surface_asset(&args.mesh) {
+        super::mesh::warn_extent(
+            &args.mesh.display().to_string(),
             report.extent_m,
-            report.mass_kg
+            units,
+            &format!(" and weighs {:.4e} kg", report.mass_kg),
         );
     }
     if args.json {

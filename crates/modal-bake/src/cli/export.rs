@@ -18,7 +18,9 @@ use modal_bake::export::{
     for a unit modal coordinate, object frame); in ParaView use Warp By Vector.\n\
     GLB: one morph target and one animation per mode (a 1 s sine); the scale and each mode's \
     modal coordinate at weight 1 are in the document's extras.dcr.\n\
-    PNG: the lowest modes side by side, coloured by displacement magnitude (viridis).")]
+    PNG: the lowest modes side by side, coloured by displacement magnitude (viridis).\n\
+    Second-order bases: each 6-node surface triangle is written as four linear ones through \
+    its mid-edge nodes, which follow the corner vertices with their own mode rows.")]
 pub struct ExportArgs {
     /// The `.modes` base.
     pub file: PathBuf,

@@ -15,13 +15,26 @@ use super::shift_invert::{shifted, ShiftInvert};
 use super::{EigenError, EigenInfo, EigenParams, EigenProgress, EigenResult};
 
 /// Ascending eigenvalues (rad²/s²), their vectors (columns) and residuals.
-type RitzPairs = (Vec<f64>, Mat<f64>, Vec<Residual>);
+pub(super) type RitzPairs = (Vec<f64>, Mat<f64>, Vec<Residual>);
 
 /// [`RitzPairs`] and M times their vectors (kg), from the residual check's products.
-type CheckedPairs = (RitzPairs, Mat<f64>);
+pub(super) type CheckedPairs = (RitzPairs, Mat<f64>);
 
 /// Problems with at most this many dofs beyond the Krylov basis size are solved densely.
 const DENSE_MARGIN: usize = 16;
+
+/// Problems with at most this many free dofs are solved densely (`dense.rs`) when more than
+/// n / [`DENSE_FRACTION_INV`] pairs are wanted, or when Lanczos fails on them (a frequency cap
+/// near or beyond the highest mode). The dense path costs O(n³) whatever is wanted; measured
+/// with `examples/dense_timing` (clamped beams, every mode, on 2 cores at load 10):
+/// 750 dofs 0.7 s, 1512 dofs 5.2 s, 2646 dofs 38–46 s, 2940 dofs 80 s, against 2.6 s and
+/// 4 s for Lanczos's n/10 lowest at 2646 and 2940 dofs. 2000 keeps the dense bake within
+/// about 15 s there.
+pub(super) const DENSE_MAX_DOFS: usize = 2000;
+
+/// Count requests for more than n / this many pairs of a small problem go straight to the
+/// dense path (Lanczos failed on 250 of the 570 dofs of the free-free beam).
+const DENSE_FRACTION_INV: usize = 4;
 
 /// With `threads == 0`, problems below this many dofs run sequentially: thread
 /// synchronisation costs more than it saves there (measured on 2 cores).
@@ -77,7 +90,7 @@ pub(crate) fn solve(
         0 if n < AUTO_SEQ_BELOW => Par::Seq,
         t => Par::rayon(t),
     };
-    let mut info = EigenInfo {
+    let info = EigenInfo {
         shift: sigma,
         ..Default::default()
     };
@@ -92,9 +105,32 @@ pub(crate) fn solve(
     }
     let b = params.block.min(n).max(1);
     let ncv0 = krylov_dim(params, params.nev.max(1), b, n);
-    if n <= ncv0 + b + DENSE_MARGIN {
-        return solve_dense(k, m, params, lam_lim, info, progress);
+    let small = n <= DENSE_MAX_DOFS;
+    if n <= ncv0 + b + DENSE_MARGIN || (small && params.nev * DENSE_FRACTION_INV > n) {
+        return super::dense::solve(k, m, params, lam_lim, info, progress);
     }
+    match solve_lanczos(k, m, params, lam_lim, par, info.clone(), progress) {
+        // A small problem whose request Lanczos cannot meet (a frequency cap near or beyond
+        // the highest mode; the Krylov basis cannot outgrow the problem) is solved densely.
+        Err(EigenError::NotConverged { .. } | EigenError::InvalidInput(_)) if small => {
+            super::dense::solve(k, m, params, lam_lim, info, progress)
+        }
+        other => other,
+    }
+}
+
+/// The Lanczos path of [`solve`] (inputs checked, not tiny).
+fn solve_lanczos(
+    k: &SparseColMat<usize, f64>,
+    m: &SparseColMat<usize, f64>,
+    params: &EigenParams,
+    lam_lim: Option<f64>,
+    par: Par,
+    mut info: EigenInfo,
+    progress: &mut dyn FnMut(EigenProgress),
+) -> Result<EigenResult, EigenError> {
+    let n = k.nrows();
+    let sigma = params.shift;
 
     // --- factorization of A = K − σM -------------------------------------------------------
     let t0 = Instant::now();
@@ -177,6 +213,15 @@ pub(crate) fn solve(
         vals.extend_from_slice(&cv);
         res.extend(cres);
         let total = locked.ncols();
+        if more && n <= DENSE_MAX_DOFS && total * DENSE_FRACTION_INV > n {
+            // A frequency cap taking in much of a small problem's spectrum: the dense path
+            // of the caller is faster than growing Lanczos further (and reaches the top).
+            return Err(EigenError::NotConverged {
+                converged: total,
+                requested: total + 1,
+                worst_residual: f64::NAN,
+            });
+        }
         let done = if more {
             let global_cap = total >= params.max_modes;
             capped = chunk_capped && global_cap;
@@ -878,7 +923,7 @@ fn finalize(
 /// residuals of the low modes by λ_w/λ₁ (measured on the 1016-node table with 160 modes:
 /// residuals 1e-5 after the rotation, 1e-10 without). The Cholesky factor is triangular, so
 /// column i only mixes in columns j < i — lower modes, whose K-amplification is below one.
-fn orthonormalize_ascending(
+pub(super) fn orthonormalize_ascending(
     k: &SparseColMat<usize, f64>,
     m: &SparseColMat<usize, f64>,
     u: Mat<f64>,
@@ -934,40 +979,6 @@ fn gram_cholesky_inverse(u: MatRef<'_, f64>, mu: MatRef<'_, f64>) -> Result<Mat<
     Ok(lower_inverse(l.as_ref()))
 }
 
-#[allow(clippy::too_many_arguments)]
-fn rayleigh_ritz(
-    k: &SparseColMat<usize, f64>,
-    m: &SparseColMat<usize, f64>,
-    u: Mat<f64>,
-    mu: Mat<f64>,
-    ku: Mat<f64>,
-    sigma: f64,
-) -> Result<RitzPairs, EigenError> {
-    let w = u.ncols();
-    let li = gram_cholesky_inverse(u.as_ref(), mu.as_ref())?;
-    let mut a = Mat::<f64>::zeros(w, w);
-    gemm(
-        a.as_mut(),
-        Accum::Replace,
-        u.as_ref().transpose(),
-        ku.as_ref(),
-        1.0,
-    );
-    let a = symmetrized(a.as_ref());
-    let c = symmetrized((&li * &a * li.transpose()).as_ref());
-    let (vals, q) = sym_eig(c.as_ref()).map_err(EigenError::Dense)?;
-    let x = li.transpose() * &q;
-    let apply = |y: &Mat<f64>| {
-        let mut o = Mat::<f64>::zeros(y.nrows(), w);
-        gemm(o.as_mut(), Accum::Replace, y.as_ref(), x.as_ref(), 1.0);
-        o
-    };
-    let _ = (mu, ku);
-    let u = apply(&u);
-    let res = residuals(k, m, u.as_ref(), &vals, sigma);
-    Ok((vals, u, res))
-}
-
 /// Relative residual of each pair and its rounding floor, as
 /// `(‖Ku − λMu‖, ‖Ku‖ + |σ|‖Mu‖, ε(‖|K||u|‖ + |λ|‖|M||u|‖))` (2-norms): the last term is the
 /// size of the rounding error committed when K u and M u are evaluated in double precision,
@@ -982,16 +993,6 @@ impl Residual {
     pub fn converged(&self, tol: f64) -> bool {
         self.rel <= tol.max(FLOOR_FACTOR * self.floor)
     }
-}
-
-fn residuals(
-    k: &SparseColMat<usize, f64>,
-    m: &SparseColMat<usize, f64>,
-    u: MatRef<'_, f64>,
-    lam: &[f64],
-    sigma: f64,
-) -> Vec<Residual> {
-    Products::new(k, m, u).residuals(lam, sigma)
 }
 
 /// K u, M u and their rounding scales |K||u|, |M||u| for the columns of u.
@@ -1070,7 +1071,7 @@ fn trim_and_sign(
 }
 
 /// Flips each column so that its entry of largest magnitude (first on ties) is positive.
-fn normalize_signs(mut u: MatMut<'_, f64>) {
+pub(super) fn normalize_signs(mut u: MatMut<'_, f64>) {
     for j in 0..u.ncols() {
         let mut best = 0.0f64;
         let mut sign = 1.0;
@@ -1089,68 +1090,6 @@ fn normalize_signs(mut u: MatMut<'_, f64>) {
 }
 
 use faer::reborrow::{Reborrow, ReborrowMut};
-
-/// Dense generalized solve for tiny problems: Cholesky of M, symmetric eigen of L⁻¹KL⁻ᵀ.
-fn solve_dense(
-    k: &SparseColMat<usize, f64>,
-    m: &SparseColMat<usize, f64>,
-    params: &EigenParams,
-    lam_lim: Option<f64>,
-    mut info: EigenInfo,
-    progress: &mut dyn FnMut(EigenProgress),
-) -> Result<EigenResult, EigenError> {
-    let t1 = Instant::now();
-    let n = k.nrows();
-    let kd = k.to_dense();
-    let mut md = m.to_dense();
-    let md_copy = md.clone();
-    small_cholesky(md.as_mut(), 0.0)
-        .map_err(|j| EigenError::InvalidInput(format!("M is not positive definite (pivot {j})")))?;
-    let l = Mat::from_fn(n, n, |i, j| if i >= j { md[(i, j)] } else { 0.0 });
-    let li = lower_inverse(l.as_ref());
-    let c = symmetrized((&li * &kd * li.transpose()).as_ref());
-    let (vals, q) = sym_eig(c.as_ref()).map_err(EigenError::Dense)?;
-    let wanted = match lam_lim {
-        None => params.nev,
-        Some(lim) => {
-            let below = vals.iter().take_while(|&&l| l < lim).count();
-            info.capped = below > params.max_modes;
-            below.max(params.nev).min(params.max_modes)
-        }
-    }
-    .min(n);
-    let u = li.transpose() * q.as_ref().subcols(0, wanted);
-    let mu = &md_copy * &u;
-    let ku = &kd * &u;
-    let (vals, u, res) = rayleigh_ritz(k, m, u, mu, ku, params.shift)?;
-    info.dense = true;
-    info.iterations = 1;
-    info.krylov_dim = n;
-    info.solve_seconds = t1.elapsed().as_secs_f64();
-    let good = res.iter().filter(|r| r.converged(params.tol)).count();
-    progress(EigenProgress {
-        converged: good,
-        requested: wanted,
-        iteration: 1,
-    });
-    if good < res.len() {
-        return Err(EigenError::NotConverged {
-            converged: good,
-            requested: wanted,
-            worst_residual: res.iter().map(|r| r.rel).fold(0.0, f64::max),
-        });
-    }
-    let keep = vals.len();
-    let mut vectors = u;
-    normalize_signs(vectors.as_mut());
-    Ok(EigenResult {
-        eigenvalues: vals[..keep].to_vec(),
-        vectors,
-        residuals: res.iter().map(|r| r.rel).collect(),
-        residual_floors: res.iter().map(|r| r.floor).collect(),
-        info,
-    })
-}
 
 #[cfg(test)]
 mod tests {

@@ -58,6 +58,12 @@
 //!   modes. Each pair therefore also reports its rounding floor
 //!   ([`EigenResult::residual_floors`]) and counts as converged when its residual is ≤ `tol`
 //!   **or** within a factor 8 of that floor.
+//! - Small problems (at most 2000 free dofs) that want more than a quarter of their modes, or
+//!   whose request Lanczos cannot meet (a frequency cap near or beyond the highest mode: the
+//!   Krylov basis cannot outgrow the problem), are solved densely (`dense.rs`): every
+//!   eigenpair of the dense shift-inverted problem by the tridiagonal QR iteration, checked on
+//!   the same explicit residual, failing pairs purified by solves with its Cholesky factor. A
+//!   count up to the number of free dofs, or a cap beyond the spectrum, returns every mode.
 //! - The start block comes from a fixed-seed splitmix64 generator, mapped once through A⁻¹M;
 //!   each eigenvector is signed so its entry of largest magnitude (first on ties) is positive.
 //!
@@ -70,6 +76,7 @@
 //! the small dense eigensolves run with `Par::Seq`. Bits may differ between machines with
 //! different SIMD support (faer dispatches on CPU features at run time).
 
+mod dense;
 mod kernels;
 mod lanczos;
 mod ordering;
@@ -180,7 +187,8 @@ pub struct EigenInfo {
     pub shift: f64,
     /// Max-frequency mode hit [`EigenParams::max_modes`].
     pub capped: bool,
-    /// The problem was small enough to be solved densely.
+    /// The problem was solved by the dense path (small, and wanting much of its spectrum or
+    /// beyond Lanczos's reach; see the module docs).
     pub dense: bool,
 }
 

@@ -15,7 +15,8 @@
 //! chosen so that its largest vertex displacement is a stated length (see each writer).
 //!
 //! Every writer draws the same surface (`ExportSurface`): the base's vertices and outward linear
-//! triangles.
+//! triangles, a second-order base's 6-node triangles each split into four through their
+//! mid-edge nodes (which carry their own mode rows).
 
 mod contact_sheet;
 mod gltf_builder;
@@ -109,9 +110,9 @@ pub fn select_modes(base: &ModesFile, n: Option<usize>) -> Result<usize, ExportE
 
 /// The surface an export shows: vertices, linear triangles and per-vertex mode rows.
 ///
-/// Built once per export by [`ExportSurface::of`] from the base's corner vertices and linear
-/// triangles (the one place to split second-order 6-node triangles into four linear ones
-/// through their mid-edge nodes; bases carrying mid-edge rows are shown by their corners).
+/// Built once per export by [`ExportSurface::of`]: for a first-order base, its vertices and
+/// triangles; for a second-order base, its corner vertices followed by one vertex per mid-edge
+/// node, each 6-node triangle split into four linear ones through its mid-edge nodes.
 pub(crate) struct ExportSurface {
     /// Vertex positions (m, object frame).
     pub positions: Vec<[f64; 3]>,
@@ -125,14 +126,54 @@ pub(crate) struct ExportSurface {
 }
 
 impl ExportSurface {
+    /// The export surface of `base`. A second-order base's mid-edge node of edge (a, b) is
+    /// placed at the midpoint of a and b (the bake accepts straight-sided elements only) with
+    /// its stored mode row and volume node, and triangle (v₀, v₁, v₂) with mid-edge nodes
+    /// e₀₁, e₁₂, e₂₀ becomes (v₀, e₀₁, e₂₀), (e₀₁, v₁, e₁₂), (e₂₀, e₁₂, v₂), (e₀₁, e₁₂, e₂₀),
+    /// all with the parent's orientation. Mid-edge vertex e is vertex `corners + e`.
     pub fn of(base: &ModesFile) -> ExportSurface {
-        ExportSurface {
+        let corners = ExportSurface {
             positions: base.surface_vertices.clone(),
             triangles: base.surface_triangles.clone(),
             volume_node: base.surface_to_volume.clone(),
             modes: base.modes.clone(),
             m: base.num_modes(),
-        }
+        };
+        let Some(q) = &base.quadratic else {
+            return corners;
+        };
+        // A base that reads has exactly its triangles' edges (checked by the reader).
+        let Ok(tri_edges) = q.triangle_edges(&base.surface_triangles) else {
+            return corners;
+        };
+        let mut out = corners;
+        let nv = out.positions.len() as u32;
+        let p = &base.surface_vertices;
+        out.positions.extend(q.edges.iter().map(|&[a, b]| {
+            let (a, b) = (p[a as usize], p[b as usize]);
+            [
+                0.5 * (a[0] + b[0]),
+                0.5 * (a[1] + b[1]),
+                0.5 * (a[2] + b[2]),
+            ]
+        }));
+        out.volume_node.extend_from_slice(&q.edge_to_volume);
+        out.modes.extend_from_slice(&q.modes);
+        out.triangles = base
+            .surface_triangles
+            .iter()
+            .zip(&tri_edges)
+            .flat_map(|(&[v0, v1, v2], &[e01, e12, e20])| {
+                let (e01, e12, e20) = (nv + e01, nv + e12, nv + e20);
+                [
+                    [v0, e01, e20],
+                    [e01, v1, e12],
+                    [e20, e12, v2],
+                    [e01, e12, e20],
+                ]
+            })
+            .collect();
+        out
     }
 
     /// Number of vertices.
