@@ -266,7 +266,7 @@ fn bad_inputs_fail_cleanly_with_located_errors() {
         (
             "meshes/cube_v41.msh",
             &["--modes", "0"],
-            "modes: the mode count must be at least 1",
+            "parameter `modes`: the mode count must be at least 1",
         ),
         ("meshes/cube_v41.msh", &["--modes", "100000"], "modes"),
         ("meshes/cube_v41.msh", &["--rayleigh", "nan,1"], "rayleigh"),

@@ -435,14 +435,14 @@ fn fixed_selectors_count_union_refuse_empty_and_hash() {
                 }],
                 ..base_params.clone()
             },
-            "fixed_below z=-0.01 fixes no node",
+            "parameter `fixed_below` (z=-0.01) fixes no node",
         ),
         (
             BakeParams {
                 fixed_boxes: vec![[1.0, 1.0, 1.0, 2.0, 2.0, 2.0]],
                 ..base_params.clone()
             },
-            "fixed_boxes 1,1,1,2,2,2 fixes no node",
+            "parameter `fixed_boxes` (1,1,1,2,2,2) fixes no node",
         ),
     ] {
         let err = bake_mesh(mesh.clone(), &bad, "box", &mut |_| {})

@@ -366,9 +366,12 @@ fn bad_transfer_options_are_clear_errors() {
     let cases: [(&[&str], &str); 6] = [
         (
             &["--transfer-h", "-1"],
-            "transfer.h must be a positive step",
+            "parameter `transfer.h` must be a positive step",
         ),
-        (&["--transfer-h", "0"], "transfer.h must be a positive step"),
+        (
+            &["--transfer-h", "0"],
+            "parameter `transfer.h` must be a positive step",
+        ),
         (
             &["--transfer-h", "0.01", "--transfer-modes", "0"],
             "mode count",

@@ -106,31 +106,31 @@ impl BakeParams {
         match self.modes {
             ModeRequest::Count(0) => {
                 return Err(BakeError::Params(
-                    "modes: the mode count must be at least 1".into(),
+                    "parameter `modes`: the mode count must be at least 1".into(),
                 ))
             }
             ModeRequest::Count(n) if n > 5000 => {
                 return Err(BakeError::Params(format!(
-                    "modes: {n} modes is more than the supported 5000"
+                    "parameter `modes`: {n} modes is more than the supported 5000"
                 )))
             }
             ModeRequest::MaxFreqHz(f) if !(f.is_finite() && f > 0.0) => {
                 return Err(BakeError::Params(format!(
-                    "modes: the maximum frequency must be positive (Hz), got {f}"
+                    "parameter `modes`: the maximum frequency must be positive (Hz), got {f}"
                 )))
             }
             _ => {}
         }
         if !self.rayleigh.iter().all(|x| x.is_finite() && *x >= 0.0) {
             return Err(BakeError::Params(format!(
-                "rayleigh: the coefficients must be finite and ≥ 0, got {:?}",
+                "parameter `rayleigh`: the coefficients must be finite and ≥ 0, got {:?}",
                 self.rayleigh
             )));
         }
         for b in &self.fixed_below {
             if b.axis > 2 || !b.value.is_finite() {
                 return Err(BakeError::Params(format!(
-                    "fixed_below: needs an axis 0, 1 or 2 (x, y, z) and a finite value in m, got axis {} value {}",
+                    "parameter `fixed_below` needs an axis 0, 1 or 2 (x, y, z) and a finite value in m, got axis {} value {}",
                     b.axis, b.value
                 )));
             }
@@ -138,7 +138,7 @@ impl BakeParams {
         for b in &self.fixed_boxes {
             if !b.iter().all(|x| x.is_finite()) || (0..3).any(|k| b[k] > b[k + 3]) {
                 return Err(BakeError::Params(format!(
-                    "fixed_boxes: {b:?}: expected finite [x0, y0, z0, x1, y1, z1] (m) with each minimum ≤ its maximum"
+                    "parameter `fixed_boxes` = {b:?}: expected finite [x0, y0, z0, x1, y1, z1] (m) with each minimum ≤ its maximum"
                 )));
             }
         }

@@ -137,7 +137,7 @@ fn solve(
     let wanted = params.min_modes() + rigid;
     if wanted > map.n_free() {
         return Err(BakeError::Params(format!(
-            "{file}: modes = {}: at most {} modes for this mesh (3 × {} nodes − {} fixed dofs{} = {})",
+            "{file}: parameter `modes` asks for {}: at most {} modes for this mesh (3 × {} nodes − {} fixed dofs{} = {})",
             params.min_modes(),
             map.n_free().saturating_sub(rigid),
             mesh.nodes.len(),
@@ -364,7 +364,7 @@ fn bake_with_table(
     tp.check().map_err(terr)?;
     if mesh.is_quadratic() {
         return Err(terr(tr::TransferError::Params(
-            "transfer: a peak-transfer table is not supported for second-order (10-node) meshes: the table interpolates P1 midpoint rows; bake the linear mesh for a table".into(),
+            "parameter `transfer`: a peak-transfer table is not supported for second-order (10-node) meshes: the table interpolates P1 midpoint rows; bake the linear mesh for a table".into(),
         )));
     }
     let (mut base, mut report) = bake_modes(mesh.clone(), params, file, progress)?;
@@ -383,7 +383,7 @@ fn bake_with_table(
     } else {
         let TransferModes::Count(n) = tp.modes else {
             return Err(terr(tr::TransferError::Params(format!(
-                "transfer.modes = all needs the dense eigensolve, but the mesh has {} free dofs (limit {}); give a count",
+                "parameter `transfer.modes` = all needs the dense eigensolve, but the mesh has {} free dofs (limit {}); give a count",
                 report.free_dofs,
                 tr::DENSE_MAX_DOFS
             ))));

@@ -50,7 +50,7 @@ fn select_fixed(
         let nodes = mesh.group_nodes(name).map_err(name_file)?.to_vec();
         if nodes.is_empty() {
             return Err(BakeError::Params(format!(
-                "{file}: fixed group {name} fixes no node (the group has no node on the tetrahedra)"
+                "{file}: parameter `fixed`: group {name} fixes no node (the group has no node on the tetrahedra)"
             )));
         }
         out.push((format!("group {name}"), nodes));
@@ -61,7 +61,7 @@ fn select_fixed(
             .collect();
         if nodes.is_empty() {
             return Err(BakeError::Params(format!(
-                "{file}: fixed_below {b} fixes no node ({})",
+                "{file}: parameter `fixed_below` ({b}) fixes no node ({})",
                 extent()
             )));
         }
@@ -73,7 +73,7 @@ fn select_fixed(
             .collect();
         if nodes.is_empty() {
             return Err(BakeError::Params(format!(
-                "{file}: fixed_boxes {} fixes no node ({})",
+                "{file}: parameter `fixed_boxes` ({}) fixes no node ({})",
                 bx.map(|x| x.to_string()).join(","),
                 extent()
             )));
