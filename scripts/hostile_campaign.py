@@ -38,11 +38,11 @@ TIMEOUT = 60
 # Where in the input a refusal points: a line (`file:12:` or `line 12`), a byte offset, an
 # element / node / tetrahedron / triangle / vertex number, an archive entry or JSON key by
 # name (`entry `modes``, `"points"[3]`), a section by name (`$Nodes`), or an option
-# (`--modes`). Every refusal must also name the file (checked separately).
+# (`--modes`) or the library parameter it sets (`parameter `modes``). Every refusal must also name the file (checked separately).
 LOCATED = re.compile(
     r"(:\d+:|\bline \d+|\bbyte \d+|\boffset \d+|\b(element|node|tetrahedron|tet|"
     r"triangle|vertex|edge|group|mode) `?[\w.-]+|\bentry `[^`]+`|\[\d+\]|\$[A-Z][A-Za-z]+|"
-    r"--[a-z][a-z-]*)")
+    r"--[a-z][a-z-]*|\bparameter `[\w.]+`)")
 
 MESHES = ["cube_v22.msh", "cube_v41.msh", "cube_v22_bin.msh", "cube_v41_bin.msh",
           "cube_cell_sets.json"]

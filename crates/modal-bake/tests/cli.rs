@@ -263,7 +263,11 @@ fn bad_inputs_fail_cleanly_with_located_errors() {
             "no_such_group",
         ),
         ("meshes/cube_v41.msh", &["--youngs", "-5"], "--youngs"),
-        ("meshes/cube_v41.msh", &["--modes", "0"], "--modes"),
+        (
+            "meshes/cube_v41.msh",
+            &["--modes", "0"],
+            "parameter `modes`: the mode count must be at least 1",
+        ),
         ("meshes/cube_v41.msh", &["--modes", "100000"], "modes"),
         ("meshes/cube_v41.msh", &["--rayleigh", "nan,1"], "rayleigh"),
     ];

@@ -435,14 +435,14 @@ fn fixed_selectors_count_union_refuse_empty_and_hash() {
                 }],
                 ..base_params.clone()
             },
-            "--fixed-below z=-0.01 fixes no node",
+            "parameter `fixed_below` (z=-0.01) fixes no node",
         ),
         (
             BakeParams {
                 fixed_boxes: vec![[1.0, 1.0, 1.0, 2.0, 2.0, 2.0]],
                 ..base_params.clone()
             },
-            "--fixed-box 1,1,1,2,2,2 fixes no node",
+            "parameter `fixed_boxes` (1,1,1,2,2,2) fixes no node",
         ),
     ] {
         let err = bake_mesh(mesh.clone(), &bad, "box", &mut |_| {})
@@ -471,7 +471,7 @@ fn fixed_selectors_count_union_refuse_empty_and_hash() {
     };
     let (b, _) = bake_mesh(mesh.clone(), &below, "box", &mut |_| {}).unwrap();
     b.write_atomic(&out).unwrap();
-    assert!(is_mesh_up_to_date(mesh.clone(), "box", &below, None, &out).unwrap());
+    assert!(is_mesh_up_to_date(mesh.clone(), "box", &below, &out).unwrap());
     let other = BakeParams {
         fixed_below: vec![FixedBelow {
             axis: 0,
@@ -479,7 +479,7 @@ fn fixed_selectors_count_union_refuse_empty_and_hash() {
         }],
         ..base_params.clone()
     };
-    assert!(!is_mesh_up_to_date(mesh.clone(), "box", &other, None, &out).unwrap());
+    assert!(!is_mesh_up_to_date(mesh.clone(), "box", &other, &out).unwrap());
     let group = BakeParams {
         fixed: vec!["xmin".into()],
         ..base_params.clone()
@@ -542,12 +542,10 @@ fn p1_only_paths_refuse_second_order() {
     assert!(err.contains("4-node tetrahedra only"), "{err}");
     let params = BakeParams {
         modes: ModeRequest::Count(2),
+        transfer: Some(modal_bake::transfer::TransferParams::default()),
         ..Default::default()
     };
-    let tp = modal_bake::transfer::TransferParams::default();
-    let Err(err) =
-        modal_bake::bake::bake_mesh_with_transfer(p2, &params, Some(&tp), "p2.msh", &mut |_| {})
-    else {
+    let Err(err) = bake_mesh(p2, &params, "p2.msh", &mut |_| {}) else {
         panic!("a transfer table was built on a second-order mesh")
     };
     let err = err.to_string();

@@ -321,7 +321,7 @@ fn table_is_bit_identical_on_any_thread_count() {
                 .unwrap();
             assert!(o.status.success(), "{}", text(&o));
             let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
-            assert_eq!(v["transfer_mode_source"], "dense", "{v}");
+            assert_eq!(v["transfer"]["mode_source"], "dense", "{v}");
             std::fs::read(&out).unwrap()
         })
         .collect();
@@ -364,8 +364,14 @@ fn bad_transfer_options_are_clear_errors() {
     let out = dir.path().join("bad.modes");
     let mesh = data("data/meshes/beam.msh");
     let cases: [(&[&str], &str); 6] = [
-        (&["--transfer-h", "-1"], "--transfer-h"),
-        (&["--transfer-h", "0"], "--transfer-h"),
+        (
+            &["--transfer-h", "-1"],
+            "parameter `transfer.h` must be a positive step",
+        ),
+        (
+            &["--transfer-h", "0"],
+            "parameter `transfer.h` must be a positive step",
+        ),
         (
             &["--transfer-h", "0.01", "--transfer-modes", "0"],
             "mode count",
@@ -376,7 +382,7 @@ fn bad_transfer_options_are_clear_errors() {
         ),
         (
             &["--transfer-h", "0.01", "--transfer-up", "0,0,0"],
-            "--transfer-up",
+            "transfer.up",
         ),
         (
             &[

@@ -20,7 +20,7 @@ use serde::Serialize;
 use crate::runner::bases::ensure_base;
 use crate::runner::outcomes::{measure_outcome, unit_of};
 use crate::runner::Trajectory;
-use crate::scene::{build_world, ElasticDesc, MethodDesc, SceneDesc};
+use crate::scene::{build_world, BuiltWorld, DriverDesc, ElasticDesc, MethodDesc, SceneDesc};
 
 /// Which response method a run uses.
 #[derive(Clone, Debug, PartialEq)]
@@ -292,6 +292,127 @@ fn group_surface_vertices(
         .collect())
 }
 
+/// The response method of elastic object `e` (modal, or the attenuation law the scene or
+/// `params.method` names) and its name for the report.
+///
+/// # Errors
+/// An unknown distance kind, or an amplitude group the mesh does not have.
+fn elastic_method(
+    e: &ElasticDesc,
+    params: &RunParams,
+    base: &ModesFile,
+) -> Result<(Method, String)> {
+    let att = attenuation_of(e, &params.method);
+    let method = match &att {
+        None => Method::Modal,
+        Some((c, beta, distance, amplitude)) => {
+            let distance = match distance.as_str() {
+                "euclidean" => DistanceKind::Euclidean,
+                "heat" => DistanceKind::Heat,
+                "heat_table" => DistanceKind::HeatTable,
+                other => bail!(
+                    "elastic object {}: distance {other:?} (expected heat, heat_table or euclidean)",
+                    e.name
+                ),
+            };
+            let amplitude = match amplitude.as_str() {
+                "per_vertex" => AmplitudeKind::PerVertex,
+                "mean" => AmplitudeKind::Mean,
+                group => {
+                    AmplitudeKind::MeanOver(group_surface_vertices(&params.root, e, base, group)?)
+                }
+            };
+            Method::Attenuation(AttenuationParams {
+                law: AttenuationLaw::Simplified { c: *c, beta: *beta },
+                distance,
+                amplitude,
+                ..AttenuationParams::default()
+            })
+        }
+    };
+    let method_name = match &att {
+        None => "modal".to_string(),
+        Some((c, b, d, a)) => format!("attenuation C={c} beta={b} {d} {a}"),
+    };
+    Ok((method, method_name))
+}
+
+/// Applies the impulses of the `drivers` (body index, description) due at time `t` (s): each
+/// fires at `start + n·period` within [start, stop], its impulse (N·s, world frame) turned
+/// about `rotate_axis` at `hz` when given, at a body-frame point or the centre of mass.
+fn apply_drivers(drivers: &[(usize, DriverDesc)], built: &mut BuiltWorld, t: f64) {
+    for (b, d) in drivers {
+        if t + 1e-9 < d.start || t > d.stop {
+            continue;
+        }
+        let phase = (t - d.start) / d.period;
+        if (phase - phase.round()).abs() > 1e-6 {
+            continue;
+        }
+        let mut j = Vector::new(d.impulse[0], d.impulse[1], d.impulse[2]);
+        if let Some(ax) = d.rotate_axis {
+            let axis = Vector::new(ax[0], ax[1], ax[2]).normalize();
+            let q = rapier3d_f64::math::Rotation::from_axis_angle(
+                axis,
+                std::f64::consts::TAU * d.hz * (t - d.start),
+            );
+            j = q * j;
+        }
+        let rb = &mut built.world.bodies[built.bodies[*b].handle];
+        match d.point {
+            Some(p) => {
+                let wp = rb.position().transform_point(Vector::new(p[0], p[1], p[2]));
+                rb.apply_impulse_at_point(j, wp, true);
+            }
+            None => rb.apply_impulse(j, true),
+        }
+    }
+}
+
+/// Writes `trajectory.npz`, `timings.npz` (per-step rapier and adapter µs, whether the world
+/// stepped, each object's query µs and resting contacts) and `summary.json` into `dir`.
+///
+/// # Errors
+/// I/O failures.
+fn write_outputs(
+    dir: &Path,
+    report: &RunReport,
+    rapier_us: &[f64],
+    adapter_us: &[f64],
+) -> Result<()> {
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    report.trajectory.write_npz(&dir.join("trajectory.npz"))?;
+    let f = std::fs::File::create(dir.join("timings.npz"))?;
+    let mut npz = NpzWriter::new(f);
+    npz.add_array("rapier_us", &Array1::from(rapier_us.to_vec()))?;
+    npz.add_array("adapter_us", &Array1::from(adapter_us.to_vec()))?;
+    npz.add_array(
+        "world_stepped",
+        &Array1::from(
+            report
+                .step_times
+                .iter()
+                .map(|t| u8::from(t.world_stepped))
+                .collect::<Vec<u8>>(),
+        ),
+    )?;
+    for m in &report.models {
+        let q = &m.stats.query_us;
+        let arr = Array2::from_shape_vec(
+            (q.len(), 2),
+            q.iter()
+                .zip(&m.stats.query_resting)
+                .flat_map(|(a, b)| [*a, *b as f64])
+                .collect(),
+        )?;
+        npz.add_array(format!("query_us_resting_{}", m.model), &arr)?;
+    }
+    npz.finish()?;
+    let json = serde_json::to_string_pretty(&report)?;
+    std::fs::write(dir.join("summary.json"), json + "\n")?;
+    Ok(())
+}
+
 /// Runs `desc` headless and, if `params.out_dir` is set, writes `trajectory.npz`,
 /// `timings.npz` and `summary.json` there.
 ///
@@ -328,41 +449,7 @@ pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
         let (path, _) = ensure_base(&params.root, &params.bases_dir, e)?;
         let base =
             ModesFile::read(&path).with_context(|| format!("reading base {}", path.display()))?;
-        let att = attenuation_of(e, &params.method);
-        let method = match &att {
-            None => Method::Modal,
-            Some((c, beta, distance, amplitude)) => {
-                let distance = match distance.as_str() {
-                    "euclidean" => DistanceKind::Euclidean,
-                    "heat" => DistanceKind::Heat,
-                    "heat_table" => DistanceKind::HeatTable,
-                    other => bail!(
-                        "elastic object {}: distance {other:?} (expected heat, heat_table or euclidean)",
-                        e.name
-                    ),
-                };
-                let amplitude = match amplitude.as_str() {
-                    "per_vertex" => AmplitudeKind::PerVertex,
-                    "mean" => AmplitudeKind::Mean,
-                    group => AmplitudeKind::MeanOver(group_surface_vertices(
-                        &params.root,
-                        e,
-                        &base,
-                        group,
-                    )?),
-                };
-                Method::Attenuation(AttenuationParams {
-                    law: AttenuationLaw::Simplified { c: *c, beta: *beta },
-                    distance,
-                    amplitude,
-                    ..AttenuationParams::default()
-                })
-            }
-        };
-        let method_name = match &att {
-            None => "modal".to_string(),
-            Some((c, b, d, a)) => format!("attenuation C={c} beta={b} {d} {a}"),
-        };
+        let (method, method_name) = elastic_method(e, params, &base)?;
         let model = ModalModel::load(&path)
             .map_err(|err| anyhow::anyhow!("loading {}: {err}", path.display()))?;
         let mut object = ElasticObjectDesc::new(model, 0);
@@ -428,7 +515,7 @@ pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
         names: rec.iter().map(|&i| built.bodies[i].name.clone()).collect(),
         ..Default::default()
     };
-    let record = |built: &crate::scene::BuiltWorld, traj: &mut Trajectory, t: f64| {
+    let record = |built: &BuiltWorld, traj: &mut Trajectory, t: f64| {
         traj.time.push(t);
         for &i in &rec {
             let p = built.world.bodies[built.bodies[i].handle].position();
@@ -450,32 +537,7 @@ pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
     let mut last_progress = Instant::now();
     for k in 0..steps {
         let t = k as f64 * desc.h;
-        for (b, d) in &drivers {
-            if t + 1e-9 < d.start || t > d.stop {
-                continue;
-            }
-            let phase = (t - d.start) / d.period;
-            if (phase - phase.round()).abs() > 1e-6 {
-                continue;
-            }
-            let mut j = Vector::new(d.impulse[0], d.impulse[1], d.impulse[2]);
-            if let Some(ax) = d.rotate_axis {
-                let axis = Vector::new(ax[0], ax[1], ax[2]).normalize();
-                let q = rapier3d_f64::math::Rotation::from_axis_angle(
-                    axis,
-                    std::f64::consts::TAU * d.hz * (t - d.start),
-                );
-                j = q * j;
-            }
-            let rb = &mut built.world.bodies[built.bodies[*b].handle];
-            match d.point {
-                Some(p) => {
-                    let wp = rb.position().transform_point(Vector::new(p[0], p[1], p[2]));
-                    rb.apply_impulse_at_point(j, wp, true);
-                }
-                None => rb.apply_impulse(j, true),
-            }
-        }
+        apply_drivers(&drivers, &mut built, t);
         let ta = Instant::now();
         dcr.before_step(&mut built.world.bodies);
         let before_us = ta.elapsed().as_secs_f64() * 1e6;
@@ -622,36 +684,7 @@ pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
     };
 
     if let Some(dir) = &params.out_dir {
-        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-        report.trajectory.write_npz(&dir.join("trajectory.npz"))?;
-        let f = std::fs::File::create(dir.join("timings.npz"))?;
-        let mut npz = NpzWriter::new(f);
-        npz.add_array("rapier_us", &Array1::from(rapier_us.clone()))?;
-        npz.add_array("adapter_us", &Array1::from(adapter_us.clone()))?;
-        npz.add_array(
-            "world_stepped",
-            &Array1::from(
-                report
-                    .step_times
-                    .iter()
-                    .map(|t| u8::from(t.world_stepped))
-                    .collect::<Vec<u8>>(),
-            ),
-        )?;
-        for m in &report.models {
-            let q = &m.stats.query_us;
-            let arr = Array2::from_shape_vec(
-                (q.len(), 2),
-                q.iter()
-                    .zip(&m.stats.query_resting)
-                    .flat_map(|(a, b)| [*a, *b as f64])
-                    .collect(),
-            )?;
-            npz.add_array(format!("query_us_resting_{}", m.model), &arr)?;
-        }
-        npz.finish()?;
-        let json = serde_json::to_string_pretty(&report)?;
-        std::fs::write(dir.join("summary.json"), json + "\n")?;
+        write_outputs(dir, &report, &rapier_us, &adapter_us)?;
     }
     Ok(report)
 }

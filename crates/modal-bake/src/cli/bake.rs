@@ -58,6 +58,7 @@ impl BakeOptions {
             } else {
                 ModesPrecision::F64
             },
+            transfer: None,
         }
     }
 }
@@ -358,9 +359,11 @@ pub fn run(args: &BakeArgs) -> anyhow::Result<()> {
     if let Some(target) = args.target_error {
         return super::target::run(args, target);
     }
-    let params = args.options.params();
+    let params = BakeParams {
+        transfer: args.transfer.params(),
+        ..args.options.params()
+    };
     let mut progress = Progress::new();
-    let transfer = args.transfer.params();
     let units = args.asset.units;
     let report =
         if is_surface_asset(&args.mesh) || args.asset.any_set() || units != super::mesh::Units::M {
@@ -368,28 +371,20 @@ pub fn run(args: &BakeArgs) -> anyhow::Result<()> {
             let (mesh, read_s) = load_mesh(&args.mesh, &args.asset)?;
             progress = Progress::new();
             let file = args.mesh.display().to_string();
-            bake::bake_mesh_with_transfer(mesh, &params, transfer.as_ref(), &file, &mut |s| {
-                progress.update(s)
-            })
-            .map_err(anyhow::Error::new)
-            .and_then(|(base, mut report)| {
-                report.read_s = read_s;
-                progress.update(BakeStage::Write);
-                let t = std::time::Instant::now();
-                super::create_parent(&args.out)?;
-                base.write_atomic(&args.out)?;
-                report.write_s = t.elapsed().as_secs_f64();
-                Ok(report)
-            })
+            bake::bake_mesh(mesh, &params, &file, &mut |s| progress.update(s))
+                .map_err(anyhow::Error::new)
+                .and_then(|(base, mut report)| {
+                    report.read_s = read_s;
+                    progress.update(BakeStage::Write);
+                    let t = std::time::Instant::now();
+                    super::create_parent(&args.out)?;
+                    base.write_atomic(&args.out)?;
+                    report.write_s = t.elapsed().as_secs_f64();
+                    Ok(report)
+                })
         } else {
-            bake::bake_file_with_transfer(
-                &args.mesh,
-                &params,
-                transfer.as_ref(),
-                &args.out,
-                &mut |s| progress.update(s),
-            )
-            .map_err(anyhow::Error::new)
+            bake::bake_file(&args.mesh, &params, &args.out, &mut |s| progress.update(s))
+                .map_err(anyhow::Error::new)
         };
     progress.bar.finish_and_clear();
     if let Some(plain) = &mut progress.plain {
@@ -414,21 +409,25 @@ pub fn run(args: &BakeArgs) -> anyhow::Result<()> {
         print_report(&args.out, &report);
     }
     if args.timings {
+        let (transfer_modes_s, transfer_s) = report
+            .transfer
+            .as_ref()
+            .map_or((0.0, 0.0), |t| (t.modes_s, t.build_s));
         eprintln!(
             "timings (s): read {:.3}  assemble {:.3}  factor {:.3}  eigensolve {:.3}  transfer modes {:.3}  transfer table {:.3}  write {:.3}  total {:.3}",
             report.read_s,
             report.assemble_s,
             report.factor_s,
             report.eigensolve_s,
-            report.transfer_modes_s,
-            report.transfer_s,
+            transfer_modes_s,
+            transfer_s,
             report.write_s,
             report.read_s
                 + report.assemble_s
                 + report.factor_s
                 + report.eigensolve_s
-                + report.transfer_modes_s
-                + report.transfer_s
+                + transfer_modes_s
+                + transfer_s
                 + report.write_s
         );
     }
@@ -487,17 +486,17 @@ pub(super) fn print_report(out: &std::path::Path, r: &BakeReport) {
         r.frequencies_hz.last().copied().unwrap_or(0.0),
         worst
     );
-    if r.transfer_vertices > 0 {
+    if let Some(t) = &r.transfer {
         outln!(
             "  transfer table: order {}, {} points ({} region vertices, {} edges), {} modes ({}), {} samples per step, built in {:.2} s",
-            r.transfer_order,
-            r.transfer_points,
-            r.transfer_vertices,
-            r.transfer_edges,
-            r.transfer_modes,
-            r.transfer_mode_source,
-            r.transfer_samples,
-            r.transfer_modes_s + r.transfer_s
+            t.order,
+            t.points,
+            t.vertices,
+            t.edges,
+            t.modes,
+            t.mode_source,
+            t.samples,
+            t.modes_s + t.build_s
         );
     }
 }

@@ -32,17 +32,13 @@ pub struct CheckArgs {
 }
 
 pub fn run(args: &CheckArgs) -> ExitCode {
-    let transfer = args.transfer.params();
+    let params = bake::BakeParams {
+        transfer: args.transfer.params(),
+        ..args.options.params()
+    };
     let file = args.mesh.display().to_string();
-    let status = super::bake::load_mesh(&args.mesh, &args.asset).and_then(|(mesh, _)| {
-        Ok(bake::mesh_base_status(
-            mesh,
-            &file,
-            &args.options.params(),
-            transfer.as_ref(),
-            &args.out,
-        )?)
-    });
+    let status = super::bake::load_mesh(&args.mesh, &args.asset)
+        .and_then(|(mesh, _)| Ok(bake::mesh_base_status(mesh, &file, &params, &args.out)?));
     match status {
         Ok(status) => {
             let fresh = status == BaseStatus::UpToDate;

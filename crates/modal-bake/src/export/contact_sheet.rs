@@ -87,7 +87,7 @@ pub fn render_contact_sheet(base: &ModesFile, p: &SheetParams) -> Result<Pixmap,
     }
     if !(p.scale.is_finite() && p.scale > 0.0) {
         return Err(ExportError::Invalid(format!(
-            "scale must be positive, got {}",
+            "parameter `scale` must be positive, got {}",
             p.scale
         )));
     }

@@ -98,9 +98,11 @@ pub fn select_modes(base: &ModesFile, n: Option<usize>) -> Result<usize, ExportE
     }
     match n {
         None => Ok(m.min(DEFAULT_EXPORT_MODES)),
-        Some(0) => Err(ExportError::Invalid("--modes must be at least 1".into())),
+        Some(0) => Err(ExportError::Invalid(
+            "parameter `modes`: the mode count must be at least 1".into(),
+        )),
         Some(n) if n > m => Err(ExportError::Invalid(format!(
-            "--modes {n}: the base has only {m} modes"
+            "parameter `modes` = {n}: the base has only {m} modes"
         ))),
         Some(n) => Ok(n),
     }

@@ -76,7 +76,7 @@ fn modes_glb_bytes(base: &ModesFile, params: &ModeGltfParams) -> Result<Vec<u8>,
     }
     if !(params.scale.is_finite() && params.scale > 0.0) {
         return Err(ExportError::Invalid(format!(
-            "--scale must be positive, got {}",
+            "parameter `scale` must be positive, got {}",
             params.scale
         )));
     }

@@ -283,14 +283,14 @@ pub fn tetrahedralize(
 ) -> Result<GmshOutput, GmshError> {
     if !matches!(params.order, 1 | 2) {
         return Err(GmshError::Params(format!(
-            "--order must be 1 or 2, got {}",
+            "parameter `order` must be 1 or 2, got {}",
             params.order
         )));
     }
     let size = match params.size {
         Some(s) if !(s.is_finite() && s > 0.0) => {
             return Err(GmshError::Params(format!(
-                "--size must be a positive length in metres, got {s}"
+                "parameter `size` must be a positive length in metres, got {s}"
             )))
         }
         Some(s) => s,
@@ -341,7 +341,7 @@ pub fn tetrahedralize(
         let hint = if params.keep_surface {
             ""
         } else {
-            " (if the surface cannot be reparametrized, try --keep-surface)"
+            " (if the surface cannot be reparametrized, keep the input surface: parameter `keep_surface`)"
         };
         return Err(GmshError::Failed {
             file: file.to_string(),

@@ -122,6 +122,7 @@ pub fn bake_to_target(
     transfer.check().map_err(terr)?;
     let base_params = BakeParams {
         modes: ModeRequest::Count(TABLE_BASE_MODES),
+        transfer: None,
         ..params.clone()
     };
     let (base20, report20) = bake_mesh(mesh.clone(), &base_params, file, progress)?;
@@ -162,79 +163,19 @@ pub fn bake_to_target(
     let h = transfer.h;
     let cost20 = modal_cost(&set, TABLE_BASE_MODES.min(set.num_modes()), h);
     let mut tried: Vec<Candidate> = Vec::new();
-    let mut chosen: Option<(ModesFile, Candidate)> = None;
-    // Modal candidates.
-    for &m in MODAL_CANDIDATES.iter().filter(|&&m| m <= set.num_modes()) {
-        let cost = modal_cost(&set, m, h);
-        if cost > 2.0 * cost20 {
-            break;
-        }
-        let b = crate::target_error::truncate(&set, &base20, m);
-        let (median_pct, worst_pct) = score(&pairs, b.clone());
-        let c = Candidate {
-            representation: Representation::Modal(m),
-            median_pct,
-            worst_pct,
-            query_cost: cost,
-            payload_bytes: modal_bytes(&set, m),
-        };
-        tried.push(c.clone());
-        if worst_pct <= target_pct {
-            chosen = Some((b, c));
-            break;
-        }
-    }
-    // Table candidates.
+    let mut chosen = try_modal(&set, &base20, &pairs, h, cost20, target_pct, &mut tried);
     if chosen.is_none() {
-        let mut variants: Vec<(TransferModes, TableOrder)> = Vec::new();
-        for modes in [TransferModes::Count(160), TransferModes::All] {
-            for order in [TableOrder::Quadratic, TableOrder::Cubic] {
-                variants.push((modes, order));
-            }
-        }
-        for (modes, order) in variants {
-            if matches!(modes, TransferModes::Count(n) if n >= set.num_modes()) {
-                continue;
-            }
-            let tp = TransferParams {
-                modes,
-                order,
-                ..transfer.clone()
-            };
-            let table = match build_transfer_table(&set, &tp, params.rayleigh, &mut |p| {
-                progress(BakeStage::Transfer(p))
-            }) {
-                Ok(t) => t,
-                // A cubic table too large for the format: the quadratic one stands.
-                Err(TransferError::Params(_)) if order == TableOrder::Cubic => continue,
-                Err(e) => return Err(terr(e)),
-            };
-            let k = match table.order {
-                1 => 3.0,
-                2 => 6.0,
-                _ => 10.0,
-            };
-            let payload = modal_bytes(&base20, TABLE_BASE_MODES) + 4 * table.peaks.len() as u64;
-            let representation = Representation::Table(
-                matches!(modes, TransferModes::Count(_)).then_some(table.modes as usize),
-                table.order,
-            );
-            let mut b = base20.clone();
-            b.transfer = Some(table);
-            let (median_pct, worst_pct) = score(&pairs, b.clone());
-            let c = Candidate {
-                representation,
-                median_pct,
-                worst_pct,
-                query_cost: k * k,
-                payload_bytes: payload,
-            };
-            tried.push(c.clone());
-            if worst_pct <= target_pct {
-                chosen = Some((b, c));
-                break;
-            }
-        }
+        chosen = try_tables(
+            &set,
+            &base20,
+            &pairs,
+            transfer,
+            params.rayleigh,
+            target_pct,
+            &mut tried,
+            progress,
+        )
+        .map_err(terr)?;
     }
     let met = chosen.is_some();
     let (mut base, c) = match chosen {
@@ -252,6 +193,130 @@ pub fn bake_to_target(
             )
         }
     };
+    record_accuracy(&mut base, &c, met, &pairs, h, target_pct, cost20);
+    let mut report = report20;
+    report.modes = base.num_modes();
+    report.frequencies_hz = base.frequencies_hz();
+    report.residuals = base.residuals.clone();
+    report.transfer = base.transfer.as_ref().map(|t| {
+        let source = if dense { "dense" } else { "lanczos" };
+        crate::bake::TransferReport::of(t, source, 0.0, 0.0)
+    });
+    Ok((base, report, tried))
+}
+
+/// The first modal candidate (the lowest m of [`MODAL_CANDIDATES`] costing at most twice the
+/// 20-mode query) whose worst error is within `target_pct`; every one scored is pushed to
+/// `tried`.
+fn try_modal(
+    set: &ModesFile,
+    base20: &ModesFile,
+    pairs: &ReferencePairs,
+    h: f64,
+    cost20: f64,
+    target_pct: f64,
+    tried: &mut Vec<Candidate>,
+) -> Option<(ModesFile, Candidate)> {
+    for &m in MODAL_CANDIDATES.iter().filter(|&&m| m <= set.num_modes()) {
+        let cost = modal_cost(set, m, h);
+        if cost > 2.0 * cost20 {
+            break;
+        }
+        let b = crate::target_error::truncate(set, base20, m);
+        let (median_pct, worst_pct) = score(pairs, b.clone());
+        let c = Candidate {
+            representation: Representation::Modal(m),
+            median_pct,
+            worst_pct,
+            query_cost: cost,
+            payload_bytes: modal_bytes(set, m),
+        };
+        tried.push(c.clone());
+        if worst_pct <= target_pct {
+            return Some((b, c));
+        }
+    }
+    None
+}
+
+/// The first table candidate (160 modes or every mode, quadratic then cubic, over the 20-mode
+/// base) whose worst error is within `target_pct`; every one scored is pushed to `tried`.
+///
+/// # Errors
+/// A table that cannot be built (a cubic table too large for the format is skipped).
+#[allow(clippy::too_many_arguments)]
+fn try_tables(
+    set: &ModesFile,
+    base20: &ModesFile,
+    pairs: &ReferencePairs,
+    transfer: &TransferParams,
+    rayleigh: [f64; 2],
+    target_pct: f64,
+    tried: &mut Vec<Candidate>,
+    progress: &mut dyn FnMut(BakeStage),
+) -> Result<Option<(ModesFile, Candidate)>, TransferError> {
+    let mut variants: Vec<(TransferModes, TableOrder)> = Vec::new();
+    for modes in [TransferModes::Count(160), TransferModes::All] {
+        for order in [TableOrder::Quadratic, TableOrder::Cubic] {
+            variants.push((modes, order));
+        }
+    }
+    for (modes, order) in variants {
+        if matches!(modes, TransferModes::Count(n) if n >= set.num_modes()) {
+            continue;
+        }
+        let tp = TransferParams {
+            modes,
+            order,
+            ..transfer.clone()
+        };
+        let table = match build_transfer_table(set, &tp, rayleigh, &mut |p| {
+            progress(BakeStage::Transfer(p))
+        }) {
+            Ok(t) => t,
+            // A cubic table too large for the format: the quadratic one stands.
+            Err(TransferError::Params(_)) if order == TableOrder::Cubic => continue,
+            Err(e) => return Err(e),
+        };
+        let k = match table.order {
+            1 => 3.0,
+            2 => 6.0,
+            _ => 10.0,
+        };
+        let payload = modal_bytes(base20, TABLE_BASE_MODES) + 4 * table.peaks.len() as u64;
+        let representation = Representation::Table(
+            matches!(modes, TransferModes::Count(_)).then_some(table.modes as usize),
+            table.order,
+        );
+        let mut b = base20.clone();
+        b.transfer = Some(table);
+        let (median_pct, worst_pct) = score(pairs, b.clone());
+        let c = Candidate {
+            representation,
+            median_pct,
+            worst_pct,
+            query_cost: k * k,
+            payload_bytes: payload,
+        };
+        tried.push(c.clone());
+        if worst_pct <= target_pct {
+            return Ok(Some((b, c)));
+        }
+    }
+    Ok(None)
+}
+
+/// Records the chosen candidate `c` in `base`: `meta.accuracy` and, in `meta.bake_params`, the
+/// table's h, modes and order and the target.
+fn record_accuracy(
+    base: &mut ModesFile,
+    c: &Candidate,
+    met: bool,
+    pairs: &ReferencePairs,
+    h: f64,
+    target_pct: f64,
+    cost20: f64,
+) {
     let table_modes = base.transfer.as_ref().map(|t| t.modes as usize);
     let table_order = base.transfer.as_ref().map(|t| t.order);
     base.meta.accuracy = Some(AccuracyRecord {
@@ -280,20 +345,6 @@ pub fn bake_to_target(
     if let Some(obj) = base.meta.bake_params.as_object_mut() {
         obj.insert("target_error_pct".into(), serde_json::json!(target_pct));
     }
-    let mut report = report20;
-    report.modes = base.num_modes();
-    report.frequencies_hz = base.frequencies_hz();
-    report.residuals = base.residuals.clone();
-    if let Some(t) = &base.transfer {
-        report.transfer_vertices = t.len();
-        report.transfer_edges = t.edges.len();
-        report.transfer_order = t.order;
-        report.transfer_points = t.num_points();
-        report.transfer_modes = t.modes as usize;
-        report.transfer_samples = t.samples as usize;
-        report.transfer_mode_source = if dense { "dense" } else { "lanczos" }.into();
-    }
-    Ok((base, report, tried))
 }
 
 /// The candidate `c` built again (when no candidate met the target and the most accurate one

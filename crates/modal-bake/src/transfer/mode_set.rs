@@ -73,6 +73,7 @@ pub fn mode_set_lanczos(
 ) -> Result<ModesFile, TransferError> {
     let p = BakeParams {
         modes: ModeRequest::Count(n),
+        transfer: None,
         ..params.clone()
     };
     bake_mesh(mesh.clone(), &p, file, &mut |_| {})

@@ -119,22 +119,22 @@ impl TransferParams {
     /// Checks ranges.
     ///
     /// # Errors
-    /// [`TransferError::Params`] naming the option.
+    /// [`TransferError::Params`] naming the parameter.
     pub fn check(&self) -> Result<(), TransferError> {
         let bad = |s: String| Err(TransferError::Params(s));
         if !(self.h.is_finite() && self.h > 0.0) {
             return bad(format!(
-                "--transfer-h must be a positive step in seconds, got {}",
+                "parameter `transfer.h` must be a positive step in seconds, got {}",
                 self.h
             ));
         }
         if self.modes == TransferModes::Count(0) {
-            return bad("--transfer-modes must be at least 1".into());
+            return bad("parameter `transfer.modes` must be at least 1".into());
         }
         for b in &self.boxes {
             if !b.iter().all(|x| x.is_finite()) || (0..3).any(|k| b[k] > b[k + 3]) {
                 return bad(format!(
-                    "--transfer-region {b:?}: expected finite xmin,ymin,zmin,xmax,ymax,zmax with min ≤ max"
+                    "parameter `transfer.boxes` = {b:?}: expected finite xmin,ymin,zmin,xmax,ymax,zmax with min ≤ max"
                 ));
             }
         }
@@ -142,18 +142,21 @@ impl TransferParams {
             let l = (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt();
             if !(l.is_finite() && l > 0.0) {
                 return bad(format!(
-                    "--transfer-up {u:?}: expected a finite non-zero direction"
+                    "parameter `transfer.up` = {u:?}: expected a finite non-zero direction"
                 ));
             }
         }
         if !(self.up_min_cos.is_finite() && self.up_min_cos.abs() <= 1.0) {
             return bad(format!(
-                "normal-filter cosine {} must be in [-1, 1]",
+                "parameter `transfer.up_min_cos` = {} must be in [-1, 1]",
                 self.up_min_cos
             ));
         }
         if !(self.oversample.is_finite() && self.oversample >= 1.0) {
-            return bad(format!("oversampling {} must be ≥ 1", self.oversample));
+            return bad(format!(
+                "parameter `transfer.oversample` = {} must be ≥ 1",
+                self.oversample
+            ));
         }
         Ok(())
     }

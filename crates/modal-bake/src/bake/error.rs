@@ -1,0 +1,71 @@
+//! [`BakeError`]: why a bake failed, naming the file and what failed.
+
+use super::MAX_RESIDUAL;
+use crate::eigen::EigenError;
+use crate::fem::MaterialError;
+use crate::mesh::MeshError;
+use dcr_runtime::format::FormatError;
+
+/// Why a bake failed. Every variant names what and where.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum BakeError {
+    /// The mesh could not be read or is invalid (file, line or element in the message).
+    #[error(transparent)]
+    Mesh(#[from] MeshError),
+    /// Material parameters out of range.
+    #[error("invalid material: {0}")]
+    Material(#[from] MaterialError),
+    /// Inconsistent bake parameters.
+    #[error("invalid bake parameters: {0}")]
+    Params(String),
+    /// The mesh has several disconnected pieces.
+    #[error(
+        "{file}: the mesh has {pieces} disconnected pieces; bake each piece as its own object"
+    )]
+    Disconnected {
+        /// Mesh file.
+        file: String,
+        /// Number of connected components.
+        pieces: usize,
+    },
+    /// A free-free object did not show exactly six rigid-body modes.
+    #[error("{file}: expected 6 rigid-body modes for a free-free object, found {found} eigenvalues with |λ| ≤ {tol:.3e} rad²/s² (a mechanism, or a near-singular mesh)")]
+    RigidModes {
+        /// Mesh file.
+        file: String,
+        /// Near-zero eigenvalues found.
+        found: usize,
+        /// Threshold used (rad²/s²).
+        tol: f64,
+    },
+    /// The eigensolver failed or did not converge; nothing is written.
+    #[error("{file}: {error}")]
+    Eigen {
+        /// Mesh file.
+        file: String,
+        /// What the solver reported.
+        error: EigenError,
+    },
+    /// Modes whose residual exceeds [`MAX_RESIDUAL`](super::MAX_RESIDUAL); nothing is written.
+    #[error("{file}: mode {mode} did not converge (relative residual {residual:.3e} > {MAX_RESIDUAL:.0e}); refusing to write the base")]
+    NotConverged {
+        /// Mesh file.
+        file: String,
+        /// 0-based elastic mode index.
+        mode: usize,
+        /// Its relative residual.
+        residual: f64,
+    },
+    /// Writing or reading the `.modes` file failed.
+    #[error(transparent)]
+    Format(#[from] FormatError),
+    /// The peak-transfer table ([`BakeParams::transfer`](super::BakeParams::transfer)) could not be built; nothing is written.
+    #[error("{file}: {error}")]
+    Transfer {
+        /// Mesh file.
+        file: String,
+        /// What failed.
+        error: Box<crate::transfer::TransferError>,
+    },
+}

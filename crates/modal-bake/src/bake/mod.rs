@@ -1,0 +1,29 @@
+//! The bake pipeline: mesh → oriented, validated mesh → K, M → boundary conditions →
+//! lowest elastic modes → surface extraction → [`ModesFile`].
+//!
+//! One file per part: `params` ([`BakeParams`], what determines a result), `error`
+//! ([`BakeError`]), `report` ([`BakeReport`], [`BakeStage`]), `hashing` ([`geometry_hash`]),
+//! `prepare` (orientation, connectivity, fixed-node selection), `surface`
+//! ([`extract_surface`]), `pipeline` ([`bake_mesh`], [`bake_file`]) and `staleness`
+//! ([`base_status`], [`BaseStatus`]).
+
+mod error;
+mod hashing;
+mod params;
+mod pipeline;
+mod prepare;
+mod report;
+mod staleness;
+mod surface;
+
+pub use dcr_runtime::format::{MaterialSi, ModesFile, ModesPrecision};
+
+pub use error::BakeError;
+pub use hashing::{geometry_hash, round_16_digits};
+pub use params::{BakeParams, FixedBelow, ModeRequest};
+pub use pipeline::{
+    bake_file, bake_mesh, MAX_RESIDUAL, OUTPUT_VERSION, RIGID_REL_TOL, TOOL_VERSION,
+};
+pub use report::{BakeReport, BakeStage, TransferReport};
+pub use staleness::{base_status, is_mesh_up_to_date, is_up_to_date, mesh_base_status, BaseStatus};
+pub use surface::extract_surface;

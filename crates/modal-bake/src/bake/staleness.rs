@@ -1,0 +1,159 @@
+//! Whether a base is up to date ([`BaseStatus`]): compared with what a bake would write by
+//! content hashes of the geometry and the parameters, the tool's output version and the
+//! transfer table's recorded parameters — never by file times.
+
+use std::path::Path;
+
+use super::pipeline::transfer_meta;
+use super::prepare::prepare;
+use super::{BakeError, BakeParams, OUTPUT_VERSION};
+use crate::mesh::TetMesh;
+use dcr_runtime::format::ModesFile;
+
+/// Whether `modes` is an up-to-date base of `mesh_path` baked with `params`: it exists, reads,
+/// its stored geometry and parameter hashes equal those of this mesh and these parameters, it
+/// holds the heat-geodesic `surface_order` a bake would store, and its peak-transfer table
+/// matches [`BakeParams::transfer`] (see [`base_status`]).
+///
+/// `Ok(false)` when the base is missing, unreadable or stale.
+///
+/// # Errors
+/// A [`BakeError`] when the mesh itself cannot be read or prepared (what `check` exits 2 on).
+pub fn is_up_to_date(
+    mesh_path: &Path,
+    params: &BakeParams,
+    modes: &Path,
+) -> Result<bool, BakeError> {
+    Ok(base_status(mesh_path, params, modes)? == BaseStatus::UpToDate)
+}
+
+/// Whether a base is up to date, and if not why (what `modal-bake check --json` reports).
+#[derive(Clone, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum BaseStatus {
+    /// The base holds what a bake of this mesh with these options would write.
+    UpToDate,
+    /// No file at the base's path.
+    Missing,
+    /// The file does not read as a valid base (the reader's message).
+    Unreadable(String),
+    /// Written by a `modal-bake` whose output differs ([`OUTPUT_VERSION`]), or without what
+    /// this one stores (the heat-geodesic order).
+    ToolChanged,
+    /// The mesh's geometry or fixed set differs ([`geometry_hash`](super::geometry_hash)).
+    GeometryChanged,
+    /// The bake parameters differ ([`BakeParams::hash`]).
+    ParametersChanged,
+    /// The peak-transfer table is missing, unwanted or built with other parameters.
+    TransferTableChanged,
+}
+
+impl BaseStatus {
+    /// The reason as one word (`up_to_date`, `missing`, `unreadable`, `tool_changed`,
+    /// `geometry_changed`, `parameters_changed`, `transfer_table_changed`).
+    pub fn reason(&self) -> &'static str {
+        match self {
+            BaseStatus::UpToDate => "up_to_date",
+            BaseStatus::Missing => "missing",
+            BaseStatus::Unreadable(_) => "unreadable",
+            BaseStatus::ToolChanged => "tool_changed",
+            BaseStatus::GeometryChanged => "geometry_changed",
+            BaseStatus::ParametersChanged => "parameters_changed",
+            BaseStatus::TransferTableChanged => "transfer_table_changed",
+        }
+    }
+}
+
+/// Compares the base at `modes` with what a bake of `mesh_path` with `params` would write: by
+/// content hashes of the parsed geometry and of the parameters, the [`OUTPUT_VERSION`] of the
+/// tool that wrote it, and the recorded transfer-table parameters — never by file times. A
+/// base is stale when it has a table and none is asked for, has none and one is asked for, or
+/// its table was built with other parameters (step h, modes, region, up direction,
+/// oversampling, order).
+///
+/// # Errors
+/// A [`BakeError`] when the mesh itself cannot be read or prepared, or the parameters are
+/// invalid (what `check` exits 2 on).
+pub fn base_status(
+    mesh_path: &Path,
+    params: &BakeParams,
+    modes: &Path,
+) -> Result<BaseStatus, BakeError> {
+    let file = mesh_path.display().to_string();
+    check_options(params, &file)?;
+    let mesh = crate::mesh::read_mesh(mesh_path)?;
+    mesh_base_status(mesh, &file, params, modes)
+}
+
+/// Checks the bake and transfer-table parameters (what `check` exits 2 on before any mesh work).
+fn check_options(params: &BakeParams, file: &str) -> Result<(), BakeError> {
+    params.check()?;
+    if let Some(tp) = &params.transfer {
+        tp.check().map_err(|error| BakeError::Transfer {
+            file: file.to_string(),
+            error: Box::new(error),
+        })?;
+    }
+    Ok(())
+}
+
+/// As [`is_up_to_date`] for a mesh already in memory (e.g. one gmsh made from a
+/// surface asset); `file` names it in messages.
+///
+/// # Errors
+/// As [`is_up_to_date`].
+pub fn is_mesh_up_to_date(
+    mesh: TetMesh,
+    file: &str,
+    params: &BakeParams,
+    modes: &Path,
+) -> Result<bool, BakeError> {
+    Ok(mesh_base_status(mesh, file, params, modes)? == BaseStatus::UpToDate)
+}
+
+/// As [`base_status`] for a mesh already in memory; `file` names it in messages.
+///
+/// # Errors
+/// As [`base_status`].
+pub fn mesh_base_status(
+    mesh: TetMesh,
+    file: &str,
+    params: &BakeParams,
+    modes: &Path,
+) -> Result<BaseStatus, BakeError> {
+    check_options(params, file)?;
+    let prepared = prepare(mesh, params, file)?;
+    if std::fs::symlink_metadata(modes).is_err() {
+        return Ok(BaseStatus::Missing);
+    }
+    let base = match ModesFile::read(modes) {
+        Ok(base) => base,
+        Err(e) => return Ok(BaseStatus::Unreadable(e.to_string())),
+    };
+    let output_version = base.meta.bake_params.get("output_version");
+    // A base without the stored heat-geodesic order (baked before it existed, or written
+    // elsewhere) is stale when this tool would store one.
+    let order_matches = base.surface_order.is_some()
+        || crate::ordering::plan_surface_order(&base.surface_vertices, &base.surface_triangles)
+            .is_err();
+    if output_version != Some(&serde_json::json!(OUTPUT_VERSION)) || !order_matches {
+        return Ok(BaseStatus::ToolChanged);
+    }
+    if base.meta.source_hash != prepared.hash {
+        return Ok(BaseStatus::GeometryChanged);
+    }
+    if base.meta.params_hash != params.hash() {
+        return Ok(BaseStatus::ParametersChanged);
+    }
+    let table_matches = match &params.transfer {
+        None => base.transfer.is_none(),
+        Some(tp) => {
+            base.transfer.is_some()
+                && base.meta.bake_params.get("transfer") == Some(&transfer_meta(tp))
+        }
+    };
+    if !table_matches {
+        return Ok(BaseStatus::TransferTableChanged);
+    }
+    Ok(BaseStatus::UpToDate)
+}

@@ -1,0 +1,157 @@
+//! Surface extraction: the boundary faces of a tetrahedral mesh (the faces of exactly one
+//! tetrahedron, oriented outward) and the surface a base stores with them.
+
+use crate::mesh::{tet_faces, TetMesh};
+use dcr_runtime::format::QuadraticSurface;
+
+/// The boundary surface of a mesh as the bake stores it.
+pub(super) struct Surface {
+    /// Sorted volume-node indices of the surface vertices.
+    pub(super) nodes: Vec<usize>,
+    /// Their positions (m).
+    pub(super) positions: Vec<[f64; 3]>,
+    /// Outward triangles in surface-vertex indices.
+    pub(super) triangles: Vec<[u32; 3]>,
+    /// The heat geodesic's elimination order, so loading skips AMD and factors less fill.
+    /// A surface the heat method cannot factor (degenerate triangles) simply stores none; the
+    /// runtime reports the problem if the heat method is used.
+    pub(super) order: Option<Vec<u32>>,
+    /// Second-order meshes: the surface edges (surface-vertex pairs, sorted) and the volume
+    /// node of each one's mid-edge node. Empty for a linear mesh.
+    pub(super) edges: Vec<[u32; 2]>,
+    pub(super) edge_nodes: Vec<usize>,
+}
+
+impl Surface {
+    /// `mid_table`: [`TetMesh::edge_mid_nodes`] (empty for a linear mesh).
+    pub(super) fn of(mesh: &TetMesh, mid_table: &[([usize; 2], usize)]) -> Surface {
+        let (nodes, tris) = extract_surface(mesh);
+        let mut local = vec![u32::MAX; mesh.nodes.len()];
+        for (i, &v) in nodes.iter().enumerate() {
+            local[v] = i as u32;
+        }
+        let triangles: Vec<[u32; 3]> = tris.iter().map(|t| t.map(|v| local[v])).collect();
+        let positions: Vec<[f64; 3]> = nodes.iter().map(|&v| mesh.nodes[v]).collect();
+        let order = crate::ordering::plan_surface_order(&positions, &triangles).ok();
+        let (mut edges, mut edge_nodes) = (Vec::new(), Vec::new());
+        if mesh.is_quadratic() {
+            edges = QuadraticSurface::edges_of(&triangles);
+            // Every surface edge is a tet edge, so the look-up succeeds on a mesh that passed
+            // `edge_mid_nodes`; `usize::MAX` would fail the base's validation, not panic.
+            edge_nodes = edges
+                .iter()
+                .map(|&[a, b]| {
+                    let key = [nodes[a as usize], nodes[b as usize]];
+                    mid_table
+                        .binary_search_by(|x| x.0.cmp(&key))
+                        .map_or(usize::MAX, |i| mid_table[i].1)
+                })
+                .collect();
+        }
+        Surface {
+            nodes,
+            positions,
+            triangles,
+            order,
+            edges,
+            edge_nodes,
+        }
+    }
+}
+
+/// Bits per node index in the packed face keys of [`extract_surface`] (3 × 21 ≤ 64).
+const PACK_BITS: u32 = 21;
+
+/// Boundary faces of a tetrahedral mesh, oriented outward, as (sorted surface-vertex list of
+/// volume nodes, triangles in volume-node indices). Deterministic: faces are sorted.
+pub fn extract_surface(mesh: &TetMesh) -> (Vec<usize>, Vec<[usize; 3]>) {
+    let packable = mesh.nodes.len() <= 1 << PACK_BITS && mesh.tets.len() < 1 << 30;
+    let tris = if packable {
+        boundary_faces_packed(&mesh.tets)
+    } else {
+        boundary_faces(&mesh.tets)
+    };
+    let mut verts: Vec<usize> = tris.iter().flatten().copied().collect();
+    verts.sort_unstable();
+    verts.dedup();
+    (verts, tris)
+}
+
+/// A face rotated so its smallest index comes first (canonical, orientation kept).
+fn canonical_face(f: [usize; 3]) -> [usize; 3] {
+    let r = (0..3).min_by_key(|&k| f[k]).unwrap_or(0);
+    [f[r], f[(r + 1) % 3], f[(r + 2) % 3]]
+}
+
+/// The faces that belong to exactly one tet, canonical, in the order of their sorted node
+/// triples.
+fn boundary_faces(tets: &[[usize; 4]]) -> Vec<[usize; 3]> {
+    let mut faces: Vec<([usize; 3], [usize; 3])> = Vec::with_capacity(tets.len() * 4);
+    for &tet in tets {
+        for f in tet_faces(tet) {
+            let mut key = f;
+            key.sort_unstable();
+            faces.push((key, f));
+        }
+    }
+    faces.sort_unstable_by_key(|x| x.0);
+    let mut tris = Vec::new();
+    let mut i = 0;
+    while i < faces.len() {
+        let mut j = i + 1;
+        while j < faces.len() && faces[j].0 == faces[i].0 {
+            j += 1;
+        }
+        if j - i == 1 {
+            tris.push(canonical_face(faces[i].1));
+        }
+        i = j;
+    }
+    tris
+}
+
+/// [`boundary_faces`] for node indices below 2^[`PACK_BITS`] and fewer than 2^30 tets: the
+/// sorted node triple packed into one u64 (same order as the triples) beside the face's
+/// number: 16-byte elements sort about twice as fast as the 48-byte (triple, face)
+/// pairs (docs/benchmarks.md, "Design measurements"). Same result.
+fn boundary_faces_packed(tets: &[[usize; 4]]) -> Vec<[usize; 3]> {
+    let mut faces: Vec<(u64, u32)> = Vec::with_capacity(tets.len() * 4);
+    for (t, &tet) in tets.iter().enumerate() {
+        for (k, mut key) in tet_faces(tet).into_iter().enumerate() {
+            key.sort_unstable();
+            let packed = ((key[0] as u64) << (2 * PACK_BITS))
+                | ((key[1] as u64) << PACK_BITS)
+                | key[2] as u64;
+            faces.push((packed, (4 * t + k) as u32));
+        }
+    }
+    faces.sort_unstable();
+    let same = |j: usize, key: u64| faces.get(j).is_some_and(|&(other, _)| other == key);
+    let mut tris = Vec::new();
+    for (i, &(key, id)) in faces.iter().enumerate() {
+        if !same(i + 1, key) && (i == 0 || !same(i - 1, key)) {
+            let id = id as usize;
+            tris.push(canonical_face(tet_faces(tets[id / 4])[id % 4]));
+        }
+    }
+    tris
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The packed-key boundary faces equal the general ones (same faces, same order), on a
+    /// structured box and on the same box with its tets listed in reverse.
+    #[test]
+    fn packed_boundary_faces_equal_the_general_ones() {
+        let mesh = TetMesh::structured_box([7, 3, 4], [1.0, 0.5, 0.5]);
+        let mut tets = mesh.tets.clone();
+        let general = boundary_faces(&tets);
+        assert_eq!(general.len(), 2 * 2 * (7 * 3 + 7 * 4 + 3 * 4));
+        assert_eq!(boundary_faces_packed(&tets), general);
+        tets.reverse();
+        assert_eq!(boundary_faces_packed(&tets), boundary_faces(&tets));
+        assert_eq!(boundary_faces(&tets), general);
+    }
+}
