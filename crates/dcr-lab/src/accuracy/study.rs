@@ -407,6 +407,7 @@ fn many_mode_set(
         },
     }
 }
+
 /// The paper's spatial attenuation row (Eq. 16, s = C r⁻¹, heat distances, the 20-mode local
 /// amplitude) with C fitted to the truth (median ratio over the pairs), and the fitted C.
 fn attenuation_row(
@@ -415,8 +416,6 @@ fn attenuation_row(
     base20_s: f64,
     name: &str,
 ) -> (MethodRow, f64) {
-    // The paper's spatial attenuation (Eq. 16, s = C r^−1, heat distances, the 20-mode local
-    // amplitude), with C fitted to the truth (median ratio over the pairs).
     let att = |c: f64| {
         Method::Attenuation(dcr_runtime::AttenuationParams {
             law: dcr_runtime::AttenuationLaw::Simplified { c, beta: 1.0 },
