@@ -259,47 +259,9 @@ pub fn study_object(
         "Newmark (β = ¼, γ = ½)"
     };
     // The independent check of the dense sum: Newmark at the step it reached.
-    let cross_check = ma.as_ref().map(|_| {
-        let loads: Vec<Vec<f64>> = pairs
-            .impacts
-            .iter()
-            .map(|i| {
-                let s = sys.surface.project(i.point).expect("on the surface");
-                sys.load_vector(&s, i.direction, i.impulse)
-            })
-            .collect();
-        let rows: Vec<Vec<f64>> = pairs
-            .resting
-            .iter()
-            .map(|c| sys.contact_row(&sys.surface.project(c.point).expect("on the surface")))
-            .collect();
-        let single = RefineParams {
-            max_refinements: 0,
-            ..pp.refine
-        };
-        let w = PeakWindow {
-            h: H,
-            dt: pairs.truth.dt,
-        };
-        let c = converged_peaks(
-            &sys,
-            PeakSolver::Newmark,
-            &loads,
-            &rows,
-            w,
-            &single,
-            &mut |_| {},
-        )
-        .expect("Newmark check");
-        let d = pairs
-            .truth
-            .peaks
-            .iter()
-            .flatten()
-            .zip(c.peaks.iter().flatten())
-            .fold(0.0f64, |m, (a, b)| m.max(((b - a) / a).abs()));
-        ("Newmark".to_string(), 100.0 * d)
-    });
+    let cross_check = ma
+        .as_ref()
+        .map(|_| newmark_cross_check(&sys, &pairs, &pp.refine));
     eprintln!(
         "{name}: truth converged {} at dt {:.2e} s, est. error {:.3} %, {:.0} s",
         pairs.truth.converged,
@@ -311,21 +273,8 @@ pub fn study_object(
     // The many-mode set: every dense mode, or a Lanczos bake of 640.
     eprintln!("{name}: mode set…");
     let t = Instant::now();
-    let (set, set_label) = match (&ma, dense) {
-        (Some(m), _) => (
-            mode_set_from_dense(&base20, &sys, m, m.eigenvalues.len()),
-            format!("all {}", m.eigenvalues.len()),
-        ),
-        _ => match mode_set_lanczos(&mesh, &bp, AUTO_LANCZOS_MODES, &file) {
-            Ok(b) => (b, AUTO_LANCZOS_MODES.to_string()),
-            Err(e) => {
-                notes.push(format!(
-                    "the {AUTO_LANCZOS_MODES}-mode Lanczos bake failed: {e}"
-                ));
-                (base20.clone(), BASE_MODES.to_string())
-            }
-        },
-    };
+    let (set, set_label) =
+        many_mode_set(ma.as_ref(), &base20, &sys, (&mesh, &bp, &file), &mut notes);
     let set_s = if dense {
         dense_s
     } else {
@@ -355,8 +304,118 @@ pub fn study_object(
             name,
         ));
     }
-    // The paper's spatial attenuation (Eq. 16, s = C r^−1, heat distances, the 20-mode local
-    // amplitude), with C fitted to the truth (median ratio over the pairs).
+    let (att_row, c_fit) = attenuation_row(&bench, &base20, base20_s, name);
+    out.push(att_row);
+    out.extend(table_rows(
+        &bench,
+        spec,
+        (&set, &set_label),
+        (&base20, base20_s + set_s),
+        quick,
+        &mut notes,
+    ));
+    ObjectStudy {
+        spec: spec.clone(),
+        nodes,
+        tets,
+        dofs,
+        region: region.len(),
+        truth_method: truth_method.into(),
+        truth: pairs.truth.clone(),
+        cross_check,
+        truth_s,
+        points: (pairs.impacts.len(), pairs.resting.len()),
+        pairs: pairs.pairs(),
+        rows: out,
+        attenuation_c: c_fit,
+        notes,
+    }
+}
+
+/// The independent check of the dense all-mode truth: Newmark (no refinement) at the step the
+/// truth reached, for the same impacts and resting contacts. Returns the solver's name and the
+/// worst relative difference of the peaks (%).
+fn newmark_cross_check(
+    sys: &FullOrderSystem,
+    pairs: &ReferencePairs,
+    refine: &RefineParams,
+) -> (String, f64) {
+    let loads: Vec<Vec<f64>> = pairs
+        .impacts
+        .iter()
+        .map(|i| {
+            let s = sys.surface.project(i.point).expect("on the surface");
+            sys.load_vector(&s, i.direction, i.impulse)
+        })
+        .collect();
+    let rows: Vec<Vec<f64>> = pairs
+        .resting
+        .iter()
+        .map(|c| sys.contact_row(&sys.surface.project(c.point).expect("on the surface")))
+        .collect();
+    let single = RefineParams {
+        max_refinements: 0,
+        ..*refine
+    };
+    let w = PeakWindow {
+        h: H,
+        dt: pairs.truth.dt,
+    };
+    let c = converged_peaks(
+        sys,
+        PeakSolver::Newmark,
+        &loads,
+        &rows,
+        w,
+        &single,
+        &mut |_| {},
+    )
+    .expect("Newmark check");
+    let d = pairs
+        .truth
+        .peaks
+        .iter()
+        .flatten()
+        .zip(c.peaks.iter().flatten())
+        .fold(0.0f64, |m, (a, b)| m.max(((b - a) / a).abs()));
+    ("Newmark".to_string(), 100.0 * d)
+}
+
+/// The many-mode set the tables are built from and its label: every dense mode (`ma`), or a
+/// Lanczos bake of [`AUTO_LANCZOS_MODES`] of `mesh` with `bp` (`file`: its name in errors);
+/// if that fails, the 20-mode base, with a note.
+fn many_mode_set(
+    ma: Option<&ModalAll>,
+    base20: &ModesFile,
+    sys: &FullOrderSystem,
+    (mesh, bp, file): (&TetMesh, &BakeParams, &str),
+    notes: &mut Vec<String>,
+) -> (ModesFile, String) {
+    match ma {
+        Some(m) => (
+            mode_set_from_dense(base20, sys, m, m.eigenvalues.len()),
+            format!("all {}", m.eigenvalues.len()),
+        ),
+        None => match mode_set_lanczos(mesh, bp, AUTO_LANCZOS_MODES, file) {
+            Ok(b) => (b, AUTO_LANCZOS_MODES.to_string()),
+            Err(e) => {
+                notes.push(format!(
+                    "the {AUTO_LANCZOS_MODES}-mode Lanczos bake failed: {e}"
+                ));
+                (base20.clone(), BASE_MODES.to_string())
+            }
+        },
+    }
+}
+
+/// The paper's spatial attenuation row (Eq. 16, s = C r⁻¹, heat distances, the 20-mode local
+/// amplitude) with C fitted to the truth (median ratio over the pairs), and the fitted C.
+fn attenuation_row(
+    bench: &Bench,
+    base20: &ModesFile,
+    base20_s: f64,
+    name: &str,
+) -> (MethodRow, f64) {
     let att = |c: f64| {
         Method::Attenuation(dcr_runtime::AttenuationParams {
             law: dcr_runtime::AttenuationLaw::Simplified { c, beta: 1.0 },
@@ -388,7 +447,22 @@ pub fn study_object(
         c_fit,
     );
     att_row.query_us = probe.query_us;
-    out.push(att_row);
+    (att_row, c_fit)
+}
+
+/// The transfer-table rows: the default (auto modes, auto order, marked best) and cheaper or
+/// lower-order variants, built from the many-mode `set` (labelled `set_label`) on `base20`;
+/// `base_s`: seconds to bake the 20-mode base and the set. A failed build adds a note.
+fn table_rows(
+    bench: &Bench,
+    spec: &ObjectSpec,
+    (set, set_label): (&ModesFile, &str),
+    (base20, base_s): (&ModesFile, f64),
+    quick: bool,
+    notes: &mut Vec<String>,
+) -> Vec<MethodRow> {
+    let name = spec.name;
+    let mut out = Vec::new();
     // Tables: the default (auto modes, auto order) and cheaper or lower-order variants.
     let mut variants: Vec<(TransferModes, TableOrder, bool)> = vec![
         (TransferModes::All, TableOrder::Auto, true),
@@ -411,7 +485,7 @@ pub fn study_object(
             ..Default::default()
         };
         let t = Instant::now();
-        let table = match build_transfer_table(&set, &tp, base20.rayleigh, &mut |_| {}) {
+        let table = match build_transfer_table(set, &tp, base20.rayleigh, &mut |_| {}) {
             Ok(t) => t,
             Err(e) => {
                 notes.push(format!("table ({modes:?}, {order:?}) failed: {e}"));
@@ -425,7 +499,7 @@ pub fn study_object(
         let used = if matches!(modes, TransferModes::Count(_)) {
             table.modes.to_string()
         } else {
-            set_label.clone()
+            set_label.to_string()
         };
         eprintln!(
             "{name}: table, {used} modes, order {}, {} points, built in {build_s:.1} s…",
@@ -440,27 +514,12 @@ pub fn study_object(
         );
         let mut b = base20.clone();
         b.transfer = Some(table);
-        let bake_s = base20_s + set_s + build_s;
+        let bake_s = base_s + build_s;
         let mut row = bench.row(label, b, ServedBy::TransferTable, bake_s, name);
         row.best = best;
         out.push(row);
     }
-    ObjectStudy {
-        spec: spec.clone(),
-        nodes,
-        tets,
-        dofs,
-        region: region.len(),
-        truth_method: truth_method.into(),
-        truth: pairs.truth.clone(),
-        cross_check,
-        truth_s,
-        points: (pairs.impacts.len(), pairs.resting.len()),
-        pairs: pairs.pairs(),
-        rows: out,
-        attenuation_c: c_fit,
-        notes,
-    }
+    out
 }
 
 /// Median of `v` (NaN when empty).

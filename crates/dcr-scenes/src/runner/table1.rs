@@ -1,14 +1,14 @@
 //! `dcr-scenes table1`: every scene on and off, our Table 1 columns beside the paper's.
 
 use std::collections::BTreeMap;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::Result;
 use serde_json::{json, Value};
 
 use dcr_rapier::f64::{ApplyMode, StepGate};
 
-use crate::runner::{run_scene, MethodChoice, RunParams, RunReport};
+use crate::runner::{run_scene, MethodChoice, ModelReport, RunParams, RunReport};
 use crate::scene::SceneDesc;
 
 /// One row of the paper's Table 1.
@@ -107,194 +107,29 @@ fn fmt_opt(x: Option<f64>, scale: f64, prec: usize) -> String {
 pub fn table1(p: &Table1Params) -> Result<(String, Value)> {
     let paper = paper_rows();
     let mut entries = Vec::new();
-    let mut text = String::new();
-    text.push_str(&format!(
-        "{:9} {:8} {:>12} {:>13} {:>9} {:>6} {:>15} {:>10} {:>22} {:>8}\n",
-        "scene",
-        "model",
-        "vertices",
-        "triangles",
-        "modes",
-        "h",
-        "T (s)",
-        "contacts",
-        "query ms med/p99",
-        "share"
-    ));
-    text.push_str(&format!(
-        "{:9} {:8} {:>12} {:>13} {:>9} {:>6} {:>15} {:>10} {:>22} {:>8}\n",
-        "",
-        "",
-        "ours/paper",
-        "ours/paper",
-        "",
-        "",
-        "ours/paper",
-        "ours/paper",
-        "ours (paper mean)",
-        "of step"
-    ));
+    let mut text = table_header();
     let mut outcome_lines = String::new();
     for name in &p.scenes {
         let desc = SceneDesc::read(&p.root.join("scenes").join(format!("{name}.json")))?;
-        let run_eta = |dcr: bool, method: MethodChoice, eta: Option<f64>| -> Result<RunReport> {
-            eprintln!(
-                "[dcr-scenes] table1: {name} dcr {}{}",
-                if dcr { "on" } else { "off" },
-                match (dcr, eta) {
-                    (false, _) => String::new(),
-                    (true, None) => " (no energy bound)".into(),
-                    (true, Some(e)) => format!(" (eta {e})"),
-                }
-            );
-            run_scene(
-                &desc,
-                &RunParams {
-                    seconds: p.seconds,
-                    method,
-                    out_dir: None,
-                    progress: true,
-                    bases_dir: p.bases_dir.clone(),
-                    apply: p.apply,
-                    energy_eta: eta,
-                    lateral_kick: p.lateral_kick,
-                    contact_recycling: p.contact_recycling,
-                    gate: p.gate,
-                    ..RunParams::new(p.root.clone(), dcr)
-                },
-            )
-        };
-        let run = |dcr: bool, method: MethodChoice| run_eta(dcr, method, p.energy_eta);
+        let run =
+            |dcr: bool, method: MethodChoice| run_one(p, (name, &desc), dcr, method, p.energy_eta);
         let on = run(true, MethodChoice::Scene)?;
         let off = run(false, MethodChoice::Scene)?;
         if let Some(dir) = &p.gltf_dir {
-            std::fs::create_dir_all(dir)?;
-            let path = dir.join(format!("{name}.glb"));
-            let sides = [&on, &off].map(|r| crate::export::Side {
-                label: crate::export::side_label(r),
-                report: r,
-            });
-            crate::export::write_scene_glb(&desc, &p.root, &p.bases_dir, &sides, &path)?;
-            eprintln!(
-                "[dcr-scenes] table1: {name} on/off glTF: {}",
-                path.display()
-            );
+            write_on_off_glb(p, (name, &desc), dir, &on, &off)?;
         }
-        // Energy-bound sweep: the unbounded run, then each η.
-        let mut sweep = Vec::new();
-        if !p.eta_sweep.is_empty() {
-            let free = if p.energy_eta.is_none() {
-                on.clone()
-            } else {
-                run_eta(true, MethodChoice::Scene, None)?
-            };
-            let mut rows = vec![(None, free)];
-            for &eta in &p.eta_sweep {
-                let r = if p.energy_eta == Some(eta) {
-                    on.clone()
-                } else {
-                    run_eta(true, MethodChoice::Scene, Some(eta))?
-                };
-                rows.push((Some(eta), r));
-            }
-            let reference = rows[0].1.outcomes.clone();
-            for (eta, r) in &rows {
-                let label = eta.map_or("none".to_string(), |e| e.to_string());
-                let mut outs = serde_json::Map::new();
-                let mut moved = Vec::new();
-                for (k, (v, unit)) in &r.outcomes {
-                    let base = reference.get(k).map_or(*v, |x| x.0);
-                    let ch = changed(*v, base);
-                    if ch {
-                        moved.push(k.clone());
-                    }
-                    outs.insert(k.clone(), json!({"value": v, "unit": unit, "changed": ch}));
-                }
-                outcome_lines.push_str(&format!(
-                    "  {:9} {:28} eta {:>5}: injected {:.4e} J, dissipated {:.4e} J, limited steps {}; changed: {}\n",
-                    name,
-                    "energy bound",
-                    label,
-                    r.injected_ke,
-                    r.dissipated,
-                    r.models.iter().map(|m| m.stats.energy_limited_steps).sum::<usize>(),
-                    if moved.is_empty() { "none".to_string() } else { moved.join(", ") }
-                ));
-                sweep.push(json!({
-                    "energy_eta": eta,
-                    "outcomes": outs,
-                    "injected_ke_j": r.injected_ke,
-                    "dissipated_j": r.dissipated,
-                    "energy_limited_steps": r.models.iter().map(|m| m.stats.energy_limited_steps).sum::<usize>(),
-                }));
-            }
-        }
-        let mut outcomes = serde_json::Map::new();
-        for (k, (v, unit)) in &on.outcomes {
-            let off_v = off.outcomes.get(k).map(|x| x.0);
-            outcomes.insert(k.clone(), json!({"on": v, "off": off_v, "unit": unit}));
-            outcome_lines.push_str(&format!(
-                "  {:9} {:28} on {:>10.3}  off {:>10.3} {}\n",
-                name,
-                k,
-                v,
-                off_v.unwrap_or(f64::NAN),
-                unit
-            ));
-        }
-        outcome_lines.push_str(&format!(
-            "  {:9} {:28} injected {:.4e} J <= dissipated {:.4e} J: {}\n",
-            name,
-            "energy (on)",
-            on.injected_ke,
-            on.dissipated,
-            on.injected_ke <= on.dissipated
-        ));
-        let mut extra = Vec::new();
-        if name == "scaffold" {
-            for &beta in &p.scaffold_betas {
-                let r = run(true, MethodChoice::AttenuationBeta(beta))?;
-                let outs: BTreeMap<_, _> = r
-                    .outcomes
-                    .iter()
-                    .map(|(k, (v, u))| (k.clone(), json!({"value": v, "unit": u})))
-                    .collect();
-                for (k, (v, u)) in &r.outcomes {
-                    outcome_lines.push_str(&format!(
-                        "  {:9} {:28} attenuation beta {beta}: {v:.3} {u}\n",
-                        name, k
-                    ));
-                }
-                let m = &r.models[0];
-                extra.push(json!({"beta": beta, "outcomes": outs, "query_us_median": m.query_us_median, "query_us_p99": m.query_us_p99}));
-            }
-        }
+        let sweep = energy_sweep(p, (name, &desc), &on, &mut outcome_lines)?;
+        let outcomes = on_off_outcomes(name, &on, &off, &mut outcome_lines);
+        let extra = if name == "scaffold" {
+            attenuation_runs(p, (name, &desc), &mut outcome_lines)?
+        } else {
+            Vec::new()
+        };
         for m in &on.models {
             let pr = paper
                 .iter()
                 .find(|r| r.scene == name.as_str() && r.model == m.model);
-            text.push_str(&format!(
-                "{:9} {:8} {:>12} {:>13} {:>9} {:>6} {:>15} {:>10} {:>22} {:>7.1}%\n",
-                name,
-                m.model,
-                format!("{}/{}", m.surface_vertices, pr.map_or(0, |r| r.vertices)),
-                format!("{}/{}", m.surface_triangles, pr.map_or(0, |r| r.triangles)),
-                format!("{}/{}", m.modes, pr.map_or(0, |r| r.modes)),
-                on.h,
-                format!(
-                    "{}/{:.1e}",
-                    fmt_opt(m.iir_t, 1.0, 6),
-                    pr.map_or(0.0, |r| r.t)
-                ),
-                format!("{}/{}", m.distant_contacts, pr.map_or(0, |r| r.contacts)),
-                format!(
-                    "{}/{} ({})",
-                    fmt_opt(m.query_us_median, 1e-3, 3),
-                    fmt_opt(m.query_us_p99, 1e-3, 3),
-                    pr.map_or(0.0, |r| r.ms)
-                ),
-                100.0 * on.dcr_share_of_step
-            ));
+            text.push_str(&model_row(name, m, pr, &on));
             entries.push(json!({
                 "name": name,
                 "model": m.model,
@@ -335,4 +170,247 @@ pub fn table1(p: &Table1Params) -> Result<(String, Value)> {
     text.push_str("\noutcomes (response on vs off):\n");
     text.push_str(&outcome_lines);
     Ok((text, json!({"scenes": entries})))
+}
+
+/// The table's two header lines (column names; which columns hold ours/paper).
+fn table_header() -> String {
+    let mut text = String::new();
+    text.push_str(&format!(
+        "{:9} {:8} {:>12} {:>13} {:>9} {:>6} {:>15} {:>10} {:>22} {:>8}\n",
+        "scene",
+        "model",
+        "vertices",
+        "triangles",
+        "modes",
+        "h",
+        "T (s)",
+        "contacts",
+        "query ms med/p99",
+        "share"
+    ));
+    text.push_str(&format!(
+        "{:9} {:8} {:>12} {:>13} {:>9} {:>6} {:>15} {:>10} {:>22} {:>8}\n",
+        "",
+        "",
+        "ours/paper",
+        "ours/paper",
+        "",
+        "",
+        "ours/paper",
+        "ours/paper",
+        "ours (paper mean)",
+        "of step"
+    ));
+    text
+}
+
+/// One run of scene `desc` (named `name` in the table) with the table's settings: response on or off, `method`, energy
+/// bound `eta` (`None`: unbounded).
+fn run_one(
+    p: &Table1Params,
+    (name, desc): (&str, &SceneDesc),
+    dcr: bool,
+    method: MethodChoice,
+    eta: Option<f64>,
+) -> Result<RunReport> {
+    eprintln!(
+        "[dcr-scenes] table1: {name} dcr {}{}",
+        if dcr { "on" } else { "off" },
+        match (dcr, eta) {
+            (false, _) => String::new(),
+            (true, None) => " (no energy bound)".into(),
+            (true, Some(e)) => format!(" (eta {e})"),
+        }
+    );
+    run_scene(
+        desc,
+        &RunParams {
+            seconds: p.seconds,
+            method,
+            out_dir: None,
+            progress: true,
+            bases_dir: p.bases_dir.clone(),
+            apply: p.apply,
+            energy_eta: eta,
+            lateral_kick: p.lateral_kick,
+            contact_recycling: p.contact_recycling,
+            gate: p.gate,
+            ..RunParams::new(p.root.clone(), dcr)
+        },
+    )
+}
+
+/// Writes the on and off runs of scene `desc` side by side as `dir/NAME.glb`.
+fn write_on_off_glb(
+    p: &Table1Params,
+    (name, desc): (&str, &SceneDesc),
+    dir: &Path,
+    on: &RunReport,
+    off: &RunReport,
+) -> Result<()> {
+    std::fs::create_dir_all(dir)?;
+    let path = dir.join(format!("{name}.glb"));
+    let sides = [on, off].map(|r| crate::export::Side {
+        label: crate::export::side_label(r),
+        report: r,
+    });
+    crate::export::write_scene_glb(desc, &p.root, &p.bases_dir, &sides, &path)?;
+    eprintln!(
+        "[dcr-scenes] table1: {name} on/off glTF: {}",
+        path.display()
+    );
+    Ok(())
+}
+
+/// Energy-bound sweep (empty without `p.eta_sweep`): the unbounded run, then each η, every
+/// outcome flagged where it moves by more than [`CHANGE_REL`] from the unbounded run. Reuses
+/// `on` where its bound matches; appends one line per run to `outcome_lines`.
+fn energy_sweep(
+    p: &Table1Params,
+    (name, desc): (&str, &SceneDesc),
+    on: &RunReport,
+    outcome_lines: &mut String,
+) -> Result<Vec<Value>> {
+    let mut sweep = Vec::new();
+    if p.eta_sweep.is_empty() {
+        return Ok(sweep);
+    }
+    let free = if p.energy_eta.is_none() {
+        on.clone()
+    } else {
+        run_one(p, (name, desc), true, MethodChoice::Scene, None)?
+    };
+    let mut rows = vec![(None, free)];
+    for &eta in &p.eta_sweep {
+        let r = if p.energy_eta == Some(eta) {
+            on.clone()
+        } else {
+            run_one(p, (name, desc), true, MethodChoice::Scene, Some(eta))?
+        };
+        rows.push((Some(eta), r));
+    }
+    let reference = rows[0].1.outcomes.clone();
+    for (eta, r) in &rows {
+        let label = eta.map_or("none".to_string(), |e| e.to_string());
+        let mut outs = serde_json::Map::new();
+        let mut moved = Vec::new();
+        for (k, (v, unit)) in &r.outcomes {
+            let base = reference.get(k).map_or(*v, |x| x.0);
+            let ch = changed(*v, base);
+            if ch {
+                moved.push(k.clone());
+            }
+            outs.insert(k.clone(), json!({"value": v, "unit": unit, "changed": ch}));
+        }
+        outcome_lines.push_str(&format!(
+            "  {:9} {:28} eta {:>5}: injected {:.4e} J, dissipated {:.4e} J, limited steps {}; changed: {}\n",
+            name,
+            "energy bound",
+            label,
+            r.injected_ke,
+            r.dissipated,
+            r.models.iter().map(|m| m.stats.energy_limited_steps).sum::<usize>(),
+            if moved.is_empty() { "none".to_string() } else { moved.join(", ") }
+        ));
+        sweep.push(json!({
+            "energy_eta": eta,
+            "outcomes": outs,
+            "injected_ke_j": r.injected_ke,
+            "dissipated_j": r.dissipated,
+            "energy_limited_steps": r.models.iter().map(|m| m.stats.energy_limited_steps).sum::<usize>(),
+        }));
+    }
+    Ok(sweep)
+}
+
+/// Every outcome of the `on` run beside the `off` run's (`{on, off, unit}` by name), with one
+/// line each and the energy balance of the `on` run appended to `outcome_lines`.
+fn on_off_outcomes(
+    name: &str,
+    on: &RunReport,
+    off: &RunReport,
+    outcome_lines: &mut String,
+) -> serde_json::Map<String, Value> {
+    let mut outcomes = serde_json::Map::new();
+    for (k, (v, unit)) in &on.outcomes {
+        let off_v = off.outcomes.get(k).map(|x| x.0);
+        outcomes.insert(k.clone(), json!({"on": v, "off": off_v, "unit": unit}));
+        outcome_lines.push_str(&format!(
+            "  {:9} {:28} on {:>10.3}  off {:>10.3} {}\n",
+            name,
+            k,
+            v,
+            off_v.unwrap_or(f64::NAN),
+            unit
+        ));
+    }
+    outcome_lines.push_str(&format!(
+        "  {:9} {:28} injected {:.4e} J <= dissipated {:.4e} J: {}\n",
+        name,
+        "energy (on)",
+        on.injected_ke,
+        on.dissipated,
+        on.injected_ke <= on.dissipated
+    ));
+    outcomes
+}
+
+/// Runs with the attenuation method at each of `p.scaffold_betas` (response on): their
+/// outcomes and first model's query times, one line per outcome appended to `outcome_lines`.
+fn attenuation_runs(
+    p: &Table1Params,
+    (name, desc): (&str, &SceneDesc),
+    outcome_lines: &mut String,
+) -> Result<Vec<Value>> {
+    let mut extra = Vec::new();
+    for &beta in &p.scaffold_betas {
+        let r = run_one(
+            p,
+            (name, desc),
+            true,
+            MethodChoice::AttenuationBeta(beta),
+            p.energy_eta,
+        )?;
+        let outs: BTreeMap<_, _> = r
+            .outcomes
+            .iter()
+            .map(|(k, (v, u))| (k.clone(), json!({"value": v, "unit": u})))
+            .collect();
+        for (k, (v, u)) in &r.outcomes {
+            outcome_lines.push_str(&format!(
+                "  {:9} {:28} attenuation beta {beta}: {v:.3} {u}\n",
+                name, k
+            ));
+        }
+        let m = &r.models[0];
+        extra.push(json!({"beta": beta, "outcomes": outs, "query_us_median": m.query_us_median, "query_us_p99": m.query_us_p99}));
+    }
+    Ok(extra)
+}
+
+/// The table line of model `m` of the `on` run of scene `name`: ours beside the paper's row
+/// `pr` (zeros without one).
+fn model_row(name: &str, m: &ModelReport, pr: Option<&PaperRow>, on: &RunReport) -> String {
+    format!(
+        "{:9} {:8} {:>12} {:>13} {:>9} {:>6} {:>15} {:>10} {:>22} {:>7.1}%\n",
+        name,
+        m.model,
+        format!("{}/{}", m.surface_vertices, pr.map_or(0, |r| r.vertices)),
+        format!("{}/{}", m.surface_triangles, pr.map_or(0, |r| r.triangles)),
+        format!("{}/{}", m.modes, pr.map_or(0, |r| r.modes)),
+        on.h,
+        format!(
+            "{}/{:.1e}",
+            fmt_opt(m.iir_t, 1.0, 6),
+            pr.map_or(0.0, |r| r.t)
+        ),
+        format!("{}/{}", m.distant_contacts, pr.map_or(0, |r| r.contacts)),
+        format!(
+            "{}/{} ({})",
+            fmt_opt(m.query_us_median, 1e-3, 3),
+            fmt_opt(m.query_us_p99, 1e-3, 3),
+            pr.map_or(0.0, |r| r.ms)
+        ),
+        100.0 * on.dcr_share_of_step
+    )
 }

@@ -8,7 +8,10 @@ use anyhow::{bail, Context, Result};
 use rapier3d_f64::math::{Pose, Rotation, Vector};
 use rapier3d_f64::prelude::*;
 
-use super::scene_desc::{name_matches, BodyKind, ColliderDesc, PoseDesc, SceneDesc, ShapeDesc};
+use super::scene_desc::{
+    name_matches, BodyKind, ColliderDesc, ElasticDesc, JointDesc, PoseDesc, PropDesc, SceneDesc,
+    ShapeDesc,
+};
 
 /// One body of the built world.
 #[derive(Clone, Debug)]
@@ -95,11 +98,34 @@ pub fn build_world(desc: &SceneDesc, root: &Path) -> Result<BuiltWorld> {
     let mut world = PhysicsWorld::new();
     world.gravity = v3(desc.gravity);
     world.integration_parameters.dt = desc.h;
-    let mut bodies = Vec::new();
-    let mut collider_body = HashMap::new();
-    let mut elastic_body = Vec::new();
-
+    let mut built = BuiltWorld {
+        world,
+        bodies: Vec::new(),
+        collider_body: HashMap::new(),
+        elastic_body: Vec::new(),
+    };
     for (ei, e) in desc.elastic.iter().enumerate() {
+        built.add_elastic(desc, root, ei, e)?;
+    }
+    for p in &desc.props {
+        built.add_prop(desc, p)?;
+    }
+    for j in &desc.joints {
+        built.add_joint(j)?;
+    }
+    Ok(built)
+}
+
+impl BuiltWorld {
+    /// Adds elastic object `ei` (`e`): a fixed or dynamic body at its pose with its
+    /// colliders (see [`elastic_colliders`]), friction `e.friction`, the scene's restitution.
+    fn add_elastic(
+        &mut self,
+        desc: &SceneDesc,
+        root: &Path,
+        ei: usize,
+        e: &ElasticDesc,
+    ) -> Result<()> {
         let pose = pose_from_desc(&e.pose);
         let (rb, dynamic) = match &e.body {
             BodyKind::Static => (RigidBodyBuilder::fixed().pose(pose), false),
@@ -108,67 +134,30 @@ pub fn build_world(desc: &SceneDesc, root: &Path) -> Result<BuiltWorld> {
                 true,
             ),
         };
-        let handle = world.insert_body(rb);
-        let idx = bodies.len();
-        let mut builders = Vec::new();
-        match &e.colliders {
-            None => {
-                if dynamic {
-                    bail!(
-                        "elastic object {}: a dynamic body needs primitive `colliders`",
-                        e.name
-                    );
-                }
-                let mesh_path = root.join(&e.mesh);
-                let mesh = modal_bake::mesh::read_mesh(&mesh_path)
-                    .with_context(|| format!("reading mesh {}", mesh_path.display()))?;
-                let (_, tris) = modal_bake::bake::extract_surface(&mesh);
-                let verts: Vec<Vector> = mesh.nodes.iter().map(|p| v3(*p)).collect();
-                let idx_tris: Vec<[u32; 3]> = tris
-                    .iter()
-                    .map(|t| [t[0] as u32, t[1] as u32, t[2] as u32])
-                    .collect();
-                let b = ColliderBuilder::trimesh_with_flags(
-                    verts.clone(),
-                    idx_tris.clone(),
-                    TriMeshFlags::FIX_INTERNAL_EDGES,
-                )
-                .or_else(|_| ColliderBuilder::trimesh(verts, idx_tris))
-                .map_err(|err| anyhow::anyhow!("trimesh of {}: {err:?}", e.name))?;
-                builders.push(b);
-            }
-            Some(cs) => {
-                let vol: f64 = cs.iter().map(collider_volume).sum::<Result<f64>>()?;
-                let density = match &e.body {
-                    BodyKind::Dynamic { mass } => mass / vol,
-                    BodyKind::Static => 1.0,
-                };
-                for c in cs {
-                    builders.push(
-                        shape_builder(&c.shape)?
-                            .position(pose_from_desc(&c.offset))
-                            .density(density),
-                    );
-                }
-            }
-        }
+        let handle = self.world.insert_body(rb);
+        let idx = self.bodies.len();
+        let builders = elastic_colliders(e, dynamic, root)?;
         for b in builders {
-            let ch = world.insert_collider(
+            let ch = self.world.insert_collider(
                 b.friction(e.friction).restitution(desc.restitution),
                 Some(handle),
             );
-            collider_body.insert(ch, idx);
+            self.collider_body.insert(ch, idx);
         }
-        bodies.push(BodyInfo {
+        self.bodies.push(BodyInfo {
             name: e.name.clone(),
             handle,
             elastic: Some(ei),
             dynamic,
         });
-        elastic_body.push(idx);
+        self.elastic_body.push(idx);
+        Ok(())
     }
 
-    for p in &desc.props {
+    /// Adds prop `p`: one body per copy (`name_i` when it has copies) at its pose, offset by
+    /// the copy's translation and placed in its `relative_to` object's frame, its colliders
+    /// sharing the density that gives the prop its mass.
+    fn add_prop(&mut self, desc: &SceneDesc, p: &PropDesc) -> Result<()> {
         let vol: f64 = p
             .colliders
             .iter()
@@ -178,19 +167,7 @@ pub fn build_world(desc: &SceneDesc, root: &Path) -> Result<BuiltWorld> {
             bail!("prop {}: mass and collider volume must be positive", p.name);
         }
         let density = p.mass / vol;
-        let frame = match &p.relative_to {
-            None => Pose::IDENTITY,
-            Some(name) => {
-                let e = desc.elastic.iter().find(|e| &e.name == name);
-                let Some(e) = e else {
-                    bail!(
-                        "prop {}: relative_to names no elastic object {name}",
-                        p.name
-                    )
-                };
-                pose_from_desc(&e.pose)
-            }
-        };
+        let frame = prop_frame(desc, p)?;
         let base = pose_from_desc(&p.pose);
         let copies: Vec<([f64; 3], String)> = if p.copies.is_empty() {
             vec![([0.0; 3], p.name.clone())]
@@ -217,27 +194,31 @@ pub fn build_world(desc: &SceneDesc, root: &Path) -> Result<BuiltWorld> {
                 .linear_damping(p.linear_damping)
                 .angular_damping(p.angular_damping)
                 .ccd_enabled(p.ccd);
-            let handle = world.insert_body(rb);
-            let idx = bodies.len();
+            let handle = self.world.insert_body(rb);
+            let idx = self.bodies.len();
             for c in &p.colliders {
                 let b = shape_builder(&c.shape)?
                     .position(pose_from_desc(&c.offset))
                     .density(density)
                     .friction(p.friction)
                     .restitution(desc.restitution);
-                let ch = world.insert_collider(b, Some(handle));
-                collider_body.insert(ch, idx);
+                let ch = self.world.insert_collider(b, Some(handle));
+                self.collider_body.insert(ch, idx);
             }
-            bodies.push(BodyInfo {
+            self.bodies.push(BodyInfo {
                 name,
                 handle,
                 elastic: None,
                 dynamic: !p.fixed,
             });
         }
+        Ok(())
     }
 
-    for j in &desc.joints {
+    /// Adds joint `j`: a spring-loaded revolute joint from body `j.body1` to every body
+    /// matching `j.body2`, at rest at the bodies' initial relative angle.
+    fn add_joint(&mut self, j: &JointDesc) -> Result<()> {
+        let bodies = &self.bodies;
         let i1 = bodies
             .iter()
             .position(|b| b.name == j.body1)
@@ -249,8 +230,8 @@ pub fn build_world(desc: &SceneDesc, root: &Path) -> Result<BuiltWorld> {
             bail!("joint: no body matches {}", j.body2);
         }
         for i2 in children {
-            let p1 = *world.bodies[bodies[i1].handle].position();
-            let p2 = *world.bodies[bodies[i2].handle].position();
+            let p1 = *self.world.bodies[bodies[i1].handle].position();
+            let p2 = *self.world.bodies[bodies[i2].handle].position();
             // The hinge sits at the same offset from every child's initial centre. The axis is
             // taken in both bodies' frames as given: the parent starts unrotated and a child
             // may only start rotated about the hinge axis itself.
@@ -265,14 +246,76 @@ pub fn build_world(desc: &SceneDesc, root: &Path) -> Result<BuiltWorld> {
             // The spring's rest angle is the initial relative angle (a leaf starts at rest).
             let rest = joint.angle(&p1.rotation, &p2.rotation);
             joint.set_motor_position(rest, j.stiffness, j.damping);
-            world.insert_impulse_joint(bodies[i1].handle, bodies[i2].handle, joint);
+            self.world
+                .insert_impulse_joint(bodies[i1].handle, bodies[i2].handle, joint);
+        }
+        Ok(())
+    }
+}
+
+/// Collider builders of elastic object `e` in its body frame: without `colliders`, the
+/// surface trimesh of its mesh (static bodies only; `root`: repository root); else its
+/// primitives at their offsets, a dynamic body's at the density giving its mass.
+fn elastic_colliders(e: &ElasticDesc, dynamic: bool, root: &Path) -> Result<Vec<ColliderBuilder>> {
+    let mut builders = Vec::new();
+    match &e.colliders {
+        None => {
+            if dynamic {
+                bail!(
+                    "elastic object {}: a dynamic body needs primitive `colliders`",
+                    e.name
+                );
+            }
+            let mesh_path = root.join(&e.mesh);
+            let mesh = modal_bake::mesh::read_mesh(&mesh_path)
+                .with_context(|| format!("reading mesh {}", mesh_path.display()))?;
+            let (_, tris) = modal_bake::bake::extract_surface(&mesh);
+            let verts: Vec<Vector> = mesh.nodes.iter().map(|p| v3(*p)).collect();
+            let idx_tris: Vec<[u32; 3]> = tris
+                .iter()
+                .map(|t| [t[0] as u32, t[1] as u32, t[2] as u32])
+                .collect();
+            let b = ColliderBuilder::trimesh_with_flags(
+                verts.clone(),
+                idx_tris.clone(),
+                TriMeshFlags::FIX_INTERNAL_EDGES,
+            )
+            .or_else(|_| ColliderBuilder::trimesh(verts, idx_tris))
+            .map_err(|err| anyhow::anyhow!("trimesh of {}: {err:?}", e.name))?;
+            builders.push(b);
+        }
+        Some(cs) => {
+            let vol: f64 = cs.iter().map(collider_volume).sum::<Result<f64>>()?;
+            let density = match &e.body {
+                BodyKind::Dynamic { mass } => mass / vol,
+                BodyKind::Static => 1.0,
+            };
+            for c in cs {
+                builders.push(
+                    shape_builder(&c.shape)?
+                        .position(pose_from_desc(&c.offset))
+                        .density(density),
+                );
+            }
         }
     }
+    Ok(builders)
+}
 
-    Ok(BuiltWorld {
-        world,
-        bodies,
-        collider_body,
-        elastic_body,
+/// The frame prop `p` is placed in: the pose of the elastic object it is `relative_to`, or
+/// the world frame.
+fn prop_frame(desc: &SceneDesc, p: &PropDesc) -> Result<Pose> {
+    Ok(match &p.relative_to {
+        None => Pose::IDENTITY,
+        Some(name) => {
+            let e = desc.elastic.iter().find(|e| &e.name == name);
+            let Some(e) = e else {
+                bail!(
+                    "prop {}: relative_to names no elastic object {name}",
+                    p.name
+                )
+            };
+            pose_from_desc(&e.pose)
+        }
     })
 }

@@ -11,7 +11,7 @@ use faer::{Accum, Mat, MatMut, MatRef, Par};
 use super::kernels::{
     gemm, lower_inverse, small_cholesky, sym_eig, sym_spmm, sym_spmm_with_abs, SplitMix64,
 };
-use super::shift_invert::{shifted, ShiftInvert};
+use super::shift_invert::{shifted, ShiftInvert, SolveBuffer};
 use super::{EigenError, EigenInfo, EigenParams, EigenProgress, EigenResult};
 
 /// Ascending eigenvalues (rad²/s²), their vectors (columns) and residuals.
@@ -285,6 +285,441 @@ fn deflate(z: MatMut<'_, f64>, locked: MatRef<'_, f64>, mlocked: MatRef<'_, f64>
     gemm(z, Accum::Add, locked, c.as_ref(), -1.0);
 }
 
+/// Krylov basis of one Lanczos run: V, MV = M V and the projected matrix H = VᵀMTV, with
+/// spare basis workspaces for the thick restart (allocated at the first restart).
+struct KrylovBasis {
+    /// Basis vectors (columns), n × `cap`.
+    v: Mat<f64>,
+    /// M times the basis vectors (kg), n × `cap`.
+    mv: Mat<f64>,
+    /// Projected block-tridiagonal (after a restart: arrowhead) matrix, `cap` × `cap`.
+    h: Mat<f64>,
+    /// Spare workspace for the restarted V.
+    v2: Mat<f64>,
+    /// Spare workspace for the restarted MV.
+    mv2: Mat<f64>,
+    /// Krylov dimension the basis is restarted at.
+    ncv: usize,
+    /// Allocated columns: `ncv` plus one block.
+    cap: usize,
+}
+
+impl KrylovBasis {
+    /// An empty basis of `n`-vectors for Krylov dimension `ncv` and block size `b`.
+    fn new(n: usize, ncv: usize, b: usize) -> Self {
+        let cap = ncv + b;
+        Self {
+            v: Mat::<f64>::zeros(n, cap),
+            mv: Mat::<f64>::zeros(n, cap),
+            h: Mat::<f64>::zeros(cap, cap),
+            v2: Mat::<f64>::zeros(0, 0),
+            mv2: Mat::<f64>::zeros(0, 0),
+            ncv,
+            cap,
+        }
+    }
+
+    /// Raises the Krylov dimension to `need` (max-frequency mode), keeping the basis and H.
+    fn grow_to(&mut self, need: usize, n: usize, b: usize) {
+        if need > self.ncv {
+            self.ncv = need;
+            let new_cap = self.ncv + b;
+            grow(&mut self.v, n, new_cap);
+            grow(&mut self.mv, n, new_cap);
+            let mut h2 = Mat::<f64>::zeros(new_cap, new_cap);
+            h2.as_mut()
+                .submatrix_mut(0, 0, self.cap, self.cap)
+                .copy_from(&self.h);
+            self.h = h2;
+            self.cap = new_cap;
+        }
+    }
+
+    /// Thick restart: keeps the best p Ritz vectors of the `kk`-column basis plus its newest
+    /// block, H becoming diag(θ) with the newest block's coupling row. Returns p.
+    fn thick_restart(&mut self, ritz: &RitzEstimates, kk: usize, wanted: usize, b: usize) -> usize {
+        let (n, ncv, cap) = (self.v.nrows(), self.ncv, self.cap);
+        let p = (wanted + (kk - wanted) / 2)
+            .min(ncv - b)
+            .max(wanted.min(ncv - b));
+        let sp = select_cols(ritz.s_asc.as_ref(), &ritz.order[..p]);
+        // New basis [V S, W] built in the spare workspaces, then swapped in (no
+        // allocation, no copies of the n × p products).
+        if self.v2.ncols() != cap {
+            self.v2 = Mat::<f64>::zeros(n, cap);
+            self.mv2 = Mat::<f64>::zeros(n, cap);
+        }
+        gemm(
+            self.v2.as_mut().subcols_mut(0, p),
+            Accum::Replace,
+            self.v.as_ref().subcols(0, kk),
+            sp.as_ref(),
+            1.0,
+        );
+        gemm(
+            self.mv2.as_mut().subcols_mut(0, p),
+            Accum::Replace,
+            self.mv.as_ref().subcols(0, kk),
+            sp.as_ref(),
+            1.0,
+        );
+        self.v2
+            .as_mut()
+            .subcols_mut(p, b)
+            .copy_from(self.v.as_ref().subcols(kk, b));
+        self.mv2
+            .as_mut()
+            .subcols_mut(p, b)
+            .copy_from(self.mv.as_ref().subcols(kk, b));
+        std::mem::swap(&mut self.v, &mut self.v2);
+        std::mem::swap(&mut self.mv, &mut self.mv2);
+        let mut coupling = Mat::<f64>::zeros(b, p);
+        gemm(
+            coupling.as_mut(),
+            Accum::Replace,
+            ritz.r_last.as_ref(),
+            sp.as_ref().subrows(kk - b, b),
+            1.0,
+        );
+        self.h.fill(0.0);
+        for i in 0..p {
+            self.h[(i, i)] = ritz.theta[i];
+        }
+        self.h
+            .as_mut()
+            .submatrix_mut(p, 0, b, p)
+            .copy_from(&coupling);
+        p
+    }
+}
+
+/// Operators and workspaces of one Lanczos run's expansion steps.
+struct Expansion<'a> {
+    /// Mass matrix M (kg).
+    m: &'a SparseColMat<usize, f64>,
+    /// Factorisation of A = K − σM.
+    fac: &'a ShiftInvert,
+    /// Locked (M-orthonormal) vectors the basis is kept M-orthogonal to, and M times them.
+    deflation: (MatRef<'a, f64>, MatRef<'a, f64>),
+    /// Newest block Z (n × b).
+    z: Mat<f64>,
+    /// M Z (kg).
+    mz: Mat<f64>,
+    /// Workspace of the block solves.
+    solve_buf: SolveBuffer,
+    /// Random source for the start block and breakdown replacements.
+    rng: SplitMix64,
+}
+
+impl Expansion<'_> {
+    /// Start block: a random block mapped into the range of T (z ← A⁻¹Mz), deflated twice
+    /// against the locked vectors, M-orthonormalised and stored as the basis's first block.
+    fn start(&mut self, basis: &mut KrylovBasis, info: &mut EigenInfo) -> Result<(), EigenError> {
+        let (n, b) = (self.z.nrows(), self.z.ncols());
+        let (locked, mlocked) = self.deflation;
+        for j in 0..b {
+            for i in 0..n {
+                self.z[(i, j)] = self.rng.next_sym();
+            }
+        }
+        // Start in the range of T (z ← A⁻¹Mz): a random block is white noise whose
+        // high-frequency content would otherwise survive in the Ritz vectors (Ericsson & Ruhe
+        // 1980) and, amplified by K, dominate their residuals.
+        sym_spmm(self.m, self.z.as_ref(), self.mz.as_mut());
+        self.z.copy_from(&self.mz);
+        self.fac
+            .solve_in_place(self.z.as_mut(), &mut self.solve_buf);
+        info.block_solves += 1;
+        deflate(self.z.as_mut(), locked, mlocked);
+        deflate(self.z.as_mut(), locked, mlocked);
+        sym_spmm(self.m, self.z.as_ref(), self.mz.as_mut());
+        let pre: Vec<f64> = (0..b)
+            .map(|j| m_norm(self.z.as_ref(), self.mz.as_ref(), j))
+            .collect();
+        orthonormalize(
+            &mut self.z,
+            &mut self.mz,
+            basis.v.as_ref().subcols(0, 0),
+            basis.mv.as_ref().subcols(0, 0),
+            self.deflation,
+            &pre,
+            self.m,
+            &mut self.rng,
+        )?;
+        basis.v.as_mut().subcols_mut(0, b).copy_from(&self.z);
+        basis.mv.as_mut().subcols_mut(0, b).copy_from(&self.mz);
+        Ok(())
+    }
+
+    /// Block Lanczos step: Z = T W = A⁻¹ M W for the newest block W at `kk..kk + b`,
+    /// M-orthogonalised against the basis in two passes (the first only against the blocks Z
+    /// couples to in exact arithmetic unless `coupled_to_all`), M-orthonormalised and
+    /// appended at `kk + b`; H receives the projections and the new subdiagonal block.
+    fn expand(
+        &mut self,
+        basis: &mut KrylovBasis,
+        kk: usize,
+        coupled_to_all: bool,
+        info: &mut EigenInfo,
+    ) -> Result<(), EigenError> {
+        let b = self.z.ncols();
+        let (locked, mlocked) = self.deflation;
+        let (v, mv) = (&mut basis.v, &mut basis.mv);
+        let nb = kk + b;
+        self.z.copy_from(mv.as_ref().subcols(kk, b));
+        self.fac
+            .solve_in_place(self.z.as_mut(), &mut self.solve_buf);
+        info.block_solves += 1;
+        let mut c = Mat::<f64>::zeros(nb, b);
+        for pass in 0..2 {
+            // First pass: only the blocks Z is coupled to in exact arithmetic (the newest
+            // and the one before it, or all after a restart); second pass: the whole basis.
+            let lo = if pass == 0 && !coupled_to_all {
+                kk - b
+            } else {
+                0
+            };
+            deflate(self.z.as_mut(), locked, mlocked);
+            let mut cp = Mat::<f64>::zeros(nb - lo, b);
+            gemm(
+                cp.as_mut(),
+                Accum::Replace,
+                mv.as_ref().subcols(lo, nb - lo).transpose(),
+                self.z.as_ref(),
+                1.0,
+            );
+            gemm(
+                self.z.as_mut(),
+                Accum::Add,
+                v.as_ref().subcols(lo, nb - lo),
+                cp.as_ref(),
+                -1.0,
+            );
+            let mut cs = c.as_mut().subrows_mut(lo, nb - lo);
+            cs += &cp;
+        }
+        basis.h.as_mut().submatrix_mut(0, kk, nb, b).copy_from(&c);
+        sym_spmm(self.m, self.z.as_ref(), self.mz.as_mut());
+        let pre: Vec<f64> = (0..b)
+            .map(|j| {
+                let cn: f64 = (0..nb).map(|i| c[(i, j)] * c[(i, j)]).sum();
+                (cn + m_norm(self.z.as_ref(), self.mz.as_ref(), j).powi(2)).sqrt()
+            })
+            .collect();
+        let r = orthonormalize(
+            &mut self.z,
+            &mut self.mz,
+            v.as_ref().subcols(0, nb),
+            mv.as_ref().subcols(0, nb),
+            self.deflation,
+            &pre,
+            self.m,
+            &mut self.rng,
+        )?;
+        v.as_mut().subcols_mut(nb, b).copy_from(&self.z);
+        mv.as_mut().subcols_mut(nb, b).copy_from(&self.mz);
+        basis.h.as_mut().submatrix_mut(nb, kk, b, b).copy_from(&r);
+        Ok(())
+    }
+}
+
+/// Result of one Rayleigh–Ritz solve on the leading `kk` × `kk` block of H, pairs in
+/// descending θ (ascending λ) order.
+struct RitzEstimates {
+    /// Eigenvectors of H's leading block (columns), in ascending θ order.
+    s_asc: Mat<f64>,
+    /// Columns of `s_asc` in descending θ order.
+    order: Vec<usize>,
+    /// Ritz values θ of T = A⁻¹M (s²/rad²), descending.
+    theta: Vec<f64>,
+    /// Eigenvalue estimates λ = σ + 1/θ (rad²/s²), ascending; +∞ where θ ≤ 0.
+    lam: Vec<f64>,
+    /// Subdiagonal block of H coupling the newest block (b × b).
+    r_last: Mat<f64>,
+    /// Lanczos residual estimates ‖R_last s_last‖ / |θ| per pair.
+    est: Vec<f64>,
+}
+
+/// Rayleigh–Ritz on H = VᵀMTV: Ritz values and vectors of the leading `kk` × `kk` block
+/// (block size `b`, shift `sigma` in rad²/s²) with their Lanczos residual estimates.
+fn rayleigh_ritz(
+    h: MatRef<'_, f64>,
+    kk: usize,
+    b: usize,
+    sigma: f64,
+) -> Result<RitzEstimates, EigenError> {
+    let hk = symmetrized(h.submatrix(0, 0, kk, kk));
+    let (theta_asc, s_asc) = sym_eig(hk.as_ref()).map_err(EigenError::Dense)?;
+    // Descending θ = ascending λ.
+    let order: Vec<usize> = (0..kk).rev().collect();
+    let theta: Vec<f64> = order.iter().map(|&i| theta_asc[i]).collect();
+    let lam: Vec<f64> = theta
+        .iter()
+        .map(|&t| {
+            if t > 0.0 {
+                sigma + 1.0 / t
+            } else {
+                f64::INFINITY
+            }
+        })
+        .collect();
+    let r_last = h.submatrix(kk, kk - b, b, b).to_owned();
+    let est: Vec<f64> = order
+        .iter()
+        .zip(&theta)
+        .map(|(&i, &t)| {
+            let mut s2 = 0.0;
+            for row in 0..b {
+                let mut acc = 0.0;
+                for col in 0..b {
+                    acc += r_last[(row, col)] * s_asc[(kk - b + col, i)];
+                }
+                s2 += acc * acc;
+            }
+            s2.sqrt() / t.abs()
+        })
+        .collect();
+    Ok(RitzEstimates {
+        s_asc,
+        order,
+        theta,
+        lam,
+        r_last,
+        est,
+    })
+}
+
+/// How many pairs are wanted of a problem with `n` dofs: `params.nev`, or with `lam_lim`
+/// (rad²/s²) every pair below it plus one, at least `params.nev` and at most
+/// `params.max_modes`. Returns (wanted, Ritz values below `lam_lim`, whether capped).
+fn wanted_pairs(
+    lam: &[f64],
+    lam_lim: Option<f64>,
+    params: &EigenParams,
+    n: usize,
+) -> (usize, usize, bool) {
+    match lam_lim {
+        None => (params.nev.min(n), 0, false),
+        Some(lim) => {
+            let below = lam.iter().take_while(|&&l| l < lim).count();
+            let capped = below >= params.max_modes;
+            let w = if capped {
+                params.max_modes
+            } else {
+                (below + 1).max(params.nev)
+            };
+            (w.min(n), below, capped)
+        }
+    }
+}
+
+/// Step of the next Rayleigh–Ritz solve after the one at `iteration` with worst wanted
+/// estimate `worst_est`: the next step, advanced by [`RR_SKIP_FRACTION`] of the steps the
+/// geometric rate since `last_est` (step, estimate) predicts until `trigger` is met.
+fn next_rr_step(
+    iteration: usize,
+    worst_est: f64,
+    trigger: f64,
+    last_est: Option<(usize, f64)>,
+) -> usize {
+    let mut rr_at = iteration + 1;
+    if let Some((step0, est0)) = last_est {
+        if worst_est > trigger && worst_est < est0 {
+            // Steps to go at the observed geometric rate; Lanczos converges
+            // superlinearly, so only a fraction of them is skipped.
+            let rate = (est0 / worst_est).ln() / (iteration - step0) as f64;
+            let to_go = (worst_est / trigger).ln() / rate;
+            rr_at += (RR_SKIP_FRACTION * to_go).floor() as usize;
+        }
+    }
+    rr_at
+}
+
+/// Convergence test of one Lanczos run, carried between residual checks.
+struct ConvergenceTest {
+    /// Estimate every wanted pair must reach before the next explicit residual check.
+    trigger: f64,
+    /// Worst explicit relative residual at the last check.
+    last_worst: f64,
+}
+
+impl ConvergenceTest {
+    /// Explicit residual check of the `wanted` lowest Ritz pairs of the `kk`-column basis.
+    /// Returns the checked pairs when every one meets the tolerance; fails when
+    /// `out_of_steps` or the residuals stall; otherwise lowers `trigger` to the estimate that
+    /// would have met the tolerance and returns `None`.
+    #[allow(clippy::too_many_arguments)]
+    fn check(
+        &mut self,
+        (k, m, fac): (
+            &SparseColMat<usize, f64>,
+            &SparseColMat<usize, f64>,
+            &ShiftInvert,
+        ),
+        basis: &KrylovBasis,
+        kk: usize,
+        ritz: &RitzEstimates,
+        wanted: usize,
+        params: &EigenParams,
+        out_of_steps: bool,
+        info: &mut EigenInfo,
+    ) -> Result<Option<CheckedPairs>, EigenError> {
+        let est = &ritz.est;
+        info.residual_checks += 1;
+        let sel = select_cols(ritz.s_asc.as_ref(), &ritz.order[..wanted.min(kk)]);
+        // Written as "not ≤" so that a NaN estimate is purified.
+        let purify: Vec<bool> = est
+            .iter()
+            .take(wanted.min(kk))
+            .map(|&e| !(e <= purify_above() * params.tol))
+            .collect();
+        let ((vals, u, res), mu) = finalize(
+            k,
+            m,
+            fac,
+            basis.v.as_ref().subcols(0, kk),
+            basis.mv.as_ref().subcols(0, kk),
+            sel.as_ref(),
+            &purify,
+            (params.shift, params.tol),
+            &mut info.purified,
+        )?;
+        let worst = res.iter().map(|r| r.rel).fold(0.0, f64::max);
+        let good = res.iter().filter(|r| r.converged(params.tol)).count();
+        if good == res.len() && wanted <= kk {
+            return Ok(Some(((vals, u, res), mu)));
+        }
+        // More steps cannot help once the explicit residuals stop improving between
+        // checks (rounding floor, or the basis has lost orthogonality): fail now rather
+        // than after `max_iters` solves.
+        // Normally the Lanczos estimate tracks the explicit residual closely; a residual
+        // 1000× above the tolerance when the estimate says converged means the basis is
+        // no longer consistent (seen beyond ~100 modes on the table mesh).
+        let stalled = worst >= 0.5 * self.last_worst || worst > 1e3 * params.tol;
+        self.last_worst = worst;
+        if out_of_steps || stalled {
+            return Err(EigenError::NotConverged {
+                converged: good,
+                requested: wanted,
+                worst_residual: worst,
+            });
+        }
+        // The estimate was optimistic: demand, before the next check, the estimate that
+        // would have met the tolerance for the worst ratio residual / estimate seen
+        // (at least 100× smaller than now; at most 100× below the tolerance's floor).
+        let needed = res
+            .iter()
+            .zip(est)
+            .filter(|(r, _)| !r.converged(params.tol))
+            .map(|(r, &e)| 0.5 * e.max(f64::MIN_POSITIVE) * params.tol / r.rel)
+            .fold(f64::INFINITY, f64::min);
+        self.trigger = needed
+            .min(self.trigger * 1e-2)
+            .max(1e-3 * params.tol * f64::EPSILON.sqrt());
+        Ok(None)
+    }
+}
+
 /// One shift-invert block Lanczos run for the `params.nev` (or, with `lam_lim`, up to
 /// `params.max_modes`) lowest pairs in the M-orthogonal complement of `locked`. Returns the
 /// pairs in ascending order and whether the max-frequency search hit `params.max_modes`.
@@ -301,57 +736,24 @@ fn lanczos_chunk(
     progress: &mut dyn FnMut(EigenProgress),
 ) -> Result<(CheckedPairs, bool), EigenError> {
     let n = k.nrows();
-    let sigma = params.shift;
     let b = params.block.min(n).max(1);
-    let ncv0 = krylov_dim(params, params.nev.max(1), b, n);
-    // --- Lanczos state ----------------------------------------------------------------------
-    let mut ncv = ncv0;
-    let mut cap = ncv + b;
-    let mut v = Mat::<f64>::zeros(n, cap);
-    let mut mv = Mat::<f64>::zeros(n, cap);
-    let mut h = Mat::<f64>::zeros(cap, cap);
-    // Spare basis workspaces for the thick restart (allocated at the first restart).
-    let mut v2 = Mat::<f64>::zeros(0, 0);
-    let mut mv2 = Mat::<f64>::zeros(0, 0);
-    let mut rng = SplitMix64(params.seed);
-    let mut solve_buf = fac.solve_buffer(b);
-
-    let mut z = Mat::<f64>::zeros(n, b);
-    let mut mz = Mat::<f64>::zeros(n, b);
-    {
-        for j in 0..b {
-            for i in 0..n {
-                z[(i, j)] = rng.next_sym();
-            }
-        }
-        // Start in the range of T (z ← A⁻¹Mz): a random block is white noise whose
-        // high-frequency content would otherwise survive in the Ritz vectors (Ericsson & Ruhe
-        // 1980) and, amplified by K, dominate their residuals.
-        sym_spmm(m, z.as_ref(), mz.as_mut());
-        z.copy_from(&mz);
-        fac.solve_in_place(z.as_mut(), &mut solve_buf);
-        info.block_solves += 1;
-        deflate(z.as_mut(), locked, mlocked);
-        deflate(z.as_mut(), locked, mlocked);
-        sym_spmm(m, z.as_ref(), mz.as_mut());
-        let pre: Vec<f64> = (0..b).map(|j| m_norm(z.as_ref(), mz.as_ref(), j)).collect();
-        orthonormalize(
-            &mut z,
-            &mut mz,
-            v.as_ref().subcols(0, 0),
-            mv.as_ref().subcols(0, 0),
-            (locked, mlocked),
-            &pre,
-            m,
-            &mut rng,
-        )?;
-        v.as_mut().subcols_mut(0, b).copy_from(&z);
-        mv.as_mut().subcols_mut(0, b).copy_from(&mz);
-    }
+    let mut basis = KrylovBasis::new(n, krylov_dim(params, params.nev.max(1), b, n), b);
+    let mut expansion = Expansion {
+        m,
+        fac,
+        deflation: (locked, mlocked),
+        z: Mat::<f64>::zeros(n, b),
+        mz: Mat::<f64>::zeros(n, b),
+        solve_buf: fac.solve_buffer(b),
+        rng: SplitMix64(params.seed),
+    };
+    expansion.start(&mut basis, info)?;
     let solves_at_start = info.block_solves;
     let mut kk = 0usize; // Rayleigh–Ritz size; the newest block sits at kk..kk+b
-    let mut trigger = params.tol;
-    let mut last_worst = f64::INFINITY;
+    let mut test = ConvergenceTest {
+        trigger: params.tol,
+        last_worst: f64::INFINITY,
+    };
     // Whether the newest block is coupled to the whole basis (right after a thick restart: to
     // every kept Ritz vector) rather than only to the block before it (Lanczos recurrence).
     let mut coupled_to_all = true;
@@ -362,69 +764,15 @@ fn lanczos_chunk(
     let mut last_conv = 0usize;
 
     loop {
-        // --- expand: Z = T W = A⁻¹ M W, M-orthogonalise against the basis ------------------
-        let nb = kk + b;
-        z.copy_from(mv.as_ref().subcols(kk, b));
-        fac.solve_in_place(z.as_mut(), &mut solve_buf);
-        info.block_solves += 1;
-        let mut c = Mat::<f64>::zeros(nb, b);
-        for pass in 0..2 {
-            // First pass: only the blocks Z is coupled to in exact arithmetic (the newest
-            // and the one before it, or all after a restart); second pass: the whole basis.
-            let lo = if pass == 0 && !coupled_to_all {
-                kk - b
-            } else {
-                0
-            };
-            deflate(z.as_mut(), locked, mlocked);
-            let mut cp = Mat::<f64>::zeros(nb - lo, b);
-            gemm(
-                cp.as_mut(),
-                Accum::Replace,
-                mv.as_ref().subcols(lo, nb - lo).transpose(),
-                z.as_ref(),
-                1.0,
-            );
-            gemm(
-                z.as_mut(),
-                Accum::Add,
-                v.as_ref().subcols(lo, nb - lo),
-                cp.as_ref(),
-                -1.0,
-            );
-            let mut cs = c.as_mut().subrows_mut(lo, nb - lo);
-            cs += &cp;
-        }
+        expansion.expand(&mut basis, kk, coupled_to_all, info)?;
         coupled_to_all = false;
-        h.as_mut().submatrix_mut(0, kk, nb, b).copy_from(&c);
-        sym_spmm(m, z.as_ref(), mz.as_mut());
-        let pre: Vec<f64> = (0..b)
-            .map(|j| {
-                let cn: f64 = (0..nb).map(|i| c[(i, j)] * c[(i, j)]).sum();
-                (cn + m_norm(z.as_ref(), mz.as_ref(), j).powi(2)).sqrt()
-            })
-            .collect();
-        let r = orthonormalize(
-            &mut z,
-            &mut mz,
-            v.as_ref().subcols(0, nb),
-            mv.as_ref().subcols(0, nb),
-            (locked, mlocked),
-            &pre,
-            m,
-            &mut rng,
-        )?;
-        v.as_mut().subcols_mut(nb, b).copy_from(&z);
-        mv.as_mut().subcols_mut(nb, b).copy_from(&mz);
-        h.as_mut().submatrix_mut(nb, kk, b, b).copy_from(&r);
-        kk = nb;
+        kk += b;
         info.iterations += 1;
         info.krylov_dim = info.krylov_dim.max(kk);
 
-        // --- Rayleigh–Ritz on H = VᵀMTV ----------------------------------------------------
-        // Skipped while the last two estimates predict no convergence yet (count mode only;
-        // never when the basis must be restarted or the step budget is spent).
-        let restart_due = kk + 2 * b > cap;
+        // Rayleigh–Ritz is skipped while the last two estimates predict no convergence yet
+        // (count mode only; never when the basis must be restarted or the budget is spent).
+        let restart_due = kk + 2 * b > basis.cap;
         let budget_left = info.block_solves - solves_at_start < params.max_iters;
         if lam_lim.is_none() && !restart_due && budget_left && info.iterations < rr_at {
             progress(EigenProgress {
@@ -434,53 +782,10 @@ fn lanczos_chunk(
             });
             continue;
         }
-        let hk = symmetrized(h.as_ref().submatrix(0, 0, kk, kk));
-        let (theta_asc, s_asc) = sym_eig(hk.as_ref()).map_err(EigenError::Dense)?;
-        // Descending θ = ascending λ.
-        let order: Vec<usize> = (0..kk).rev().collect();
-        let theta: Vec<f64> = order.iter().map(|&i| theta_asc[i]).collect();
-        let lam: Vec<f64> = theta
-            .iter()
-            .map(|&t| {
-                if t > 0.0 {
-                    sigma + 1.0 / t
-                } else {
-                    f64::INFINITY
-                }
-            })
-            .collect();
-        let r_last = h.as_ref().submatrix(kk, kk - b, b, b).to_owned();
-        let est: Vec<f64> = order
-            .iter()
-            .zip(&theta)
-            .map(|(&i, &t)| {
-                let mut s2 = 0.0;
-                for row in 0..b {
-                    let mut acc = 0.0;
-                    for col in 0..b {
-                        acc += r_last[(row, col)] * s_asc[(kk - b + col, i)];
-                    }
-                    s2 += acc * acc;
-                }
-                s2.sqrt() / t.abs()
-            })
-            .collect();
-
-        // --- how many pairs are wanted -----------------------------------------------------
-        let (wanted, below, capped) = match lam_lim {
-            None => (params.nev.min(n), 0, false),
-            Some(lim) => {
-                let below = lam.iter().take_while(|&&l| l < lim).count();
-                let capped = below >= params.max_modes;
-                let w = if capped {
-                    params.max_modes
-                } else {
-                    (below + 1).max(params.nev)
-                };
-                (w.min(n), below, capped)
-            }
-        };
-        let conv = est
+        let ritz = rayleigh_ritz(basis.h.as_ref(), kk, b, params.shift)?;
+        let (wanted, below, capped) = wanted_pairs(&ritz.lam, lam_lim, params, n);
+        let conv = ritz
+            .est
             .iter()
             .take(wanted.min(kk))
             .filter(|&&e| e <= params.tol)
@@ -492,139 +797,36 @@ fn lanczos_chunk(
         });
         last_conv = conv;
         if wanted <= kk {
-            let worst_est = est.iter().take(wanted).fold(0.0f64, |a, &e| a.max(e));
-            rr_at = info.iterations + 1;
-            if let Some((step0, est0)) = last_est {
-                if worst_est > trigger && worst_est < est0 {
-                    // Steps to go at the observed geometric rate; Lanczos converges
-                    // superlinearly, so only a fraction of them is skipped.
-                    let rate = (est0 / worst_est).ln() / (info.iterations - step0) as f64;
-                    let to_go = (worst_est / trigger).ln() / rate;
-                    rr_at += (RR_SKIP_FRACTION * to_go).floor() as usize;
-                }
-            }
+            let worst_est = ritz.est.iter().take(wanted).fold(0.0f64, |a, &e| a.max(e));
+            rr_at = next_rr_step(info.iterations, worst_est, test.trigger, last_est);
             last_est = Some((info.iterations, worst_est));
         }
 
         let ready = wanted <= kk
-            && est.iter().take(wanted).all(|&e| e <= trigger)
+            && ritz.est.iter().take(wanted).all(|&e| e <= test.trigger)
             && (lam_lim.is_none() || capped || below < kk);
         // The step budget is per run (chunk).
         let out_of_steps = info.block_solves - solves_at_start >= params.max_iters;
         if ready || out_of_steps {
-            info.residual_checks += 1;
-            let sel = select_cols(s_asc.as_ref(), &order[..wanted.min(kk)]);
-            // Written as "not ≤" so that a NaN estimate is purified.
-            let purify: Vec<bool> = est
-                .iter()
-                .take(wanted.min(kk))
-                .map(|&e| !(e <= purify_above() * params.tol))
-                .collect();
-            let ((vals, u, res), mu) = finalize(
-                k,
-                m,
-                fac,
-                v.as_ref().subcols(0, kk),
-                mv.as_ref().subcols(0, kk),
-                sel.as_ref(),
-                &purify,
-                (sigma, params.tol),
-                &mut info.purified,
+            let checked = test.check(
+                (k, m, fac),
+                &basis,
+                kk,
+                &ritz,
+                wanted,
+                params,
+                out_of_steps,
+                info,
             )?;
-            let worst = res.iter().map(|r| r.rel).fold(0.0, f64::max);
-            let good = res.iter().filter(|r| r.converged(params.tol)).count();
-            if good == res.len() && wanted <= kk {
-                return Ok((((vals, u, res), mu), capped));
+            if let Some(pairs) = checked {
+                return Ok((pairs, capped));
             }
-            // More steps cannot help once the explicit residuals stop improving between
-            // checks (rounding floor, or the basis has lost orthogonality): fail now rather
-            // than after `max_iters` solves.
-            // Normally the Lanczos estimate tracks the explicit residual closely; a residual
-            // 1000× above the tolerance when the estimate says converged means the basis is
-            // no longer consistent (seen beyond ~100 modes on the table mesh).
-            let stalled = worst >= 0.5 * last_worst || worst > 1e3 * params.tol;
-            last_worst = worst;
-            if out_of_steps || stalled {
-                return Err(EigenError::NotConverged {
-                    converged: good,
-                    requested: wanted,
-                    worst_residual: worst,
-                });
-            }
-            // The estimate was optimistic: demand, before the next check, the estimate that
-            // would have met the tolerance for the worst ratio residual / estimate seen
-            // (at least 100× smaller than now; at most 100× below the tolerance's floor).
-            let needed = res
-                .iter()
-                .zip(&est)
-                .filter(|(r, _)| !r.converged(params.tol))
-                .map(|(r, &e)| 0.5 * e.max(f64::MIN_POSITIVE) * params.tol / r.rel)
-                .fold(f64::INFINITY, f64::min);
-            trigger = needed
-                .min(trigger * 1e-2)
-                .max(1e-3 * params.tol * f64::EPSILON.sqrt());
         }
 
-        // --- make room: grow (max-frequency mode) or thick-restart --------------------------
-        let need = krylov_dim(params, wanted, b, n);
-        if need > ncv {
-            ncv = need;
-            let new_cap = ncv + b;
-            grow(&mut v, n, new_cap);
-            grow(&mut mv, n, new_cap);
-            let mut h2 = Mat::<f64>::zeros(new_cap, new_cap);
-            h2.as_mut().submatrix_mut(0, 0, cap, cap).copy_from(&h);
-            h = h2;
-            cap = new_cap;
-        }
-        if kk + 2 * b > cap {
-            // Keep the best p Ritz vectors plus the newest block.
-            let p = (wanted + (kk - wanted) / 2)
-                .min(ncv - b)
-                .max(wanted.min(ncv - b));
-            let sp = select_cols(s_asc.as_ref(), &order[..p]);
-            // New basis [V S, W] built in the spare workspaces, then swapped in (no
-            // allocation, no copies of the n × p products).
-            if v2.ncols() != cap {
-                v2 = Mat::<f64>::zeros(n, cap);
-                mv2 = Mat::<f64>::zeros(n, cap);
-            }
-            gemm(
-                v2.as_mut().subcols_mut(0, p),
-                Accum::Replace,
-                v.as_ref().subcols(0, kk),
-                sp.as_ref(),
-                1.0,
-            );
-            gemm(
-                mv2.as_mut().subcols_mut(0, p),
-                Accum::Replace,
-                mv.as_ref().subcols(0, kk),
-                sp.as_ref(),
-                1.0,
-            );
-            v2.as_mut()
-                .subcols_mut(p, b)
-                .copy_from(v.as_ref().subcols(kk, b));
-            mv2.as_mut()
-                .subcols_mut(p, b)
-                .copy_from(mv.as_ref().subcols(kk, b));
-            std::mem::swap(&mut v, &mut v2);
-            std::mem::swap(&mut mv, &mut mv2);
-            let mut coupling = Mat::<f64>::zeros(b, p);
-            gemm(
-                coupling.as_mut(),
-                Accum::Replace,
-                r_last.as_ref(),
-                sp.as_ref().subrows(kk - b, b),
-                1.0,
-            );
-            h.fill(0.0);
-            for i in 0..p {
-                h[(i, i)] = theta[i];
-            }
-            h.as_mut().submatrix_mut(p, 0, b, p).copy_from(&coupling);
-            kk = p;
+        // Make room: grow (max-frequency mode) or thick-restart.
+        basis.grow_to(krylov_dim(params, wanted, b, n), n, b);
+        if kk + 2 * b > basis.cap {
+            kk = basis.thick_restart(&ritz, kk, wanted, b);
             coupled_to_all = true;
             info.restarts += 1;
         }
