@@ -33,10 +33,17 @@ enum OnOff {
     Both,
 }
 
+/// A response method for every elastic object of a run.
 #[derive(Clone, Copy, ValueEnum)]
 enum MethodArg {
+    /// The 20-mode modal filters (Eq. 9–13).
     Modal,
+    /// Spatial attenuation (Eq. 14–16): the object's `attenuation` settings, or C = 1, β = 1.
     Attenuation,
+    /// The bake-time peak-transfer table (many modes, baked for the scene's h into
+    /// out/bases/NAME.transfer.modes): the object's `method` or `transfer` settings; objects
+    /// without them are refused.
+    Transfer,
 }
 
 /// How the responses reach the bodies.
@@ -103,6 +110,16 @@ impl From<GateArg> for StepGate {
 #[derive(Clone, Copy)]
 struct Eta(Option<f64>);
 
+fn parse_gain(s: &str) -> Result<f64, String> {
+    let v: f64 = s
+        .parse()
+        .map_err(|_| format!("{s:?} is not a number (a scale ≥ 0 on the response Δv)"))?;
+    if !(v.is_finite() && v >= 0.0) {
+        return Err(format!("{v} is not a finite scale ≥ 0"));
+    }
+    Ok(v)
+}
+
 fn parse_eta(s: &str) -> Result<Eta, String> {
     if s.eq_ignore_ascii_case("off") || s.eq_ignore_ascii_case("none") {
         return Ok(Eta(None));
@@ -141,6 +158,10 @@ enum Cmd {
         /// Attenuation exponent β (implies --method attenuation).
         #[arg(long)]
         beta: Option<f64>,
+        /// Scale on every elastic object's response Δv, replacing the objects' own `gain`
+        /// (1 = the paper's Eq. 12/18 unscaled). Default: each object's `gain`.
+        #[arg(long, value_name = "G", value_parser = parse_gain)]
+        gain: Option<f64>,
         /// Output directory (default out/SCENE). Without --out the runs go to out/SCENE/on
         /// and out/SCENE/off (as with --dcr both), so an on and an off run never overwrite
         /// each other; with --out a single run writes there.
@@ -250,6 +271,7 @@ fn real_main() -> Result<()> {
             dcr,
             method,
             beta,
+            gain,
             out,
             bases,
             gltf,
@@ -265,9 +287,13 @@ fn real_main() -> Result<()> {
             }
             let desc = SceneDesc::read(&path)?;
             let method = match (method, beta) {
+                (Some(MethodArg::Modal | MethodArg::Transfer), Some(_)) => {
+                    bail!("--beta is the attenuation exponent: use it without --method or with --method attenuation")
+                }
                 (_, Some(b)) => MethodChoice::AttenuationBeta(b),
                 (Some(MethodArg::Attenuation), None) => MethodChoice::Attenuation,
                 (Some(MethodArg::Modal), None) => MethodChoice::Modal,
+                (Some(MethodArg::Transfer), None) => MethodChoice::Transfer,
                 (None, None) => MethodChoice::Scene,
             };
             if let Some(s) = seconds {
@@ -295,6 +321,7 @@ fn real_main() -> Result<()> {
                     &RunParams {
                         seconds,
                         method: method.clone(),
+                        gain,
                         bases_dir: bases_dir.clone(),
                         out_dir: Some(dir.clone()),
                         progress: true,
