@@ -155,6 +155,12 @@ pub struct ResponseEvent {
     pub point: [f64; 3],
     /// Impulse (N·s, world frame).
     pub impulse: [f64; 3],
+    /// Velocity change at the point along the object's normal (m/s; the world's
+    /// `ImpulseEvent::delta_v`).
+    pub delta_v: f64,
+    /// Whether the transfer table computed it (`ServedBy::TransferTable`); else the modal base
+    /// or the attenuation law did.
+    pub by_table: bool,
 }
 
 /// What the responses gave one receiving body over a run (every response impulse issued to it,
@@ -712,6 +718,8 @@ pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
                     body,
                     point: e.point,
                     impulse: e.impulse,
+                    delta_v: e.delta_v,
+                    by_table: e.served_by == ServedBy::TransferTable,
                 });
             } else {
                 debug_assert!(false, "event for unknown body {:?}", body_handle(e.body));
