@@ -160,7 +160,7 @@ enum Cmd {
         beta: Option<f64>,
         /// Scale on every elastic object's response Δv, replacing the objects' own `gain`
         /// (1 = the paper's Eq. 12/18 unscaled). Default: each object's `gain`.
-        #[arg(long, value_name = "G", value_parser = parse_gain)]
+        #[arg(long, value_name = "G", value_parser = parse_gain, allow_hyphen_values = true)]
         gain: Option<f64>,
         /// Output directory (default out/SCENE). Without --out the runs go to out/SCENE/on
         /// and out/SCENE/off (as with --dcr both), so an on and an off run never overwrite

@@ -299,3 +299,34 @@ fn run_gain_scales_every_response() {
     assert_eq!(zero.injected_ke, 0.0);
     assert!(zero.events.iter().all(|ev| ev.delta_v == 0.0));
 }
+
+/// The CLI: `run dinner --method transfer` (the table has no transfer settings) exits non-zero
+/// with one line naming the object, before any bake; `--gain -1` is refused by the parser.
+#[test]
+fn cli_refuses_transfer_without_settings_and_a_negative_gain() {
+    let exe = env!("CARGO_BIN_EXE_dcr-scenes");
+    let bases = bases_dir("cli");
+    let out = std::process::Command::new(exe)
+        .args(["run", "dinner", "--method", "transfer", "--seconds", "0.01"])
+        .arg("--bases")
+        .arg(&bases)
+        .arg("--out")
+        .arg(bases.join("run"))
+        .current_dir(repo_root())
+        .output()
+        .expect("dcr-scenes runs");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "exit 0; stderr {err}");
+    assert!(
+        err.contains("elastic object table") && err.contains("--method transfer"),
+        "{err}"
+    );
+    assert!(!bases.join("table.transfer.modes").exists());
+    let out = std::process::Command::new(exe)
+        .args(["run", "dinner", "--gain", "-1"])
+        .current_dir(repo_root())
+        .output()
+        .expect("dcr-scenes runs");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && err.contains("--gain"), "{err}");
+}

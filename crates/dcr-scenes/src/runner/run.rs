@@ -313,13 +313,13 @@ fn transfer_of<'a>(e: &'a ElasticDesc, choice: &MethodChoice) -> Result<Option<&
         MethodChoice::Transfer => match own.or(e.transfer.as_ref()) {
             Some(t) => Some(t),
             None => bail!(
-                "elastic object {}: `--method transfer` needs its transfer-table settings: add                  `\"transfer\": {{\"up\": [0, 1, 0]}}` (region options: up, boxes, modes,                  order; docs/scenes.md) to the object in the scene file",
+                "elastic object {}: `--method transfer` needs its transfer-table settings: add \
+                 `\"transfer\": {{\"up\": [0, 1, 0]}}` (region options: up, boxes, modes, \
+                 order; docs/scenes.md) to the object in the scene file",
                 e.name
             ),
         },
-        MethodChoice::Modal | MethodChoice::Attenuation | MethodChoice::AttenuationBeta(_) => {
-            None
-        }
+        MethodChoice::Modal | MethodChoice::Attenuation | MethodChoice::AttenuationBeta(_) => None,
     })
 }
 
