@@ -36,9 +36,10 @@ enum OnOff {
 /// A response method for every elastic object of a run.
 #[derive(Clone, Copy, ValueEnum)]
 enum MethodArg {
-    /// The 20-mode modal filters (Eq. 9–13).
+    /// The modal filters over the object's base (its `modes`, 20 by default; Eq. 9–13).
     Modal,
-    /// Spatial attenuation (Eq. 14–16): the object's `attenuation` settings, or C = 1, β = 1.
+    /// Spatial attenuation (Eq. 14–16): the object's own or `attenuation` settings, else C = 1,
+    /// β = 1.
     Attenuation,
     /// The bake-time peak-transfer table (many modes, baked for the scene's h into
     /// out/bases/NAME.transfer.modes): the object's `method` or `transfer` settings; objects
@@ -245,6 +246,17 @@ fn print_report(report: &RunReport, out_dir: &std::path::Path) {
             m.query_us_median.map_or("-".into(), |v| format!("{v:.1}")),
             m.query_us_p99.map_or("-".into(), |v| format!("{v:.1}"))
         );
+        if m.method.starts_with("transfer") {
+            println!(
+                "  model {:8} {} ({}): {} of {} events from the table; {} contacts served by the modal base outside its region",
+                m.model,
+                m.method,
+                m.base,
+                m.stats.events_by_table,
+                m.stats.responses_applied,
+                m.stats.contacts_table_fallback
+            );
+        }
     }
     println!(
         "  rapier {:.1} ms, dcr {:.1} ms ({:.2}% of step); energy injected {:.4e} J, dissipated {:.4e} J",
