@@ -100,7 +100,23 @@ pub fn base_path(bases_dir: &Path, e: &ElasticDesc) -> PathBuf {
     bases_dir.join(format!("{}.modes", e.name))
 }
 
-/// Where an elastic object's base with a transfer table lives (`NAME.transfer.modes`).
+/// Where an elastic object's base with a transfer table lives (`NAME.transfer.modes`), beside
+/// and distinct from its modal base.
+///
+/// ```
+/// use std::path::Path;
+/// use dcr_scenes::runner::{base_path, transfer_base_path};
+/// use dcr_scenes::scene::ElasticDesc;
+/// let e: ElasticDesc = serde_json::from_str(
+///     r#"{"name": "floor", "mesh": "data/scenes/floor.msh",
+///         "material": {"youngs": 1e10, "poisson": 0.3, "density": 540},
+///         "body": "static", "method": {"transfer": {"up": [0, 1, 0]}}}"#,
+/// )
+/// .unwrap();
+/// let dir = Path::new("out/bases");
+/// assert_eq!(base_path(dir, &e), dir.join("floor.modes"));
+/// assert_eq!(transfer_base_path(dir, &e), dir.join("floor.transfer.modes"));
+/// ```
 pub fn transfer_base_path(bases_dir: &Path, e: &ElasticDesc) -> PathBuf {
     bases_dir.join(format!("{}.transfer.modes", e.name))
 }
