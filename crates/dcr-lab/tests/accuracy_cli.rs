@@ -21,6 +21,10 @@ fn bad_options_are_refused_and_nothing_is_written() {
         (&["--newmark-impacts", "0"][..], "--newmark-impacts"),
         (&["--newmark-impacts", "7"][..], "1..=6"),
         (&["--only", "teapot"][..], "known: table, roof, scaffold"),
+        (&["--impacts", "cliff"][..], "expected NAME=N"),
+        (&["--impacts", "cliff=0"][..], "from 1 to 6"),
+        (&["--impacts", "cliff=x"][..], "whole number"),
+        (&["--impacts", "teapot=2"][..], "--impacts teapot"),
     ] {
         let o = accuracy(&out, args);
         let err = String::from_utf8_lossy(&o.stderr);

@@ -2,6 +2,7 @@
 //! truth there, and every method's peaks through the runtime (`DistantResponse`), with their
 //! errors, query cost, bake time and base size.
 
+use std::path::Path;
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -20,6 +21,7 @@ use modal_bake::transfer::{
 };
 
 use super::objects::ObjectSpec;
+use super::truth_cache::cached_converged_peaks;
 
 /// Rigid-body step of every scene (s).
 pub const H: f64 = 0.01;
@@ -84,8 +86,11 @@ pub struct ObjectStudy {
     pub truth: ConvergedPeaks,
     /// Independent check at the step reached: method and largest difference (%).
     pub cross_check: Option<(String, f64)>,
-    /// Seconds of the truth (eigensolve or factorizations, and every level).
+    /// Seconds of the truth (eigensolve or factorizations, and every level; for a cached
+    /// truth, the levels' seconds when it was computed).
     pub truth_s: f64,
+    /// The truth's levels were read from the cache.
+    pub truth_cached: bool,
     /// Impacts and resting contacts sampled.
     pub points: (usize, usize),
     /// Pairs evaluated (distance ≥ [`MIN_DISTANCE`]).
@@ -96,6 +101,8 @@ pub struct ObjectStudy {
     pub attenuation_c: f64,
     /// Notes (failed bakes and the like).
     pub notes: Vec<String>,
+    /// The default table's worst pairs, one Markdown line each.
+    pub worst: Vec<String>,
 }
 
 /// The lowest `m` modes of `base` (same surface and metadata; no table).
@@ -188,12 +195,15 @@ impl Bench<'_> {
 
 /// The full study of one object (see the module docs). `quick`: fewer rows; `newmark_impacts`:
 /// impacts for an object whose truth is Newmark (more than [`DENSE_MAX_DOFS`] free dofs; each
-/// impact is one more Newmark run at every level of the refinement), [`IMPACTS`] when `None`.
+/// impact is one more Newmark run at every level of the refinement), [`IMPACTS`] when `None`;
+/// `impacts`: this object's impacts, overriding both; `truth_cache`: folder of cached truths ([`super::truth_cache`]), `None` to always compute.
 pub fn study_object(
     spec: &ObjectSpec,
     mesh: TetMesh,
     quick: bool,
     newmark_impacts: Option<usize>,
+    impacts: Option<usize>,
+    truth_cache: Option<&Path>,
 ) -> ObjectStudy {
     let name = spec.name;
     let file = spec.source.clone();
@@ -224,8 +234,9 @@ pub fn study_object(
     let dense = dofs <= DENSE_MAX_DOFS;
     let ma = dense.then(|| ModalAll::new(&sys, DENSE_MAX_DOFS).expect("dense eigensolve"));
     let dense_s = t.elapsed().as_secs_f64();
-    let impacts = match newmark_impacts {
-        Some(n) if !dense => n,
+    let impacts = match (impacts, newmark_impacts) {
+        (Some(n), _) => n,
+        (None, Some(n)) if !dense => n,
         _ => IMPACTS,
     };
     let pp = PairsParams {
@@ -242,17 +253,31 @@ pub fn study_object(
         },
     };
     let mut last_line = Instant::now();
-    let pairs = ReferencePairs::new(&sys, ma.as_ref(), &base20, &region, &pp, &mut |p| {
-        if p.done == 0 || last_line.elapsed().as_secs() >= 10 {
-            eprintln!(
-                "{name}: truth level {} (dt {:.2e} s) {}/{}",
-                p.level, p.dt, p.done, p.total
-            );
-            last_line = Instant::now();
-        }
+    let mut cached = false;
+    let pairs = ReferencePairs::with_truth(&sys, ma.as_ref(), &base20, &region, &pp, &mut |tp| {
+        cached_converged_peaks(
+            truth_cache,
+            &sys,
+            tp,
+            &mut |p| {
+                if p.done == 0 || last_line.elapsed().as_secs() >= 10 {
+                    eprintln!(
+                        "{name}: truth level {} (dt {:.2e} s) {}/{}",
+                        p.level, p.dt, p.done, p.total
+                    );
+                    last_line = Instant::now();
+                }
+            },
+            &mut cached,
+        )
     })
     .expect("truth");
-    let truth_s = t.elapsed().as_secs_f64();
+    // A cached truth reports the seconds its levels took when it was computed.
+    let truth_s = if cached {
+        dense_s + pairs.truth.history.iter().map(|l| l.seconds).sum::<f64>()
+    } else {
+        t.elapsed().as_secs_f64()
+    };
     let truth_method = if dense {
         "sum over every mode (dense)"
     } else {
@@ -314,8 +339,14 @@ pub fn study_object(
         quick,
         &mut notes,
     ));
+    let worst = out
+        .iter()
+        .find(|r| r.best)
+        .map(|r| worst_pairs(&pairs, r, 3))
+        .unwrap_or_default();
     ObjectStudy {
         spec: spec.clone(),
+        worst,
         nodes,
         tets,
         dofs,
@@ -324,6 +355,7 @@ pub fn study_object(
         truth: pairs.truth.clone(),
         cross_check,
         truth_s,
+        truth_cached: cached,
         points: (pairs.impacts.len(), pairs.resting.len()),
         pairs: pairs.pairs(),
         rows: out,
@@ -520,6 +552,38 @@ fn table_rows(
         out.push(row);
     }
     out
+}
+
+/// The `n` pairs of `row` with the largest |error|, one line each: where the impact and the
+/// contact are (m, object frame; at a vertex or inside a triangle), their distance (m), the truth
+/// and the method's peak (m). `row.errors` lists the counted pairs impact by impact, contact by
+/// contact, as [`ReferencePairs::errors`] does.
+fn worst_pairs(pairs: &ReferencePairs, row: &MethodRow, n: usize) -> Vec<String> {
+    let ids: Vec<(usize, usize)> = (0..pairs.impacts.len())
+        .flat_map(|i| (0..pairs.resting.len()).map(move |c| (i, c)))
+        .filter(|&(i, c)| pairs.pair_ok[i][c])
+        .collect();
+    let mut order: Vec<usize> = (0..row.errors.len().min(ids.len())).collect();
+    order.sort_by(|&a, &b| row.errors[b].0.abs().total_cmp(&row.errors[a].0.abs()));
+    let fmt = |p: [f64; 3]| format!("({:.3}, {:.3}, {:.3})", p[0], p[1], p[2]);
+    order
+        .into_iter()
+        .take(n)
+        .map(|k| {
+            let (i, c) = ids[k];
+            let (a, b) = (pairs.impacts[i].point, pairs.resting[c].point);
+            let d = (0..3).map(|j| (a[j] - b[j]).powi(2)).sum::<f64>().sqrt();
+            let t = pairs.truth.peaks[i][c];
+            let e = row.errors[k].0;
+            format!(
+                "{e:+.1} %: impact {} → contact {} ({}), {d:.3} m apart; truth {t:.3e} m, table {:.3e} m",
+                fmt(a),
+                fmt(b),
+                if pairs.contact_at_vertex[c] { "at a vertex" } else { "inside a triangle" },
+                t * (1.0 + e / 100.0)
+            )
+        })
+        .collect()
 }
 
 /// Median of `v` (NaN when empty).

@@ -15,7 +15,7 @@ pub struct AccuracyArgs {
     #[arg(long, value_name = "DIR", default_value = ".")]
     pub root: PathBuf,
     /// Only these objects (repeatable): table, roof, scaffold, ground, cliff, floor, fridge,
-    /// slab.
+    /// fridge-surface, slab.
     #[arg(long, value_name = "NAME")]
     pub only: Vec<String>,
     /// Fewer method rows and no attenuation fit (a pipeline check).
@@ -26,6 +26,36 @@ pub struct AccuracyArgs {
     /// the refinement). Default: the same 6 as every object.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..=6))]
     pub newmark_impacts: Option<u64>,
+    /// Impacts of one object, NAME=N (repeatable; 1 ≤ N ≤ 6), overriding --newmark-impacts:
+    /// e.g. `--impacts cliff=2`, whose Newmark truth on 18k free dofs costs most per impact.
+    #[arg(long, value_name = "NAME=N", value_parser = parse_impacts)]
+    pub impacts: Vec<(String, usize)>,
+    /// Folder of cached full-order truths (one JSON file per object, keyed by a SHA-256 of the
+    /// matrices, points and settings): a rerun reuses them instead of repeating the refinement.
+    /// Relative paths are under ROOT.
+    #[arg(long, value_name = "DIR", default_value = "out/truth-cache")]
+    pub truth_cache: PathBuf,
+    /// Compute every truth afresh (neither read nor write the truth cache).
+    #[arg(long)]
+    pub no_truth_cache: bool,
+    /// Leave out the energy-bound section (every scene run unbounded and at η = 1, 0.5, 0.1).
+    #[arg(long)]
+    pub no_energy: bool,
+}
+
+/// `NAME=N` with 1 ≤ N ≤ 6.
+fn parse_impacts(s: &str) -> Result<(String, usize), String> {
+    let (name, n) = s
+        .split_once('=')
+        .ok_or_else(|| format!("{s:?}: expected NAME=N, e.g. cliff=2"))?;
+    let n: usize = n
+        .trim()
+        .parse()
+        .map_err(|_| format!("{s:?}: N must be a whole number from 1 to 6"))?;
+    if !(1..=6).contains(&n) {
+        return Err(format!("{s:?}: N must be from 1 to 6"));
+    }
+    Ok((name.trim().to_string(), n))
 }
 
 pub fn run(args: &AccuracyArgs) -> anyhow::Result<()> {
@@ -33,12 +63,25 @@ pub fn run(args: &AccuracyArgs) -> anyhow::Result<()> {
     if let Some(bad) = args.only.iter().find(|n| !known.contains(&n.as_str())) {
         anyhow::bail!("--only {bad}: no such object (known: {})", known.join(", "));
     }
+    if let Some((bad, _)) = args
+        .impacts
+        .iter()
+        .find(|(n, _)| !known.contains(&n.as_str()))
+    {
+        anyhow::bail!(
+            "--impacts {bad}=…: no such object (known: {})",
+            known.join(", ")
+        );
+    }
     let svg = args.out.join("accuracy");
     std::fs::create_dir_all(&svg).with_context(|| format!("creating {}", svg.display()))?;
     let opts = AccuracyOptions {
         only: args.only.clone(),
         quick: args.quick,
         newmark_impacts: args.newmark_impacts.map(|n| n as usize),
+        impacts: args.impacts.clone(),
+        truth_cache: (!args.no_truth_cache).then(|| args.root.join(&args.truth_cache)),
+        no_energy: args.no_energy,
     };
     let md = dcr_lab::accuracy::generate(&args.root, &args.out, &opts)?;
     let path = args.out.join("accuracy.md");

@@ -17,7 +17,7 @@
 
 mod reference_pairs;
 
-pub use reference_pairs::{sample_points, PairsParams, ReferencePairs, SamplePoint};
+pub use reference_pairs::{sample_points, PairsParams, ReferencePairs, SamplePoint, TruthProblem};
 
 use std::sync::Arc;
 

@@ -75,6 +75,21 @@ pub fn sample_points(
         .collect()
 }
 
+/// The truth [`ReferencePairs::with_truth`] asks for: the arguments of [`converged_peaks`]
+/// (on the pairs' [`FullOrderSystem`]).
+pub struct TruthProblem<'a> {
+    /// Dense all-mode sum or Newmark.
+    pub solver: PeakSolver<'a>,
+    /// One impulse per impact (N·s, free dofs).
+    pub loads: &'a [Vec<f64>],
+    /// One measurement row per resting contact (free dofs).
+    pub rows: &'a [Vec<f64>],
+    /// Window and first step (s).
+    pub window: PeakWindow,
+    /// Refinement.
+    pub refine: &'a RefineParams,
+}
+
 /// Seeded impacts and resting contacts with their converged full-order peaks.
 #[derive(Clone, Debug)]
 pub struct ReferencePairs {
@@ -148,6 +163,24 @@ impl ReferencePairs {
         params: &PairsParams,
         progress: &mut dyn FnMut(RefineProgress),
     ) -> Result<ReferencePairs, FullOrderError> {
+        Self::with_truth(sys, modal_all, base, region, params, &mut |t| {
+            converged_peaks(sys, t.solver, t.loads, t.rows, t.window, t.refine, progress)
+        })
+    }
+
+    /// As [`ReferencePairs::new`], with the converged peaks computed by `truth` from the
+    /// sampled problem (e.g. read from a cache of [`converged_peaks`] results keyed by it).
+    ///
+    /// # Errors
+    /// As [`ReferencePairs::new`], and `truth`'s.
+    pub fn with_truth(
+        sys: &FullOrderSystem,
+        modal_all: Option<&ModalAll>,
+        base: &ModesFile,
+        region: &[u32],
+        params: &PairsParams,
+        truth: &mut dyn FnMut(&TruthProblem) -> Result<ConvergedPeaks, FullOrderError>,
+    ) -> Result<ReferencePairs, FullOrderError> {
         let mut rng = SplitMix64(params.seed);
         let imp = sample_points(base, region, params.impacts, &mut rng);
         let con = sample_points(base, region, params.contacts, &mut rng);
@@ -176,7 +209,13 @@ impl ReferencePairs {
             h: params.h,
             dt: params.dt0,
         };
-        let truth = converged_peaks(sys, solver, &loads, &rows, window, &params.refine, progress)?;
+        let truth = truth(&TruthProblem {
+            solver,
+            loads: &loads,
+            rows: &rows,
+            window,
+            refine: &params.refine,
+        })?;
         let impacts: Vec<Impact> = isp
             .iter()
             .map(|s| Impact {
