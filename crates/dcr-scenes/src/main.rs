@@ -33,10 +33,18 @@ enum OnOff {
     Both,
 }
 
+/// A response method for every elastic object of a run.
 #[derive(Clone, Copy, ValueEnum)]
 enum MethodArg {
+    /// The modal filters over the object's base (its `modes`, 20 by default; Eq. 9–13).
     Modal,
+    /// Spatial attenuation (Eq. 14–16): the object's own or `attenuation` settings, else C = 1,
+    /// β = 1.
     Attenuation,
+    /// The bake-time peak-transfer table (many modes, baked for the scene's h into
+    /// out/bases/NAME.transfer.modes): the object's `method` or `transfer` settings; objects
+    /// without them are refused.
+    Transfer,
 }
 
 /// How the responses reach the bodies.
@@ -103,6 +111,16 @@ impl From<GateArg> for StepGate {
 #[derive(Clone, Copy)]
 struct Eta(Option<f64>);
 
+fn parse_gain(s: &str) -> Result<f64, String> {
+    let v: f64 = s
+        .parse()
+        .map_err(|_| format!("{s:?} is not a number (a scale ≥ 0 on the response Δv)"))?;
+    if !(v.is_finite() && v >= 0.0) {
+        return Err(format!("{v} is not a finite scale ≥ 0"));
+    }
+    Ok(v)
+}
+
 fn parse_eta(s: &str) -> Result<Eta, String> {
     if s.eq_ignore_ascii_case("off") || s.eq_ignore_ascii_case("none") {
         return Ok(Eta(None));
@@ -141,6 +159,10 @@ enum Cmd {
         /// Attenuation exponent β (implies --method attenuation).
         #[arg(long)]
         beta: Option<f64>,
+        /// Scale on every elastic object's response Δv, replacing the objects' own `gain`
+        /// (1 = the paper's Eq. 12/18 unscaled). Default: each object's `gain`.
+        #[arg(long, value_name = "G", value_parser = parse_gain, allow_hyphen_values = true)]
+        gain: Option<f64>,
         /// Output directory (default out/SCENE). Without --out the runs go to out/SCENE/on
         /// and out/SCENE/off (as with --dcr both), so an on and an off run never overwrite
         /// each other; with --out a single run writes there.
@@ -224,6 +246,17 @@ fn print_report(report: &RunReport, out_dir: &std::path::Path) {
             m.query_us_median.map_or("-".into(), |v| format!("{v:.1}")),
             m.query_us_p99.map_or("-".into(), |v| format!("{v:.1}"))
         );
+        if m.method.starts_with("transfer") {
+            println!(
+                "  model {:8} {} ({}): {} of {} events from the table; {} contacts served by the modal base outside its region",
+                m.model,
+                m.method,
+                m.base,
+                m.stats.events_by_table,
+                m.stats.responses_applied,
+                m.stats.contacts_table_fallback
+            );
+        }
     }
     println!(
         "  rapier {:.1} ms, dcr {:.1} ms ({:.2}% of step); energy injected {:.4e} J, dissipated {:.4e} J",
@@ -250,6 +283,7 @@ fn real_main() -> Result<()> {
             dcr,
             method,
             beta,
+            gain,
             out,
             bases,
             gltf,
@@ -265,9 +299,13 @@ fn real_main() -> Result<()> {
             }
             let desc = SceneDesc::read(&path)?;
             let method = match (method, beta) {
+                (Some(MethodArg::Modal | MethodArg::Transfer), Some(_)) => {
+                    bail!("--beta is the attenuation exponent: use it without --method or with --method attenuation")
+                }
                 (_, Some(b)) => MethodChoice::AttenuationBeta(b),
                 (Some(MethodArg::Attenuation), None) => MethodChoice::Attenuation,
                 (Some(MethodArg::Modal), None) => MethodChoice::Modal,
+                (Some(MethodArg::Transfer), None) => MethodChoice::Transfer,
                 (None, None) => MethodChoice::Scene,
             };
             if let Some(s) = seconds {
@@ -295,6 +333,7 @@ fn real_main() -> Result<()> {
                     &RunParams {
                         seconds,
                         method: method.clone(),
+                        gain,
                         bases_dir: bases_dir.clone(),
                         out_dir: Some(dir.clone()),
                         progress: true,

@@ -25,7 +25,7 @@ use rapier3d_f64::math::Pose;
 use serde_json::json as j;
 
 use super::shape_mesh::{shape_triangles, ShapeMesh};
-use crate::runner::{base_path, RunReport, Trajectory};
+use crate::runner::{surface_base_path, RunReport, Trajectory};
 use crate::scene::{build_world, BodyInfo, BuiltWorld, SceneDesc};
 
 /// One run shown in the file.
@@ -240,7 +240,7 @@ impl BodyMeshes {
             let mesh = match b.elastic {
                 Some(ei) => {
                     let e = &desc.elastic[ei];
-                    let bp = base_path(bases_dir, e);
+                    let bp = surface_base_path(bases_dir, e);
                     let base = ModesFile::read(&bp)
                         .with_context(|| format!("reading base {}", bp.display()))?;
                     ShapeMesh {

@@ -1,12 +1,19 @@
 //! Modal bases for a scene's elastic objects: baked on demand into `out/bases/`, rebaked
-//! when the mesh or the bake parameters change (content hashes, `modal_bake::bake::is_up_to_date`).
+//! when the mesh or the bake parameters change (content hashes, `modal_bake::bake::is_up_to_date`,
+//! which also compares a base's transfer-table parameters).
+//!
+//! Each object has up to two bases: `NAME.modes` (the modal base every method but the transfer
+//! table reads) and `NAME.transfer.modes` (the same modes plus the bake-time peak-transfer
+//! table, baked only when a run asks for `transfer`). The two never share a file, so baking a
+//! table leaves the modal base and the runs that read it untouched.
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result};
+use anyhow::{bail, Context, Result};
 use modal_bake::bake::{BakeParams, MaterialSi, ModeRequest};
+use modal_bake::transfer::{TableOrder, TransferModes, TransferParams};
 
-use crate::scene::ElasticDesc;
+use crate::scene::{ElasticDesc, TableOrderDesc, TransferDesc};
 
 /// The bake parameters of an elastic object (material, modes, fixed groups, Rayleigh).
 pub fn bake_params(e: &ElasticDesc) -> BakeParams {
@@ -23,43 +30,192 @@ pub fn bake_params(e: &ElasticDesc) -> BakeParams {
     }
 }
 
-/// Where an elastic object's base lives.
+/// The transfer-table parameters of elastic object `e` with settings `t`, for a scene stepping
+/// `h` (s): the table is baked for that step. `root` is the repository root (the mesh is read
+/// to resolve the default mode count).
+///
+/// The default mode count (`t.modes` unset) is resolved here, as a bake resolves
+/// `TransferModes::Auto`: every mode when the mesh has at most `DENSE_MAX_DOFS` free dofs, else
+/// `AUTO_LANCZOS_MODES`. A bake records the resolved count, and the staleness check compares
+/// the recorded count with the requested one, so an unresolved `Auto` would make the base
+/// stale on every run.
+///
+/// # Errors
+/// `t.h` is set and differs from `h` (relative tolerance 1e-9, the runtime's): a table serves
+/// one step only. The message names the object and both steps. The mesh cannot be read.
+pub fn transfer_params(
+    root: &Path,
+    e: &ElasticDesc,
+    t: &TransferDesc,
+    h: f64,
+) -> Result<TransferParams> {
+    if let Some(th) = t.h {
+        if !((th - h).abs() <= 1e-9 * h.abs()) {
+            bail!(
+                "elastic object {}: its transfer table is pinned to h = {th} s but the scene steps \
+                 h = {h} s; a table serves one step only (set `transfer.h` to {h} or remove it to \
+                 bake the table for the scene's step)",
+                e.name
+            );
+        }
+    }
+    Ok(TransferParams {
+        h,
+        modes: match t.modes {
+            Some(n) => TransferModes::Count(n),
+            None => TransferModes::Auto.resolve(free_dofs(root, e)?),
+        },
+        boxes: t.boxes.clone(),
+        up: t.up,
+        order: match t.order {
+            TableOrderDesc::Auto => TableOrder::Auto,
+            TableOrderDesc::Linear => TableOrder::Linear,
+            TableOrderDesc::Quadratic => TableOrder::Quadratic,
+            TableOrderDesc::Cubic => TableOrder::Cubic,
+        },
+        ..TransferParams::default()
+    })
+}
+
+/// Free degrees of freedom of `e`'s mesh: 3 per node not in a `fixed` group.
+///
+/// # Errors
+/// The mesh cannot be read (file and location in the message).
+fn free_dofs(root: &Path, e: &ElasticDesc) -> Result<usize> {
+    let path = root.join(&e.mesh);
+    let mesh = modal_bake::mesh::read_mesh(&path)
+        .with_context(|| format!("elastic object {}: reading {}", e.name, path.display()))?;
+    let fixed: std::collections::BTreeSet<usize> = e
+        .fixed
+        .iter()
+        .filter_map(|g| mesh.groups.get(g))
+        .flatten()
+        .copied()
+        .collect();
+    Ok(3 * (mesh.nodes.len() - fixed.len().min(mesh.nodes.len())))
+}
+
+/// Where an elastic object's modal base lives (`NAME.modes`).
 pub fn base_path(bases_dir: &Path, e: &ElasticDesc) -> PathBuf {
     bases_dir.join(format!("{}.modes", e.name))
 }
 
-/// Bakes `e`'s base into `bases_dir` unless an up-to-date one is there. Returns the path and
-/// whether it baked. Progress on stderr.
+/// Where an elastic object's base with a transfer table lives (`NAME.transfer.modes`), beside
+/// and distinct from its modal base.
+///
+/// ```
+/// use std::path::Path;
+/// use dcr_scenes::runner::{base_path, transfer_base_path};
+/// use dcr_scenes::scene::ElasticDesc;
+/// let e: ElasticDesc = serde_json::from_str(
+///     r#"{"name": "floor", "mesh": "data/scenes/floor.msh",
+///         "material": {"youngs": 1e10, "poisson": 0.3, "density": 540},
+///         "body": "static", "method": {"transfer": {"up": [0, 1, 0]}}}"#,
+/// )
+/// .unwrap();
+/// let dir = Path::new("out/bases");
+/// assert_eq!(base_path(dir, &e), dir.join("floor.modes"));
+/// assert_eq!(transfer_base_path(dir, &e), dir.join("floor.transfer.modes"));
+/// ```
+pub fn transfer_base_path(bases_dir: &Path, e: &ElasticDesc) -> PathBuf {
+    bases_dir.join(format!("{}.transfer.modes", e.name))
+}
+
+/// A base whose surface shows object `e` (the modal base, or the transfer base when only that
+/// one was baked: both hold the same surface).
+pub fn surface_base_path(bases_dir: &Path, e: &ElasticDesc) -> PathBuf {
+    let modal = base_path(bases_dir, e);
+    let transfer = transfer_base_path(bases_dir, e);
+    if !modal.exists() && transfer.exists() {
+        transfer
+    } else {
+        modal
+    }
+}
+
+/// Bakes `e`'s modal base into `bases_dir` unless an up-to-date one is there. Returns the path
+/// and whether it baked. Progress on stderr.
 ///
 /// # Errors
 /// Mesh or bake failures, with the mesh path.
 pub fn ensure_base(root: &Path, bases_dir: &Path, e: &ElasticDesc) -> Result<(PathBuf, bool)> {
-    std::fs::create_dir_all(bases_dir)
-        .with_context(|| format!("creating {}", bases_dir.display()))?;
-    let mesh = root.join(&e.mesh);
-    let params = bake_params(e);
-    let out = base_path(bases_dir, e);
-    let fresh = modal_bake::bake::is_up_to_date(&mesh, &params, &out)
-        .with_context(|| format!("checking base of {}", mesh.display()))?;
-    if fresh {
-        return Ok((out, false));
+    ensure(root, &base_path(bases_dir, e), e, &bake_params(e))
+}
+
+/// Bakes `e`'s base with the peak-transfer table `t` for step `h` (s) into `bases_dir`
+/// (`NAME.transfer.modes`) unless an up-to-date one is there (same mesh, bake and table
+/// parameters). Returns the path and whether it baked. Progress on stderr.
+///
+/// # Errors
+/// As [`transfer_params`]; mesh, bake or table failures (an empty region among them), with the
+/// object and the mesh path.
+pub fn ensure_transfer_base(
+    root: &Path,
+    bases_dir: &Path,
+    e: &ElasticDesc,
+    t: &TransferDesc,
+    h: f64,
+) -> Result<(PathBuf, bool)> {
+    let params = BakeParams {
+        transfer: Some(transfer_params(root, e, t, h)?),
+        ..bake_params(e)
+    };
+    ensure(root, &transfer_base_path(bases_dir, e), e, &params)
+}
+
+/// Bakes `e`'s mesh with `params` to `out` unless `out` is up to date.
+fn ensure(
+    root: &Path,
+    out: &Path,
+    e: &ElasticDesc,
+    params: &BakeParams,
+) -> Result<(PathBuf, bool)> {
+    if let Some(dir) = out.parent() {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     }
+    let mesh = root.join(&e.mesh);
+    let fresh = modal_bake::bake::is_up_to_date(&mesh, params, out).with_context(|| {
+        format!(
+            "elastic object {}: checking base of {}",
+            e.name,
+            mesh.display()
+        )
+    })?;
+    if fresh {
+        return Ok((out.to_path_buf(), false));
+    }
+    let table = match &params.transfer {
+        None => String::new(),
+        Some(t) => format!(
+            " with a transfer table (h {} s, up {:?}, {} boxes)",
+            t.h,
+            t.up,
+            t.boxes.len()
+        ),
+    };
     eprintln!(
-        "[dcr-scenes] baking {} ({} modes, fixed {:?}) -> {}",
+        "[dcr-scenes] baking {} ({} modes, fixed {:?}){table} -> {}",
         e.name,
         e.modes,
         e.fixed,
         out.display()
     );
     let t = std::time::Instant::now();
-    let report = modal_bake::bake::bake_file(&mesh, &params, &out, &mut |_| {})
-        .with_context(|| format!("baking {}", mesh.display()))?;
+    let report = modal_bake::bake::bake_file(&mesh, params, out, &mut |_| {})
+        .with_context(|| format!("elastic object {}: baking {}", e.name, mesh.display()))?;
+    let table = match &report.transfer {
+        None => String::new(),
+        Some(r) => format!(
+            "; table: order {}, {} points ({} region vertices), {} modes ({}), {} samples per step, modes {:.1} s + table {:.1} s",
+            r.order, r.points, r.vertices, r.modes, r.mode_source, r.samples, r.modes_s, r.build_s
+        ),
+    };
     eprintln!(
-        "[dcr-scenes] baked {} in {:.1} s ({} nodes, {} tets)",
+        "[dcr-scenes] baked {} in {:.1} s ({} nodes, {} tets){table}",
         e.name,
         t.elapsed().as_secs_f64(),
         report.nodes,
         report.tets
     );
-    Ok((out, true))
+    Ok((out.to_path_buf(), true))
 }

@@ -8,10 +8,14 @@ mod stress_bench;
 mod table1;
 mod trajectory;
 
-pub use bases::{bake_params, base_path, ensure_base};
+pub use bases::{
+    bake_params, base_path, ensure_base, ensure_transfer_base, surface_base_path,
+    transfer_base_path, transfer_params,
+};
 pub use outcomes::{measure_outcome, unit_of};
 pub use run::{
-    run_scene, MethodChoice, ModelReport, ModelStats, ResponseEvent, RunParams, RunReport, StepTime,
+    run_scene, BodyReceived, MethodChoice, ModelReport, ModelStats, ResponseEvent, RunParams,
+    RunReport, StepTime,
 };
 pub use stress_bench::{stress_bench, StressBenchParams};
 pub use table1::{paper_rows, table1, PaperRow, Table1Params};

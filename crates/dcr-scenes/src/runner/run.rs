@@ -10,17 +10,19 @@ use dcr_rapier::{ElasticHandle, ElasticObjectDesc, WorldParams};
 use dcr_runtime::format::ModesFile;
 use dcr_runtime::{
     AmplitudeKind, AttenuationLaw, AttenuationParams, DistanceKind, Method, ModalModel,
-    ResponseParams,
+    ResponseParams, ServedBy, TableFallback, TablePolicy,
 };
 use ndarray::{Array1, Array2};
 use ndarray_npy::NpzWriter;
 use rapier3d_f64::math::Vector;
 use serde::Serialize;
 
-use crate::runner::bases::ensure_base;
+use crate::runner::bases::{ensure_base, ensure_transfer_base};
 use crate::runner::outcomes::{measure_outcome, unit_of};
 use crate::runner::Trajectory;
-use crate::scene::{build_world, BuiltWorld, DriverDesc, ElasticDesc, MethodDesc, SceneDesc};
+use crate::scene::{
+    build_world, BuiltWorld, DriverDesc, ElasticDesc, MethodDesc, SceneDesc, TransferDesc,
+};
 
 /// Which response method a run uses.
 #[derive(Clone, Debug, PartialEq)]
@@ -34,6 +36,9 @@ pub enum MethodChoice {
     Attenuation,
     /// Spatial attenuation with this β (the object's other settings kept).
     AttenuationBeta(f64),
+    /// The bake-time peak-transfer table for every object (its `method` if that is
+    /// `transfer`, else its `transfer` settings; an object with neither is refused).
+    Transfer,
 }
 
 /// Settings of one run.
@@ -45,6 +50,9 @@ pub struct RunParams {
     pub dcr: bool,
     /// Method.
     pub method: MethodChoice,
+    /// Scale on every elastic object's response Δv, replacing the objects' own `gain`
+    /// (`None`: each object's `gain`).
+    pub gain: Option<f64>,
     /// Repository root (mesh paths are relative to it).
     pub root: PathBuf,
     /// Where bases are baked/read.
@@ -76,6 +84,7 @@ impl RunParams {
             seconds: None,
             dcr,
             method: MethodChoice::Scene,
+            gain: None,
             bases_dir: root.join("out").join("bases"),
             root,
             out_dir: None,
@@ -118,6 +127,17 @@ pub struct ModelStats {
     pub received: f64,
     /// Steps on which the energy bound scaled the object's responses down.
     pub energy_limited_steps: usize,
+    /// Resting contacts (summed over the queries) whose response came from the transfer
+    /// table.
+    pub contacts_by_table: usize,
+    /// Resting contacts (summed over the queries) a transfer response served with its modal
+    /// base instead (outside the table's region; reasons in `table_fallback_steps`).
+    pub contacts_table_fallback: usize,
+    /// Queries on which the table did not serve (some) contacts, by reason
+    /// (`impact_outside_region`, `contacts_outside_region`, `forces`, `unavailable`).
+    pub table_fallback_steps: BTreeMap<String, usize>,
+    /// Impulse events computed from the transfer table (`ServedBy::TransferTable`).
+    pub events_by_table: usize,
 }
 
 /// One response impulse of a run (what a viewer marks).
@@ -135,6 +155,25 @@ pub struct ResponseEvent {
     pub point: [f64; 3],
     /// Impulse (N·s, world frame).
     pub impulse: [f64; 3],
+    /// Velocity change at the point along the object's normal (m/s; the world's
+    /// `ImpulseEvent::delta_v`).
+    pub delta_v: f64,
+    /// Whether the transfer table computed it (`ServedBy::TransferTable`); else the modal base
+    /// or the attenuation law did.
+    pub by_table: bool,
+}
+
+/// What the responses gave one receiving body over a run (every response impulse issued to it,
+/// applied or, in an off run, only measured).
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct BodyReceived {
+    /// Impulse events.
+    pub events: usize,
+    /// Largest Δv of an event at its contact along the normal (m/s, after gain, Gauss–Seidel and
+    /// energy bound).
+    pub max_delta_v: f64,
+    /// Largest impulse magnitude of an event (N·s).
+    pub max_impulse: f64,
 }
 
 /// One elastic object's figures from a run (a Table 1 row).
@@ -148,8 +187,13 @@ pub struct ModelReport {
     pub surface_triangles: usize,
     /// Modes in the base.
     pub modes: usize,
-    /// Method used (`modal`, `attenuation C=.. beta=..`).
+    /// Method used (`modal`, `attenuation C=.. beta=..`, `transfer order .. ..`).
     pub method: String,
+    /// File name of the base the run read (`NAME.modes`, or `NAME.transfer.modes` for the
+    /// transfer method).
+    pub base: String,
+    /// Scale on the response Δv the run used (the object's `gain` or the run's override).
+    pub gain: f64,
     /// IIR sub-step T (s); None when off.
     pub iir_t: Option<f64>,
     /// IIR samples per rigid step h/T.
@@ -209,6 +253,8 @@ pub struct RunReport {
     pub gate: String,
     /// Steps on which the contacts were read and the world stepped.
     pub world_steps: usize,
+    /// Per receiving body (by name): what the responses gave it.
+    pub received: BTreeMap<String, BodyReceived>,
     /// In-solver path: collider pairs whose replay rapier's hook never saw (applied after the
     /// step instead).
     pub replay_missed: usize,
@@ -251,6 +297,32 @@ fn percentile(v: &[f64], p: f64) -> Option<f64> {
     Some(s[i.min(s.len() - 1)])
 }
 
+/// The settings of the transfer method for object `e` under `choice` (`None`: another
+/// method).
+///
+/// # Errors
+/// `choice` is [`MethodChoice::Transfer`] and the object has no transfer settings (the message
+/// names the object and says what to add).
+fn transfer_of<'a>(e: &'a ElasticDesc, choice: &MethodChoice) -> Result<Option<&'a TransferDesc>> {
+    let own = match &e.method {
+        MethodDesc::Transfer(t) => Some(t),
+        _ => None,
+    };
+    Ok(match choice {
+        MethodChoice::Scene => own,
+        MethodChoice::Transfer => match own.or(e.transfer.as_ref()) {
+            Some(t) => Some(t),
+            None => bail!(
+                "elastic object {}: `--method transfer` needs its transfer-table settings: add \
+                 `\"transfer\": {{\"up\": [0, 1, 0]}}` (region options: up, boxes, modes, \
+                 order; docs/scenes.md) to the object in the scene file",
+                e.name
+            ),
+        },
+        MethodChoice::Modal | MethodChoice::Attenuation | MethodChoice::AttenuationBeta(_) => None,
+    })
+}
+
 fn attenuation_of(e: &ElasticDesc, choice: &MethodChoice) -> Option<(f64, f64, String, String)> {
     let from = |m: &MethodDesc| match m {
         MethodDesc::Attenuation {
@@ -259,12 +331,12 @@ fn attenuation_of(e: &ElasticDesc, choice: &MethodChoice) -> Option<(f64, f64, S
             distance,
             amplitude,
         } => Some((*c, *beta, distance.clone(), amplitude.clone())),
-        MethodDesc::Modal => None,
+        MethodDesc::Modal | MethodDesc::Transfer(_) => None,
     };
     let own = from(&e.method).or_else(|| e.attenuation.as_ref().and_then(from));
     match choice {
         MethodChoice::Scene => from(&e.method),
-        MethodChoice::Modal => None,
+        MethodChoice::Modal | MethodChoice::Transfer => None,
         MethodChoice::Attenuation => {
             Some(own.unwrap_or((1.0, 1.0, "heat".into(), "per_vertex".into())))
         }
@@ -292,8 +364,9 @@ fn group_surface_vertices(
         .collect())
 }
 
-/// The response method of elastic object `e` (modal, or the attenuation law the scene or
-/// `params.method` names) and its name for the report.
+/// The response method of elastic object `e` (modal, the attenuation law or the transfer
+/// table the scene or `params.method` names) and its name for the report. `base` is the base
+/// the run reads (with a table for the transfer method).
 ///
 /// # Errors
 /// An unknown distance kind, or an amplitude group the mesh does not have.
@@ -302,6 +375,19 @@ fn elastic_method(
     params: &RunParams,
     base: &ModesFile,
 ) -> Result<(Method, String)> {
+    if transfer_of(e, &params.method)?.is_some() {
+        let name = match &base.transfer {
+            Some(t) => format!(
+                "transfer order {} points {} modes {} samples {}",
+                t.order,
+                t.num_points(),
+                t.modes,
+                t.samples
+            ),
+            None => "transfer".to_string(),
+        };
+        return Ok((Method::Transfer, name));
+    }
     let att = attenuation_of(e, &params.method);
     let method = match &att {
         None => Method::Modal,
@@ -446,7 +532,11 @@ pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
     let mut infos = Vec::new();
     let mut handles: Vec<ElasticHandle> = Vec::new();
     for (i, e) in desc.elastic.iter().enumerate() {
-        let (path, _) = ensure_base(&params.root, &params.bases_dir, e)?;
+        let transfer = transfer_of(e, &params.method)?;
+        let (path, _) = match transfer {
+            Some(t) => ensure_transfer_base(&params.root, &params.bases_dir, e, t, desc.h)?,
+            None => ensure_base(&params.root, &params.bases_dir, e)?,
+        };
         let base =
             ModesFile::read(&path).with_context(|| format!("reading base {}", path.display()))?;
         let (method, method_name) = elastic_method(e, params, &base)?;
@@ -459,9 +549,13 @@ pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
             max_map_distance: 0.1,
             method,
             lateral_kick: params.lateral_kick,
+            // The table was baked for this scene: a table that does not apply is an error,
+            // not a silent modal run.
+            table_policy: TablePolicy::Refuse,
             ..ResponseParams::default()
         };
-        object.gain = e.gain;
+        let gain = params.gain.unwrap_or(e.gain);
+        object.gain = gain;
         let body = built.bodies[built.elastic_body[i]].handle;
         let handle = dcr
             .add_object(
@@ -473,6 +567,9 @@ pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
             .map_err(|err| anyhow::anyhow!("elastic object {}: {err}", e.name))?;
         let response = dcr.world().response(handle);
         infos.push((
+            path.file_name()
+                .map_or(String::new(), |f| f.to_string_lossy().into_owned()),
+            gain,
             base.num_surface_vertices(),
             base.surface_triangles.len(),
             base.num_modes(),
@@ -532,6 +629,7 @@ pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
     let mut events = Vec::new();
     let mut world_steps = 0;
     let mut replay_missed = 0;
+    let mut received: BTreeMap<String, BodyReceived> = BTreeMap::new();
     let mut step_times = Vec::with_capacity(steps);
     let wall = Instant::now();
     let mut last_progress = Instant::now();
@@ -575,6 +673,19 @@ pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
             s.dissipated = info.energy.total_dissipated;
             s.received = info.energy.total_received;
             s.energy_limited_steps += usize::from(info.energy.scale < 1.0);
+            s.contacts_by_table += info.response.contacts_by_table as usize;
+            s.contacts_table_fallback += info.response.contacts_table_fallback as usize;
+            if let Some(reason) = info.response.table_fallback {
+                let reason = match reason {
+                    TableFallback::Unavailable => "unavailable",
+                    TableFallback::Forces => "forces",
+                    TableFallback::ImpactOutsideRegion => "impact_outside_region",
+                    TableFallback::ContactsOutsideRegion => "contacts_outside_region",
+                };
+                *s.table_fallback_steps
+                    .entry(reason.to_string())
+                    .or_default() += 1;
+            }
             if info.queried {
                 s.query_us.push(info.response_time_ns as f64 / 1e3);
                 s.query_resting.push(info.resting as usize);
@@ -586,6 +697,16 @@ pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
                 .position(|&h| h == e.object)
                 .unwrap_or_default();
             stats[i].max_delta_v = stats[i].max_delta_v.max(e.delta_v);
+            stats[i].events_by_table += usize::from(e.served_by == ServedBy::TransferTable);
+            if let Some(&body) = body_index.get(&e.body) {
+                let r = received.entry(built.bodies[body].name.clone()).or_default();
+                r.events += 1;
+                r.max_delta_v = r.max_delta_v.max(e.delta_v);
+                let j = e.impulse;
+                r.max_impulse = r
+                    .max_impulse
+                    .max((j[0] * j[0] + j[1] * j[1] + j[2] * j[2]).sqrt());
+            }
             // Off runs apply nothing: no events to show.
             if apply == ApplyMode::MeasureOnly {
                 continue;
@@ -597,6 +718,8 @@ pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
                     body,
                     point: e.point,
                     impulse: e.impulse,
+                    delta_v: e.delta_v,
+                    by_table: e.served_by == ServedBy::TransferTable,
                 });
             } else {
                 debug_assert!(false, "event for unknown body {:?}", body_handle(e.body));
@@ -619,20 +742,24 @@ pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
     let models: Vec<ModelReport> = stats
         .into_iter()
         .zip(infos)
-        .map(|(s, (sv, st, modes, method, t, sps))| ModelReport {
-            model: s.name.clone(),
-            surface_vertices: sv,
-            surface_triangles: st,
-            modes,
-            method,
-            iir_t: t,
-            samples_per_step: sps,
-            distant_contacts: s.query_resting.iter().copied().max().unwrap_or(0),
-            queries: s.query_us.len(),
-            query_us_median: percentile(&s.query_us, 50.0),
-            query_us_p99: percentile(&s.query_us, 99.0),
-            stats: s,
-        })
+        .map(
+            |(s, (base, gain, sv, st, modes, method, t, sps))| ModelReport {
+                model: s.name.clone(),
+                base,
+                gain,
+                surface_vertices: sv,
+                surface_triangles: st,
+                modes,
+                method,
+                iir_t: t,
+                samples_per_step: sps,
+                distant_contacts: s.query_resting.iter().copied().max().unwrap_or(0),
+                queries: s.query_us.len(),
+                query_us_median: percentile(&s.query_us, 50.0),
+                query_us_p99: percentile(&s.query_us, 99.0),
+                stats: s,
+            },
+        )
         .collect();
     let mut outcomes = BTreeMap::new();
     for o in &desc.outcomes {
@@ -676,6 +803,7 @@ pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
         }
         .to_string(),
         world_steps,
+        received,
         replay_missed,
         trajectory: traj,
         events,

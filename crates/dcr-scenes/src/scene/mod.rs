@@ -5,6 +5,7 @@ mod world_builder;
 
 pub use scene_desc::{
     name_matches, BodyKind, ColliderDesc, DriverDesc, ElasticDesc, JointDesc, MaterialDesc,
-    MethodDesc, OutcomeDesc, PoseDesc, PropDesc, SceneDesc, ShapeDesc,
+    MethodDesc, OutcomeDesc, PoseDesc, PropDesc, SceneDesc, ShapeDesc, TableOrderDesc,
+    TransferDesc,
 };
 pub use world_builder::{build_world, pose_from_desc, BodyInfo, BuiltWorld};

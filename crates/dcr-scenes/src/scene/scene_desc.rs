@@ -121,6 +121,56 @@ pub enum MethodDesc {
         #[serde(default = "default_amplitude")]
         amplitude: String,
     },
+    /// The base's bake-time peak-transfer table (`dcr_runtime::Method::Transfer`): peaks
+    /// summed over many modes (every mode where the dense eigensolve fits), looked up between
+    /// the table's region points. Contacts and impacts outside the region are served by the
+    /// 20-mode modal base the table is stored in (`ServedBy::Modal` in the events).
+    Transfer(TransferDesc),
+}
+
+/// What an elastic object's peak-transfer table covers (`modal_bake::transfer::TransferParams`).
+/// The table is baked for the scene's step `h` and the object's Rayleigh damping, into its own
+/// base file (`out/bases/NAME.transfer.modes`) beside the plain modal base.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TransferDesc {
+    /// Up direction (mesh frame, any length): the region keeps surface vertices whose outward
+    /// normal is within 60° of it. `None` (default): no normal filter.
+    #[serde(default)]
+    pub up: Option<[f64; 3]>,
+    /// Region boxes `[xmin, ymin, zmin, xmax, ymax, zmax]` (m, mesh frame): the region keeps
+    /// surface vertices inside any of them. Empty (default): the whole surface.
+    #[serde(default)]
+    pub boxes: Vec<[f64; 6]>,
+    /// Modes summed by the table. `None` (default): every mode when the mesh has at most
+    /// 6000 free dofs (dense eigensolve), else the lowest 640 (Lanczos).
+    #[serde(default)]
+    pub modes: Option<usize>,
+    /// Interpolation order over each region triangle. Default `auto` (cubic up to 5792
+    /// points, else quadratic).
+    #[serde(default)]
+    pub order: TableOrderDesc,
+    /// The step the table is baked for (s). Optional: a table is valid for one h only, and it
+    /// is always baked for the scene's `h`; stating it pins the table to that step, and a run
+    /// whose scene steps another h is refused (error naming the object) instead of rebaking.
+    #[serde(default)]
+    pub h: Option<f64>,
+}
+
+/// Interpolation order of a transfer table over each region triangle
+/// (`modal_bake::transfer::TableOrder`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum TableOrderDesc {
+    /// Cubic when the cubic table has at most 5792 points, else quadratic.
+    #[default]
+    Auto,
+    /// Vertices only.
+    Linear,
+    /// Vertices and edge midpoints (P2).
+    Quadratic,
+    /// Vertices, two points per edge and face centroids (P3).
+    Cubic,
 }
 
 fn default_distance() -> String {
@@ -168,10 +218,16 @@ pub struct ElasticDesc {
     /// default is modal.
     #[serde(default)]
     pub attenuation: Option<MethodDesc>,
+    /// Transfer-table settings used when a run asks for `--method transfer` on a scene whose
+    /// default is another method (a run refuses `--method transfer` for an object without
+    /// them, or without `method: {"transfer": ...}`).
+    #[serde(default)]
+    pub transfer: Option<TransferDesc>,
     /// Impacts below this normal impulse (N·s) are ignored (paper §4.5). Default 0.5.
     #[serde(default = "default_threshold")]
     pub impact_threshold: f64,
-    /// Scale on the response impulses (1 = the paper's Eq. 18). Default 1.
+    /// Scale on the response impulses (1 = the paper's Eq. 18); a run's `--gain` overrides it
+    /// for every object. Default 1.
     #[serde(default = "default_gain")]
     pub gain: f64,
 }
