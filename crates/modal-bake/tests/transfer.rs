@@ -424,3 +424,28 @@ fn bad_transfer_options_are_clear_errors() {
     ]);
     assert!(!o.status.success());
 }
+
+/// `check` with the bake's own options says fresh for a table baked at its default mode count
+/// (`auto`, recorded resolved for the mesh), and stale when a table option changes.
+#[test]
+fn check_is_fresh_after_a_default_table_bake() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("beam.modes");
+    let mesh = data("data/meshes/beam.msh");
+    let (mesh, out_s) = (mesh.to_str().unwrap(), out.to_str().unwrap());
+    let common = ["--fixed", "clamp", "--modes", "8", "--transfer-order", "1"];
+    let mut bake = vec!["bake", mesh, "-o", out_s, "--transfer-h", "0.004"];
+    bake.extend_from_slice(&common);
+    let o = run(&bake);
+    assert!(o.status.success(), "{}", text(&o));
+    let check = |h: &str| {
+        let mut args = vec!["check", mesh, out_s, "--transfer-h", h];
+        args.extend_from_slice(&common);
+        run(&args)
+    };
+    let o = check("0.004");
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let o = check("0.005");
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+    assert!(text(&o).contains("transfer"), "{}", text(&o));
+}

@@ -42,7 +42,7 @@ pub fn energy_section(root: &Path) -> anyhow::Result<String> {
 /// entry per elastic object, the sweep repeated on each of a scene's objects).
 fn render(value: &Value) -> String {
     let mut md = String::new();
-    let _ = writeln!(md, "## Energy bound (η)\n");
+    let _ = writeln!(md, "\n## Energy bound (η)\n");
     let _ = writeln!(md, "The world (`DcrWorld`, `WorldParams::energy_eta`, `dcr-scenes … --energy-eta`) bounds, per elastic object and step, the kinetic energy its distant responses inject by η × (the energy that step's impacts on it dissipated + what chained impulses gave its body), scaling the object's impulses uniformly when over; default η = 1 (passive: a response never gives more than its impacts lost). The property is proven by `crates/dcr-runtime/tests/energy_bound.rs` (seeded random worlds, gains up to 100, the injected energy measured independently from the bodies' kinetic energies; the bound holds to rounding at η = 1, 0.5 and 0.1 and is active in some steps).\n");
     let _ = writeln!(md, "Every scene of Table 1 as committed (its methods and gains), unbounded and at each η (`dcr-scenes table1 --energy-sweep 1,0.5,0.1`); energies summed over the run (J); `bounded` = object-steps the bound scaled; `changed` = outcomes that moved by more than 5 % from the unbounded run.\n");
     let _ = write!(

@@ -31,24 +31,14 @@ pub fn bake_params(e: &ElasticDesc) -> BakeParams {
 }
 
 /// The transfer-table parameters of elastic object `e` with settings `t`, for a scene stepping
-/// `h` (s): the table is baked for that step. `root` is the repository root (the mesh is read
-/// to resolve the default mode count).
-///
-/// The default mode count (`t.modes` unset) is resolved here, as a bake resolves
+/// `h` (s): the table is baked for that step. The default mode count (`t.modes` unset) is
 /// `TransferModes::Auto`: every mode when the mesh has at most `DENSE_MAX_DOFS` free dofs, else
-/// `AUTO_LANCZOS_MODES`. A bake records the resolved count, and the staleness check compares
-/// the recorded count with the requested one, so an unresolved `Auto` would make the base
-/// stale on every run.
+/// `AUTO_LANCZOS_MODES`.
 ///
 /// # Errors
 /// `t.h` is set and differs from `h` (relative tolerance 1e-9, the runtime's): a table serves
-/// one step only. The message names the object and both steps. The mesh cannot be read.
-pub fn transfer_params(
-    root: &Path,
-    e: &ElasticDesc,
-    t: &TransferDesc,
-    h: f64,
-) -> Result<TransferParams> {
+/// one step only. The message names the object and both steps.
+pub fn transfer_params(e: &ElasticDesc, t: &TransferDesc, h: f64) -> Result<TransferParams> {
     if let Some(th) = t.h {
         if !((th - h).abs() <= 1e-9 * h.abs()) {
             bail!(
@@ -63,7 +53,7 @@ pub fn transfer_params(
         h,
         modes: match t.modes {
             Some(n) => TransferModes::Count(n),
-            None => TransferModes::Auto.resolve(free_dofs(root, e)?),
+            None => TransferModes::Auto,
         },
         boxes: t.boxes.clone(),
         up: t.up,
@@ -75,24 +65,6 @@ pub fn transfer_params(
         },
         ..TransferParams::default()
     })
-}
-
-/// Free degrees of freedom of `e`'s mesh: 3 per node not in a `fixed` group.
-///
-/// # Errors
-/// The mesh cannot be read (file and location in the message).
-fn free_dofs(root: &Path, e: &ElasticDesc) -> Result<usize> {
-    let path = root.join(&e.mesh);
-    let mesh = modal_bake::mesh::read_mesh(&path)
-        .with_context(|| format!("elastic object {}: reading {}", e.name, path.display()))?;
-    let fixed: std::collections::BTreeSet<usize> = e
-        .fixed
-        .iter()
-        .filter_map(|g| mesh.groups.get(g))
-        .flatten()
-        .copied()
-        .collect();
-    Ok(3 * (mesh.nodes.len() - fixed.len().min(mesh.nodes.len())))
 }
 
 /// Where an elastic object's modal base lives (`NAME.modes`).
@@ -157,7 +129,7 @@ pub fn ensure_transfer_base(
     h: f64,
 ) -> Result<(PathBuf, bool)> {
     let params = BakeParams {
-        transfer: Some(transfer_params(root, e, t, h)?),
+        transfer: Some(transfer_params(e, t, h)?),
         ..bake_params(e)
     };
     ensure(root, &transfer_base_path(bases_dir, e), e, &params)

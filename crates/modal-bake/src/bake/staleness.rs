@@ -145,11 +145,18 @@ pub fn mesh_base_status(
     if base.meta.params_hash != params.hash() {
         return Ok(BaseStatus::ParametersChanged);
     }
+    // The bake records the table's mode count resolved for the mesh (`auto` → `all` or a
+    // Lanczos count), so compare with the same resolution.
+    let free_dofs = 3 * (prepared.mesh.nodes.len() - prepared.fixed.len());
     let table_matches = match &params.transfer {
         None => base.transfer.is_none(),
         Some(tp) => {
+            let resolved = crate::transfer::TransferParams {
+                modes: tp.modes.resolve(free_dofs),
+                ..tp.clone()
+            };
             base.transfer.is_some()
-                && base.meta.bake_params.get("transfer") == Some(&transfer_meta(tp))
+                && base.meta.bake_params.get("transfer") == Some(&transfer_meta(&resolved))
         }
     };
     if !table_matches {
