@@ -19,13 +19,11 @@ use std::path::Path;
 use std::sync::Arc;
 
 use dcr_lab::accuracy::truth_cache::cached_converged_peaks;
-use dcr_lab::accuracy::{
-    all_objects, load_mesh, BASE_MODES, CONTACTS, H, IMPACTS, IMPULSE, MIN_DISTANCE, TRUTH_DT0,
-};
+use dcr_lab::accuracy::{all_objects, load_mesh, pairs_params, BASE_MODES, H, IMPACTS};
 use dcr_runtime::{Method, ModalModel, RestingContact};
 use modal_bake::bake::{bake_mesh, BakeParams, ModeRequest};
-use modal_bake::full_order::{FullOrderSystem, ModalAll, RefineParams, SystemParams};
-use modal_bake::target_error::{PairsParams, ReferencePairs};
+use modal_bake::full_order::{FullOrderSystem, ModalAll, SystemParams};
+use modal_bake::target_error::ReferencePairs;
 use modal_bake::transfer::{
     build_transfer_table, mode_set_from_dense, select_region, TransferModes, TransferParams,
     DENSE_MAX_DOFS, UP_MIN_COS,
@@ -64,19 +62,7 @@ fn main() -> anyhow::Result<()> {
         "{name}: more than {DENSE_MAX_DOFS} free dofs"
     );
     let ma = ModalAll::new(&sys, DENSE_MAX_DOFS)?;
-    let pp = PairsParams {
-        impacts: IMPACTS,
-        contacts: CONTACTS,
-        seed: 2,
-        min_distance: MIN_DISTANCE,
-        impulse: IMPULSE,
-        h: H,
-        dt0: TRUTH_DT0,
-        refine: RefineParams {
-            max_refinements: 8,
-            ..RefineParams::default()
-        },
-    };
+    let pp = pairs_params(IMPACTS);
     let cache = Path::new("out/truth-cache");
     let mut hit = false;
     let pairs = ReferencePairs::with_truth(&sys, Some(&ma), &base20, &region, &pp, &mut |tp| {

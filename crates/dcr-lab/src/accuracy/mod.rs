@@ -21,8 +21,8 @@ use std::time::Instant;
 
 pub use objects::{all_objects, load_mesh, ObjectSpec};
 pub use study::{
-    maxv, median, study_object, truncate, MethodRow, ObjectStudy, BASE_MODES, CONTACTS, H, IMPACTS,
-    IMPULSE, MIN_DISTANCE, TRUTH_DT0,
+    maxv, median, pairs_params, study_object, truncate, MethodRow, ObjectStudy, BASE_MODES,
+    CONTACTS, H, IMPACTS, IMPULSE, MIN_DISTANCE, TRUTH_DT0,
 };
 
 use crate::attenuation_fit::{fit_attenuation_mesh, AttenuationFitParams};

@@ -39,6 +39,25 @@ pub const TRUTH_DT0: f64 = 1e-5;
 /// Modes of the runtime base every table sits in (the paper's count).
 pub const BASE_MODES: usize = 20;
 
+/// The report's seeded pairs with `impacts` impacts: [`CONTACTS`] resting contacts, seed 2,
+/// [`MIN_DISTANCE`], [`IMPULSE`], window [`H`], the truth refined from [`TRUTH_DT0`] (at most 8
+/// halvings, 0.5 %).
+pub fn pairs_params(impacts: usize) -> PairsParams {
+    PairsParams {
+        impacts,
+        contacts: CONTACTS,
+        seed: 2,
+        min_distance: MIN_DISTANCE,
+        impulse: IMPULSE,
+        h: H,
+        dt0: TRUTH_DT0,
+        refine: RefineParams {
+            max_refinements: 8,
+            ..RefineParams::default()
+        },
+    }
+}
+
 /// One method's result on an object.
 #[derive(Clone, Debug)]
 pub struct MethodRow {
@@ -239,19 +258,7 @@ pub fn study_object(
         (None, Some(n)) if !dense => n,
         _ => IMPACTS,
     };
-    let pp = PairsParams {
-        impacts,
-        contacts: CONTACTS,
-        seed: 2,
-        min_distance: MIN_DISTANCE,
-        impulse: IMPULSE,
-        h: H,
-        dt0: TRUTH_DT0,
-        refine: RefineParams {
-            max_refinements: 8,
-            ..RefineParams::default()
-        },
-    };
+    let pp = pairs_params(impacts);
     let mut last_line = Instant::now();
     let mut cached = false;
     let pairs = ReferencePairs::with_truth(&sys, ma.as_ref(), &base20, &region, &pp, &mut |tp| {
