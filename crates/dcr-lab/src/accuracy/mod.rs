@@ -22,7 +22,7 @@ use std::time::Instant;
 pub use objects::{all_objects, load_mesh, ObjectSpec};
 pub use study::{
     maxv, median, pairs_params, study_object, truncate, MethodRow, ObjectStudy, BASE_MODES,
-    CONTACTS, H, IMPACTS, IMPULSE, MIN_DISTANCE, TRUTH_DT0,
+    CONTACTS, H, IMPACTS, IMPULSE, MANY_IMPACTS, MIN_DISTANCE, TRUTH_DT0,
 };
 
 use crate::attenuation_fit::{fit_attenuation_mesh, AttenuationFitParams};
@@ -169,7 +169,7 @@ fn header(md: &mut String, date: &str, load: &str, opts: &AccuracyOptions) {
     let _ = writeln!(md, "- Quantity: the peak |normal displacement| over one rigid-body step h = {H} s (Eq. 11; Δv = peak/h, Eq. 12). Error = (method − truth)/truth in %.");
     let _ = writeln!(md, "- **Truth**: the full-order FEM response (P1 tets, every dof; Rayleigh 10 1/s, 1e-7 s): the exact sum over every elastic mode (dense eigensolve) up to 6000 free dofs, else implicit Newmark (β = ¼, γ = ½). Either way the step starts at {TRUTH_DT0:e} s (the dense sum at 8 samples per period of its top mode, if finer) and is halved until no peak changes by more than 0.5 % over two successive halvings (`dcr-lab truth` does the same); the step reached, the estimated error (the larger of those two changes) and, for the dense sum, its difference from Newmark at that step are given per object. Converged truths are cached in `out/truth-cache/` (keyed by a SHA-256 of the matrices, points and settings; `--no-truth-cache` recomputes them); an object whose truth was read from the cache says so.");
     let _ = writeln!(md, "- **Methods**, read and stepped through `DistantResponse` as an engine does (`carry_over = false`): the modal filters over m modes (paper T sampling; 20 = the paper's choice and the cost reference); the paper's spatial attenuation s = C/r with the 20-mode local amplitude and the C that best fits the truth; and the bake-time transfer table (`Method::Transfer`) in a 20-mode base, built from every mode where the dense solve fits and 640 Lanczos modes elsewhere, at the default order (cubic where the table has at most 5792 points, else quadratic) — **the default of `modal-bake bake MESH --transfer-h H --transfer-up AXIS`, marked ★**, which the verdict is about — and variants (quadratic; 160 modes).");
-    let _ = writeln!(md, "- Cost: query = one `step` with 1 impact and 8 resting contacts, the least of 15 batch means of 400 warm steps (µs), and its ratio to the 20-mode modal query; bake = 20-mode bake + the table's mode set (dense eigensolve or Lanczos) + the table build (s); base = the written `.modes` file (KiB). Times are on this shared machine, under the load above.\n");
+    let _ = writeln!(md, "- Cost: query = one `step` with 1 impact and 8 resting contacts, the least of 15 batch means of 400 warm steps (µs), and its ratio to the 20-mode modal query (the goal's cost); busy query = the same with {MANY_IMPACTS} impacts and all {CONTACTS} resting contacts at once (a table's cost grows with impacts × contacts, the modal filters' with impacts + contacts); bake = 20-mode bake + the table's mode set (dense eigensolve or Lanczos) + the table build (s); base = the written `.modes` file (KiB). Times are on this shared machine, under the load above.\n");
 }
 
 fn verdict(r: &MethodRow) -> (f64, f64, bool) {
@@ -189,6 +189,14 @@ fn q20(s: &ObjectStudy) -> f64 {
         .map_or(f64::NAN, |r| r.query_us)
 }
 
+/// The 20-mode busy query (µs).
+fn q20_many(s: &ObjectStudy) -> f64 {
+    s.rows
+        .iter()
+        .find(|r| r.label == format!("modal, {BASE_MODES} modes"))
+        .map_or(f64::NAN, |r| r.query_many_us)
+}
+
 fn summary_table(md: &mut String, studies: &[ObjectStudy]) {
     let _ = writeln!(
         md,
@@ -199,8 +207,8 @@ fn summary_table(md: &mut String, studies: &[ObjectStudy]) {
         md,
         "![worst and median error per object](accuracy/summary.svg)\n"
     );
-    let _ = writeln!(md, "| object | free dofs | truth: Δt reached, est. error | 20 modes: median / worst % | ★ table: median / worst % | goal | query µs (× 20-mode) | bake s | base KiB |");
-    let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|");
+    let _ = writeln!(md, "| object | free dofs | truth: Δt reached, est. error | 20 modes: median / worst % | ★ table: median / worst % | goal | query µs (× 20-mode) | busy query µs (× 20-mode) | bake s | base KiB |");
+    let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|---|");
     for s in studies {
         let m20 = s
             .rows
@@ -227,12 +235,14 @@ fn summary_table(md: &mut String, studies: &[ObjectStudy]) {
                 let ratio = r.query_us / q20(s);
                 let _ = writeln!(
                     md,
-                    "| {} | {} | {} | {a:.1} / {b:.1} | {med:.1} / {worst:.1} | {} | {:.2} ({ratio:.2}×) | {:.1} | {:.0} |",
+                    "| {} | {} | {} | {a:.1} / {b:.1} | {med:.1} / {worst:.1} | {} | {:.2} ({ratio:.2}×) | {:.2} ({:.2}×) | {:.1} | {:.0} |",
                     s.spec.name,
                     s.dofs,
                     truth,
                     if ok && ratio <= 2.0 && s.truth.converged { "met" } else { "**missed**" },
                     r.query_us,
+                    r.query_many_us,
+                    r.query_many_us / q20_many(s),
                     r.bake_s,
                     r.bytes as f64 / 1024.0
                 );
@@ -240,7 +250,7 @@ fn summary_table(md: &mut String, studies: &[ObjectStudy]) {
             None => {
                 let _ = writeln!(
                     md,
-                    "| {} | {} | {} | {a:.1} / {b:.1} | no table | **missed** | | | |",
+                    "| {} | {} | {} | {a:.1} / {b:.1} | no table | **missed** | | | | |",
                     s.spec.name, s.dofs, truth
                 );
             }
@@ -307,9 +317,10 @@ fn object_section(md: &mut String, s: &ObjectStudy) {
         }
     );
     let _ = writeln!(md);
-    let _ = writeln!(md, "| method | at vertices: median / worst % | inside triangles: median / worst % | all: median / worst % | signed min / max % | query µs | × 20-mode | bake s | base KiB |");
-    let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|");
+    let _ = writeln!(md, "| method | at vertices: median / worst % | inside triangles: median / worst % | all: median / worst % | signed min / max % | query µs | × 20-mode | busy query µs | × 20-mode | bake s | base KiB |");
+    let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|---|---|");
     let q = q20(s);
+    let qm = q20_many(s);
     for r in &s.rows {
         let (v, i, a) = (r.abs(|x| x), r.abs(|x| !x), r.abs(|_| true));
         let (lo, hi) = r
@@ -320,7 +331,7 @@ fn object_section(md: &mut String, s: &ObjectStudy) {
             });
         let _ = writeln!(
             md,
-            "| {}{} | {:.1} / {:.1} | {:.1} / {:.1} | {:.1} / {:.1} | {lo:+.1} / {hi:+.1} | {:.2} | {:.2} | {} | {:.0} |",
+            "| {}{} | {:.1} / {:.1} | {:.1} / {:.1} | {:.1} / {:.1} | {lo:+.1} / {hi:+.1} | {:.2} | {:.2} | {:.2} | {:.2} | {} | {:.0} |",
             if r.best { "★ " } else { "" },
             r.label,
             median(&v),
@@ -331,6 +342,8 @@ fn object_section(md: &mut String, s: &ObjectStudy) {
             maxv(&a),
             r.query_us,
             r.query_us / q,
+            r.query_many_us,
+            r.query_many_us / qm,
             if r.bake_s.is_finite() { format!("{:.1}", r.bake_s) } else { "–".into() },
             r.bytes as f64 / 1024.0
         );

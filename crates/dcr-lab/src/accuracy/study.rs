@@ -36,6 +36,9 @@ pub const CONTACTS: usize = 24;
 pub const MIN_DISTANCE: f64 = 0.1;
 /// First step of the truth's refinement (s).
 pub const TRUTH_DT0: f64 = 1e-5;
+/// Impacts of the busy query (with every sampled resting contact): a table's cost grows with
+/// impacts × contacts, a modal base's with impacts + contacts.
+pub const MANY_IMPACTS: usize = 4;
 /// Modes of the runtime base every table sits in (the paper's count).
 pub const BASE_MODES: usize = 20;
 
@@ -69,6 +72,8 @@ pub struct MethodRow {
     pub errors: Vec<(f64, bool)>,
     /// One query: 1 impact, 8 resting contacts (µs, least of 15 batch means).
     pub query_us: f64,
+    /// One busy query: [`MANY_IMPACTS`] impacts, every sampled resting contact (µs, as above).
+    pub query_many_us: f64,
     /// Seconds to bake it (20-mode base + mode set + table), NaN when not measured.
     pub bake_s: f64,
     /// Written base size (bytes).
@@ -201,11 +206,14 @@ impl Bench<'_> {
         assert!(by.iter().all(|b| *b == served), "{label}: served by {by:?}");
         let n = self.pairs.resting.len().min(8);
         let query_us = time_step(&mut dr, &self.pairs.impacts[..1], &self.pairs.resting[..n]);
+        let k = self.pairs.impacts.len().min(MANY_IMPACTS);
+        let query_many_us = time_step(&mut dr, &self.pairs.impacts[..k], &self.pairs.resting);
         MethodRow {
             label,
             best: false,
             errors,
             query_us,
+            query_many_us,
             bake_s,
             bytes,
         }
@@ -486,6 +494,7 @@ fn attenuation_row(
         c_fit,
     );
     att_row.query_us = probe.query_us;
+    att_row.query_many_us = probe.query_many_us;
     (att_row, c_fit)
 }
 
