@@ -14,14 +14,15 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use dcr_lab::accuracy::truth_cache::cached_converged_peaks;
-use dcr_lab::accuracy::{all_objects, load_mesh, maxv, median, pairs_params, BASE_MODES, H};
+use dcr_lab::accuracy::{
+    abs_errors, all_objects, base20, load_mesh, maxv, median, pairs_params, system_params, Base20,
+    H,
+};
 use dcr_runtime::{Method, ModalModel};
-use modal_bake::bake::{bake_mesh, BakeParams, ModeRequest};
-use modal_bake::full_order::{FullOrderSystem, ModalAll, PeakSolver, SystemParams};
+use modal_bake::full_order::{FullOrderSystem, ModalAll, PeakSolver};
 use modal_bake::target_error::ReferencePairs;
 use modal_bake::transfer::{
-    build_transfer_table, mode_set_from_dense, select_region, TransferModes, TransferParams,
-    UP_MIN_COS,
+    build_transfer_table, mode_set_from_dense, TransferModes, TransferParams,
 };
 
 fn main() -> anyhow::Result<()> {
@@ -32,27 +33,13 @@ fn main() -> anyhow::Result<()> {
         .find(|o| o.name == name)
         .ok_or_else(|| anyhow::anyhow!("no object {name}"))?;
     let mesh = load_mesh(&spec, Path::new("."))?;
-    let bp = BakeParams {
-        material: spec.material,
-        modes: ModeRequest::Count(BASE_MODES),
-        fixed: spec.fixed.clone(),
-        ..Default::default()
-    };
-    let t = Instant::now();
-    let (base20, _) = bake_mesh(mesh.clone(), &bp, &spec.source, &mut |_| {})?;
-    let base20_s = t.elapsed().as_secs_f64();
-    let region = select_region(
-        &ModalModel::from_base(base20.clone())?,
-        &spec.boxes,
-        spec.up,
-        UP_MIN_COS,
-    );
-    let sp = SystemParams {
-        material: spec.material,
-        fixed: spec.fixed.clone(),
-        ..Default::default()
-    };
-    let sys = FullOrderSystem::new(mesh, &sp, &spec.source)?;
+    let Base20 {
+        base: base20,
+        seconds: base20_s,
+        region,
+        ..
+    } = base20(&spec, &mesh)?;
+    let sys = FullOrderSystem::new(mesh, &system_params(&spec), &spec.source)?;
     // The report's pairs and Newmark truth (read from the cache).
     let pp = pairs_params(impacts);
     let mut hit = false;
@@ -95,14 +82,11 @@ fn main() -> anyhow::Result<()> {
     let _ = std::fs::remove_file(&tmp);
     let mut dr = pairs.response(Arc::new(ModalModel::from_base(b)?), Method::Transfer);
     let (errors, _) = pairs.errors(&mut dr, 1.0);
-    let abs = |keep: &dyn Fn(bool) -> bool| -> Vec<f64> {
-        errors
-            .iter()
-            .filter(|(_, v)| keep(*v))
-            .map(|(e, _)| e.abs())
-            .collect()
-    };
-    let (v, i, a) = (abs(&|x| x), abs(&|x| !x), abs(&|_| true));
+    let (v, i, a) = (
+        abs_errors(&errors, |x| x),
+        abs_errors(&errors, |x| !x),
+        abs_errors(&errors, |_| true),
+    );
     println!(
         "{name}: table, all {} modes (dense), order {order} ({points} points, S = {samples}): \
          at vertices {:.1} / {:.1} %, inside triangles {:.1} / {:.1} %, all {:.1} / {:.1} % \

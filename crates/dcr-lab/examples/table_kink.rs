@@ -19,14 +19,14 @@ use std::path::Path;
 use std::sync::Arc;
 
 use dcr_lab::accuracy::truth_cache::cached_converged_peaks;
-use dcr_lab::accuracy::{all_objects, load_mesh, pairs_params, BASE_MODES, H, IMPACTS};
+use dcr_lab::accuracy::{
+    all_objects, base20, load_mesh, pairs_params, system_params, Base20, H, IMPACTS,
+};
 use dcr_runtime::{Method, ModalModel, RestingContact};
-use modal_bake::bake::{bake_mesh, BakeParams, ModeRequest};
-use modal_bake::full_order::{FullOrderSystem, ModalAll, SystemParams};
+use modal_bake::full_order::{FullOrderSystem, ModalAll};
 use modal_bake::target_error::ReferencePairs;
 use modal_bake::transfer::{
-    build_transfer_table, mode_set_from_dense, select_region, TransferModes, TransferParams,
-    DENSE_MAX_DOFS, UP_MIN_COS,
+    build_transfer_table, mode_set_from_dense, TransferModes, TransferParams, DENSE_MAX_DOFS,
 };
 
 fn main() -> anyhow::Result<()> {
@@ -38,25 +38,12 @@ fn main() -> anyhow::Result<()> {
         .find(|o| o.name == name)
         .ok_or_else(|| anyhow::anyhow!("no object {name}"))?;
     let mesh = load_mesh(&spec, Path::new("."))?;
-    let bp = BakeParams {
-        material: spec.material,
-        modes: ModeRequest::Count(BASE_MODES),
-        fixed: spec.fixed.clone(),
-        ..Default::default()
-    };
-    let (base20, _) = bake_mesh(mesh.clone(), &bp, &spec.source, &mut |_| {})?;
-    let region = select_region(
-        &ModalModel::from_base(base20.clone())?,
-        &spec.boxes,
-        spec.up,
-        UP_MIN_COS,
-    );
-    let sp = SystemParams {
-        material: spec.material,
-        fixed: spec.fixed.clone(),
-        ..Default::default()
-    };
-    let sys = FullOrderSystem::new(mesh, &sp, &spec.source)?;
+    let Base20 {
+        base: base20,
+        region,
+        ..
+    } = base20(&spec, &mesh)?;
+    let sys = FullOrderSystem::new(mesh, &system_params(&spec), &spec.source)?;
     anyhow::ensure!(
         sys.n() <= DENSE_MAX_DOFS,
         "{name}: more than {DENSE_MAX_DOFS} free dofs"

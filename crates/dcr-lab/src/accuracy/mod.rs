@@ -21,8 +21,9 @@ use std::time::Instant;
 
 pub use objects::{all_objects, load_mesh, ObjectSpec};
 pub use study::{
-    maxv, median, pairs_params, study_object, truncate, MethodRow, ObjectStudy, BASE_MODES,
-    CONTACTS, H, IMPACTS, IMPULSE, MANY_IMPACTS, MIN_DISTANCE, TRUTH_DT0,
+    abs_errors, base20, maxv, median, pairs_params, study_object, system_params, truncate, Base20,
+    MethodRow, ObjectStudy, BASE_MODES, CONTACTS, H, IMPACTS, IMPULSE, MANY_IMPACTS, MIN_DISTANCE,
+    TRUTH_DT0,
 };
 
 use crate::attenuation_fit::{fit_attenuation_mesh, AttenuationFitParams};

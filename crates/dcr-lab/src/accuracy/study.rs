@@ -8,7 +8,7 @@ use std::time::Instant;
 
 use dcr_runtime::format::ModesFile;
 use dcr_runtime::{DistantResponse, Impact, Method, ModalModel, RestingContact, ServedBy};
-use modal_bake::bake::{bake_mesh, BakeParams, ModeRequest};
+use modal_bake::bake::{bake_mesh, BakeError, BakeParams, ModeRequest};
 use modal_bake::full_order::{
     converged_peaks, ConvergedPeaks, FullOrderSystem, ModalAll, PeakSolver, PeakWindow,
     RefineParams, SystemParams,
@@ -61,6 +61,65 @@ pub fn pairs_params(impacts: usize) -> PairsParams {
     }
 }
 
+/// An object's 20-mode runtime base (the cost reference every table sits in) and its region.
+pub struct Base20 {
+    /// The bake parameters (material, fixed groups, [`BASE_MODES`] modes).
+    pub params: BakeParams,
+    /// The base.
+    pub base: ModesFile,
+    /// Free dofs of the mesh.
+    pub free_dofs: usize,
+    /// Seconds of the bake.
+    pub seconds: f64,
+    /// Region vertices (ascending surface-vertex indices) of the object's boxes and up filter.
+    pub region: Vec<u32>,
+}
+
+/// Bakes `spec`'s 20-mode base from `mesh` and selects its region.
+///
+/// # Errors
+/// The bake's.
+pub fn base20(spec: &ObjectSpec, mesh: &TetMesh) -> Result<Base20, BakeError> {
+    let params = BakeParams {
+        material: spec.material,
+        modes: ModeRequest::Count(BASE_MODES),
+        fixed: spec.fixed.clone(),
+        ..Default::default()
+    };
+    let t = Instant::now();
+    let (base, rep) = bake_mesh(mesh.clone(), &params, &spec.source, &mut |_| {})?;
+    let seconds = t.elapsed().as_secs_f64();
+    let model = ModalModel::from_base(base.clone())
+        .map_err(|e| BakeError::Params(format!("{}: {e}", spec.source)))?;
+    let region = select_region(&model, &spec.boxes, spec.up, UP_MIN_COS);
+    Ok(Base20 {
+        params,
+        base,
+        free_dofs: rep.free_dofs,
+        seconds,
+        region,
+    })
+}
+
+/// The full-order system parameters of `spec` (its material and fixed groups, the bake's
+/// default Rayleigh damping).
+pub fn system_params(spec: &ObjectSpec) -> SystemParams {
+    SystemParams {
+        material: spec.material,
+        fixed: spec.fixed.clone(),
+        ..Default::default()
+    }
+}
+
+/// |errors| (%) of the pairs selected by `keep(contact at vertex)`.
+pub fn abs_errors(errors: &[(f64, bool)], keep: impl Fn(bool) -> bool) -> Vec<f64> {
+    errors
+        .iter()
+        .filter(|(_, v)| keep(*v))
+        .map(|(e, _)| e.abs())
+        .collect()
+}
+
 /// One method's result on an object.
 #[derive(Clone, Debug)]
 pub struct MethodRow {
@@ -83,11 +142,7 @@ pub struct MethodRow {
 impl MethodRow {
     /// |errors| of the pairs selected by `keep(contact at vertex)`.
     pub fn abs(&self, keep: impl Fn(bool) -> bool) -> Vec<f64> {
-        self.errors
-            .iter()
-            .filter(|(_, v)| keep(*v))
-            .map(|(e, _)| e.abs())
-            .collect()
+        abs_errors(&self.errors, keep)
     }
 }
 
@@ -223,7 +278,8 @@ impl Bench<'_> {
 /// The full study of one object (see the module docs). `quick`: fewer rows; `newmark_impacts`:
 /// impacts for an object whose truth is Newmark (more than [`DENSE_MAX_DOFS`] free dofs; each
 /// impact is one more Newmark run at every level of the refinement), [`IMPACTS`] when `None`;
-/// `impacts`: this object's impacts, overriding both; `truth_cache`: folder of cached truths ([`super::truth_cache`]), `None` to always compute.
+/// `impacts`: this object's impacts, overriding both; `truth_cache`: folder of cached truths
+/// ([`super::truth_cache`]), `None` to always compute.
 pub fn study_object(
     spec: &ObjectSpec,
     mesh: TetMesh,
@@ -237,27 +293,18 @@ pub fn study_object(
     let (nodes, tets) = (mesh.nodes.len(), mesh.tets.len());
     let mut notes = Vec::new();
     eprintln!("{name}: 20-mode base…");
-    let bp = BakeParams {
-        material: spec.material,
-        modes: ModeRequest::Count(BASE_MODES),
-        fixed: spec.fixed.clone(),
-        ..Default::default()
-    };
-    let t = Instant::now();
-    let (base20, rep) = bake_mesh(mesh.clone(), &bp, &file, &mut |_| {}).expect("20-mode bake");
-    let base20_s = t.elapsed().as_secs_f64();
-    let dofs = rep.free_dofs;
-    let model20 = ModalModel::from_base(base20.clone()).expect("model");
-    let region = select_region(&model20, &spec.boxes, spec.up, UP_MIN_COS);
+    let Base20 {
+        params: bp,
+        base: base20,
+        free_dofs: dofs,
+        seconds: base20_s,
+        region,
+    } = base20(spec, &mesh).expect("20-mode bake");
     // Truth: the dense all-mode sum where it fits, else Newmark; refined until converged.
     eprintln!("{name}: truth ({dofs} free dofs)…");
     let t = Instant::now();
-    let sp = SystemParams {
-        material: spec.material,
-        fixed: spec.fixed.clone(),
-        ..Default::default()
-    };
-    let sys = FullOrderSystem::new(mesh.clone(), &sp, &file).expect("full-order system");
+    let sys =
+        FullOrderSystem::new(mesh.clone(), &system_params(spec), &file).expect("full-order system");
     let dense = dofs <= DENSE_MAX_DOFS;
     let ma = dense.then(|| ModalAll::new(&sys, DENSE_MAX_DOFS).expect("dense eigensolve"));
     let dense_s = t.elapsed().as_secs_f64();
