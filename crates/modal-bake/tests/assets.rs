@@ -1,7 +1,7 @@
 //! Surface assets: the OBJ / STL / PLY readers agree, defects are refused with their position,
 //! and a real asset made by someone else (gmsh's tutorial STL `t13_data.stl`, shipped in the
 //! PyPI `gmsh` package, GPL-2.0-or-later) goes through `mesh` → `bake` → `probe` with the real
-//! gmsh, plus a copy with a hole that is refused with the hole's position.
+//! gmsh, plus a copy with a hole that `--mesher gmsh` refuses with the hole's position and the fix.
 //!
 //! Tests that need gmsh skip with a message when it is missing, unless `DCR_REQUIRE_GMSH=1`
 //! (set by `.ci/run`), where they fail.
@@ -419,14 +419,16 @@ fn real_asset_mesh_bake_probe_and_a_holed_copy() {
         .arg(&holed)
         .arg("-o")
         .arg(dir.path().join("holed.msh"))
-        .args(["--units", "mm"])
+        .args(["--units", "mm", "--mesher", "gmsh"])
         .output()
         .unwrap();
     assert!(!out.status.success());
     assert!(!dir.path().join("holed.msh").exists());
     let err = String::from_utf8_lossy(&out.stderr).to_string();
     assert!(
-        err.contains("holed.stl") && err.contains("open edge from ("),
+        err.contains("holed.stl")
+            && err.contains("open edge from (")
+            && err.contains("use --mesher ftetwild or --mesher auto"),
         "{err}"
     );
     // The positions printed (6 decimals, m) are corners of the removed facet.

@@ -106,12 +106,12 @@ pub fn load_mesh(
 ) -> anyhow::Result<(modal_bake::mesh::TetMesh, f64)> {
     let t = std::time::Instant::now();
     if is_surface_asset(path) {
-        let (out, _) = super::mesh::mesh_asset(path, asset)?;
+        let out = super::mesh::mesh_asset(path, asset)?;
         return Ok((out.mesh, t.elapsed().as_secs_f64()));
     }
     if asset.any_set() {
         anyhow::bail!(
-            "--size, --order, --gmsh and --keep-surface apply to surface assets (.obj, .stl, .ply), not to the volume mesh {}",
+            "--mesher, --size, --order, --envelope, --gmsh, --ftetwild, --keep-surface and --mesher-timeout apply to surface assets (.obj, .stl, .ply), not to the volume mesh {}",
             path.display()
         );
     }

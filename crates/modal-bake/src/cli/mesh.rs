@@ -4,8 +4,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 use clap::Args;
-use modal_bake::mesh::gmsh::{GmshOutput, GmshParams};
-use modal_bake::mesh::surface::SurfaceInfo;
+use modal_bake::mesh::{MeshParams, MeshedAsset, MesherChoice};
 
 /// Length unit of a mesh's or surface asset's coordinates.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -86,6 +85,18 @@ pub fn warn_extent(what: &str, extent_m: f64, units: Units, extra: &str) {
     );
 }
 
+/// The tetrahedral mesher (`--mesher`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum MesherArg {
+    /// Inspect the surface: gmsh when it bounds one solid as it is, fTetWild otherwise; the
+    /// other one when the first fails.
+    Auto,
+    /// gmsh only (quality remeshing of clean closed surfaces); a defective surface is refused.
+    Gmsh,
+    /// fTetWild only (any surface: open, self-intersecting, non-manifold, several shells).
+    Ftetwild,
+}
+
 /// How the geometry is read: the unit of its coordinates (any mesh) and how a surface asset is
 /// tetrahedralized (shared by `mesh`, `bake` and `check`).
 #[derive(Args, Clone, Debug)]
@@ -95,49 +106,89 @@ pub struct AssetOptions {
     /// --fixed-box, --transfer-region) are in metres.
     #[arg(long, value_enum, default_value_t = Units::M)]
     pub units: Units,
-    /// Surface assets: target tetrahedron size (m) [default: 1/20 of the bounding-box
-    /// diagonal].
+    /// Surface assets: the tetrahedral mesher. `auto` inspects the surface first (open and
+    /// non-manifold edges, non-manifold vertices, self-intersections, shells) and runs gmsh on
+    /// a surface that bounds one solid as it is, fTetWild on any other, falling back to the
+    /// other when one fails; the report says which ran and why.
+    #[arg(long, value_enum, default_value_t = MesherArg::Auto)]
+    pub mesher: MesherArg,
+    /// Surface assets: target tetrahedron size (m; fTetWild's ideal edge length) [default:
+    /// 1/20 of the bounding-box diagonal].
     #[arg(long, value_name = "M")]
     pub size: Option<f64>,
     /// Surface assets: element order, 1 (4-node tetrahedra) or 2 (10-node, straight-sided;
     /// far more accurate per degree of freedom).
     #[arg(long, value_name = "1|2", default_value_t = 1, value_parser = clap::value_parser!(u8).range(1..=2))]
     pub order: u8,
+    /// Surface assets, fTetWild: how far (m) the tetrahedral surface may lie from the asset's
+    /// triangles [default: 1/1000 of the bounding-box diagonal].
+    #[arg(long, value_name = "M")]
+    pub envelope: Option<f64>,
     /// Surface assets: the gmsh to run: an executable, or the PyPI package's gmsh.py
     /// [default: `gmsh` on PATH, else python3's gmsh module].
     #[arg(long, value_name = "PATH")]
     pub gmsh: Option<PathBuf>,
-    /// Surface assets: keep the asset's triangles as the boundary instead of remeshing the
-    /// surface at --size (for surfaces gmsh cannot reparametrize).
+    /// Surface assets: a FloatTetwild_bin executable to run for fTetWild [default: python3
+    /// with the PyPI package pytetwild].
+    #[arg(long, value_name = "PATH")]
+    pub ftetwild: Option<PathBuf>,
+    /// Surface assets: gmsh keeps the asset's triangles as the boundary instead of remeshing
+    /// the surface at --size (for surfaces gmsh cannot reparametrize).
     #[arg(long)]
     pub keep_surface: bool,
+    /// Surface assets: time limit of one mesher run (s); the mesher is stopped past it.
+    #[arg(long, value_name = "S", default_value_t = modal_bake::mesh::work::DEFAULT_TIMEOUT_S)]
+    pub mesher_timeout: f64,
 }
 
 impl AssetOptions {
-    /// The gmsh parameters.
-    pub fn params(&self) -> GmshParams {
-        GmshParams {
+    /// The meshing parameters.
+    ///
+    /// # Errors
+    /// An invalid `--mesher-timeout`.
+    pub fn params(&self) -> anyhow::Result<MeshParams> {
+        Ok(MeshParams {
+            mesher: match self.mesher {
+                MesherArg::Auto => MesherChoice::Auto,
+                MesherArg::Gmsh => MesherChoice::Gmsh,
+                MesherArg::Ftetwild => MesherChoice::Ftetwild,
+            },
             size: self.size,
             order: self.order,
+            envelope: self.envelope,
             gmsh: self.gmsh.clone(),
+            ftetwild: self.ftetwild.clone(),
             keep_surface: self.keep_surface,
-        }
+            timeout: modal_bake::mesh::work::timeout_of(self.mesher_timeout)
+                .map_err(anyhow::Error::msg)?,
+        })
     }
 
     /// Whether any surface-asset option differs from its default (all but --units apply to
     /// surface assets only).
     pub fn any_set(&self) -> bool {
-        self.size.is_some() || self.order != 1 || self.gmsh.is_some() || self.keep_surface
+        self.size.is_some()
+            || self.order != 1
+            || self.gmsh.is_some()
+            || self.keep_surface
+            || self.mesher != MesherArg::Auto
+            || self.envelope.is_some()
+            || self.ftetwild.is_some()
+            || self.mesher_timeout != modal_bake::mesh::work::DEFAULT_TIMEOUT_S
     }
 }
 
 /// Arguments of `modal-bake mesh`.
 #[derive(Args)]
 #[command(
-    after_help = "The surface must be closed, manifold and consistently oriented; the \
-    error names the first defect with its position (m). gmsh runs on one thread with fixed \
-    algorithms and seed, so a given gmsh version always gives the same mesh. Without gmsh: \
-    `pip install gmsh` or `apt-get install gmsh`."
+    after_help = "The surface is inspected first (open and non-manifold edges, non-manifold \
+    vertices, self-intersections, shells; each with its position in m). With --mesher auto \
+    (the default) a surface that bounds one solid goes to gmsh, any other to fTetWild, and \
+    the other backend runs when the first fails. The report names the backend and why, \
+    the solid that was filled, and the Hausdorff distance between the asset and the mesh \
+    boundary. Both backends run on one thread with fixed seeds: the same inputs and versions \
+    give the same bytes. Install: `pip install gmsh` (or `apt-get install gmsh`) and \
+    `pip install pytetwild==0.4.2`."
 )]
 pub struct MeshArgs {
     /// Surface asset: .obj, .stl (ASCII or binary) or .ply (ASCII or binary).
@@ -153,38 +204,50 @@ pub struct MeshArgs {
     pub json: bool,
 }
 
-/// Meshes `asset` with a line on stderr while gmsh runs.
-pub fn mesh_asset(
-    asset: &Path,
-    options: &AssetOptions,
-) -> anyhow::Result<(GmshOutput, SurfaceInfo)> {
+/// Meshes `asset`, with progress lines on stderr (which backend runs and why).
+pub fn mesh_asset(asset: &Path, options: &AssetOptions) -> anyhow::Result<MeshedAsset> {
+    let params = options.params()?;
     eprintln!(
-        "meshing {} with gmsh (order {}) ...",
+        "meshing {} (order {}, --mesher {}) ...",
         asset.display(),
-        options.order
+        options.order,
+        match options.mesher {
+            MesherArg::Auto => "auto",
+            MesherArg::Gmsh => "gmsh",
+            MesherArg::Ftetwild => "ftetwild",
+        }
     );
-    let (out, info) =
-        modal_bake::mesh::mesh_asset(asset, options.units.to_metres(), &options.params())
-            .with_context(|| format!("meshing {} failed; nothing was written", asset.display()))?;
-    let [lo, hi] = info.bbox;
+    let progress = |line: &str| eprintln!("  {line}");
+    let out = modal_bake::mesh::mesh_asset(asset, options.units.to_metres(), &params, &progress)
+        .with_context(|| format!("meshing {} failed; nothing was written", asset.display()))?;
+    let r = &out.report;
+    eprintln!("  backend: {} — {}", r.backend.name(), r.reason);
+    if let Some(f) = &r.fallback_from {
+        eprintln!("  fallback: {f}");
+    }
+    let [lo, hi] = r.inspection.bbox;
     let extent = (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt();
     warn_extent(&asset.display().to_string(), extent, options.units, "");
-    Ok((out, info))
+    Ok(out)
 }
 
 pub fn run(args: &MeshArgs) -> anyhow::Result<()> {
     super::check_output(&args.out, "-o", &[&args.asset])?;
-    let (out, surface) = mesh_asset(&args.asset, &args.asset_options)?;
-    write_atomic(&args.out, &out.msh).with_context(|| format!("writing {}", args.out.display()))?;
+    let out = mesh_asset(&args.asset, &args.asset_options)?;
+    dcr_runtime::format::write_atomic(&args.out, &out.msh)
+        .with_context(|| format!("writing {}", args.out.display()))?;
     let m = &out.mesh;
+    let r = &out.report;
     if args.json {
         outln!(
             "{}",
             serde_json::to_string_pretty(&serde_json::json!({
                 "asset": args.asset.display().to_string(),
                 "out": args.out.display().to_string(),
-                "surface": surface,
-                "gmsh": out.info,
+                "report": r,
+                "backend": r.backend,
+                "reason": r.reason,
+                "distance": r.distance,
                 "nodes": m.nodes.len(),
                 "tets": m.tets.len(),
                 "order": if m.is_quadratic() { 2 } else { 1 },
@@ -192,46 +255,62 @@ pub fn run(args: &MeshArgs) -> anyhow::Result<()> {
             }))?
         );
     } else {
+        let i = &r.inspection;
         outln!("wrote {}", args.out.display());
         outln!(
-            "  surface: {} vertices, {} triangles, volume {:.6e} m³{}",
-            surface.vertices,
-            surface.triangles,
-            surface.volume_m3,
-            if surface.flipped {
-                " (triangles faced inward: reversed)"
-            } else {
-                ""
+            "  surface: {} vertices, {} triangles: {}{}",
+            i.vertices,
+            i.triangles,
+            i.summary(),
+            match i.first_defect() {
+                Some(d) => format!(" (first: {d})"),
+                None => String::new(),
             }
         );
         outln!(
-            "  mesh: {} nodes, {} {}-node tetrahedra ({} dofs), size {:.4e} m",
+            "  backend: {} {} ({}), {:.2} s — {}",
+            r.backend.name(),
+            r.version,
+            r.program,
+            r.seconds,
+            r.reason
+        );
+        if let Some(f) = &r.fallback_from {
+            outln!("  fallback: {f}");
+        }
+        outln!("  solid: {}", r.solid);
+        outln!(
+            "  mesh: {} nodes, {} {}-node tetrahedra ({} dofs), size {:.4e} m{}{}",
             m.nodes.len(),
             m.tets.len(),
             if m.is_quadratic() { 10 } else { 4 },
             m.dofs(),
-            out.info.size_m
+            r.size_m,
+            r.envelope_m
+                .map(|e| format!(", envelope {e:.4e} m"))
+                .unwrap_or_default(),
+            if r.reproducible {
+                ""
+            } else {
+                " (not reproducible on this platform: fTetWild's random seed could not be fixed)"
+            }
         );
+        let d = &r.distance;
         outln!(
-            "  gmsh {} ({}), {:.2} s",
-            out.info.version,
-            out.info.program,
-            out.info.seconds
+            "  distance asset ↔ mesh boundary: Hausdorff {:.4e} m ({:.3} % of the {:.4e} m diagonal); asset→mesh {:.4e} m at ({:.4}, {:.4}, {:.4}), mesh→asset {:.4e} m at ({:.4}, {:.4}, {:.4}); sampled every {:.2e} m",
+            d.hausdorff_m,
+            100.0 * d.relative,
+            if d.relative > 0.0 { d.hausdorff_m / d.relative } else { 0.0 },
+            d.asset_to_mesh_m,
+            d.asset_to_mesh_at[0],
+            d.asset_to_mesh_at[1],
+            d.asset_to_mesh_at[2],
+            d.mesh_to_asset_m,
+            d.mesh_to_asset_at[0],
+            d.mesh_to_asset_at[1],
+            d.mesh_to_asset_at[2],
+            d.spacing_m
         );
     }
-    Ok(())
-}
-
-/// Writes `bytes` to `path` through a temporary file in the same folder and a rename.
-fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    use std::io::Write;
-    let dir = path
-        .parent()
-        .filter(|d| !d.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    let mut tmp = tempfile::NamedTempFile::new_in(dir)?;
-    tmp.write_all(bytes)?;
-    tmp.as_file().sync_all()?;
-    tmp.persist(path).map_err(|e| e.error)?;
     Ok(())
 }

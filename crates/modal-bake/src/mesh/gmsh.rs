@@ -11,12 +11,17 @@
 //!
 //! Determinism: one thread (`General.NumThreads = 1`), fixed algorithms and `Mesh.RandomSeed`;
 //! the same surface, size, order and gmsh version give the same mesh.
+//!
+//! gmsh runs in a private work folder under `$TMPDIR` (prefix `modal-bake-gmsh`), removed on
+//! every exit path, signals included, and for at most [`GmshParams::timeout`]
+//! ([`super::work`]).
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
-use std::time::Instant;
+use std::time::Duration;
 
 use super::surface::SurfaceMesh;
+use super::work::{run_child, WorkDir, DEFAULT_TIMEOUT_S};
 use super::{MeshError, TetMesh};
 
 /// How to install gmsh, for the error when none is found.
@@ -37,6 +42,9 @@ pub struct GmshParams {
     /// (for surfaces gmsh cannot reparametrize; the tetrahedra then follow the asset's
     /// triangle sizes near the surface). Default false.
     pub keep_surface: bool,
+    /// Time limit of the gmsh run; gmsh is stopped and an error returned past it. Default
+    /// [`DEFAULT_TIMEOUT_S`].
+    pub timeout: Duration,
 }
 
 impl Default for GmshParams {
@@ -46,6 +54,7 @@ impl Default for GmshParams {
             order: 1,
             gmsh: None,
             keep_surface: false,
+            timeout: Duration::from_secs_f64(DEFAULT_TIMEOUT_S),
         }
     }
 }
@@ -92,6 +101,16 @@ pub enum GmshError {
     /// Writing the input or reading the output failed.
     #[error("gmsh work files: {0}")]
     Io(String),
+    /// The time limit ended the run.
+    #[error("gmsh {version} did not finish meshing {file} within {seconds:.0} s and was stopped; raise --mesher-timeout, give a larger --size, or try --mesher ftetwild")]
+    TimedOut {
+        /// The surface file.
+        file: String,
+        /// gmsh's version.
+        version: String,
+        /// The limit (s).
+        seconds: f64,
+    },
     /// gmsh ran but produced no mesh.
     #[error("gmsh {version} failed to mesh {file}: {detail}")]
     Failed {
@@ -151,18 +170,21 @@ impl Launcher {
         }
     }
 
-    /// gmsh's version, or `None` when it does not run.
+    /// gmsh's version, or `None` when it does not run (or does not answer within a minute).
     fn version(&self) -> Option<String> {
-        let out = match self {
-            Launcher::Binary(_) => self.command("").arg("--version").output().ok()?,
-            Launcher::Python(_) => self.command(PY_VERSION).output().ok()?,
+        let cmd = match self {
+            Launcher::Binary(_) => {
+                let mut c = self.command("");
+                c.arg("--version");
+                c
+            }
+            Launcher::Python(_) => self.command(PY_VERSION),
         };
-        if !out.status.success() {
+        let out = run_child(cmd, Duration::from_secs(60), &|_| {}).ok()?;
+        if !out.status?.success() {
             return None;
         }
-        let text = String::from_utf8_lossy(&out.stdout).to_string()
-            + &String::from_utf8_lossy(&out.stderr);
-        let v = text.split_whitespace().next()?.to_string();
+        let v = out.text.split_whitespace().next()?.to_string();
         v.chars().next()?.is_ascii_digit().then_some(v)
     }
 }
@@ -281,6 +303,19 @@ pub fn tetrahedralize(
     params: &GmshParams,
     file: &str,
 ) -> Result<GmshOutput, GmshError> {
+    tetrahedralize_with_progress(surface, params, file, &|_| {})
+}
+
+/// [`tetrahedralize`], calling `progress` about every 15 s with the seconds gmsh has run.
+///
+/// # Errors
+/// As [`tetrahedralize`], and [`GmshError::TimedOut`] past [`GmshParams::timeout`].
+pub fn tetrahedralize_with_progress(
+    surface: &SurfaceMesh,
+    params: &GmshParams,
+    file: &str,
+    progress: &dyn Fn(f64),
+) -> Result<GmshOutput, GmshError> {
     if !matches!(params.order, 1 | 2) {
         return Err(GmshError::Params(format!(
             "parameter `order` must be 1 or 2, got {}",
@@ -298,10 +333,7 @@ pub fn tetrahedralize(
     };
     let (launcher, version) = find_gmsh(params.gmsh.as_deref())?;
     let io = |e: std::io::Error| GmshError::Io(e.to_string());
-    let dir = tempfile::Builder::new()
-        .prefix("modal-bake-gmsh")
-        .tempdir()
-        .map_err(io)?;
+    let dir = WorkDir::new("modal-bake-gmsh").map_err(io)?;
     std::fs::write(dir.path().join("surface.msh"), surface_msh(surface)).map_err(io)?;
     std::fs::write(
         dir.path().join("volume.geo"),
@@ -318,23 +350,28 @@ pub fn tetrahedralize(
         "-v",
         "4",
     ];
-    let t = Instant::now();
     let mut cmd = launcher.command(PY_RUN);
     cmd.args(args).current_dir(dir.path());
-    let out = cmd.output().map_err(|e| GmshError::NotFound {
+    let out = run_child(cmd, params.timeout, progress).map_err(|e| GmshError::NotFound {
         detail: format!("{}: {e}", launcher.describe()),
     })?;
-    let seconds = t.elapsed().as_secs_f64();
-    let text =
-        String::from_utf8_lossy(&out.stdout).to_string() + &String::from_utf8_lossy(&out.stderr);
+    let seconds = out.seconds;
+    let Some(status) = out.status else {
+        return Err(GmshError::TimedOut {
+            file: file.to_string(),
+            version,
+            seconds: params.timeout.as_secs_f64(),
+        });
+    };
+    let text = out.text;
     let errors: Vec<&str> = text
         .lines()
         .filter(|l| l.trim_start().starts_with("Error"))
         .collect();
     let result = dir.path().join("volume.msh");
-    if !out.status.success() || !errors.is_empty() || !result.is_file() {
+    if !status.success() || !errors.is_empty() || !result.is_file() {
         let detail = if errors.is_empty() {
-            format!("exit status {}, no mesh written", out.status)
+            format!("exit status {status}, no mesh written")
         } else {
             errors.join("; ")
         };

@@ -23,18 +23,28 @@
 
 mod asset;
 mod cursor;
+mod distance;
+pub mod ftetwild;
 pub mod gmsh;
 mod json;
 mod mesh_builder;
 mod mesh_error;
+pub mod mesher;
 mod msh;
+mod msh_writer;
 pub mod surface;
 mod tet_mesh;
 mod validate;
+pub mod work;
 
 use std::path::Path;
 
-pub use asset::{mesh_asset, AssetError};
+pub use asset::mesh_asset;
+pub use distance::{surface_distance, SurfaceDistance};
+pub use mesher::{
+    mesh_surface, AssetError, Backend, MeshParams, MeshReport, MeshedAsset, MesherChoice,
+};
+pub use msh_writer::msh41_bytes;
 pub use mesh_error::{Location, MeshError, MeshErrorKind};
 pub(crate) use tet_mesh::tet_faces;
 pub use tet_mesh::{signed_volume, TetMesh, TET10_EDGES};

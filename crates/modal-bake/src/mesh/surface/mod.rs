@@ -9,12 +9,14 @@
 //! Unsupported: non-triangle primitives other than planar polygons, textures and materials
 //! (ignored).
 
+mod inspect;
 mod surface_error;
 mod surface_mesh;
 
 use std::io::{BufReader, Cursor};
 use std::path::Path;
 
+pub use inspect::{inspect_surface, Defect, DefectKind, SurfaceInspection, MAX_EXAMPLES};
 pub use surface_error::SurfaceError;
 pub use surface_mesh::{SurfaceInfo, SurfaceMesh};
 
