@@ -66,8 +66,9 @@ impl BakeOptions {
 #[derive(Args)]
 pub struct BakeArgs {
     /// Tetrahedral mesh: gmsh .msh (2.2 or 4.1, ASCII or binary, 4- or 10-node tetrahedra) or
-    /// meshio-style .json; or a closed surface asset .obj / .stl / .ply, meshed with gmsh
-    /// first (--size, --order, --gmsh). Coordinates in metres unless --units says otherwise.
+    /// meshio-style .json; or a surface asset .obj / .stl / .ply, meshed first as `modal-bake
+    /// mesh` does (--mesher, --size, --order, ...). Coordinates in metres unless --units says
+    /// otherwise.
     pub mesh: PathBuf,
     /// Output base (written atomically: nothing is left behind on failure).
     #[arg(short = 'o', long = "out", value_name = "OUT.modes")]
@@ -98,7 +99,7 @@ pub struct BakeArgs {
     pub target_error: Option<f64>,
 }
 
-/// The tetrahedral mesh of `path`: read, or (a surface asset) meshed with gmsh; with the
+/// The tetrahedral mesh of `path`: read, or (a surface asset) meshed by the meshing chain; with the
 /// seconds it took. Meshing options given with a volume mesh are an error.
 pub fn load_mesh(
     path: &std::path::Path,

@@ -21,7 +21,7 @@ pub struct CheckArgs {
     /// table when none is asked for, is stale).
     #[command(flatten)]
     pub transfer: TransferOptions,
-    /// How a surface asset was meshed (it is meshed again with gmsh and compared).
+    /// How a surface asset was meshed (it is meshed again the same way and compared).
     #[command(flatten)]
     pub asset: AssetOptions,
     /// Print one JSON object: {"base", "mesh", "up_to_date", "reason" (up_to_date, missing,

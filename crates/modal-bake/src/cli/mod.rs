@@ -37,10 +37,11 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Bake MESH (gmsh MSH 2.2/4.1 ASCII or binary, meshio JSON, or a surface asset .obj /
-    /// .stl / .ply meshed with gmsh) into OUT.modes.
+    /// .stl / .ply meshed with gmsh or fTetWild) into OUT.modes.
     #[command(allow_negative_numbers = true)]
     Bake(bake::BakeArgs),
-    /// Tetrahedralize a surface asset (OBJ, STL, PLY) with gmsh into a .msh mesh.
+    /// Tetrahedralize a surface asset (OBJ, STL, PLY) into a .msh mesh: inspected, then gmsh
+    /// or fTetWild (--mesher auto).
     Mesh(mesh::MeshArgs),
     /// Print a readable summary of a .modes file (or one JSON object with --json).
     Info(info::InfoArgs),

@@ -9,8 +9,9 @@
 //! are reported with the edge, not again), shells (components joined across shared edges) and
 //! degenerate triangles (a repeated vertex or zero area).
 //!
-//! Self-intersections: candidate pairs from a bounding-volume hierarchy of the triangles'
-//! boxes (parry's `Bvh`), each tested exactly with Shewchuk's adaptive `orient3d` (the
+//! Self-intersections: candidate pairs from a traversal of a bounding-volume hierarchy of the
+//! triangles' boxes against itself (parry's `Bvh`), pairs on two sides of a plane rejected in
+//! floating point with a wide margin, the rest tested exactly with Shewchuk's adaptive `orient3d` (the
 //! `robust` crate): two triangles with no common vertex intersect when an edge of one meets
 //! the other (closed triangles: touching counts); two sharing one vertex intersect beyond it
 //! when the edge opposite the shared vertex of one meets the other. Pairs sharing an edge and
@@ -23,7 +24,7 @@
 
 use parry3d_f64::bounding_volume::Aabb;
 use parry3d_f64::math::Vector;
-use parry3d_f64::partitioning::{Bvh, BvhBuildStrategy};
+use parry3d_f64::partitioning::{Bvh, BvhBuildStrategy, BvhWorkspace};
 use robust::{orient3d, Coord3D};
 
 use super::SurfaceMesh;
@@ -336,23 +337,37 @@ pub fn inspect_surface(surface: &SurfaceMesh) -> SurfaceInspection {
             Aabb::new(lo, hi)
         })
         .collect();
-    if !tris.is_empty() {
+    if tris.len() > 1 {
         let bvh = Bvh::from_leaves(BvhBuildStrategy::Binned, &boxes);
+        // Plane of each triangle (unnormalised normal) for a floating-point rejection before
+        // the exact tests.
+        let planes: Vec<([f64; 3], f64)> = tris
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|v| x[v]);
+                let (u, w) = (sub(b, a), sub(c, a));
+                (
+                    cross(u, w),
+                    (crate::vec3::norm2(u) * crate::vec3::norm2(w)).sqrt(),
+                )
+            })
+            .collect();
         let mut hits: Vec<(usize, usize, [f64; 3])> = Vec::new();
-        for (t, tri) in tris.iter().enumerate() {
-            if degenerate[t] {
-                continue;
+        let mut workspace = BvhWorkspace::default();
+        bvh.traverse_bvtt_single_tree::<false>(&mut workspace, &mut |a, b| {
+            let (t, u) = (a.min(b) as usize, a.max(b) as usize);
+            if t == u || degenerate[t] || degenerate[u] {
+                return;
             }
-            for u in bvh.intersect_aabb(&boxes[t]) {
-                let u = u as usize;
-                if u <= t || degenerate[u] {
-                    continue;
-                }
-                if let Some(p) = triangles_intersect(x, *tri, tris[u]) {
-                    hits.push((t, u, p));
-                }
+            if separated(x, tris[t], planes[t], tris[u])
+                || separated(x, tris[u], planes[u], tris[t])
+            {
+                return;
             }
-        }
+            if let Some(p) = triangles_intersect(x, tris[t], tris[u]) {
+                hits.push((t, u, p));
+            }
+        });
         hits.sort_unstable_by_key(|h| (h.0, h.1));
         for (_, _, p) in hits {
             push(
@@ -366,6 +381,37 @@ pub fn inspect_surface(surface: &SurfaceMesh) -> SurfaceInspection {
     examples.sort_by_key(|d| d.kind);
     out.examples = examples;
     out
+}
+
+/// Whether the triangle `other` meets the plane of `tri` (normal `n = (b−a)×(c−a)`, `scale`
+/// = |b−a|·|c−a|) at most in vertices it shares with `tri`: its other vertices strictly on one
+/// side, decided in floating point with a margin (1e-9 relative) far above the rounding error of
+/// `n` and of the products; `false` leaves the decision to the exact tests.
+fn separated(
+    x: &[[f64; 3]],
+    tri: [usize; 3],
+    (n, scale): ([f64; 3], f64),
+    other: [usize; 3],
+) -> bool {
+    let p = x[tri[0]];
+    let mut pos = 0;
+    let mut neg = 0;
+    let mut free = 0;
+    for v in other {
+        if tri.contains(&v) {
+            continue;
+        }
+        free += 1;
+        let d = sub(x[v], p);
+        let s = crate::vec3::dot(n, d);
+        let margin = 1e-9 * scale * crate::vec3::norm2(d).sqrt();
+        if s > margin {
+            pos += 1;
+        } else if s < -margin {
+            neg += 1;
+        }
+    }
+    free > 0 && (pos == free || neg == free)
 }
 
 fn c3(p: [f64; 3]) -> Coord3D<f64> {
@@ -409,10 +455,10 @@ fn segment_meets_triangle(
 /// Whether triangles `s` and `t` (vertex indices into `x`) intersect as described in the
 /// module docs; a point of the intersection when they do.
 fn triangles_intersect(x: &[[f64; 3]], s: [usize; 3], t: [usize; 3]) -> Option<[f64; 3]> {
-    let shared: Vec<usize> = s.iter().copied().filter(|v| t.contains(v)).collect();
+    let shared_count = s.iter().filter(|v| t.contains(v)).count();
     let ps = s.map(|v| x[v]);
     let pt = t.map(|v| x[v]);
-    match shared.len() {
+    match shared_count {
         0 => {
             // Quick rejection: one triangle strictly on one side of the other's plane.
             let side = |tri: [[f64; 3]; 3], pts: [[f64; 3]; 3]| {
@@ -433,7 +479,7 @@ fn triangles_intersect(x: &[[f64; 3]], s: [usize; 3], t: [usize; 3]) -> Option<[
             None
         }
         1 => {
-            let v = shared[0];
+            let v = s.iter().copied().find(|v| t.contains(v)).unwrap_or(s[0]);
             let opposite = |tri: [usize; 3]| {
                 let k = tri.iter().position(|&w| w == v).unwrap_or(0);
                 (x[tri[(k + 1) % 3]], x[tri[(k + 2) % 3]])
