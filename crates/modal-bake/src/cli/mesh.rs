@@ -86,6 +86,10 @@ pub fn warn_extent(what: &str, extent_m: f64, units: Units, extra: &str) {
     );
 }
 
+/// Element order of a surface asset's tetrahedra when `--order` is not given: 10-node
+/// (order 2), far more accurate per degree of freedom than 4-node tetrahedra in bending.
+pub const DEFAULT_ORDER: u8 = 2;
+
 /// How the geometry is read: the unit of its coordinates (any mesh) and how a surface asset is
 /// tetrahedralized (shared by `mesh`, `bake` and `check`).
 #[derive(Args, Clone, Debug)]
@@ -100,9 +104,10 @@ pub struct AssetOptions {
     #[arg(long, value_name = "M")]
     pub size: Option<f64>,
     /// Surface assets: element order, 1 (4-node tetrahedra) or 2 (10-node, straight-sided;
-    /// far more accurate per degree of freedom).
-    #[arg(long, value_name = "1|2", default_value_t = 1, value_parser = clap::value_parser!(u8).range(1..=2))]
-    pub order: u8,
+    /// far more accurate per degree of freedom) [default: 2; 1 with --transfer-h, whose table
+    /// needs 4-node tetrahedra].
+    #[arg(long, value_name = "1|2", value_parser = clap::value_parser!(u8).range(1..=2))]
+    pub order: Option<u8>,
     /// Surface assets: the gmsh to run: an executable, or the PyPI package's gmsh.py
     /// [default: `gmsh` on PATH, else python3's gmsh module].
     #[arg(long, value_name = "PATH")]
@@ -114,11 +119,16 @@ pub struct AssetOptions {
 }
 
 impl AssetOptions {
+    /// The element order: `--order`, else [`DEFAULT_ORDER`].
+    pub fn order(&self) -> u8 {
+        self.order.unwrap_or(DEFAULT_ORDER)
+    }
+
     /// The gmsh parameters.
     pub fn params(&self) -> GmshParams {
         GmshParams {
             size: self.size,
-            order: self.order,
+            order: self.order(),
             gmsh: self.gmsh.clone(),
             keep_surface: self.keep_surface,
         }
@@ -127,7 +137,7 @@ impl AssetOptions {
     /// Whether any surface-asset option differs from its default (all but --units apply to
     /// surface assets only).
     pub fn any_set(&self) -> bool {
-        self.size.is_some() || self.order != 1 || self.gmsh.is_some() || self.keep_surface
+        self.size.is_some() || self.order.is_some() || self.gmsh.is_some() || self.keep_surface
     }
 }
 
@@ -151,6 +161,8 @@ pub struct MeshArgs {
     /// Print the report as one JSON object on stdout.
     #[arg(long)]
     pub json: bool,
+    #[command(flatten)]
+    pub budget: super::budget::BudgetOptions,
 }
 
 /// Meshes `asset` with a line on stderr while gmsh runs.
@@ -161,11 +173,14 @@ pub fn mesh_asset(
     eprintln!(
         "meshing {} with gmsh (order {}) ...",
         asset.display(),
-        options.order
+        options.order()
     );
-    let (out, info) =
-        modal_bake::mesh::mesh_asset(asset, options.units.to_metres(), &options.params())
-            .with_context(|| format!("meshing {} failed; nothing was written", asset.display()))?;
+    let mut progress = super::progress::Progress::new("mesh");
+    progress.stage("gmsh", &format!("meshing {} with gmsh", asset.display()));
+    let result = modal_bake::mesh::mesh_asset(asset, options.units.to_metres(), &options.params());
+    progress.finish();
+    let (out, info) = result
+        .with_context(|| format!("meshing {} failed; nothing was written", asset.display()))?;
     let [lo, hi] = info.bbox;
     let extent = (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt();
     warn_extent(&asset.display().to_string(), extent, options.units, "");
@@ -174,6 +189,8 @@ pub fn mesh_asset(
 
 pub fn run(args: &MeshArgs) -> anyhow::Result<()> {
     super::check_output(&args.out, "-o", &[&args.asset])?;
+    args.budget
+        .check_surface(&args.asset, &args.asset_options, 26, false)?;
     let (out, surface) = mesh_asset(&args.asset, &args.asset_options)?;
     write_atomic(&args.out, &out.msh).with_context(|| format!("writing {}", args.out.display()))?;
     let m = &out.mesh;
