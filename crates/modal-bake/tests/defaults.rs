@@ -432,7 +432,7 @@ fn an_over_budget_surface_is_refused_with_the_estimate() {
     let o = bake(
         &asset,
         &out,
-        &["--size", "0.002", "--material", "steel", "--max-time", "20"],
+        &["--size", "0.002", "--material", "steel", "--max-time", "5"],
     );
     assert!(!o.status.success());
     let e = stderr(&o);
@@ -453,7 +453,7 @@ fn an_over_budget_surface_is_refused_with_the_estimate() {
             "--material",
             "steel",
             "--max-time",
-            "20",
+            "5",
             "--modes",
             "3",
         ],

@@ -302,7 +302,7 @@ pub fn run(args: &BakeArgs) -> anyhow::Result<()> {
     };
     if is_surface_asset(&args.mesh) {
         args.budget
-            .check_surface(&args.mesh, &asset, args.options.modes_for_estimate(), true)?;
+            .check_surface(&args.mesh, &asset, args.options.modes_for_estimate())?;
     }
     let (mesh, read_s) = load_mesh_with_progress(&args.mesh, &asset)?;
     bake_loaded(args, &params, mesh, read_s)

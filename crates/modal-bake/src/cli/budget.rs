@@ -53,8 +53,9 @@ impl BudgetOptions {
         )
     }
 
-    /// Estimates meshing the surface asset `path` with `asset` (and baking `modes` modes when
-    /// `bake`), prints the estimate (stderr) and refuses it over the budget unless `--force`.
+    /// Estimates meshing the surface asset `path` with `asset` and baking `modes` modes of the
+    /// mesh (`mesh` too: the mesh is made to be baked), prints the estimate (stderr) and
+    /// refuses it over the budget unless `--force`.
     /// The refusal names the estimate, the budget and the smallest coarsening of `--size` that
     /// fits.
     ///
@@ -65,7 +66,6 @@ impl BudgetOptions {
         path: &Path,
         asset: &AssetOptions,
         modes: usize,
-        bake: bool,
     ) -> anyhow::Result<SizeEstimate> {
         let budget = self.budget()?;
         let mut s = modal_bake::mesh::surface::read_surface(path)
@@ -80,13 +80,9 @@ impl BudgetOptions {
             .unwrap_or_else(|| modal_bake::mesh::gmsh::default_size(s.bounding_box()));
         let order = asset.order();
         let est = |size: f64, order: u8| {
-            let mut e = SizeEstimate::of_surface(&measures, size, asset.keep_surface, order, modes);
-            if !bake {
-                e.bake_s = 0.0;
-                e.bake_bytes = 0.0;
-            }
-            e
+            SizeEstimate::of_surface(&measures, size, asset.keep_surface, order, modes)
         };
+        let fits = |e: &SizeEstimate| e.fits(&budget);
         let e = est(size, order);
         eprintln!(
             "size estimate for {} ({} triangles, {:.4e} m³, size {:.4e} m{}): {}",
@@ -104,7 +100,7 @@ impl BudgetOptions {
             },
             e.describe()
         );
-        if e.fits(&budget) {
+        if fits(&e) {
             return Ok(e);
         }
         let mut how = Vec::new();
@@ -121,22 +117,20 @@ impl BudgetOptions {
             );
         } else if let Some(fit) = (1..=40)
             .map(|k| size * 1.2f64.powi(k))
-            .find(|&h| est(h, order).fits(&budget))
+            .find(|&h| fits(&est(h, order)))
         {
             how.push(format!(
                 "a coarser --size {fit:.3e} m ({})",
                 est(fit, order).describe()
             ));
         }
-        if order == 2 && est(size, 1).fits(&budget) {
+        if order == 2 && fits(&est(size, 1)) {
             how.push(format!(
                 "--order 1 ({}; linear tetrahedra are much less accurate in bending)",
                 est(size, 1).describe()
             ));
         }
-        if bake {
-            how.push("fewer --modes".into());
-        }
+        how.push("fewer --modes".into());
         self.refuse(&path.display().to_string(), &e, &how, measures.extent_m)
     }
 

@@ -190,7 +190,7 @@ pub fn mesh_asset(
 pub fn run(args: &MeshArgs) -> anyhow::Result<()> {
     super::check_output(&args.out, "-o", &[&args.asset])?;
     args.budget
-        .check_surface(&args.asset, &args.asset_options, 26, false)?;
+        .check_surface(&args.asset, &args.asset_options, 26)?;
     let (out, surface) = mesh_asset(&args.asset, &args.asset_options)?;
     write_atomic(&args.out, &out.msh).with_context(|| format!("writing {}", args.out.display()))?;
     let m = &out.mesh;

@@ -30,7 +30,7 @@ pub fn run(args: &BakeArgs, asset: &AssetOptions, target: f64) -> anyhow::Result
     };
     if surface {
         args.budget
-            .check_surface(&args.mesh, asset, args.options.modes_for_estimate(), true)?;
+            .check_surface(&args.mesh, asset, args.options.modes_for_estimate())?;
     }
     let (mesh, _) = super::bake::load_mesh_with_progress(&args.mesh, asset)?;
     let file = args.mesh.display().to_string();
