@@ -476,3 +476,45 @@ fn an_over_budget_surface_is_refused_with_the_estimate() {
         "{e}"
     );
 }
+
+/// `--target-error` without a transfer table picks a surface asset's mesh: it refines --size
+/// until the lowest modes move by less than the target, reports each mesh, bakes the last;
+/// a target the budget cannot reach is baked at the finest mesh that fits, with a warning.
+#[test]
+fn target_error_refines_the_mesh_of_a_surface_asset() {
+    if !have_gmsh("target_error_refines_the_mesh_of_a_surface_asset") {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let asset = dir.path().join("box.obj");
+    std::fs::write(&asset, box_obj(0.1, 2)).unwrap();
+    let out = dir.path().join("box.modes");
+    let common = ["--size", "0.04", "--material", "aluminium", "--modes", "3"];
+    let mut a = common.to_vec();
+    a.extend(["--target-error", "5", "--json"]);
+    let o = bake(&asset, &out, &a);
+    let r: serde_json::Value = serde_json::from_str(&ok(&o)).unwrap();
+    let e = stderr(&o);
+    assert!(e.contains("target error 5 %: met at --size"), "{e}");
+    let steps = e.matches("  size ").count();
+    assert!(steps >= 2, "{e}");
+    // The base is the last (finest) mesh's: its tetrahedra are the last step's.
+    let last_tets: u64 = e
+        .lines()
+        .filter(|l| l.starts_with("  size "))
+        .last()
+        .and_then(|l| l.split(": ").nth(1))
+        .and_then(|l| l.split(' ').next())
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert_eq!(r["tets"].as_u64().unwrap(), last_tets);
+    assert_eq!(r["order"], 2);
+    // An unreachable target within a tiny budget: baked anyway at the finest mesh that fits,
+    // with the warning.
+    let mut a = common.to_vec();
+    a.extend(["--target-error", "1e-6", "--max-time", "3"]);
+    let o = bake(&asset, &out, &a);
+    ok(&o);
+    assert!(stderr(&o).contains("NOT met"), "{}", stderr(&o));
+}

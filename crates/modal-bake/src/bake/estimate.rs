@@ -174,11 +174,15 @@ impl SizeEstimate {
         } else {
             (size, s.area_m2 / (3f64.sqrt() / 4.0 * size * size))
         };
-        let tets = (TETS_PER_VOLUME * s.volume_m3 / h.powi(3) + TETS_PER_BOUNDARY_TRI * boundary)
-            .max(1.0);
+        let tets =
+            (TETS_PER_VOLUME * s.volume_m3 / h.powi(3) + TETS_PER_BOUNDARY_TRI * boundary).max(1.0);
         let (a, b) = NODES[usize::from(order == 2)];
         let nodes = a * tets + b * boundary;
-        let rebuilt = if keep_surface { 0.0 } else { s.triangles as f64 };
+        let rebuilt = if keep_surface {
+            0.0
+        } else {
+            s.triangles as f64
+        };
         let mut e = SizeEstimate {
             tets,
             order,

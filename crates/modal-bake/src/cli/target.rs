@@ -180,8 +180,13 @@ fn choose_mesh_and_bake(args: &BakeArgs, asset: &AssetOptions, target: f64) -> a
                 .map(|f| format!("{f:.2}"))
                 .collect::<Vec<_>>()
                 .join(", "),
-            st.change_pct
-                .map_or_else(String::new, |c| format!("; moved ≤ {c:.2} %"))
+            match (st.change_pct, st.size_m < start) {
+                (Some(c), _) => format!("; moved ≤ {c:.2} %"),
+                (None, true) =>
+                    "; the same mesh as the previous size (gmsh kept a finer size of its own)"
+                        .into(),
+                (None, false) => String::new(),
+            }
         );
     }
     let last = choice.steps.last().expect("one step at least");

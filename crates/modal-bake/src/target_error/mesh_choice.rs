@@ -1,7 +1,8 @@
 //! Choosing a surface asset's mesh for an accuracy target (`modal-bake bake ASSET
 //! --target-error PCT` without a transfer table): mesh at a starting element size, bake the
 //! lowest modes, mesh again at the size divided by [`REFINE`], and stop when no one of the
-//! lowest modes moved by more than the target between the last two meshes.
+//! lowest modes moved by more than the target between the last two meshes. A step whose mesh
+//! is the previous one (a mesher that keeps a finer size of its own) is not compared.
 //!
 //! Conforming finite elements converge from above at a rate h^p (p = 2 for 4-node, 4 for
 //! 10-node tetrahedra, the square of the displacement's order), so with r = [`REFINE`] the
@@ -31,7 +32,7 @@ pub struct MeshStep {
     /// The lowest elastic frequencies (Hz).
     pub frequencies_hz: Vec<f64>,
     /// Largest relative change of those frequencies from the previous mesh (%); `None` for the
-    /// first.
+    /// first, and for a mesh identical to the previous one (the mesher did not refine).
     pub change_pct: Option<f64>,
 }
 
@@ -103,7 +104,11 @@ pub fn choose_mesh(
         let tets = mesh.tets.len();
         let (base, report) = bake_mesh(mesh.clone(), &probe, file, progress)?;
         let freqs = base.frequencies_hz();
-        let change = steps.last().map(|prev| {
+        // A mesher that did not refine (the same tetrahedra at a smaller size) proves nothing:
+        // compare with the previous mesh only when this one is finer.
+        let prev = steps.last();
+        let same = prev.is_some_and(|p| p.tets == tets && p.dofs == report.free_dofs);
+        let change = prev.filter(|_| !same).map(|prev| {
             prev.frequencies_hz
                 .iter()
                 .zip(&freqs)
