@@ -4,21 +4,28 @@
 use clap::Args;
 
 use crate::bake::MaterialSi;
+use crate::fem::MaterialPreset;
 use crate::full_order::SystemParams;
 
 /// The object's material, boundary conditions and damping (shared by `modal-bake bake`
 /// and `check`, and `dcr-lab truth` and `fit-attenuation`).
 #[derive(Args, Clone, Debug)]
 pub struct ModelOptions {
-    /// Young's modulus E (Pa).
-    #[arg(long, value_name = "PA", default_value_t = 1.1e9)]
-    pub youngs: f64,
-    /// Poisson ratio ν (−1 < ν < 0.5).
-    #[arg(long, value_name = "NU", default_value_t = 0.3)]
-    pub poisson: f64,
-    /// Density ρ (kg/m³).
-    #[arg(long, value_name = "KG_M3", default_value_t = 770.0)]
-    pub density: f64,
+    /// Material preset: oak, pine, steel, aluminium, brass, cast-iron, glass, ceramic,
+    /// concrete, stone, marble, abs, pla, acrylic (typical values and their sources:
+    /// docs/artist-guide.md). --youngs, --poisson and --density given with it replace its values.
+    /// Without a preset or all three values, 1.1e9 Pa, 0.3, 770 kg/m³ fill in, with a warning.
+    #[arg(long, value_name = "NAME", value_parser = preset)]
+    pub material: Option<&'static MaterialPreset>,
+    /// Young's modulus E (Pa) [default: the --material's, else 1.1e9].
+    #[arg(long, value_name = "PA")]
+    pub youngs: Option<f64>,
+    /// Poisson ratio ν (−1 < ν < 0.5) [default: the --material's, else 0.3].
+    #[arg(long, value_name = "NU")]
+    pub poisson: Option<f64>,
+    /// Density ρ (kg/m³) [default: the --material's, else 770].
+    #[arg(long, value_name = "KG_M3")]
+    pub density: Option<f64>,
     /// Fix every node of this named physical group (repeatable). Nothing fixed: free-free (the
     /// six rigid-body modes, or the rigid-body part of a response, are excluded).
     #[arg(long, value_name = "NAME")]
@@ -31,7 +38,125 @@ pub struct ModelOptions {
     pub lumped: bool,
 }
 
+/// The material used when neither `--material` nor all of `--youngs`, `--poisson`,
+/// `--density` are given: E 1.1e9 Pa, ν 0.3, ρ 770 kg/m³ (the paper's table).
+pub const DEFAULT_MATERIAL: MaterialSi = MaterialSi {
+    youngs: 1.1e9,
+    poisson: 0.3,
+    density: 770.0,
+};
+
+/// Parses a `--material` name.
+fn preset(s: &str) -> Result<&'static MaterialPreset, String> {
+    MaterialPreset::find(s).ok_or_else(|| {
+        format!(
+            "unknown material `{s}`; presets: {} (or give --youngs, --poisson and --density)",
+            MaterialPreset::names()
+        )
+    })
+}
+
+/// Where a bake's material came from: a preset, explicit values, or the default.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MaterialChoice {
+    /// The `--material` preset, if one was named.
+    pub preset: Option<&'static MaterialPreset>,
+    /// The values given explicitly (`youngs`, `poisson`, `density`), which win over the preset.
+    pub explicit: Vec<&'static str>,
+    /// The values taken from [`DEFAULT_MATERIAL`] (neither the preset nor explicit).
+    pub defaulted: Vec<&'static str>,
+}
+
+impl MaterialChoice {
+    /// One phrase for reports: `steel`, `steel with --youngs`, `given (--youngs, --poisson,
+    /// --density)`, `default (no --material given)`.
+    pub fn describe(&self) -> String {
+        let flags = |v: &[&str]| {
+            v.iter()
+                .map(|s| format!("--{s}"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        match (
+            self.preset,
+            self.explicit.is_empty(),
+            self.defaulted.is_empty(),
+        ) {
+            (Some(p), true, _) => p.name.to_string(),
+            (Some(p), false, _) => format!("{} with {}", p.name, flags(&self.explicit)),
+            (None, _, true) => format!("given ({})", flags(&self.explicit)),
+            (None, true, false) => "default (no --material given)".to_string(),
+            (None, false, false) => format!(
+                "given ({}), default {}",
+                flags(&self.explicit),
+                flags(&self.defaulted)
+            ),
+        }
+    }
+
+    /// The record stored in a base's `meta.bake_params.material_choice`:
+    /// `{"preset": "steel" | null, "explicit": ["youngs", ...], "defaulted": [...]}`.
+    pub fn to_json(&self) -> serde_json::Value {
+        serde_json::json!({
+            "preset": self.preset.map(|p| p.name),
+            "explicit": self.explicit,
+            "defaulted": self.defaulted,
+        })
+    }
+}
+
 impl ModelOptions {
+    /// Where each material value comes from.
+    pub fn material_choice(&self) -> MaterialChoice {
+        let mut explicit = Vec::new();
+        let mut defaulted = Vec::new();
+        for (name, given) in [
+            ("youngs", self.youngs.is_some()),
+            ("poisson", self.poisson.is_some()),
+            ("density", self.density.is_some()),
+        ] {
+            if given {
+                explicit.push(name);
+            } else if self.material.is_none() {
+                defaulted.push(name);
+            }
+        }
+        MaterialChoice {
+            preset: self.material,
+            explicit,
+            defaulted,
+        }
+    }
+
+    /// The warning (one line, no `warning:` prefix) a bake prints when some material value
+    /// falls back to [`DEFAULT_MATERIAL`]: it names the values used and how to choose; `None`
+    /// when a preset or all three values were given.
+    pub fn default_material_warning(&self) -> Option<String> {
+        let choice = self.material_choice();
+        if choice.defaulted.is_empty() {
+            return None;
+        }
+        let m = self.material();
+        Some(format!(
+            "no material given ({} not set): using E {:e} Pa, ν {}, ρ {} kg/m³ (the paper's softened wood); \
+             name one with --material {} or give --youngs PA --poisson NU --density KG_M3",
+            choice
+                .defaulted
+                .iter()
+                .map(|s| format!("--{s}"))
+                .collect::<Vec<_>>()
+                .join(", "),
+            m.youngs,
+            m.poisson,
+            m.density,
+            MaterialPreset::ALL
+                .iter()
+                .map(|p| p.name)
+                .collect::<Vec<_>>()
+                .join("|")
+        ))
+    }
+
     /// Refuses a Young's modulus or density outside the supported ranges, naming the option,
     /// and warns (stderr) about values that look like a unit mistake.
     ///
@@ -39,55 +164,63 @@ impl ModelOptions {
     /// A one-line message naming `--youngs` or `--density` and the range that works.
     pub fn check_ranges(&self) -> anyhow::Result<()> {
         use crate::fem::Material;
+        let MaterialSi {
+            youngs,
+            poisson,
+            density,
+        } = self.material();
         let [elo, ehi] = Material::YOUNGS_RANGE;
-        if !(self.youngs >= elo && self.youngs <= ehi) {
+        if !(youngs >= elo && youngs <= ehi) {
             anyhow::bail!(
-                "--youngs {:e} Pa is outside the supported {elo:e} … {ehi:e} Pa (foams ~1e5, polymers ~1e9, steel 2e11)",
-                self.youngs
+                "--youngs {youngs:e} Pa is outside the supported {elo:e} … {ehi:e} Pa (foams ~1e5, polymers ~1e9, steel 2e11)"
             );
         }
-        if !(self.poisson > -1.0 && self.poisson < 0.5) {
+        if !(poisson > -1.0 && poisson < 0.5) {
             anyhow::bail!(
-                "--poisson {} must satisfy −1 < ν < 0.5 (rubber ~0.49, metals ~0.3, cork ~0)",
-                self.poisson
+                "--poisson {poisson} must satisfy −1 < ν < 0.5 (rubber ~0.49, metals ~0.3, cork ~0)"
             );
         }
         let [dlo, dhi] = Material::DENSITY_RANGE;
-        if !(self.density >= dlo && self.density <= dhi) {
+        if !(density >= dlo && density <= dhi) {
             anyhow::bail!(
-                "--density {:e} kg/m³ is outside the supported {dlo} … {dhi:e} kg/m³ (aerogel ~2, wood ~700, steel 7850)",
-                self.density
+                "--density {density:e} kg/m³ is outside the supported {dlo} … {dhi:e} kg/m³ (aerogel ~2, wood ~700, steel 7850)"
             );
         }
-        if self.youngs < 1e5 {
+        if youngs < 1e5 {
             eprintln!(
-                "warning: --youngs {} Pa is softer than any solid object (plausible: 1e5 Pa foam … 1.2e12 Pa diamond); \
-                 the unit is Pa: did you mean {} GPa = {:e} Pa or {} MPa = {:e} Pa?",
-                self.youngs,
-                self.youngs,
-                self.youngs * 1e9,
-                self.youngs,
-                self.youngs * 1e6
+                "warning: --youngs {youngs} Pa is softer than any solid object (plausible: 1e5 Pa foam … 1.2e12 Pa diamond); \
+                 the unit is Pa: did you mean {youngs} GPa = {:e} Pa or {youngs} MPa = {:e} Pa?",
+                youngs * 1e9,
+                youngs * 1e6
             );
         }
-        if self.density < 100.0 {
+        if density < 100.0 {
             eprintln!(
-                "warning: --density {} kg/m³ is lighter than solids other than foams and aerogels (plausible: 100 … 22600 kg/m³); \
-                 the unit is kg/m³: did you mean {} g/cm³ = {} kg/m³?",
-                self.density,
-                self.density,
-                self.density * 1000.0
+                "warning: --density {density} kg/m³ is lighter than solids other than foams and aerogels (plausible: 100 … 22600 kg/m³); \
+                 the unit is kg/m³: did you mean {density} g/cm³ = {} kg/m³?",
+                density * 1000.0
             );
         }
         Ok(())
     }
 
-    /// The material in SI units.
+    /// The material in SI units: each of E, ν, ρ given explicitly, else the preset's, else
+    /// [`DEFAULT_MATERIAL`]'s.
     pub fn material(&self) -> MaterialSi {
+        let p = self.material;
         MaterialSi {
-            youngs: self.youngs,
-            poisson: self.poisson,
-            density: self.density,
+            youngs: self
+                .youngs
+                .or(p.map(|p| p.youngs))
+                .unwrap_or(DEFAULT_MATERIAL.youngs),
+            poisson: self
+                .poisson
+                .or(p.map(|p| p.poisson))
+                .unwrap_or(DEFAULT_MATERIAL.poisson),
+            density: self
+                .density
+                .or(p.map(|p| p.density))
+                .unwrap_or(DEFAULT_MATERIAL.density),
         }
     }
 

@@ -418,7 +418,7 @@ fn rescaled_json(src: &Path, dst: &Path, f: impl Fn(f64) -> f64) {
 fn units_mm_bakes_the_metre_mesh_and_check_needs_the_same_units() {
     let dir = tempfile::tempdir().unwrap();
     let src = data("meshes/cube_cell_sets.json");
-    let args = ["--fixed", "bottom", "--modes", "8"];
+    let args = ["--fixed", "bottom", "--modes", "8", "--material", "oak"];
     // Whole millimetres: k/1000 is one correctly rounded division, so the mm mesh read with
     // --units mm has exactly the coordinates of the metre mesh written in decimal.
     let (m_mesh, mm_mesh) = (dir.path().join("m.json"), dir.path().join("mm.json"));

@@ -470,6 +470,8 @@ fn likely_unit_mistakes_are_warned_about() {
         out.to_str().unwrap(),
         "--modes",
         "4",
+        "--material",
+        "oak",
     ]);
     assert!(!stderr(&o).contains("warning"), "{}", stderr(&o));
 }

@@ -4,13 +4,16 @@
 //! One file per part: `params` ([`BakeParams`], what determines a result), `error`
 //! ([`BakeError`]), `report` ([`BakeReport`], [`BakeStage`]), `hashing` ([`geometry_hash`]),
 //! `prepare` (orientation, connectivity, fixed-node selection), `surface`
-//! ([`extract_surface`]), `pipeline` ([`bake_mesh`], [`bake_file`]) and `staleness`
+//! ([`extract_surface`]), `estimate` ([`SizeEstimate`], [`Budget`]: size before work),
+//! `plausibility` ([`unit_hint`], [`plausibility_warnings`]: unit mistakes named), `pipeline` ([`bake_mesh`], [`bake_file`]) and `staleness`
 //! ([`base_status`], [`BaseStatus`]).
 
 mod error;
+mod estimate;
 mod hashing;
 mod params;
 mod pipeline;
+mod plausibility;
 mod prepare;
 mod report;
 mod staleness;
@@ -19,10 +22,17 @@ mod surface;
 pub use dcr_runtime::format::{MaterialSi, ModesFile, ModesPrecision};
 
 pub use error::BakeError;
+pub use estimate::{
+    format_bytes, format_count, format_seconds, Budget, SizeEstimate, SurfaceMeasures,
+};
 pub use hashing::{geometry_hash, round_16_digits};
 pub use params::{BakeParams, FixedBelow, ModeRequest};
 pub use pipeline::{
     bake_file, bake_mesh, MAX_RESIDUAL, OUTPUT_VERSION, RIGID_REL_TOL, TOOL_VERSION,
+};
+pub use plausibility::{
+    plausibility_warnings, unit_hint, PLAUSIBLE_EXTENT_M, PLAUSIBLE_LOWEST_HZ, PLAUSIBLE_MASS_KG,
+    PLAUSIBLE_WAVE_SPEED,
 };
 pub use report::{BakeReport, BakeStage, TransferReport};
 pub use staleness::{base_status, is_mesh_up_to_date, is_up_to_date, mesh_base_status, BaseStatus};

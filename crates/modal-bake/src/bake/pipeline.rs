@@ -78,6 +78,7 @@ fn bake_modes(
     let prepared = prepare(mesh, params, file)?;
     let mesh = &prepared.mesh;
     report.order = if mesh.is_quadratic() { 2 } else { 1 };
+    report.material = Some(params.material);
     report.fixed_by = prepared.fixed_by.clone();
     report.nodes = mesh.nodes.len();
     report.tets = mesh.tets.len();

@@ -1,7 +1,7 @@
 //! A mesh made ready for baking: tetrahedra oriented and checked, connectivity checked, the
 //! fixed-node set selected (groups, half-spaces, boxes) and the geometry hashed.
 
-use super::{geometry_hash, BakeError, BakeParams};
+use super::{geometry_hash, unit_hint, BakeError, BakeParams};
 use crate::mesh::{MeshError, TetMesh, DEFAULT_DEGENERATE_REL_TOL, DEFAULT_STRAIGHT_REL_TOL};
 
 /// A mesh prepared for baking: oriented, checked, with its fixed-node set and hash.
@@ -41,8 +41,14 @@ fn select_fixed(
     }
     let extent = || {
         format!(
-            "the mesh spans x {:.6}…{:.6}, y {:.6}…{:.6}, z {:.6}…{:.6} m",
-            lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]
+            "the mesh spans x {:.6}…{:.6}, y {:.6}…{:.6}, z {:.6}…{:.6} m{}",
+            lo[0],
+            hi[0],
+            lo[1],
+            hi[1],
+            lo[2],
+            hi[2],
+            scale_note(mesh)
         )
     };
     let mut out = Vec::new();
@@ -128,14 +134,16 @@ pub(super) fn prepare(
     if !fixed.is_empty() && !spans_a_plane(&mesh, &fixed) {
         return Err(BakeError::Params(format!(
             "{file}: the fixed nodes ({} of them: {}) are collinear, so rotations about their line stay free \
-             (a mechanism, K is singular); fix a patch of at least three non-collinear nodes",
+             (a mechanism, K is singular); fix a patch of at least three non-collinear nodes{}",
             fixed.len(),
-            fixed_by.iter().map(|(w, _)| w.as_str()).collect::<Vec<_>>().join(", ")
+            fixed_by.iter().map(|(w, _)| w.as_str()).collect::<Vec<_>>().join(", "),
+            scale_note(&mesh)
         )));
     }
     if !fixed.is_empty() && fixed.len() == mesh.nodes.len() {
         return Err(BakeError::Params(format!(
-            "{file}: the fixed-node selectors fix every node; nothing can vibrate"
+            "{file}: the fixed-node selectors fix every node; nothing can vibrate{}",
+            scale_note(&mesh)
         )));
     }
     let hash = geometry_hash(&mesh, &fixed);
@@ -147,6 +155,12 @@ pub(super) fn prepare(
         reoriented,
         hash,
     })
+}
+
+/// `"; note: <unit hint>"` when the mesh's size is implausible ([`unit_hint`]), else empty: a
+/// selector that fixes nothing, one node, a line or everything is often a length-unit mistake.
+fn scale_note(mesh: &TetMesh) -> String {
+    unit_hint(mesh.extent()).map_or_else(String::new, |h| format!("; note: {h}"))
 }
 
 /// Whether the nodes `set` contain three non-collinear points (relative tolerance 1e-9 of the

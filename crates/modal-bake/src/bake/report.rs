@@ -31,6 +31,11 @@ pub struct BakeReport {
     pub fixed_by: Vec<(String, usize)>,
     /// Element order: 1 (4-node tetrahedra) or 2 (10-node).
     pub order: u8,
+    /// The material baked (E in Pa, ν, ρ in kg/m³).
+    pub material: Option<dcr_runtime::format::MaterialSi>,
+    /// Where the material came from, as the caller describes it (`steel`, `steel with
+    /// --youngs`, `default (no --material given)`); empty when not said.
+    pub material_name: String,
     /// Second-order bases: surface mid-edge nodes whose mode rows are stored (0 for P1).
     pub surface_edge_nodes: usize,
     /// Rigid-body modes detected and excluded (6 when free-free).

@@ -1,18 +1,19 @@
 //! `modal-bake bake`.
 
 use std::path::PathBuf;
-use std::time::Duration;
 
 use anyhow::Context;
 use clap::Args;
-use indicatif::{ProgressBar, ProgressStyle};
 use modal_bake::bake::{
     self, BakeParams, BakeReport, BakeStage, FixedBelow, ModeRequest, ModesPrecision,
 };
 use modal_bake::transfer::{TableOrder, TransferModes, TransferParams};
 
+use super::budget::BudgetOptions;
 use super::mesh::AssetOptions;
 use super::parse;
+pub use super::progress::Progress;
+use dcr_runtime::format::ModesFile;
 pub use modal_bake::args::ModelOptions;
 use modal_bake::mesh::surface::is_surface_asset;
 
@@ -85,17 +86,17 @@ pub struct BakeArgs {
     pub transfer: TransferOptions,
     #[command(flatten)]
     pub asset: AssetOptions,
-    /// Choose the cheapest representation (modes; a transfer table, its modes and order) whose
-    /// worst peak error against the bake's own converged full-order truth, at seeded pairs of
-    /// the table region (--transfer-up / --transfer-region), is at most PCT percent; needs
-    /// --transfer-h (the scene's step). The estimate, query cost and size are stored in the
-    /// base (`info` shows them). Overrides --modes and --transfer-modes / --transfer-order.
-    #[arg(
-        long,
-        value_name = "PCT",
-        requires = "transfer_h",
-        conflicts_with = "max_freq"
-    )]
+    #[command(flatten)]
+    pub budget: BudgetOptions,
+    /// With --transfer-h (the scene's step): choose the cheapest representation (modes; a
+    /// transfer table, its modes and order) whose worst peak error against the bake's own
+    /// converged full-order truth, at seeded pairs of the table region (--transfer-up /
+    /// --transfer-region), is at most PCT percent; the estimate, query cost and size are stored
+    /// in the base (`info` shows them); overrides --modes and --transfer-modes /
+    /// --transfer-order. Without --transfer-h, for a surface asset: choose the mesh, refining
+    /// --size (from its default) until the lowest five modes move by less than PCT percent
+    /// between successive meshes, within the budget.
+    #[arg(long, value_name = "PCT", conflicts_with = "max_freq")]
     pub target_error: Option<f64>,
 }
 
@@ -125,6 +126,25 @@ pub fn load_mesh(
         }
     }
     Ok((mesh, t.elapsed().as_secs_f64()))
+}
+
+/// [`load_mesh`] with a progress stage for reading a volume mesh (meshing a surface asset
+/// reports its own).
+///
+/// # Errors
+/// As [`load_mesh`].
+pub fn load_mesh_with_progress(
+    path: &std::path::Path,
+    asset: &AssetOptions,
+) -> anyhow::Result<(modal_bake::mesh::TetMesh, f64)> {
+    if is_surface_asset(path) {
+        return load_mesh(path, asset);
+    }
+    let mut progress = Progress::new("bake");
+    progress.update(BakeStage::Read);
+    let result = load_mesh(path, asset);
+    progress.finish();
+    result
 }
 
 /// The optional bake-time peak-transfer table (`dcr_runtime::Method::Transfer`).
@@ -200,209 +220,153 @@ impl TransferOptions {
     }
 }
 
-/// Progress of a bake on stderr: on a terminal a spinner per stage and a bar for the
-/// eigensolve and the transfer table; otherwise (CI logs, redirected stderr) plain lines for the
-/// stages longer than [`PLAIN_EVERY`]: one every `PLAIN_EVERY` while a stage that reports
-/// progress runs, and one with its duration when it ends. Short bakes print nothing.
-pub(super) struct Progress {
-    pub(super) bar: ProgressBar,
-    pub(super) plain: Option<Plain>,
+/// The asset options a bake meshes with: a transfer table needs 4-node tetrahedra, so without
+/// `--order` a surface asset is meshed at order 1 when `table` (with a note on stderr).
+pub fn asset_for(asset: &AssetOptions, table: bool, mesh: &std::path::Path) -> AssetOptions {
+    if table && asset.order.is_none() && is_surface_asset(mesh) {
+        eprintln!(
+            "note: meshing {} at --order 1: the peak-transfer table (--transfer-h) needs 4-node tetrahedra",
+            mesh.display()
+        );
+        return AssetOptions {
+            order: Some(1),
+            ..asset.clone()
+        };
+    }
+    asset.clone()
 }
 
-/// Interval between plain progress lines, and the shortest stage that gets one (seconds;
-/// `MODAL_BAKE_PROGRESS_EVERY` overrides it, e.g. 0 for every event).
-const PLAIN_EVERY: Duration = Duration::from_secs(5);
-
-/// State of the plain-line progress.
-pub(super) struct Plain {
-    every: Duration,
-    start: std::time::Instant,
-    stage: &'static str,
-    label: String,
-    stage_start: std::time::Instant,
-    last: std::time::Instant,
-}
-
-impl Plain {
-    fn line(&self, text: &str) {
-        eprintln!("bake [{:7.1} s] {text}", self.start.elapsed().as_secs_f64());
-    }
-
-    /// Ends the current stage (a line with its duration if it was long).
-    pub(super) fn end_stage(&mut self) {
-        let took = self.stage_start.elapsed();
-        if !self.stage.is_empty() && took >= self.every {
-            self.line(&format!(
-                "{}: done in {:.1} s",
-                self.label,
-                took.as_secs_f64()
-            ));
-        }
-    }
-
-    /// Records progress of `stage` described by `label`.
-    fn report(&mut self, stage: &'static str, label: impl FnOnce() -> String) {
-        let now = std::time::Instant::now();
-        if stage != self.stage {
-            self.end_stage();
-            self.stage = stage;
-            self.label = label();
-            self.stage_start = now;
-            self.last = now;
-        } else if now.duration_since(self.last) >= self.every {
-            self.label = label();
-            self.line(&self.label);
-            self.last = now;
-        }
+impl BakeOptions {
+    /// The modes the eigensolver will be asked for, for the size estimate: the count (20
+    /// for a frequency request) plus six rigid-body modes.
+    pub fn modes_for_estimate(&self) -> usize {
+        self.modes.unwrap_or(20) + 6
     }
 }
 
-impl Progress {
-    pub(super) fn new() -> Progress {
-        use std::io::IsTerminal;
-        if std::io::stderr().is_terminal() {
-            let bar = ProgressBar::new_spinner();
-            bar.enable_steady_tick(Duration::from_millis(120));
-            Progress { bar, plain: None }
-        } else {
-            let now = std::time::Instant::now();
-            Progress {
-                bar: ProgressBar::hidden(),
-                plain: Some(Plain {
-                    every: std::env::var("MODAL_BAKE_PROGRESS_EVERY")
-                        .ok()
-                        .and_then(|s| s.parse::<f64>().ok())
-                        .filter(|s| s.is_finite() && *s >= 0.0)
-                        .map_or(PLAIN_EVERY, Duration::from_secs_f64),
-                    start: now,
-                    stage: "",
-                    label: String::new(),
-                    stage_start: now,
-                    last: now,
-                }),
-            }
-        }
+/// What a bake does before the factorization, once the mesh is in memory: the size estimate
+/// against the budget (a refusal unless `--force`), and warnings about an implausible size
+/// (unless `surface`: meshing already said it) or mass, naming the likely unit mistake.
+///
+/// # Errors
+/// The estimate over the budget.
+pub fn before_factorization(
+    file: &str,
+    mesh: &modal_bake::mesh::TetMesh,
+    options: &BakeOptions,
+    budget: &super::budget::BudgetOptions,
+    units: super::mesh::Units,
+    surface: bool,
+) -> anyhow::Result<()> {
+    budget.check_mesh(file, mesh, options.modes_for_estimate())?;
+    let extent = mesh.extent();
+    let material = options.model.material();
+    let mass = material.density * mesh.volume();
+    if !surface {
+        super::mesh::warn_extent(file, extent, units, &format!(" and weighs {mass:.4e} kg"));
     }
+    let small = extent < bake::PLAUSIBLE_EXTENT_M[0];
+    let warnings = bake::plausibility_warnings(small.then_some(extent), mass, &material, None);
+    for w in warnings {
+        eprintln!("warning: {file}: {w}");
+    }
+    Ok(())
+}
 
-    pub(super) fn update(&mut self, stage: BakeStage) {
-        if let Some(plain) = &mut self.plain {
-            match stage {
-                BakeStage::Read => plain.report("read", || "reading mesh".into()),
-                BakeStage::Assemble => plain.report("assemble", || "assembling K and M".into()),
-                BakeStage::Factor => plain.report("factor", || "factoring K − σM".into()),
-                BakeStage::Eigensolve(p) => plain.report("eigensolve", || {
-                    format!(
-                        "eigensolve: {}/{} modes converged, Lanczos step {}",
-                        p.converged.min(p.requested),
-                        p.requested,
-                        p.iteration
-                    )
-                }),
-                BakeStage::TransferModes => plain.report("transfer modes", || {
-                    "solving for the transfer table's modes".into()
-                }),
-                BakeStage::Transfer(p) => plain.report("transfer", || {
-                    format!("transfer table: {}/{} rows", p.done, p.total)
-                }),
-                BakeStage::Write => plain.report("write", || "writing".into()),
-            }
-            return;
-        }
-        match stage {
-            BakeStage::Read => self.bar.set_message("reading mesh"),
-            BakeStage::Assemble => self.bar.set_message("assembling K and M"),
-            BakeStage::Factor => self.bar.set_message("factoring K − σM"),
-            BakeStage::Eigensolve(p) => {
-                if self.bar.length().is_none() {
-                    self.bar.set_style(
-                        ProgressStyle::with_template(
-                            "{spinner} eigensolve [{bar:30}] {pos}/{len} modes converged ({msg})",
-                        )
-                        .unwrap_or_else(|_| ProgressStyle::default_bar())
-                        .progress_chars("=> "),
-                    );
-                    self.bar.set_length(p.requested as u64);
-                }
-                self.bar.set_length(p.requested as u64);
-                self.bar.set_position(p.converged.min(p.requested) as u64);
-                self.bar
-                    .set_message(format!("Lanczos step {}", p.iteration));
-            }
-            BakeStage::TransferModes => {
-                self.bar.set_style(ProgressStyle::default_spinner());
-                self.bar
-                    .set_message("solving for the transfer table's modes");
-            }
-            BakeStage::Transfer(p) => {
-                if self.bar.length() != Some(p.total as u64) {
-                    self.bar.set_style(
-                        ProgressStyle::with_template(
-                            "{spinner} transfer table [{bar:30}] {pos}/{len} rows ({eta} left)",
-                        )
-                        .unwrap_or_else(|_| ProgressStyle::default_bar())
-                        .progress_chars("=> "),
-                    );
-                    self.bar.set_length(p.total as u64);
-                }
-                self.bar.set_position(p.done as u64);
-            }
-            BakeStage::Write => {
-                self.bar.set_style(ProgressStyle::default_spinner());
-                self.bar.set_message("writing");
-            }
-        }
+/// Records in `base`'s free-form `meta.bake_params` where its material came from
+/// (`material_choice`) and what each fixed-node selector fixed (`fixed_by`); neither enters
+/// `params_hash`.
+pub fn annotate(base: &mut ModesFile, options: &BakeOptions, report: &BakeReport) {
+    if let Some(obj) = base.meta.bake_params.as_object_mut() {
+        obj.insert(
+            "material_choice".into(),
+            options.model.material_choice().to_json(),
+        );
+        obj.insert("fixed_by".into(), serde_json::json!(report.fixed_by));
     }
 }
 
 pub fn run(args: &BakeArgs) -> anyhow::Result<()> {
     super::check_output(&args.out, "-o", &[&args.mesh])?;
     args.options.model.check_ranges()?;
+    args.budget.budget()?;
+    if let Some(w) = args.options.model.default_material_warning() {
+        eprintln!("warning: {w}");
+    }
+    let asset = asset_for(&args.asset, args.transfer.transfer_h.is_some(), &args.mesh);
     if let Some(target) = args.target_error {
-        return super::target::run(args, target);
+        return super::target::run(args, &asset, target);
     }
     let params = BakeParams {
         transfer: args.transfer.params(),
         ..args.options.params()
     };
-    let mut progress = Progress::new();
-    let units = args.asset.units;
-    let report =
-        if is_surface_asset(&args.mesh) || args.asset.any_set() || units != super::mesh::Units::M {
-            progress.bar.finish_and_clear();
-            let (mesh, read_s) = load_mesh(&args.mesh, &args.asset)?;
-            progress = Progress::new();
-            let file = args.mesh.display().to_string();
-            bake::bake_mesh(mesh, &params, &file, &mut |s| progress.update(s))
-                .map_err(anyhow::Error::new)
-                .and_then(|(base, mut report)| {
-                    report.read_s = read_s;
-                    progress.update(BakeStage::Write);
-                    let t = std::time::Instant::now();
-                    super::create_parent(&args.out)?;
-                    base.write_atomic(&args.out)?;
-                    report.write_s = t.elapsed().as_secs_f64();
-                    Ok(report)
-                })
-        } else {
-            bake::bake_file(&args.mesh, &params, &args.out, &mut |s| progress.update(s))
-                .map_err(anyhow::Error::new)
-        };
-    progress.bar.finish_and_clear();
-    if let Some(plain) = &mut progress.plain {
-        plain.end_stage();
+    if is_surface_asset(&args.mesh) {
+        args.budget
+            .check_surface(&args.mesh, &asset, args.options.modes_for_estimate())?;
     }
+    let (mesh, read_s) = load_mesh_with_progress(&args.mesh, &asset)?;
+    bake_loaded(args, &params, mesh, read_s)
+}
+
+/// Bakes the mesh `--target-error` chose for a surface asset, as `bake` would.
+///
+/// # Errors
+/// As `bake`.
+pub fn bake_chosen_mesh(args: &BakeArgs, mesh: modal_bake::mesh::TetMesh) -> anyhow::Result<()> {
+    let params = BakeParams {
+        transfer: args.transfer.params(),
+        ..args.options.params()
+    };
+    bake_loaded(args, &params, mesh, 0.0)
+}
+
+/// The bake of a mesh in memory (read in `read_s` seconds): the checks before the
+/// factorization, the bake, the record of the material and selectors, the atomic write and
+/// the report.
+fn bake_loaded(
+    args: &BakeArgs,
+    params: &BakeParams,
+    mesh: modal_bake::mesh::TetMesh,
+    read_s: f64,
+) -> anyhow::Result<()> {
+    let surface = is_surface_asset(&args.mesh);
+    let file = args.mesh.display().to_string();
+    before_factorization(
+        &file,
+        &mesh,
+        &args.options,
+        &args.budget,
+        args.asset.units,
+        surface,
+    )?;
+    let mut progress = Progress::new("bake");
+    let report = bake::bake_mesh(mesh, params, &file, &mut |s| progress.update(s))
+        .map_err(anyhow::Error::new)
+        .and_then(|(mut base, mut report)| {
+            report.read_s = read_s;
+            report.material_name = args.options.model.material_choice().describe();
+            annotate(&mut base, &args.options, &report);
+            progress.update(BakeStage::Write);
+            let t = std::time::Instant::now();
+            super::create_parent(&args.out)?;
+            base.write_atomic(&args.out)?;
+            report.write_s = t.elapsed().as_secs_f64();
+            Ok(report)
+        });
+    progress.finish();
     let report = report
         .with_context(|| format!("baking {} failed; nothing was written", args.mesh.display()))?;
-    if let Some(dir) = &report.created_folder {
-        eprintln!("note: created folder {dir}");
-    }
-    if !is_surface_asset(&args.mesh) {
-        super::mesh::warn_extent(
-            &args.mesh.display().to_string(),
-            report.extent_m,
-            units,
-            &format!(" and weighs {:.4e} kg", report.mass_kg),
-        );
+    if let Some(w) = bake::plausibility_warnings(
+        None,
+        f64::NAN,
+        &args.options.model.material(),
+        report.frequencies_hz.first().copied(),
+    )
+    .into_iter()
+    .find(|w| w.contains("lowest elastic mode"))
+    {
+        eprintln!("warning: {file}: {w}");
     }
     if args.json {
         outln!("{}", serde_json::to_string_pretty(&report)?);
@@ -445,6 +409,24 @@ pub(super) fn print_report(out: &std::path::Path, r: &BakeReport) {
         r.free_dofs,
         r.mass_kg
     );
+    if let Some(m) = &r.material {
+        outln!(
+            "  material: {}: E {:.4e} Pa, ν {}, ρ {} kg/m³",
+            if r.material_name.is_empty() {
+                "given"
+            } else {
+                r.material_name.as_str()
+            },
+            m.youngs,
+            m.poisson,
+            m.density
+        );
+    }
+    outln!(
+        "  element order {} ({}-node tetrahedra)",
+        r.order,
+        if r.order == 2 { 10 } else { 4 }
+    );
     for n in &r.notes {
         outln!("  note: {n}");
     }
@@ -453,14 +435,14 @@ pub(super) fn print_report(out: &std::path::Path, r: &BakeReport) {
     }
     if r.rigid_modes_excluded > 0 {
         outln!(
-            "  free-free: {} rigid-body modes detected (|λ| ≤ {:.2e} rad²/s²) and excluded",
+            "  fixed: nothing (free-free): {} rigid-body modes detected (|λ| ≤ {:.2e} rad²/s²) and excluded",
             r.rigid_modes_excluded,
             r.rigid_eigenvalues
                 .iter()
                 .fold(0.0f64, |a, l| a.max(l.abs()))
         );
     } else {
-        outln!("  fixed nodes: {}", r.fixed_nodes);
+        outln!("  fixed: {} nodes", r.fixed_nodes);
         for (what, n) in &r.fixed_by {
             outln!("    {what}: {n} nodes");
         }

@@ -37,7 +37,8 @@ pub fn run(args: &CheckArgs) -> ExitCode {
         ..args.options.params()
     };
     let file = args.mesh.display().to_string();
-    let status = super::bake::load_mesh(&args.mesh, &args.asset)
+    let asset = super::bake::asset_for(&args.asset, args.transfer.transfer_h.is_some(), &args.mesh);
+    let status = super::bake::load_mesh(&args.mesh, &asset)
         .and_then(|(mesh, _)| Ok(bake::mesh_base_status(mesh, &file, &params, &args.out)?));
     match status {
         Ok(status) => {

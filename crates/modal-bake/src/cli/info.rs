@@ -15,10 +15,107 @@ pub struct InfoArgs {
     pub json: bool,
 }
 
+/// Where the base's material came from, from `meta.bake_params.material_choice` (`steel`,
+/// `steel with --youngs`, `given`, `default (no --material given)`, or `not recorded` for a
+/// base baked before it was stored).
+fn material_name(base: &ModesFile) -> String {
+    let Some(c) = base.meta.bake_params.get("material_choice") else {
+        return "not recorded".into();
+    };
+    let list = |k: &str| -> Vec<String> {
+        c.get(k)
+            .and_then(|v| v.as_array())
+            .map(|a| {
+                a.iter()
+                    .filter_map(|s| s.as_str().map(|s| format!("--{s}")))
+                    .collect()
+            })
+            .unwrap_or_default()
+    };
+    let (explicit, defaulted) = (list("explicit"), list("defaulted"));
+    match c.get("preset").and_then(|p| p.as_str()) {
+        Some(p) if explicit.is_empty() => p.to_string(),
+        Some(p) => format!("{p} with {}", explicit.join(", ")),
+        None if defaulted.is_empty() => format!("given ({})", explicit.join(", ")),
+        None if explicit.is_empty() => "default (no --material given)".into(),
+        None => format!(
+            "given ({}), default {}",
+            explicit.join(", "),
+            defaulted.join(", ")
+        ),
+    }
+}
+
+/// The fixed-node selectors of the base (`below y=0.005: 120 nodes`, `group feet`, ...), from
+/// `meta.bake_params`; empty for a free-free base.
+fn selectors(base: &ModesFile) -> Vec<String> {
+    let p = &base.meta.bake_params;
+    if let Some(by) = p.get("fixed_by").and_then(|v| v.as_array()) {
+        return by
+            .iter()
+            .filter_map(|e| {
+                let what = e.get(0)?.as_str()?;
+                let n = e.get(1)?.as_u64()?;
+                Some(format!("{what} ({n} nodes)"))
+            })
+            .collect();
+    }
+    let mut out = Vec::new();
+    for g in p
+        .get("fixed")
+        .and_then(|v| v.as_array())
+        .into_iter()
+        .flatten()
+    {
+        if let Some(g) = g.as_str() {
+            out.push(format!("group {g}"));
+        }
+    }
+    for b in p
+        .get("fixed_below")
+        .and_then(|v| v.as_array())
+        .into_iter()
+        .flatten()
+    {
+        if let Ok(b) = serde_json::from_value::<modal_bake::bake::FixedBelow>(b.clone()) {
+            out.push(format!("below {b}"));
+        }
+    }
+    for b in p
+        .get("fixed_boxes")
+        .and_then(|v| v.as_array())
+        .into_iter()
+        .flatten()
+    {
+        out.push(format!("box {b}"));
+    }
+    out
+}
+
+/// Warnings about an implausible size, mass or lowest frequency of the base (a unit mistake).
+fn warnings(base: &ModesFile) -> Vec<String> {
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for p in &base.surface_vertices {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    let extent = (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt();
+    modal_bake::bake::plausibility_warnings(
+        Some(extent),
+        base.meta.mass_kg,
+        &base.material,
+        base.frequencies_hz().first().copied(),
+    )
+}
+
 pub fn run(args: &InfoArgs) -> anyhow::Result<()> {
     // FormatError messages name the file and the entry at fault.
     let base = ModesFile::read(&args.file)?;
     let freqs = base.frequencies_hz();
+    let order = if base.quadratic.is_some() { 2 } else { 1 };
+    let warnings = warnings(&base);
     if args.json {
         let v = serde_json::json!({
             "file": args.file.display().to_string(),
@@ -32,14 +129,16 @@ pub fn run(args: &InfoArgs) -> anyhow::Result<()> {
             "residuals": base.residuals,
             "surface_vertices": base.num_surface_vertices(),
             "surface_triangles": base.surface_triangles.len(),
-            "order": if base.quadratic.is_some() { 2 } else { 1 },
+            "order": order,
             "surface_mid_edge_nodes": base.quadratic.as_ref().map_or(0, |q| q.edges.len()),
             "volume_nodes": base.meta.volume_nodes,
             "volume_tets": base.meta.volume_tets,
             "fixed_nodes": base.fixed_nodes.len(),
             "rigid_modes_excluded": base.meta.rigid_modes_excluded,
             "mass_kg": base.meta.mass_kg,
-            "material": {"youngs_pa": base.material.youngs, "poisson": base.material.poisson, "density_kg_m3": base.material.density},
+            "material": {"name": material_name(&base), "youngs_pa": base.material.youngs, "poisson": base.material.poisson, "density_kg_m3": base.material.density},
+            "fixed_by": selectors(&base),
+            "warnings": warnings,
             "rayleigh": base.rayleigh,
             "precision": base.precision,
             "bake_params": base.meta.bake_params,
@@ -73,23 +172,36 @@ pub fn run(args: &InfoArgs) -> anyhow::Result<()> {
     )?;
     writeln!(
         out,
-        "  material: E {:.4e} Pa, ν {}, ρ {} kg/m³; mass {:.6} kg",
-        base.material.youngs, base.material.poisson, base.material.density, base.meta.mass_kg
+        "  material: {}: E {:.4e} Pa, ν {}, ρ {} kg/m³; mass {:.6} kg",
+        material_name(&base),
+        base.material.youngs,
+        base.material.poisson,
+        base.material.density,
+        base.meta.mass_kg
     )?;
     writeln!(
         out,
-        "  volume mesh: {} nodes, {} tets; {}",
+        "  volume mesh: {} nodes, {} tets, element order {order} ({}-node tetrahedra)",
         base.meta.volume_nodes,
         base.meta.volume_tets,
-        if base.fixed_nodes.is_empty() {
-            format!(
-                "free-free ({} rigid modes excluded)",
-                base.meta.rigid_modes_excluded
-            )
-        } else {
-            format!("{} fixed nodes", base.fixed_nodes.len())
-        }
+        if order == 2 { 10 } else { 4 }
     )?;
+    if base.fixed_nodes.is_empty() {
+        writeln!(
+            out,
+            "  fixed: nothing (free-free, {} rigid modes excluded)",
+            base.meta.rigid_modes_excluded
+        )?;
+    } else {
+        let sel = selectors(&base);
+        writeln!(
+            out,
+            "  fixed: {} nodes{}{}",
+            base.fixed_nodes.len(),
+            if sel.is_empty() { "" } else { " by " },
+            sel.join("; ")
+        )?;
+    }
     match &base.quadratic {
         Some(q) => writeln!(
             out,
@@ -159,6 +271,9 @@ pub fn run(args: &InfoArgs) -> anyhow::Result<()> {
             a.query_cost / a.query_cost_20,
             a.payload_bytes as f64 / 1024.0
         )?;
+    }
+    for w in &warnings {
+        writeln!(out, "  warning: {w}")?;
     }
     writeln!(out, "  {} modes:", base.num_modes())?;
     writeln!(out, "     #   freq (Hz)      λ (rad²/s²)    residual")?;

@@ -97,6 +97,10 @@ pub enum MesherArg {
     Ftetwild,
 }
 
+/// Element order of a surface asset's tetrahedra when `--order` is not given: 10-node
+/// (order 2), far more accurate per degree of freedom than 4-node tetrahedra in bending.
+pub const DEFAULT_ORDER: u8 = 2;
+
 /// How the geometry is read: the unit of its coordinates (any mesh) and how a surface asset is
 /// tetrahedralized (shared by `mesh`, `bake` and `check`).
 #[derive(Args, Clone, Debug)]
@@ -117,9 +121,10 @@ pub struct AssetOptions {
     #[arg(long, value_name = "M")]
     pub size: Option<f64>,
     /// Surface assets: element order, 1 (4-node tetrahedra) or 2 (10-node, straight-sided;
-    /// far more accurate per degree of freedom).
-    #[arg(long, value_name = "1|2", default_value_t = 1, value_parser = clap::value_parser!(u8).range(1..=2))]
-    pub order: u8,
+    /// far more accurate per degree of freedom) [default: 2; 1 with --transfer-h, whose table
+    /// needs 4-node tetrahedra].
+    #[arg(long, value_name = "1|2", value_parser = clap::value_parser!(u8).range(1..=2))]
+    pub order: Option<u8>,
     /// Surface assets, fTetWild: how far (m) the tetrahedral surface may lie from the asset's
     /// triangles [default: 1/1000 of the bounding-box diagonal].
     #[arg(long, value_name = "M")]
@@ -142,6 +147,11 @@ pub struct AssetOptions {
 }
 
 impl AssetOptions {
+    /// The element order: `--order`, else [`DEFAULT_ORDER`].
+    pub fn order(&self) -> u8 {
+        self.order.unwrap_or(DEFAULT_ORDER)
+    }
+
     /// The meshing parameters.
     ///
     /// # Errors
@@ -154,7 +164,7 @@ impl AssetOptions {
                 MesherArg::Ftetwild => MesherChoice::Ftetwild,
             },
             size: self.size,
-            order: self.order,
+            order: self.order(),
             envelope: self.envelope,
             gmsh: self.gmsh.clone(),
             ftetwild: self.ftetwild.clone(),
@@ -168,7 +178,7 @@ impl AssetOptions {
     /// surface assets only).
     pub fn any_set(&self) -> bool {
         self.size.is_some()
-            || self.order != 1
+            || self.order.is_some()
             || self.gmsh.is_some()
             || self.keep_surface
             || self.mesher != MesherArg::Auto
@@ -202,6 +212,8 @@ pub struct MeshArgs {
     /// Print the report as one JSON object on stdout.
     #[arg(long)]
     pub json: bool,
+    #[command(flatten)]
+    pub budget: super::budget::BudgetOptions,
 }
 
 /// Meshes `asset`, with progress lines on stderr (which backend runs and why).
@@ -210,15 +222,19 @@ pub fn mesh_asset(asset: &Path, options: &AssetOptions) -> anyhow::Result<Meshed
     eprintln!(
         "meshing {} (order {}, --mesher {}) ...",
         asset.display(),
-        options.order,
+        options.order(),
         match options.mesher {
             MesherArg::Auto => "auto",
             MesherArg::Gmsh => "gmsh",
             MesherArg::Ftetwild => "ftetwild",
         }
     );
+    let mut heartbeat = super::progress::Progress::new("mesh");
+    heartbeat.stage("mesh", &format!("meshing {}", asset.display()));
     let progress = |line: &str| eprintln!("  {line}");
-    let out = modal_bake::mesh::mesh_asset(asset, options.units.to_metres(), &params, &progress)
+    let result = modal_bake::mesh::mesh_asset(asset, options.units.to_metres(), &params, &progress);
+    heartbeat.finish();
+    let out = result
         .with_context(|| format!("meshing {} failed; nothing was written", asset.display()))?;
     let r = &out.report;
     eprintln!("  backend: {} — {}", r.backend.name(), r.reason);
@@ -233,6 +249,8 @@ pub fn mesh_asset(asset: &Path, options: &AssetOptions) -> anyhow::Result<Meshed
 
 pub fn run(args: &MeshArgs) -> anyhow::Result<()> {
     super::check_output(&args.out, "-o", &[&args.asset])?;
+    args.budget
+        .check_surface(&args.asset, &args.asset_options, 26)?;
     let out = mesh_asset(&args.asset, &args.asset_options)?;
     dcr_runtime::format::write_atomic(&args.out, &out.msh)
         .with_context(|| format!("writing {}", args.out.display()))?;

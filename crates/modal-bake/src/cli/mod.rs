@@ -9,6 +9,7 @@ macro_rules! outln {
 }
 
 mod bake;
+mod budget;
 mod check;
 mod export;
 mod geodesic;
@@ -17,6 +18,7 @@ mod lab_alias;
 mod mesh;
 mod parse;
 mod probe;
+mod progress;
 mod target;
 
 use std::path::Path;

@@ -4,7 +4,9 @@
 use anyhow::Context;
 use modal_bake::target_error::{bake_to_target, Candidate, PairsParams, Representation};
 
-use super::bake::{print_report, BakeArgs, Progress};
+use super::bake::{annotate, before_factorization, print_report, BakeArgs, Progress};
+use super::mesh::AssetOptions;
+use modal_bake::mesh::surface::is_surface_asset;
 
 fn describe(r: Representation) -> String {
     match r {
@@ -14,15 +16,33 @@ fn describe(r: Representation) -> String {
     }
 }
 
-pub fn run(args: &BakeArgs, target: f64) -> anyhow::Result<()> {
+pub fn run(args: &BakeArgs, asset: &AssetOptions, target: f64) -> anyhow::Result<()> {
     let params = args.options.params();
-    let transfer = args
-        .transfer
-        .params()
-        .context("--target-error needs --transfer-h (the scene's step)")?;
-    let mut progress = Progress::new();
-    let (mesh, _) = super::bake::load_mesh(&args.mesh, &args.asset)?;
+    let surface = is_surface_asset(&args.mesh);
+    let Some(transfer) = args.transfer.params() else {
+        if !surface {
+            anyhow::bail!(
+                "--target-error without --transfer-h chooses the mesh of a surface asset (.obj, .stl, .ply); {} is a volume mesh: give --transfer-h (the scene's step) to choose its representation",
+                args.mesh.display()
+            );
+        }
+        return choose_mesh_and_bake(args, asset, target);
+    };
+    if surface {
+        args.budget
+            .check_surface(&args.mesh, asset, args.options.modes_for_estimate())?;
+    }
+    let (mesh, _) = super::bake::load_mesh_with_progress(&args.mesh, asset)?;
     let file = args.mesh.display().to_string();
+    before_factorization(
+        &file,
+        &mesh,
+        &args.options,
+        &args.budget,
+        asset.units,
+        surface,
+    )?;
+    let mut progress = Progress::new("bake");
     let res = bake_to_target(
         mesh,
         &params,
@@ -32,12 +52,11 @@ pub fn run(args: &BakeArgs, target: f64) -> anyhow::Result<()> {
         &file,
         &mut |s| progress.update(s),
     );
-    progress.bar.finish_and_clear();
-    if let Some(plain) = &mut progress.plain {
-        plain.end_stage();
-    }
-    let (base, report, tried) =
+    progress.finish();
+    let (mut base, mut report, tried) =
         res.with_context(|| format!("baking {} failed; nothing was written", args.mesh.display()))?;
+    report.material_name = args.options.model.material_choice().describe();
+    annotate(&mut base, &args.options, &report);
     base.write_atomic(&args.out)
         .with_context(|| format!("writing {} failed", args.out.display()))?;
     let acc = base
@@ -94,4 +113,95 @@ pub fn run(args: &BakeArgs, target: f64) -> anyhow::Result<()> {
         );
     }
     Ok(())
+}
+
+/// Lowest modes compared between successive meshes of the refinement.
+const MESH_CHOICE_MODES: usize = 5;
+
+/// `--target-error` without a transfer table on a surface asset: refine the mesh until the
+/// lowest modes converge to the target ([`modal_bake::target_error::choose_mesh`]), then bake
+/// the chosen mesh as `bake` would.
+fn choose_mesh_and_bake(args: &BakeArgs, asset: &AssetOptions, target: f64) -> anyhow::Result<()> {
+    use modal_bake::bake::{BakeError, SizeEstimate, SurfaceMeasures};
+    use modal_bake::target_error::choose_mesh;
+    let budget = args.budget.budget()?;
+    let mut s = modal_bake::mesh::surface::read_surface(&args.mesh)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", args.mesh.display()))?;
+    if asset.units.to_metres() != 1.0 {
+        s.scale(asset.units.to_metres());
+    }
+    let measures = SurfaceMeasures::of(&s.vertices, &s.triangles);
+    let start = asset
+        .size
+        .unwrap_or_else(|| modal_bake::mesh::gmsh::default_size(s.bounding_box()));
+    let order = asset.order();
+    let modes = args.options.modes_for_estimate();
+    let force = args.budget.force;
+    let file = args.mesh.display().to_string();
+    let estimate =
+        |h: f64| SizeEstimate::of_surface(&measures, h, asset.keep_surface, order, modes);
+    let mut fits = |h: f64| force || estimate(h).fits(&budget);
+    let mut mesh_at = |h: f64| {
+        eprintln!(
+            "target error: meshing at --size {h:.4e} m ({})",
+            estimate(h).describe()
+        );
+        let opts = AssetOptions {
+            size: Some(h),
+            ..asset.clone()
+        };
+        super::mesh::mesh_asset(&args.mesh, &opts)
+            .map(|out| out.mesh)
+            .map_err(|e| BakeError::Params(super::one_line(&e)))
+    };
+    let mut progress = Progress::new("bake");
+    let choice = choose_mesh(
+        &mut mesh_at,
+        &mut fits,
+        start,
+        order,
+        &args.options.params(),
+        target,
+        MESH_CHOICE_MODES,
+        &file,
+        &mut |s| progress.update(s),
+    );
+    progress.finish();
+    let choice = choice
+        .with_context(|| format!("choosing a mesh for {file} failed; nothing was written"))?;
+    for st in &choice.steps {
+        eprintln!(
+            "  size {:.4e} m: {} tets, {} dofs, lowest {} Hz{}",
+            st.size_m,
+            st.tets,
+            st.dofs,
+            st.frequencies_hz
+                .iter()
+                .map(|f| format!("{f:.2}"))
+                .collect::<Vec<_>>()
+                .join(", "),
+            match (st.change_pct, st.size_m < start) {
+                (Some(c), _) => format!("; moved ≤ {c:.2} %"),
+                (None, true) =>
+                    "; the same mesh as the previous size (gmsh kept a finer size of its own)"
+                        .into(),
+                (None, false) => String::new(),
+            }
+        );
+    }
+    let last = choice.steps.last().expect("one step at least");
+    match (choice.converged, choice.error_pct()) {
+        (true, Some(e)) => eprintln!(
+            "target error {target} %: met at --size {:.4e} m (order {order}); the lowest {MESH_CHOICE_MODES} modes moved ≤ {:.2} % in the last refinement, estimated error ≈ {e:.2} % (Richardson)",
+            last.size_m,
+            last.change_pct.unwrap_or(0.0)
+        ),
+        (_, e) => eprintln!(
+            "warning: target error {target} % NOT met: the finest mesh within the budget (--size {:.4e} m) still moved {} (estimated error {}); raise --max-memory / --max-time, or --force",
+            last.size_m,
+            last.change_pct.map_or("(one mesh only)".into(), |c| format!("{c:.2} %")),
+            e.map_or("unknown".into(), |e| format!("≈ {e:.2} %"))
+        ),
+    }
+    super::bake::bake_chosen_mesh(args, choice.mesh)
 }

@@ -10,13 +10,17 @@
 //!   the bake uses: bit-identical, without the full matrices).
 //! - [`rigid_body_modes`]: the 6-dimensional null space of the free-free K.
 //!
+//! - [`MaterialPreset`]: named typical materials (`--material steel`).
+//!
 //! Unsupported: anisotropic or heterogeneous materials, curved (non-affine) 10-node
 //! tetrahedra (refused by [`crate::mesh::TetMesh::check_straight`] before assembly).
 
 mod assembly;
 mod dof_map;
 mod material;
+mod material_preset;
 
 pub use assembly::{assemble_clamped, assemble_mass, assemble_stiffness, rigid_body_modes};
 pub use dof_map::{reduce_fixed, DofMap, DofMapError};
 pub use material::{Material, MaterialError};
+pub use material_preset::MaterialPreset;

@@ -14,9 +14,14 @@
 //! the smallest worst error, marked as not meeting it. The choice and its figures are stored
 //! in the base ([`dcr_runtime::format::AccuracyRecord`]); they are deterministic, so the file is
 //! too.
+//!
+//! For a surface asset without a transfer table, [`choose_mesh`] picks the mesh instead:
+//! refined until the lowest modes move by less than the target.
 
+mod mesh_choice;
 mod reference_pairs;
 
+pub use mesh_choice::{choose_mesh, MeshChoice, MeshStep, MAX_STEPS, REFINE};
 pub use reference_pairs::{sample_points, PairsParams, ReferencePairs, SamplePoint, TruthProblem};
 
 use std::sync::Arc;

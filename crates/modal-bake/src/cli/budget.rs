@@ -1,0 +1,186 @@
+//! Size before work (`--max-memory`, `--max-time`, `--force`): the estimate of
+//! [`modal_bake::bake::SizeEstimate`] printed before meshing and baking, and a refusal with the
+//! estimate and how to lower it when it is over the budget.
+
+use std::path::Path;
+
+use clap::Args;
+use modal_bake::bake::{self as mb, Budget, SizeEstimate, SurfaceMeasures};
+
+use super::mesh::AssetOptions;
+
+/// The budget of one `mesh` or `bake` run.
+#[derive(Args, Clone, Debug)]
+pub struct BudgetOptions {
+    /// Refuse (before any long work) when the estimated peak memory of meshing or baking is
+    /// above this (GB, 1e9 bytes).
+    #[arg(long, value_name = "GB", default_value_t = 2.0)]
+    pub max_memory: f64,
+    /// Refuse (before any long work) when the estimated wall time of meshing plus baking is
+    /// above this (seconds).
+    #[arg(long, value_name = "SECONDS", default_value_t = 300.0)]
+    pub max_time: f64,
+    /// Run even when the estimate is over --max-memory or --max-time.
+    #[arg(long)]
+    pub force: bool,
+}
+
+impl BudgetOptions {
+    /// The budget in SI units.
+    ///
+    /// # Errors
+    /// A non-positive or non-finite `--max-memory` or `--max-time`.
+    pub fn budget(&self) -> anyhow::Result<Budget> {
+        for (name, v) in [
+            ("--max-memory", self.max_memory),
+            ("--max-time", self.max_time),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                anyhow::bail!("{name} {v} must be a positive number");
+            }
+        }
+        Ok(Budget {
+            max_bytes: self.max_memory * 1e9,
+            max_seconds: self.max_time,
+        })
+    }
+
+    fn describe(&self) -> String {
+        format!(
+            "the budget of {} GB and {} (--max-memory, --max-time)",
+            self.max_memory,
+            mb::format_seconds(self.max_time)
+        )
+    }
+
+    /// Estimates meshing the surface asset `path` with `asset` and baking `modes` modes of the
+    /// mesh (`mesh` too: the mesh is made to be baked), prints the estimate (stderr) and
+    /// refuses it over the budget unless `--force`.
+    /// The refusal names the estimate, the budget and the smallest coarsening of `--size` that
+    /// fits.
+    ///
+    /// # Errors
+    /// An unreadable surface (the reader's message), or the estimate over the budget.
+    pub fn check_surface(
+        &self,
+        path: &Path,
+        asset: &AssetOptions,
+        modes: usize,
+    ) -> anyhow::Result<SizeEstimate> {
+        let budget = self.budget()?;
+        let mut s = modal_bake::mesh::surface::read_surface(path)
+            .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+        let to_m = asset.units.to_metres();
+        if to_m != 1.0 {
+            s.scale(to_m);
+        }
+        let measures = SurfaceMeasures::of(&s.vertices, &s.triangles);
+        let size = asset
+            .size
+            .unwrap_or_else(|| modal_bake::mesh::gmsh::default_size(s.bounding_box()));
+        let order = asset.order();
+        let est = |size: f64, order: u8| {
+            SizeEstimate::of_surface(&measures, size, asset.keep_surface, order, modes)
+        };
+        let fits = |e: &SizeEstimate| e.fits(&budget);
+        let e = est(size, order);
+        eprintln!(
+            "size estimate for {} ({} triangles, {:.4e} m³, size {:.4e} m{}): {}",
+            path.display(),
+            mb::format_count(measures.triangles as f64),
+            measures.volume_m3,
+            size,
+            if asset.keep_surface {
+                format!(
+                    ", --keep-surface: its {:.4e} m triangles set the size",
+                    measures.mean_edge()
+                )
+            } else {
+                String::new()
+            },
+            e.describe()
+        );
+        if fits(&e) {
+            return Ok(e);
+        }
+        let mut how = Vec::new();
+        if asset.keep_surface {
+            how.push(format!(
+                "drop --keep-surface (its {} triangles, {:.4e} m apart, set the tetrahedra; remeshing at --size {:.4e} gives {})",
+                mb::format_count(measures.triangles as f64),
+                measures.mean_edge(),
+                size,
+                SizeEstimate::of_surface(&measures, size, false, order, modes).describe()
+            ));
+            how.push(
+                "decimate the asset in the modelling tool (Blender: Decimate modifier)".into(),
+            );
+        } else if let Some(fit) = (1..=40)
+            .map(|k| size * 1.2f64.powi(k))
+            .find(|&h| fits(&est(h, order)))
+        {
+            how.push(format!(
+                "a coarser --size {fit:.3e} m ({})",
+                est(fit, order).describe()
+            ));
+        }
+        if order == 2 && fits(&est(size, 1)) {
+            how.push(format!(
+                "--order 1 ({}; linear tetrahedra are much less accurate in bending)",
+                est(size, 1).describe()
+            ));
+        }
+        how.push("fewer --modes".into());
+        self.refuse(&path.display().to_string(), &e, &how, measures.extent_m)
+    }
+
+    /// Estimates baking `modes` modes of `mesh`, prints it when it is long (stderr) and refuses
+    /// it over the budget unless `--force`.
+    ///
+    /// # Errors
+    /// The estimate over the budget.
+    pub fn check_mesh(
+        &self,
+        file: &str,
+        mesh: &modal_bake::mesh::TetMesh,
+        modes: usize,
+    ) -> anyhow::Result<SizeEstimate> {
+        let budget = self.budget()?;
+        let order = if mesh.is_quadratic() { 2 } else { 1 };
+        let e = SizeEstimate::of_mesh(mesh.nodes.len(), mesh.tets.len(), order, modes);
+        if e.bake_s >= 10.0 || !e.fits(&budget) {
+            eprintln!("size estimate for baking {file}: {}", e.describe());
+        }
+        if e.fits(&budget) {
+            return Ok(e);
+        }
+        let how = vec![
+            "a coarser mesh (a larger --size when meshing; halving the tetrahedra more than halves the time)".to_string(),
+            "fewer --modes".to_string(),
+        ];
+        self.refuse(file, &e, &how, mesh.extent())
+    }
+
+    fn refuse(
+        &self,
+        file: &str,
+        e: &SizeEstimate,
+        how: &[String],
+        extent_m: f64,
+    ) -> anyhow::Result<SizeEstimate> {
+        if self.force {
+            eprintln!(
+                "warning: {file}: the estimate is over {}; running anyway (--force)",
+                self.describe()
+            );
+            return Ok(*e);
+        }
+        let scale = mb::unit_hint(extent_m).map_or_else(String::new, |h| format!("; note: {h}"));
+        anyhow::bail!(
+            "{file}: refused before meshing or baking: estimated {} is over {}; to lower it: {}; or pass --force to run anyway{scale}",
+            e.describe(),
+            self.describe(),
+            how.join(", or ")
+        )
+    }
+}
