@@ -106,7 +106,7 @@ fn onto_keeps_the_assets_vertices_and_reproduces_the_nodal_modes() {
         base.surface_vertices[e1 as usize],
     );
     verts.push(std::array::from_fn(|a| 0.5 * (p0[a] + p1[a])));
-    verts.push([0.5, 0.05, 0.05]);
+    verts.push([0.5, 0.0, 0.05]); // on the face y = 0, used by no triangle
     let flip = |v: u32| ns as u32 - 1 - v;
     let tris: Vec<[u32; 3]> = base
         .surface_triangles

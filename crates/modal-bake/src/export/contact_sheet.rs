@@ -1,6 +1,6 @@
 //! [`render_contact_sheet`]: the lowest modes of a base side by side (the paper's Fig. 2), each
 //! panel the surface displaced along one mode and coloured by the displacement magnitude over
-//! a light-grey ghost of the rest shape, rendered on the CPU (our z-buffer rasterizer into a
+//! a light-grey ghost of the rest shape (and its outline over the displaced surface), rendered on the CPU (our z-buffer rasterizer into a
 //! tiny-skia pixmap, 2 × 2 supersampled). A title band names the object, the material and the
 //! mesh; a legend band gives the colour scale and what it means.
 //!
@@ -58,6 +58,8 @@ impl Default for SheetParams {
 const BG: [f32; 3] = [1.0, 1.0, 1.0];
 /// Rest-shape ghost colour (light grey).
 const GHOST: [f32; 3] = [0.84, 0.84, 0.86];
+/// Grey level of the rest shape's outline drawn over the displaced surface.
+const OUTLINE: f32 = 0.97;
 const SS: usize = 2;
 const LABEL_H: usize = 22;
 /// Height of the title band above the panels (pixels).
@@ -216,10 +218,26 @@ pub fn render_contact_sheet(base: &ModesFile, p: &SheetParams) -> Result<Pixmap,
         };
         let ghost = draw(&surf.positions, &|_| GHOST);
         let mut r = draw(&pos, &|v| col_v[v]);
-        // The rest shape shows where the displaced surface does not cover it.
-        for (c, g) in r.color.iter_mut().zip(&ghost.color) {
+        // The rest shape shows where the displaced surface does not cover it, and its outline
+        // is drawn over the displaced surface (motion within the silhouette: stretching,
+        // twisting).
+        let covered: Vec<bool> = ghost.color.iter().map(|g| *g != BG).collect();
+        for (k, (c, g)) in r.color.iter_mut().zip(&ghost.color).enumerate() {
             if *c == BG {
                 *c = *g;
+            } else if covered[k] {
+                let (x, y) = (k % sw, k / sw);
+                let edge = x == 0
+                    || y == 0
+                    || x + 1 == sw
+                    || y + 1 == sh
+                    || !covered[k - 1]
+                    || !covered[k + 1]
+                    || !covered[k - sw]
+                    || !covered[k + sw];
+                if edge {
+                    *c = c.map(|v| 0.35 * v + 0.65 * OUTLINE);
+                }
             }
         }
         let r = r.downsample(SS);
@@ -447,4 +465,97 @@ pub fn write_modes_png(base: &ModesFile, p: &SheetParams, path: &Path) -> Result
         detail: e.to_string(),
     })?;
     write_file_atomic(path, &bytes)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use dcr_runtime::testing::{box_surface, synthetic_base};
+
+    /// A 1 × 0.2 × 0.1 m box base whose mode 0 translates every vertex along `d0` and mode 1
+    /// along `d1` (unit vectors; the rows are not M-orthonormal, which the sheet does not need).
+    fn translating_base(d0: [f64; 3], d1: [f64; 3]) -> ModesFile {
+        let mut base = synthetic_base(
+            box_surface(4, [1.0, 0.2, 0.1]),
+            &[100.0, 200.0],
+            [0.0, 0.0],
+            7,
+        );
+        let m = base.num_modes();
+        for v in 0..base.surface_vertices.len() {
+            for a in 0..3 {
+                base.modes[(v * 3 + a) * m] = d0[a];
+                base.modes[(v * 3 + a) * m + 1] = d1[a];
+            }
+        }
+        base
+    }
+
+    fn default_eye() -> [f64; 3] {
+        let p = SheetParams::default();
+        let (az, el) = (p.azimuth_deg.to_radians(), p.elevation_deg.to_radians());
+        [el.cos() * az.sin(), el.sin(), el.cos() * az.cos()]
+    }
+
+    /// Each mode's camera sees its dominant direction side-on: view ⟂ d, also when d is the
+    /// default line of sight; for d ⟂ the default view, the default view is kept.
+    #[test]
+    fn each_modes_view_is_perpendicular_to_its_dominant_motion() {
+        let eye0 = default_eye();
+        let x = [1.0, 0.0, 0.0];
+        let base = translating_base(eye0, x);
+        let surf = ExportSurface::of(&base);
+        for (j, d) in [(0, eye0), (1, x)] {
+            let dd = dominant_direction(&surf, j);
+            assert!((dot(dd, d).abs() - 1.0).abs() < 1e-9, "mode {j}: {dd:?}");
+            let e = view_for_mode(&surf, j, eye0);
+            assert!((dot(e, e) - 1.0).abs() < 1e-12);
+            assert!(dot(e, d).abs() < 1e-9, "mode {j}: view {e:?} sees d {d:?} head-on");
+        }
+        let base = translating_base([-eye0[2], 0.0, eye0[0]], x);
+        let e = view_for_mode(&ExportSurface::of(&base), 0, eye0);
+        assert!((dot(e, eye0) - 1.0).abs() < 1e-9, "{e:?}");
+    }
+
+    /// Light-grey rest-shape pixels left uncovered by the displaced surface in panel j.
+    fn ghost_pixels(pix: &Pixmap, p: &SheetParams, j: usize) -> usize {
+        let (pw, ph) = (p.panel[0] as u32, p.panel[1] as u32);
+        let (x0, y0) = (
+            (j % p.columns) as u32 * pw,
+            SHEET_TITLE_H as u32 + (j / p.columns) as u32 * ph,
+        );
+        let mut n = 0;
+        for y in y0 + LABEL_H as u32 + 1..y0 + ph - 1 {
+            for x in x0 + 1..x0 + pw - 1 {
+                let c = pix.pixel(x, y).unwrap();
+                let (r, g, b) = (c.red() as i32, c.green() as i32, c.blue() as i32);
+                if (r - g).abs() < 6 && (g - b).abs() < 8 && (60..225).contains(&r) {
+                    n += 1;
+                }
+            }
+        }
+        n
+    }
+
+    /// A mode moving along the default line of sight (invisible to a fixed orthographic
+    /// camera: the displaced surface would cover the rest shape exactly) shows its motion: the
+    /// rest shape's ghost is visible beside the displaced surface, as for a sideways mode.
+    #[test]
+    fn a_mode_along_the_default_line_of_sight_is_drawn_visibly_moving() {
+        let base = translating_base(default_eye(), [1.0, 0.0, 0.0]);
+        let p = SheetParams {
+            modes: 2,
+            scale: 0.1,
+            ..Default::default()
+        };
+        let pix = render_contact_sheet(&base, &p).unwrap();
+        assert_eq!(
+            pix.height() as usize,
+            SHEET_TITLE_H + p.panel[1] + SHEET_LEGEND_H
+        );
+        for j in 0..2 {
+            let n = ghost_pixels(&pix, &p, j);
+            assert!(n > 500, "mode {j}: only {n} rest-shape pixels visible");
+        }
+    }
 }
