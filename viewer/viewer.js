@@ -149,7 +149,7 @@ function showFixed(root, fixed) {
   fixed.forEach((v, k) => xyz.set([pos.getX(v), pos.getY(v), pos.getZ(v)], 3 * k));
   const g = new BufferGeometry();
   g.setAttribute('position', new BufferAttribute(xyz, 3));
-  const pts = new Points(g, new PointsMaterial({ color: 0xcc2200, size: 5, sizeAttenuation: false, depthTest: true }));
+  const pts = new Points(g, new PointsMaterial({ color: 0xcc2200, size: 7, sizeAttenuation: false, depthTest: true }));
   pts.name = 'fixed vertices';
   mesh.add(pts);
   return fixed.length;
