@@ -6,7 +6,7 @@ Needs the `bpy` module (python3 -m pip install bpy==4.5.7) and a release modal-b
 fresh Blender scene (private user folder), installs the add-on from blender/modal_bake as an
 extension, builds a 40 × 20 × 600 mm bar standing on the ground (its long edges cut 24 times so
 the shape keys have vertices to bend), fixes it below z = 1 mm, and presses Bake (pine, order 2,
-6 modes). It then renders, with Workbench at 1000 × 400, the rest mesh beside four copies with
+6 modes). It then renders, with Workbench at 750 × 600 (turned 45° so both bending directions show), the rest mesh beside four copies with
 the keys "Mode 1 … 4" at 1.0 (the add-on's scale: largest displacement 5 % of the diagonal),
 each labelled with its key's name.
 """
@@ -32,8 +32,8 @@ def main():
     for var, sub in (("BLENDER_USER_CONFIG", "config"), ("BLENDER_USER_SCRIPTS", "scripts"),
                      ("BLENDER_USER_EXTENSIONS", "extensions")):
         os.environ[var] = os.path.join(work, sub)
-    import bmesh
     import bpy
+    import bmesh  # available once bpy is imported
 
     src = os.path.join(ROOT, "blender", "modal_bake")
     zpath = os.path.join(work, "modal_bake.zip")
@@ -64,9 +64,13 @@ def main():
     s.material, s.order, s.modes = "pine", "2", 6
     s.fixed, s.fixed_height = "below", 0.001
     s.output_dir = os.path.join(work, "bake")
-    res = bpy.ops.modal_bake.bake()
-    if res != {"FINISHED"} and s.material != "default":
-        # A modal-bake without --material: the add-on said so; use explicit pine values.
+    try:
+        res = bpy.ops.modal_bake.bake()
+    except RuntimeError as e:
+        if "--material" not in str(e):
+            raise
+        # A modal-bake without --material (the add-on said so): explicit pine-like values.
+        print("this modal-bake has no --material: using E = 10 GPa, nu = 0.3, rho = 500 kg/m3")
         s.material = "custom"
         s.youngs_pa, s.poisson, s.density_kg_m3 = 1.0e10, 0.3, 500.0
         res = bpy.ops.modal_bake.bake()
@@ -74,7 +78,7 @@ def main():
     keys = [kb for kb in bar.data.shape_keys.key_blocks if kb.name.startswith("Mode ")]
 
     scene = bpy.context.scene
-    spacing = 0.22
+    spacing = 0.2
     shown = [None] + keys[:4]
     for i, kb in enumerate(shown):
         obj = bar if i == 0 else bar.copy()
@@ -82,26 +86,36 @@ def main():
             obj.data = bar.data.copy()
             scene.collection.objects.link(obj)
             obj.data.shape_keys.key_blocks[kb.name].value = 1.0
+        # Turned 45° about z: both bending directions of the bar are seen from the camera.
         obj.location.x = (i - 2) * spacing
-        bpy.ops.object.text_add(location=((i - 2) * spacing - 0.09, -0.05, -0.06))
+        obj.rotation_euler.z = math.radians(45)
+        obj.color = (0.85, 0.6, 0.35, 1.0)
+        bpy.ops.object.text_add(location=((i - 2) * spacing - 0.075, 0.0, 0.72))
         txt = bpy.context.active_object
-        txt.data.body = "rest" if kb is None else kb.name.replace(" — ", "\n")
-        txt.data.size = 0.028
+        txt.data.body = "rest\n" if kb is None else kb.name.replace(" — ", "\n")
+        txt.data.size = 0.03
         txt.rotation_euler = (math.radians(90), 0, 0)
-    bpy.ops.object.camera_add(location=(0, -2.2, 0.3), rotation=(math.radians(90), 0, 0))
+        txt.color = (0.1, 0.1, 0.1, 1.0)
+    bpy.ops.object.camera_add(location=(0, -2.2, 0.36), rotation=(math.radians(90), 0, 0))
     cam = bpy.context.active_object
     cam.data.type = "ORTHO"
-    cam.data.ortho_scale = 1.12
+    cam.data.ortho_scale = 1.1
     scene.camera = cam
+    if scene.world is None:
+        scene.world = bpy.data.worlds.new("World")
+    scene.world.color = (1.0, 1.0, 1.0)
     scene.render.engine = "BLENDER_WORKBENCH"
     scene.display.shading.light = "STUDIO"
-    scene.display.shading.color_type = "SINGLE"
-    scene.display.shading.single_color = (0.8, 0.55, 0.3)
+    scene.display.shading.color_type = "OBJECT"
     scene.display.shading.show_cavity = True
-    scene.render.resolution_x, scene.render.resolution_y = 1000, 400
+    scene.view_settings.view_transform = "Standard"
+    scene.render.resolution_x, scene.render.resolution_y = 750, 600
     scene.render.film_transparent = False
     scene.render.image_settings.file_format = "PNG"
     scene.render.image_settings.color_mode = "RGB"
+    scene.render.image_settings.color_depth = "8"
+    scene.render.image_settings.compression = 100
+    scene.render.dither_intensity = 0.0
     scene.render.filepath = args.out
     os.makedirs(os.path.dirname(args.out), exist_ok=True)
     bpy.ops.render.render(write_still=True)

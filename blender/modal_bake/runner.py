@@ -144,9 +144,12 @@ def run_step(cmd, what, progress):
     if proc.returncode != 0:
         opt = _unknown_option(text)
         if opt:
+            setting = {"--material": "set Material to Custom (explicit E, ν, ρ) or CLI default",
+                       "--mesher": "set Mesher to Auto",
+                       "--target-error": "set Target error to 0"}.get(opt, "reset that setting")
             raise BakeError(
                 f"{what}: this modal-bake ({cmd[0]}) does not know the option {opt}: update "
-                "modal-bake, or leave that setting at its default so the option is not passed")
+                f"modal-bake, or {setting} so the option is not passed")
         tail = "\n".join(lines[-12:])
         raise BakeError(f"{what} failed (exit {proc.returncode}):\n{tail}")
     return text
