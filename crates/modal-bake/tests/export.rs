@@ -313,10 +313,7 @@ fn png_sheet_has_one_distinct_panel_per_mode_and_exports_are_deterministic() {
         modal_bake::export::SHEET_TITLE_H as u32,
         modal_bake::export::SHEET_LEGEND_H as u32,
     );
-    assert_eq!(
-        (png.width(), png.height()),
-        (1280, title + 480 + legend)
-    );
+    assert_eq!((png.width(), png.height()), (1280, title + 480 + legend));
     let mut panels = Vec::new();
     for k in 0..8u32 {
         let (ink, px) = panel_ink(&png, (k % 4) * 320 + 1, title + (k / 4) * 240 + 1, 318, 217);

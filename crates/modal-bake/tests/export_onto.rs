@@ -52,8 +52,11 @@ fn write_obj(path: &Path, vertices: &[[f64; 3]], tris: &[[u32; 3]], factor: f64)
     std::fs::write(path, t).unwrap();
 }
 
-/// Morph targets (per mode, per vertex, m) and the modal coordinates of an --onto GLB.
-fn targets(glb: &Glb) -> (usize, Vec<Vec<[f64; 3]>>, Vec<f64>, Vec<String>) {
+/// Per mode, per vertex displacements (m).
+type Targets = Vec<Vec<[f64; 3]>>;
+
+/// Vertex count, morph targets, modal coordinates and target names of an --onto GLB.
+fn targets(glb: &Glb) -> (usize, Targets, Vec<f64>, Vec<String>) {
     let prim = &glb.root.meshes[0].primitives[0];
     let pos = glb.floats(
         prim.attributes
@@ -108,11 +111,7 @@ fn onto_keeps_the_assets_vertices_and_reproduces_the_nodal_modes() {
     verts.push(std::array::from_fn(|a| 0.5 * (p0[a] + p1[a])));
     verts.push([0.5, 0.0, 0.05]); // on the face y = 0, used by no triangle
     let flip = |v: u32| ns as u32 - 1 - v;
-    let tris: Vec<[u32; 3]> = base
-        .surface_triangles
-        .iter()
-        .map(|t| t.map(flip))
-        .collect();
+    let tris: Vec<[u32; 3]> = base.surface_triangles.iter().map(|t| t.map(flip)).collect();
     let asset = dir.path().join("beam_asset.obj");
     write_obj(&asset, &verts, &tris, 1.0);
     let glb_path = dir.path().join("onto.glb");
@@ -156,7 +155,10 @@ fn onto_keeps_the_assets_vertices_and_reproduces_the_nodal_modes() {
         );
         for c in 0..3 {
             let want = a[j] * 0.5 * (u0[c] + u1[c]);
-            assert!((d[j][ns][c] - want).abs() <= 1e-6 * diag, "mode {j} midpoint");
+            assert!(
+                (d[j][ns][c] - want).abs() <= 1e-6 * diag,
+                "mode {j} midpoint"
+            );
         }
     }
     let ex = glb.extras();
@@ -171,7 +173,11 @@ fn onto_keeps_the_assets_vertices_and_reproduces_the_nodal_modes() {
         .collect();
     assert!(!fixed.is_empty());
     for &v in &fixed {
-        assert!(verts[v][0].abs() < 1e-9, "fixed vertex {v} at {:?}", verts[v]);
+        assert!(
+            verts[v][0].abs() < 1e-9,
+            "fixed vertex {v} at {:?}",
+            verts[v]
+        );
         assert!(d.iter().all(|dj| dj[v] == [0.0; 3]));
     }
 }
@@ -226,7 +232,8 @@ fn onto_p2_base_interpolates_quadratically_and_honours_units() {
                     "mode {j} edge {e}: {got} vs {}",
                     a[j] * u[c]
                 );
-                differs_from_mean = differs_from_mean.max((a[j] * (u[c] - 0.5 * (ux[c] + uy[c]))).abs());
+                differs_from_mean =
+                    differs_from_mean.max((a[j] * (u[c] - 0.5 * (ux[c] + uy[c]))).abs());
             }
         }
     }
@@ -290,19 +297,47 @@ fn onto_bad_assets_fail_with_file_and_line_and_write_nothing() {
     let png = dir.path().join("out.png");
     let cases: Vec<(Vec<&str>, &str)> = vec![
         (
-            vec!["export", s(&base_path), "--gltf", s(&glb), "--onto", s(&bad_index)],
+            vec![
+                "export",
+                s(&base_path),
+                "--gltf",
+                s(&glb),
+                "--onto",
+                s(&bad_index),
+            ],
             "bad_index.obj:4",
         ),
         (
-            vec!["export", s(&base_path), "--gltf", s(&glb), "--onto", s(&bad_number)],
+            vec![
+                "export",
+                s(&base_path),
+                "--gltf",
+                s(&glb),
+                "--onto",
+                s(&bad_number),
+            ],
             "bad_number.obj:2",
         ),
         (
-            vec!["export", s(&base_path), "--gltf", s(&glb), "--onto", "/nonexistent/a.obj"],
+            vec![
+                "export",
+                s(&base_path),
+                "--gltf",
+                s(&glb),
+                "--onto",
+                "/nonexistent/a.obj",
+            ],
             "/nonexistent/a.obj",
         ),
         (
-            vec!["export", s(&base_path), "--png", s(&png), "--onto", s(&bad_index)],
+            vec![
+                "export",
+                s(&base_path),
+                "--png",
+                s(&png),
+                "--onto",
+                s(&bad_index),
+            ],
             "--gltf",
         ),
     ];

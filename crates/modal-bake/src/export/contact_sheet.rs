@@ -510,7 +510,10 @@ mod tests {
             assert!((dot(dd, d).abs() - 1.0).abs() < 1e-9, "mode {j}: {dd:?}");
             let e = view_for_mode(&surf, j, eye0);
             assert!((dot(e, e) - 1.0).abs() < 1e-12);
-            assert!(dot(e, d).abs() < 1e-9, "mode {j}: view {e:?} sees d {d:?} head-on");
+            assert!(
+                dot(e, d).abs() < 1e-9,
+                "mode {j}: view {e:?} sees d {d:?} head-on"
+            );
         }
         let base = translating_base([-eye0[2], 0.0, eye0[0]], x);
         let e = view_for_mode(&ExportSurface::of(&base), 0, eye0);

@@ -50,13 +50,17 @@ impl AssetMesh {
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("obj"));
         let (mut positions, triangles) = if is_obj {
-            read_obj_ordered(&data, &name)?
+            let a = read_obj_ordered(&data, &name)?;
+            (a.positions, a.triangles)
         } else {
-            let (p, t) =
-                read_surface_unwelded(&data, &name).map_err(|e| ExportError::Invalid(e.to_string()))?;
+            let (p, t) = read_surface_unwelded(&data, &name)
+                .map_err(|e| ExportError::Invalid(e.to_string()))?;
             (p, t.into_iter().map(|t| t.map(|i| i as u32)).collect())
         };
-        if let Some(v) = positions.iter().position(|p| !p.iter().all(|x| x.is_finite())) {
+        if let Some(v) = positions
+            .iter()
+            .position(|p| !p.iter().all(|x| x.is_finite()))
+        {
             return Err(ExportError::Invalid(format!(
                 "{name}: vertex {v} has a non-finite coordinate"
             )));
@@ -75,7 +79,7 @@ impl AssetMesh {
 
 /// OBJ `v` records in file order and `f` records fan-triangulated (`i`, `i/t`, `i//n`,
 /// `i/t/n`; negative indices count back from the last vertex read).
-fn read_obj_ordered(data: &[u8], name: &str) -> Result<(Vec<[f64; 3]>, Vec<[u32; 3]>), ExportError> {
+fn read_obj_ordered(data: &[u8], name: &str) -> Result<AssetMesh, ExportError> {
     let bad = |line: usize, what: String| ExportError::Invalid(format!("{name}:{line}: {what}"));
     let text = std::str::from_utf8(data)
         .map_err(|e| ExportError::Invalid(format!("{name}: not a text OBJ file: {e}")))?;
@@ -88,9 +92,9 @@ fn read_obj_ordered(data: &[u8], name: &str) -> Result<(Vec<[f64; 3]>, Vec<[u32;
             Some("v") => {
                 let mut p = [0.0; 3];
                 for (a, x) in p.iter_mut().enumerate() {
-                    let t = tok
-                        .next()
-                        .ok_or_else(|| bad(line, format!("`v` record has {a} coordinates, needs 3")))?;
+                    let t = tok.next().ok_or_else(|| {
+                        bad(line, format!("`v` record has {a} coordinates, needs 3"))
+                    })?;
                     *x = t
                         .parse()
                         .map_err(|_| bad(line, format!("`{t}` is not a number")))?;
@@ -109,13 +113,18 @@ fn read_obj_ordered(data: &[u8], name: &str) -> Result<(Vec<[f64; 3]>, Vec<[u32;
                     if i == 0 || idx < 0 || idx >= n {
                         return Err(bad(
                             line,
-                            format!("face names vertex {i}, but {n} vertices are defined before it"),
+                            format!(
+                                "face names vertex {i}, but {n} vertices are defined before it"
+                            ),
                         ));
                     }
                     face.push(idx as u32);
                 }
                 if face.len() < 3 {
-                    return Err(bad(line, format!("face has {} corners, needs 3", face.len())));
+                    return Err(bad(
+                        line,
+                        format!("face has {} corners, needs 3", face.len()),
+                    ));
                 }
                 for c in 1..face.len() - 1 {
                     triangles.push([face[0], face[c], face[c + 1]]);
@@ -125,9 +134,14 @@ fn read_obj_ordered(data: &[u8], name: &str) -> Result<(Vec<[f64; 3]>, Vec<[u32;
         }
     }
     if triangles.is_empty() {
-        return Err(ExportError::Invalid(format!("{name}: the file holds no faces")));
+        return Err(ExportError::Invalid(format!(
+            "{name}: the file holds no faces"
+        )));
     }
-    Ok((positions, triangles))
+    Ok(AssetMesh {
+        positions,
+        triangles,
+    })
 }
 
 /// Mode shapes read at an asset's vertices.
@@ -147,10 +161,10 @@ pub struct OntoMapping {
 impl OntoMapping {
     /// Largest mapping distance (m) and the vertex where it occurs.
     pub fn max_distance(&self) -> (f64, usize) {
-        self.distance
-            .iter()
-            .enumerate()
-            .fold((0.0, 0), |(d, i), (k, &x)| if x > d { (x, k) } else { (d, i) })
+        self.distance.iter().enumerate().fold(
+            (0.0, 0),
+            |(d, i), (k, &x)| if x > d { (x, k) } else { (d, i) },
+        )
     }
 }
 
@@ -340,7 +354,11 @@ fn onto_glb_bytes(
         ));
     }
     let nv = asset.positions.len();
-    if let Some(t) = asset.triangles.iter().find(|t| t.iter().any(|&i| i as usize >= nv)) {
+    if let Some(t) = asset
+        .triangles
+        .iter()
+        .find(|t| t.iter().any(|&i| i as usize >= nv))
+    {
         return Err(ExportError::Invalid(format!(
             "asset triangle {t:?} names a vertex beyond its {nv} vertices"
         )));
@@ -349,7 +367,11 @@ fn onto_glb_bytes(
     let map = map_modes_onto(base, &asset.positions, n)?;
     let diag = diagonal(&asset.positions);
     let freqs = base.frequencies_hz();
-    let positions: Vec<[f32; 3]> = asset.positions.iter().map(|p| p.map(|x| x as f32)).collect();
+    let positions: Vec<[f32; 3]> = asset
+        .positions
+        .iter()
+        .map(|p| p.map(|x| x as f32))
+        .collect();
     let mut targets = Vec::with_capacity(n);
     let mut modes_info = Vec::with_capacity(n);
     for j in 0..n {
