@@ -16,7 +16,8 @@ EXE = "modal-bake.exe" if sys.platform == "win32" else "modal-bake"
 
 # Material presets the panel offers; passed as `--material NAME` (a newer modal-bake option).
 MATERIALS = [
-    "oak", "pine", "steel", "aluminium", "glass", "ceramic", "concrete", "stone", "abs",
+    "oak", "pine", "steel", "aluminium", "brass", "cast-iron", "glass", "ceramic", "concrete",
+    "stone", "marble", "abs", "pla", "acrylic",
 ]
 
 

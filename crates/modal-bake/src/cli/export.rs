@@ -123,7 +123,7 @@ pub fn run(args: &ExportArgs) -> anyhow::Result<()> {
             );
             if !(rel <= ONTO_WARN_FRACTION) {
                 eprintln!(
-                    "warning: asset vertices lie up to {:.1} % of the diagonal from the base's surface (more than {:.0} %): check that {} was baked from {} and that --units matches the bake's",
+                    "warning: asset vertices lie up to {:.1} % of the diagonal from the base's surface (more than {:.0} %): check that {} was baked from {} and that --units matches the bake's (a mesher that closed openings of the asset, as fTetWild does, also moves the boundary: compare with the distance `modal-bake mesh` reported)",
                     100.0 * rel,
                     100.0 * ONTO_WARN_FRACTION,
                     args.file.display(),
