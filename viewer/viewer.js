@@ -1,9 +1,12 @@
 // dcr viewer: plays glTF files written by `dcr-scenes run … --gltf` (runs side by side, response
-// events from extras.dcr) and `modal-bake export … --gltf` (one animation per mode).
+// events from extras.dcr) and `modal-bake export … --gltf [--onto ASSET]` (one animation per
+// mode: the label "mode N — F Hz", the physical time of the mode's own oscillation, and the
+// fixed vertices as dark points).
 // Static page; three.js comes bundled in vendor/ (no network at run time).
 import {
-  AmbientLight, AnimationMixer, ArrowHelper, Box3, BufferAttribute, Color, DirectionalLight, HemisphereLight,
-  LoopRepeat, PerspectiveCamera, Scene, SRGBColorSpace, Vector3, WebGLRenderer,
+  AmbientLight, AnimationMixer, ArrowHelper, Box3, BufferAttribute, BufferGeometry, Color, DirectionalLight,
+  HemisphereLight, LoopRepeat, PerspectiveCamera, Points, PointsMaterial, Scene, SRGBColorSpace, Vector3,
+  WebGLRenderer,
   GLTFLoader, OrbitControls,
 } from 'three-bundle';
 
@@ -38,6 +41,7 @@ const state = {
   playing: params.get('paused') !== '1', speed: Number($('speed').value), h: 0, rows: 0,
   sides: [], layout: params.get('layout') || 'split', left: null, right: null,
   markers: params.get('markers') !== '0', modes: [], name: '',
+  modeInfo: [], mode: -1, period: 1, fixedCount: 0,
 };
 $('layout').value = state.layout;
 $('markers').checked = state.markers;
@@ -46,7 +50,10 @@ if (params.get('speed')) { state.speed = Number(params.get('speed')); }
 function clearModel() {
   if (state.root) scene.remove(state.root);
   for (const s of state.sides) for (const a of s.arrows) a.arrow.parent?.remove(a.arrow);
-  Object.assign(state, { kind: null, root: null, mixer: null, action: null, duration: 0, time: 0, sides: [], modes: [] });
+  Object.assign(state, {
+    kind: null, root: null, mixer: null, action: null, duration: 0, time: 0, sides: [], modes: [],
+    modeInfo: [], mode: -1, period: 1, fixedCount: 0,
+  });
 }
 
 function sideOf(label) { return state.sides.find((s) => s.label === label) || state.sides[0]; }
@@ -127,15 +134,43 @@ function setupScene(gltf, dcr) {
   $('info').textContent = `${dcr.scene} — ${state.rows} rows, h = ${state.h} s; ${ev}`;
 }
 
+// "mode N — F Hz" (F: one decimal from 1 Hz, three significant digits below).
+function modeTitle(i, hz) {
+  return `mode ${i + 1} — ${hz >= 1 ? hz.toFixed(1) : hz.toPrecision(3)} Hz`;
+}
+
+// The fixed vertices (extras.dcr.fixed_vertices) as dark points on the surface mesh.
+function showFixed(root, fixed) {
+  let mesh = null;
+  root.traverse((o) => { if (!mesh && o.isMesh) mesh = o; });
+  if (!mesh || !fixed?.length) return 0;
+  const pos = mesh.geometry.getAttribute('position');
+  const xyz = new Float32Array(3 * fixed.length);
+  fixed.forEach((v, k) => xyz.set([pos.getX(v), pos.getY(v), pos.getZ(v)], 3 * k));
+  const g = new BufferGeometry();
+  g.setAttribute('position', new BufferAttribute(xyz, 3));
+  const pts = new Points(g, new PointsMaterial({ color: 0xcc2200, size: 7, sizeAttenuation: false, depthTest: true }));
+  pts.name = 'fixed vertices';
+  mesh.add(pts);
+  return fixed.length;
+}
+
 function setupModes(gltf, dcr) {
   state.kind = 'modes';
   state.modes = gltf.animations;
+  state.modeInfo = gltf.animations.map((a, i) => {
+    const m = dcr.modes?.[i] || {};
+    return { name: m.frequency_hz ? modeTitle(i, m.frequency_hz) : a.name, hz: m.frequency_hz || 0 };
+  });
+  state.period = dcr.period_s || 1;
   state.mixer = new AnimationMixer(gltf.scene);
-  $('mode').innerHTML = gltf.animations.map((a, i) => `<option value="${i}">${a.name}</option>`).join('');
+  $('mode').innerHTML = state.modeInfo.map((m, i) => `<option value="${i}">${m.name}</option>`).join('');
+  state.fixedCount = showFixed(gltf.scene, dcr.fixed_vertices);
   const want = Number(params.get('mode') || 1) - 1;
   selectMode(Math.max(0, Math.min(want, gltf.animations.length - 1)));
   frame(gltf.scene, null);
-  $('info').textContent = `${dcr.modes.length} modes, largest displacement ${dcr.scale} × diagonal (${(dcr.scale * dcr.diagonal_m).toPrecision(3)} m)`;
+  const fixed = state.fixedCount ? `; ${state.fixedCount} fixed vertices (red points)` : '; free-free';
+  $('info').textContent = `${dcr.modes.length} modes, largest displacement ${dcr.scale} × diagonal (${(dcr.scale * dcr.diagonal_m).toPrecision(3)} m)${fixed}`;
 }
 
 // Viridis (as the PNG contact sheet): displacement magnitude of the selected mode as colour.
@@ -169,6 +204,7 @@ function selectMode(i) {
   state.action = state.mixer.clipAction(state.modes[i]);
   state.action.setLoop(LoopRepeat, Infinity).play();
   state.duration = state.modes[i].duration;
+  state.mode = i;
   $('mode').value = String(i);
   applyTime();
 }
@@ -191,7 +227,7 @@ function setup(gltf, name) {
   scene.add(gltf.scene);
   const dcr = gltf.parser.json.extras?.dcr;
   if (dcr?.kind === 'scene_run') setupScene(gltf, dcr);
-  else if (dcr?.kind === 'modes') setupModes(gltf, dcr);
+  else if (dcr?.kind === 'modes' || dcr?.kind === 'modes_onto') setupModes(gltf, dcr);
   else setupGeneric(gltf);
   document.querySelectorAll('.scene-only').forEach((e) => e.classList.toggle('hidden', state.kind !== 'scene_run'));
   document.querySelectorAll('.modes-only').forEach((e) => e.classList.toggle('hidden', state.kind !== 'modes'));
@@ -244,8 +280,26 @@ function applyTime() {
   }
   $('time').value = state.duration > 0 ? String(state.time / state.duration) : '0';
   const row = state.h > 0 ? Math.round(state.time / state.h) : null;
-  $('clock').textContent = `t = ${state.time.toFixed(3)} s` + (row !== null ? ` (row ${row})` : '');
+  $('clock').textContent = clockText(row);
   requestRender();
+}
+
+// Clock: simulated time for a run; for a mode, the physical time of its own oscillation (the
+// animation plays one period of the mode, T = 1/F, in `period_s` of animation time).
+function clockText(row) {
+  const m = state.kind === 'modes' ? state.modeInfo[state.mode] : null;
+  if (m && m.hz > 0) {
+    const T = 1 / m.hz;
+    const t = (state.time / state.period) * T;
+    return `t = ${fmtSeconds(t)} of T = ${fmtSeconds(T)} (physical)`;
+  }
+  return `t = ${state.time.toFixed(3)} s` + (row !== null ? ` (row ${row})` : '');
+}
+function fmtSeconds(t) {
+  if (t === 0) return '0 s';
+  if (t < 1e-3) return `${(t * 1e6).toPrecision(3)} µs`;
+  if (t < 1) return `${(t * 1e3).toPrecision(3)} ms`;
+  return `${t.toPrecision(3)} s`;
 }
 
 // Viewports: split = one per chosen side with the same camera relative to each side's offset.
@@ -286,6 +340,15 @@ function render() {
     renderer.setViewport(vp.x, h - vp.y - vp.h, vp.w, vp.h);
     renderer.setScissor(vp.x, h - vp.y - vp.h, vp.w, vp.h);
     renderer.render(scene, cam);
+    if (vp.label === null && state.kind === 'modes' && state.modeInfo[state.mode]) {
+      const tag = document.createElement('div');
+      tag.className = 'tag';
+      tag.id = 'mode-tag';
+      tag.textContent = state.modeInfo[state.mode].name;
+      tag.style.left = `${vp.x + 8}px`;
+      view.appendChild(tag);
+      tags.push(tag);
+    }
     if (vp.label !== null) {
       const tag = document.createElement('div');
       tag.className = 'tag';
@@ -363,6 +426,9 @@ window.dcrViewer = {
     layout: state.layout, left: state.left, right: state.right, time: state.time,
     sides: state.sides.map((s) => ({ label: s.label, dcr: s.dcr, events: s.events.length, bodies: [...s.bodies.keys()] })),
     modes: state.modes.map((a) => a.name),
+    modeNames: state.modeInfo.map((m) => m.name),
+    mode: state.mode, fixed: state.fixedCount,
+    clock: $('clock').textContent, tag: document.getElementById('mode-tag')?.textContent ?? null,
   }),
   events: (label) => sideOf(label)?.events ?? [],
   viewports,

@@ -4,7 +4,9 @@
 // - at the step after the pot lands the plates' pixels differ between the on and off sides,
 //   while the same comparison finds them identical one step before the first response and
 //   with the response off on both sides (the controls);
-// - a mode-shape GLB plays: the surface moves between two times of its animation.
+// - a mode-shape GLB plays: the surface moves between two times of its animation;
+// - a mode's label reads "mode N — F Hz", the clock the physical time of the mode's own
+//   period, and a clamped base's fixed vertices are drawn.
 // Needs target/release/dcr-scenes and modal-bake (cargo build --release) and `npm ci` here.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
@@ -30,6 +32,12 @@ before(async () => {
   files['table_modes.glb'] = join(OUT, 'table_modes.glb');
   execFileSync(bin('modal-bake'), ['export', join(ROOT, 'out', 'bases', 'table.modes'), '--modes', '8',
     '--gltf', files['table_modes.glb']], { cwd: ROOT, stdio: ['ignore', 'ignore', 'inherit'] });
+  const beam = join(OUT, 'beam.modes');
+  execFileSync(bin('modal-bake'), ['bake', join(ROOT, 'data', 'meshes', 'beam.msh'), '-o', beam, '--fixed', 'clamp',
+    '--modes', '4'], { cwd: ROOT, stdio: ['ignore', 'ignore', 'inherit'] });
+  files['beam_modes.glb'] = join(OUT, 'beam_modes.glb');
+  execFileSync(bin('modal-bake'), ['export', beam, '--gltf', files['beam_modes.glb']],
+    { cwd: ROOT, stdio: ['ignore', 'ignore', 'inherit'] });
   server = await serve(files);
   browser = await launch({ width: 1280, height: 600 });
 });
@@ -147,6 +155,34 @@ test('mode-shape GLB: one animation per mode, and the surface moves', async () =
   const moved = await pixelStats(page, { against: 'rest' });
   await page.screenshot({ path: join(OUT, 'table_mode4.png') });
   assert.ok(moved > 200, `mode 4 moves only ${moved} pixels`);
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
+test('mode labels: "mode N — F Hz", physical time of the mode, fixed vertices shown', async () => {
+  const { page, errors } = await openViewer(browser.ctx, server.url, 'file=/files/beam_modes.glb&paused=1&mode=2');
+  const doc = JSON.parse(execFileSync('node', ['-e', `
+    const b = require('fs').readFileSync(process.argv[1]);
+    const n = b.readUInt32LE(12);
+    process.stdout.write(b.subarray(20, 20 + n).toString());`, files['beam_modes.glb']]).toString());
+  const dcr = doc.extras.dcr;
+  const hz = dcr.modes[1].frequency_hz;
+  await page.evaluate(() => window.dcrViewer.setTime(0.25));
+  const info = await page.evaluate(() => window.dcrViewer.info());
+  assert.equal(info.kind, 'modes');
+  assert.equal(info.mode, 1);
+  assert.equal(info.tag, `mode 2 — ${hz.toFixed(1)} Hz`);
+  assert.equal(info.modeNames[0], `mode 1 — ${dcr.modes[0].frequency_hz.toFixed(1)} Hz`);
+  // A quarter of the animation's period is a quarter of the mode's physical period 1/F.
+  const m = info.clock.match(/^t = ([0-9.]+) ms of T = ([0-9.]+) ms \(physical\)$/);
+  assert.ok(m, info.clock);
+  const T = 1000 / hz;
+  assert.ok(Math.abs(Number(m[2]) - T) <= 0.01 * T, `${info.clock} vs T = ${T} ms`);
+  assert.ok(Math.abs(Number(m[1]) - T / 4) <= 0.01 * T, `${info.clock} vs t = ${T / 4} ms`);
+  // The clamped end's surface vertices are drawn as points (and the base has some).
+  assert.ok(dcr.fixed_vertices.length > 0);
+  assert.equal(info.fixed, dcr.fixed_vertices.length);
+  await page.screenshot({ path: join(OUT, 'beam_mode2.png') });
   assert.deepEqual(errors, []);
   await page.close();
 });

@@ -308,11 +308,15 @@ fn png_sheet_has_one_distinct_panel_per_mode_and_exports_are_deterministic() {
     assert!(a == b, "two exports of the same base differ");
     validate_gltf(&dir.path().join("a.glb"));
     let png = tiny_skia::Pixmap::decode_png(&a[2]).unwrap();
-    // 6 modes in 4 columns: 2 rows of 320 × 240 panels.
-    assert_eq!((png.width(), png.height()), (1280, 480));
+    // 6 modes in 4 columns: 2 rows of 320 × 240 panels between the title and legend bands.
+    let (title, legend) = (
+        modal_bake::export::SHEET_TITLE_H as u32,
+        modal_bake::export::SHEET_LEGEND_H as u32,
+    );
+    assert_eq!((png.width(), png.height()), (1280, title + 480 + legend));
     let mut panels = Vec::new();
     for k in 0..8u32 {
-        let (ink, px) = panel_ink(&png, (k % 4) * 320 + 1, (k / 4) * 240 + 1, 318, 217);
+        let (ink, px) = panel_ink(&png, (k % 4) * 320 + 1, title + (k / 4) * 240 + 1, 318, 217);
         if k < 6 {
             // The beam fills a good part of its panel...
             assert!(ink > 318 * 217 / 50, "panel {k}: {ink} coloured pixels");

@@ -6,19 +6,32 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context};
 use dcr_runtime::format::ModesFile;
 use modal_bake::export::{
-    select_modes, write_modes_glb, write_modes_png, write_modes_vtu, ModeGltfParams, SheetParams,
+    select_modes, write_modes_glb, write_modes_glb_onto, write_modes_png, write_modes_vtu,
+    AssetMesh, ModeGltfParams, OntoParams, SheetParams,
 };
+
+use super::mesh::Units;
+
+/// Largest mapping distance, as a fraction of the asset's bounding-box diagonal, below which
+/// `--onto` does not warn (gmsh's remeshed surface lies within a small fraction of the asset).
+const ONTO_WARN_FRACTION: f64 = 0.02;
 
 /// Arguments of `modal-bake export`.
 #[derive(clap::Args, Debug, Clone)]
 #[command(after_help = "Examples:\n  \
     modal-bake export out/bases/table.modes --vtu table.vtu --gltf table.glb --png table.png\n  \
-    modal-bake export table.modes --png sheet.png --modes 8 --columns 4\n\n\
+    modal-bake export table.modes --png sheet.png --modes 8 --columns 4\n  \
+    modal-bake export chair.modes --gltf chair_modes.glb --onto chair.obj\n\n\
     VTU: surface triangles, one point-data vector per mode named mode_NN_F.FHz (displacement in m \
     for a unit modal coordinate, object frame); in ParaView use Warp By Vector.\n\
     GLB: one morph target and one animation per mode (a 1 s sine); the scale and each mode's \
     modal coordinate at weight 1 are in the document's extras.dcr.\n\
-    PNG: the lowest modes side by side, coloured by displacement magnitude (viridis).\n\
+    PNG: the lowest modes side by side, coloured by displacement magnitude normalised per mode \
+    (viridis, legend below), over a grey ghost of the rest shape, each seen side-on to its own \
+    motion; the title names the base, its material and mesh.\n\
+    GLB with --onto ASSET: the asset's own mesh (its vertex count and order, positions in m) \
+    with the modes as morph targets named \"mode N — F Hz\"; each asset vertex takes the mode at \
+    its closest point on the base's surface (the largest such distance is printed).\n\
     Second-order bases: each 6-node surface triangle is written as four linear ones through \
     its mid-edge nodes, which follow the corner vertices with their own mode rows.")]
 pub struct ExportArgs {
@@ -30,6 +43,13 @@ pub struct ExportArgs {
     /// Write the surface with one morph target and one animation per mode here (.glb).
     #[arg(long, value_name = "OUT.glb")]
     pub gltf: Option<PathBuf>,
+    /// With --gltf: put the morph targets on this surface asset's own vertices (.obj, .stl,
+    /// .ply; the file the base was baked from) instead of the base's surface.
+    #[arg(long, value_name = "ASSET", requires = "gltf")]
+    pub onto: Option<PathBuf>,
+    /// Unit of the --onto asset's coordinates (as given to `mesh`/`bake` --units).
+    #[arg(long, value_enum, default_value_t = Units::M, requires = "onto")]
+    pub units: Units,
     /// Write a contact sheet of the modes here (.png).
     #[arg(long, value_name = "OUT.png")]
     pub png: Option<PathBuf>,
@@ -74,13 +94,52 @@ pub fn run(args: &ExportArgs) -> anyhow::Result<()> {
     }
     if let Some(p) = &args.gltf {
         let t = std::time::Instant::now();
-        let params = ModeGltfParams {
-            modes,
-            scale: args.scale,
-            ..Default::default()
-        };
-        write_modes_glb(&base, &params, p).with_context(|| format!("writing {}", p.display()))?;
-        report(p, &format!("GLB, {modes} morph targets"), t);
+        if let Some(asset_path) = &args.onto {
+            let asset = AssetMesh::read(asset_path, args.units.to_metres())
+                .with_context(|| format!("reading --onto {}", asset_path.display()))?;
+            let params = OntoParams {
+                modes,
+                scale: args.scale,
+                ..Default::default()
+            };
+            let info = write_modes_glb_onto(&base, &asset, &params, p)
+                .with_context(|| format!("writing {}", p.display()))?;
+            report(
+                p,
+                &format!(
+                    "GLB, {modes} morph targets on {} vertices of {}",
+                    info.vertices,
+                    asset_path.display()
+                ),
+                t,
+            );
+            let rel = info.max_distance_m / info.diagonal_m;
+            eprintln!(
+                "  mapping: largest distance from an asset vertex to the base's surface {:.3e} m ({:.2} % of the {:.4} m diagonal, vertex {})",
+                info.max_distance_m,
+                100.0 * rel,
+                info.diagonal_m,
+                info.max_distance_vertex
+            );
+            if !(rel <= ONTO_WARN_FRACTION) {
+                eprintln!(
+                    "warning: asset vertices lie up to {:.1} % of the diagonal from the base's surface (more than {:.0} %): check that {} was baked from {} and that --units matches the bake's (a mesher that closed openings of the asset, as fTetWild does, also moves the boundary: compare with the distance `modal-bake mesh` reported)",
+                    100.0 * rel,
+                    100.0 * ONTO_WARN_FRACTION,
+                    args.file.display(),
+                    asset_path.display()
+                );
+            }
+        } else {
+            let params = ModeGltfParams {
+                modes,
+                scale: args.scale,
+                ..Default::default()
+            };
+            write_modes_glb(&base, &params, p)
+                .with_context(|| format!("writing {}", p.display()))?;
+            report(p, &format!("GLB, {modes} morph targets"), t);
+        }
     }
     if let Some(p) = &args.png {
         let t = std::time::Instant::now();
@@ -88,6 +147,11 @@ pub fn run(args: &ExportArgs) -> anyhow::Result<()> {
             modes,
             scale: args.scale,
             columns: args.columns,
+            title: args
+                .file
+                .file_stem()
+                .map(|n| n.to_string_lossy().into_owned())
+                .unwrap_or_default(),
             ..Default::default()
         };
         write_modes_png(&base, &params, p).with_context(|| format!("writing {}", p.display()))?;

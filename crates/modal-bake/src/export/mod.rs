@@ -4,9 +4,11 @@
 //!   meshio) with one point-data vector array per mode (m, object frame);
 //! - [`write_modes_glb`]: the surface as binary glTF 2.0 (`.glb`, Blender, three.js) with one
 //!   morph target and one animation per mode;
+//! - [`write_modes_glb_onto`]: the same morph targets on the artist's own mesh (its vertex
+//!   count and order), each vertex mapped to the closest point of the base's surface;
 //! - [`render_contact_sheet`] / [`write_modes_png`]: a PNG contact sheet of the lowest modes
-//!   (displacement magnitude as colour, fixed camera from the bounding box; the paper's Fig. 2),
-//!   rendered on the CPU.
+//!   (displacement magnitude as colour over the rest shape, each mode seen side-on to its
+//!   motion, a title and a colour legend; the paper's Fig. 2), rendered on the CPU.
 //!
 //! [`GltfBuilder`] is the small glTF/GLB assembler both this module and `dcr-scenes` use.
 //!
@@ -21,6 +23,7 @@
 mod contact_sheet;
 mod gltf_builder;
 mod mode_gltf;
+mod mode_onto;
 mod mode_vtu;
 mod raster;
 
@@ -28,9 +31,14 @@ use std::path::{Path, PathBuf};
 
 use dcr_runtime::format::ModesFile;
 
-pub use contact_sheet::{render_contact_sheet, write_modes_png, SheetParams};
+pub use contact_sheet::{
+    render_contact_sheet, write_modes_png, SheetParams, SHEET_LEGEND_H, SHEET_TITLE_H,
+};
 pub use gltf_builder::{extras_of, GltfBuilder, GLTF_GENERATOR};
 pub use mode_gltf::{write_modes_glb, ModeGltfParams};
+pub use mode_onto::{
+    map_modes_onto, mode_title, write_modes_glb_onto, AssetMesh, OntoInfo, OntoMapping, OntoParams,
+};
 pub use mode_vtu::write_modes_vtu;
 
 /// What went wrong writing an export.

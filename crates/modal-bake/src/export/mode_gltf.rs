@@ -42,9 +42,10 @@ impl Default for ModeGltfParams {
 /// Morph target j is a_j U_j (m), U_j the mode's surface rows (m·kg^-½) and a_j (kg^½·m) the
 /// modal coordinate at weight 1, chosen so that the largest vertex displacement is
 /// `scale × diagonal`. `extras.dcr` on the document records `kind: "modes"`, `scale`,
-/// `diagonal_m`, `period_s` and per mode `{mode, label, frequency_hz, eigenvalue,
-/// modal_coordinate, max_displacement_m}` (`modal_coordinate` = a_j), so the physical shape
-/// is recoverable: displacement = weight × target.
+/// `diagonal_m`, `period_s`, `fixed_vertices` (the vertices whose volume node the bake held
+/// fixed, ascending) and per mode `{mode, label, name, frequency_hz, eigenvalue,
+/// modal_coordinate, max_displacement_m}` (`name` = [`super::mode_title`], `modal_coordinate`
+/// = a_j), so the physical shape is recoverable: displacement = weight × target.
 ///
 /// Written atomically (temporary file + rename).
 ///
@@ -115,6 +116,7 @@ fn modes_glb_bytes(base: &ModesFile, params: &ModeGltfParams) -> Result<Vec<u8>,
         info.push(serde_json::json!({
             "mode": j + 1,
             "label": label,
+            "name": super::mode_title(j, freqs[j]),
             "frequency_hz": freqs[j],
             "eigenvalue": base.eigenvalues[j],
             "modal_coordinate": a,
@@ -176,12 +178,17 @@ fn modes_glb_bytes(base: &ModesFile, params: &ModeGltfParams) -> Result<Vec<u8>,
             }],
         });
     }
+    let fixed: std::collections::BTreeSet<u32> = base.fixed_nodes.iter().copied().collect();
+    let fixed_vertices: Vec<usize> = (0..ns)
+        .filter(|&v| fixed.contains(&surf.volume_node[v]))
+        .collect();
     b.root.extras = extras_of(&serde_json::json!({
         "dcr": {
             "kind": "modes",
             "scale": params.scale,
             "diagonal_m": diag,
             "period_s": params.period_s,
+            "fixed_vertices": fixed_vertices,
             "source_hash": base.meta.source_hash,
             "modes": info,
         }

@@ -63,6 +63,18 @@ pub fn read_surface(path: &Path) -> Result<SurfaceMesh, SurfaceError> {
 /// # Errors
 /// As [`read_surface`].
 pub fn read_surface_bytes(data: &[u8], name: &str) -> Result<SurfaceMesh, SurfaceError> {
+    let (positions, triangles) = read_surface_unwelded(data, name)?;
+    Ok(SurfaceMesh::welded(positions, triangles))
+}
+
+/// The file's own vertices (in file order, none merged or dropped) and its polygons
+/// fan-triangulated, as [`read_surface_bytes`] reads them before welding. OBJ files are
+/// renumbered per object in first-use order by the parser (use a reader that keeps the `v`
+/// order when that order matters).
+///
+/// # Errors
+/// As [`read_surface`].
+pub fn read_surface_unwelded(data: &[u8], name: &str) -> Result<Soup3, SurfaceError> {
     let file = || name.to_string();
     let (positions, faces) = match format_of(Path::new(name)) {
         Some(Format::Obj) => read_obj(data, name)?,
@@ -100,8 +112,11 @@ pub fn read_surface_bytes(data: &[u8], name: &str) -> Result<SurfaceMesh, Surfac
     if triangles.is_empty() {
         return Err(SurfaceError::Empty { file: file() });
     }
-    Ok(SurfaceMesh::welded(positions, triangles))
+    Ok((positions, triangles))
 }
+
+/// Vertex positions (as in the file) and triangles (0-based indices into them).
+pub type Soup3 = (Vec<[f64; 3]>, Vec<[usize; 3]>);
 
 type Soup = (Vec<[f64; 3]>, Vec<Vec<i64>>);
 

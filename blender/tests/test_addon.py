@@ -1,0 +1,237 @@
+"""Headless test of the Modal Bake add-on in the real Blender (the `bpy` module, Blender 4.5 LTS).
+
+    python3 blender/tests/test_addon.py [--binary target/release/modal-bake]
+
+Installs the add-on as an extension (zip, `extensions.package_install_files`) into a temporary
+user folder, enables it, points its preference at the modal-bake binary, and:
+
+- bakes Blender's default cube (order 2, fixed below z = -0.9 m): one shape key per mode named
+  "Mode N — F Hz", each with the object's vertex count, whose frequencies equal a CLI bake of the
+  same exported OBJ run here (`modal-bake bake OBJ`, `modal-bake info --json`);
+- checks the keys are the morph targets of `export --onto` (largest displacement 0.05 × the
+  diagonal) and that Preview Mode animates one key through a sine period;
+- bakes Suzanne (open eyes: needs `modal-bake mesh --mesher`, skipped with the reason if the
+  binary has no such option; fTetWild takes minutes on it, so the CLI comparison bakes the
+  add-on's tetrahedral mesh rather than meshing the OBJ again);
+- checks that a missing binary is a clear error, not a crash.
+
+Prints one line per check and "N passed, N failed, N skipped"; exits 1 on a failure. Without
+bpy it skips, except with DCR_REQUIRE_BPY=1 (CI), where that is a failure.
+"""
+
+import argparse
+import json
+import os
+import re
+import subprocess
+import sys
+import tempfile
+import traceback
+import zipfile
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
+ADDON_SRC = os.path.join(ROOT, "blender", "modal_bake")
+NAME_RE = re.compile(r"^Mode (\d+) — ([0-9.]+) Hz$")
+
+results = {"passed": 0, "failed": 0, "skipped": 0}
+
+
+def check(name, fn):
+    try:
+        fn()
+    except Skip as s:
+        results["skipped"] += 1
+        print(f"SKIPPED {name}: {s}", flush=True)
+    except Exception:
+        results["failed"] += 1
+        print(f"FAILED {name}", flush=True)
+        traceback.print_exc()
+    else:
+        results["passed"] += 1
+        print(f"ok {name}", flush=True)
+
+
+class Skip(Exception):
+    pass
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    default_bin = os.path.join(os.environ.get("CARGO_TARGET_DIR", os.path.join(ROOT, "target")),
+                               "release", "modal-bake")
+    ap.add_argument("--binary", default=default_bin, help="modal-bake executable to test with")
+    args = ap.parse_args()
+    exe = os.path.abspath(args.binary)
+    if not os.path.isfile(exe):
+        print(f"FAILED: no modal-bake at {exe} (cargo build --release -p modal-bake)")
+        print("0 passed, 1 failed, 0 skipped")
+        return 1
+
+    work = tempfile.mkdtemp(prefix="modal_bake_addon_test_")
+    # A private Blender user folder: nothing is installed into the user's own.
+    for var, sub in (("BLENDER_USER_CONFIG", "config"), ("BLENDER_USER_SCRIPTS", "scripts"),
+                     ("BLENDER_USER_EXTENSIONS", "extensions")):
+        os.environ[var] = os.path.join(work, sub)
+    try:
+        import bpy
+    except ImportError as e:
+        msg = f"bpy is not installed ({e}): python3 -m pip install bpy==4.5.7"
+        if os.environ.get("DCR_REQUIRE_BPY") == "1":
+            print(f"FAILED: {msg} (DCR_REQUIRE_BPY=1)")
+            print("0 passed, 1 failed, 0 skipped")
+            return 1
+        print(f"SKIPPED: {msg}")
+        print("0 passed, 0 failed, 1 skipped")
+        return 0
+    print(f"Blender {bpy.app.version_string}, modal-bake {exe}", flush=True)
+
+    zpath = os.path.join(work, "modal_bake.zip")
+    with zipfile.ZipFile(zpath, "w") as z:
+        for name in sorted(os.listdir(ADDON_SRC)):
+            if name.endswith((".py", ".toml")):
+                z.write(os.path.join(ADDON_SRC, name), name)
+    res = bpy.ops.extensions.package_install_files(
+        filepath=zpath, repo="user_default", enable_on_install=True)
+    assert res == {"FINISHED"}, f"extension install: {res}"
+    pkg = "bl_ext.user_default.modal_bake"
+    assert pkg in bpy.context.preferences.addons, "the extension is not enabled"
+    prefs = bpy.context.preferences.addons[pkg].preferences
+    prefs.binary = exe
+    print(f"installed and enabled {pkg}", flush=True)
+
+    def cli(*a):
+        out = subprocess.run([exe, *a], capture_output=True, text=True)
+        assert out.returncode == 0, f"modal-bake {' '.join(a)}:\n{out.stderr}"
+        return out.stdout
+
+    def select(obj):
+        for o in bpy.context.view_layer.objects:
+            o.select_set(False)
+        obj.select_set(True)
+        bpy.context.view_layer.objects.active = obj
+
+    def mode_keys(obj):
+        return [kb for kb in obj.data.shape_keys.key_blocks if NAME_RE.match(kb.name)]
+
+    def cli_freqs(modes_path):
+        return json.loads(cli("info", "--json", modes_path))["frequencies_hz"]
+
+    def bake_and_check(obj, nmodes, cli_extra, from_msh=False):
+        select(obj)
+        res = bpy.ops.modal_bake.bake()
+        assert res == {"FINISHED"}, f"bake operator: {res}"
+        keys = mode_keys(obj)
+        assert len(keys) == nmodes, f"{len(keys)} mode keys, want {nmodes}"
+        nv = len(obj.data.vertices)
+        for j, kb in enumerate(keys):
+            assert int(NAME_RE.match(kb.name).group(1)) == j + 1, kb.name
+            assert len(kb.data) == nv, f"{kb.name}: {len(kb.data)} points, object {nv}"
+        freqs = list(obj["modal_bake_frequencies_hz"])
+        for kb, f in zip(keys, freqs):
+            shown = float(NAME_RE.match(kb.name).group(2))
+            assert abs(shown - f) <= 0.05 + 1e-9 * f, f"{kb.name} vs {f} Hz"
+        modes_path = obj["modal_bake_modes"]
+        assert os.path.isfile(modes_path), modes_path
+        # The CLI on the same OBJ the add-on wrote, with the same options (from_msh: on the
+        # add-on's tetrahedral mesh of it, for a surface whose meshing takes minutes).
+        obj_path = os.path.splitext(modes_path)[0] + ".obj"
+        ref = os.path.join(work, obj.name + "_ref.modes")
+        if from_msh:
+            msh = os.path.splitext(modes_path)[0] + ".msh"
+            cli("bake", msh, "-o", ref, "--modes", str(nmodes), *cli_extra)
+        else:
+            cli("bake", obj_path, "-o", ref, "--order", "2", "--modes", str(nmodes),
+                *cli_extra)
+        want = cli_freqs(ref)
+        assert len(want) == nmodes
+        for j, (a, b) in enumerate(zip(freqs, want)):
+            assert abs(a - b) <= 1e-9 * b, f"mode {j + 1}: add-on {a} Hz, CLI {b} Hz"
+        print(f"  {obj.name}: {nv} vertices, modes {', '.join(f'{f:.2f}' for f in freqs)} Hz "
+              f"(= CLI bake of {os.path.basename(obj_path)})", flush=True)
+        return keys
+
+    cube = bpy.data.objects["Cube"]
+    cube.modal_bake.order = "2"
+    cube.modal_bake.modes = 6
+    cube.modal_bake.fixed = "below"
+    cube.modal_bake.fixed_height = -0.9
+    cube.modal_bake.output_dir = os.path.join(work, "cube")
+
+    def cube_bake():
+        bake_and_check(cube, 6, ["--fixed-below=z=-0.9"])
+
+    check("default cube: shape keys per mode with the CLI's frequencies", cube_bake)
+
+    def cube_key_shapes():
+        keys = mode_keys(cube)
+        basis = cube.data.shape_keys.reference_key
+        mw = cube.matrix_world
+        pts = [mw @ v.co for v in basis.data]
+        diag = (max(p.x for p in pts) - min(p.x for p in pts)) ** 2 + \
+               (max(p.y for p in pts) - min(p.y for p in pts)) ** 2 + \
+               (max(p.z for p in pts) - min(p.z for p in pts)) ** 2
+        diag = diag ** 0.5
+        for kb in keys:
+            peak = max(((mw @ k.co) - (mw @ b.co)).length for k, b in zip(kb.data, basis.data))
+            assert abs(peak - 0.05 * diag) <= 1e-4 * diag, f"{kb.name}: peak {peak}"
+            # Fixed below z = -0.9: the bottom face's vertices do not move.
+            for k, b in zip(kb.data, basis.data):
+                if (mw @ b.co).z < -0.9:
+                    assert ((mw @ k.co) - (mw @ b.co)).length < 1e-6 * diag, kb.name
+        assert "modal_bake_binary" in cube and exe in cube["modal_bake_binary"]
+
+    check("cube keys: peak 0.05 × diagonal, fixed vertices still", cube_key_shapes)
+
+    def preview():
+        select(cube)
+        assert bpy.ops.modal_bake.preview_mode(mode=2, frames=24) == {"FINISHED"}
+        keys = cube.data.shape_keys
+        action = keys.animation_data.action
+        assert action is not None
+        target = mode_keys(cube)[1]
+        values = []
+        for f in range(bpy.context.scene.frame_start, bpy.context.scene.frame_start + 25):
+            bpy.context.scene.frame_set(f)
+            values.append(target.value)
+        assert abs(max(values) - 1.0) < 1e-6 and abs(min(values) + 1.0) < 1e-6, values
+        assert all(kb.value == 0.0 for kb in mode_keys(cube) if kb != target)
+
+    check("preview: mode 2's key runs one sine period, the others stay 0", preview)
+
+    def suzanne():
+        helptext = cli("mesh", "--help")
+        if "--mesher" not in helptext:
+            raise Skip("this modal-bake has no `mesh --mesher` (Suzanne's open eyes need "
+                       "fTetWild)")
+        bpy.ops.mesh.primitive_monkey_add(size=0.3, location=(0.0, 0.0, 0.0))
+        monkey = bpy.context.active_object
+        monkey.modal_bake.order = "2"
+        monkey.modal_bake.modes = 4
+        monkey.modal_bake.size = 0.04
+        monkey.modal_bake.output_dir = os.path.join(work, "suzanne")
+        bake_and_check(monkey, 4, [], from_msh=True)
+
+    check("Suzanne: shape keys with the CLI's frequencies", suzanne)
+
+    def missing_binary():
+        prefs.binary = os.path.join(work, "no-such-modal-bake")
+        select(cube)
+        try:
+            res = bpy.ops.modal_bake.bake()
+        except RuntimeError as e:  # operator errors surface as RuntimeError in bpy
+            assert "modal-bake not found" in str(e), str(e)
+        else:
+            raise AssertionError(f"bake without a binary returned {res}")
+        finally:
+            prefs.binary = exe
+
+    check("missing binary: a clear error naming where it looked", missing_binary)
+
+    print(f"{results['passed']} passed, {results['failed']} failed, "
+          f"{results['skipped']} skipped", flush=True)
+    return 1 if results["failed"] else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
