@@ -37,7 +37,12 @@ pub fn run(args: &CheckArgs) -> ExitCode {
         ..args.options.params()
     };
     let file = args.mesh.display().to_string();
-    let status = super::bake::load_mesh(&args.mesh, &args.asset)
+    // The options are checked as `bake` checks them, naming the option.
+    let status = args
+        .options
+        .model
+        .check_ranges()
+        .and_then(|()| super::bake::load_mesh(&args.mesh, &args.asset))
         .and_then(|(mesh, _)| Ok(bake::mesh_base_status(mesh, &file, &params, &args.out)?));
     match status {
         Ok(status) => {

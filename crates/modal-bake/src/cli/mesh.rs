@@ -175,7 +175,8 @@ pub fn mesh_asset(
 pub fn run(args: &MeshArgs) -> anyhow::Result<()> {
     super::check_output(&args.out, "-o", &[&args.asset])?;
     let (out, surface) = mesh_asset(&args.asset, &args.asset_options)?;
-    write_atomic(&args.out, &out.msh).with_context(|| format!("writing {}", args.out.display()))?;
+    dcr_runtime::format::write_atomic(&args.out, &out.msh)
+        .with_context(|| format!("writing {}", args.out.display()))?;
     let m = &out.mesh;
     if args.json {
         outln!(
@@ -219,19 +220,5 @@ pub fn run(args: &MeshArgs) -> anyhow::Result<()> {
             out.info.seconds
         );
     }
-    Ok(())
-}
-
-/// Writes `bytes` to `path` through a temporary file in the same folder and a rename.
-fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    use std::io::Write;
-    let dir = path
-        .parent()
-        .filter(|d| !d.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    let mut tmp = tempfile::NamedTempFile::new_in(dir)?;
-    tmp.write_all(bytes)?;
-    tmp.as_file().sync_all()?;
-    tmp.persist(path).map_err(|e| e.error)?;
     Ok(())
 }
