@@ -130,7 +130,8 @@ fn a_device_node_is_refused_by_every_exporter_and_by_mesh_and_bake() {
 }
 
 // Regression: `--scale -1`, `--rayleigh -1,0` and `--youngs -1e9` were read as unknown flags
-// ("unexpected argument '-1' found"); they reach the option's range check.
+// ("unexpected argument '-1' found"); they reach the option's range check. `--scale 1e308`
+// failed on a non-finite accessor without naming the option.
 #[test]
 fn negative_numbers_reach_the_options_range_check() {
     let dir = tempfile::tempdir().unwrap();
@@ -139,7 +140,8 @@ fn negative_numbers_reach_the_options_range_check() {
     let mesh = repo_root().join("data/meshes/beam.msh");
     let out = dir.path().join("o.modes");
     for (args, needle) in [
-        (vec!["export", s(&base), "--gltf", s(&glb), "--scale", "-1e-3"], "scale"),
+        (vec!["export", s(&base), "--gltf", s(&glb), "--scale", "-1e-3"], "--scale"),
+        (vec!["export", s(&base), "--gltf", s(&glb), "--scale", "1e308"], "--scale"),
         (vec!["bake", s(&mesh), "-o", s(&out), "--youngs", "-1e9"], "--youngs"),
         (vec!["bake", s(&mesh), "-o", s(&out), "--rayleigh", "-1,0"], "rayleigh"),
         (vec!["check", s(&mesh), s(&out), "--poisson", "-1.5"], "--poisson"),

@@ -371,10 +371,11 @@ impl SceneDesc {
         let max_s = (MAX_STEPS * self.h).min(MAX_STEP_BODIES / recorded * self.h);
         if !(steps <= MAX_STEPS && (steps + 1.0) * recorded <= MAX_STEP_BODIES) {
             return Err(format!(
-                "{field} {} s is {steps:.3e} steps of h = {} s for {recorded} recorded bodies; \
+                "{field} {} s is {} steps of h = {} s for {recorded} recorded bodies; \
                  at most {MAX_STEPS:.0e} steps and {MAX_STEP_BODIES:.0e} steps × bodies: give at \
                  most {max_s:.4} s",
                 N(s),
+                N(steps),
                 self.h
             ));
         }
@@ -390,16 +391,16 @@ impl SceneDesc {
         finite_in("h", self.h, H_RANGE_S.0, H_RANGE_S.1, " s")?;
         vec_in("gravity", self.gravity, MAX_GRAVITY, " m/s²")?;
         finite_in("restitution", self.restitution, 0.0, 1.0, "")?;
-        if let Some(t) = self.test_seconds {
-            self.run_steps(Some(t))
-                .map_err(|e| e.replacen("--seconds", "test_seconds", 1))?;
-        }
         let bodies = self.body_names();
         if bodies.len() > MAX_BODIES {
             return Err(format!(
                 "the scene has {} bodies (elastic objects and prop copies); at most {MAX_BODIES}",
                 bodies.len()
             ));
+        }
+        if let Some(t) = self.test_seconds {
+            self.run_steps(Some(t))
+                .map_err(|e| e.replacen("--seconds", "test_seconds", 1))?;
         }
         self.run_steps(None)?;
         if self.elastic.is_empty() {

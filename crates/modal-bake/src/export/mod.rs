@@ -33,6 +33,10 @@ pub use gltf_builder::{extras_of, GltfBuilder, GLTF_GENERATOR};
 pub use mode_gltf::{write_modes_glb, ModeGltfParams};
 pub use mode_vtu::write_modes_vtu;
 
+/// Largest visual amplitude `scale` of the GLB morph targets and the PNG sheet: the largest
+/// displacement as a fraction of the bounding-box diagonal.
+pub const MAX_SCALE: f64 = 10.0;
+
 /// What went wrong writing an export.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
