@@ -48,7 +48,8 @@ fn a_bad_root_or_output_folder_is_refused_and_leaves_nothing() {
     let file = dir.path().join("file");
     std::fs::write(&file, b"x").unwrap();
     for (bad, says) in [(file.as_path(), "a regular file"), ("/dev/null".as_ref(), "a character device")] {
-        let o = accuracy(bad, &["--quick"]);
+        let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../..");
+        let o = accuracy(bad, &["--quick", "--root", root]);
         let err = String::from_utf8_lossy(&o.stderr);
         assert!(!o.status.success());
         assert!(err.contains("--out") && err.contains(says), "{err}");
@@ -67,6 +68,7 @@ fn dense_size_and_negative_steps_are_refused_by_option() {
     ] {
         let o = Command::new(env!("CARGO_BIN_EXE_dcr-lab"))
             .args(["truth", mesh, "--impact", "0.5,0.5,1", "--contact", "0.2,0.3,1"])
+            .args(["--impulse", "1"])
             .args(&args)
             .output()
             .unwrap();
