@@ -7,8 +7,9 @@ use anyhow::{bail, Context, Result};
 use clap::{Parser, Subcommand, ValueEnum};
 use dcr_rapier::f64::{ApplyMode, StepGate};
 use dcr_scenes::export::{side_label, write_outcomes_svg, write_scene_glb, Side};
+use dcr_runtime::format::OutputPlan;
 use dcr_scenes::runner::{
-    run_scene, stress_bench, table1, MethodChoice, RunParams, RunReport, StressBenchParams,
+    base_path, run_scene, transfer_base_path, RUN_OUTPUTS, stress_bench, table1, MethodChoice, RunParams, RunReport, StressBenchParams,
     Table1Params,
 };
 use dcr_scenes::scene::SceneDesc;
@@ -274,7 +275,7 @@ fn print_report(report: &RunReport, out_dir: &std::path::Path) {
 }
 
 fn real_main() -> Result<()> {
-    let cli = Cli::parse();
+    let cli = Cli::parse_from(modal_bake::args::join_negative_values(std::env::args_os()));
     let root = repo_root();
     match cli.cmd {
         Cmd::Run {
@@ -290,7 +291,7 @@ fn real_main() -> Result<()> {
             response,
         } => {
             let path = scene_path(&root, &scene);
-            if !path.exists() {
+            if std::fs::symlink_metadata(&path).is_err() {
                 bail!(
                     "no scene {scene:?} ({} does not exist; scenes: {})",
                     path.display(),
@@ -308,11 +309,8 @@ fn real_main() -> Result<()> {
                 (Some(MethodArg::Transfer), None) => MethodChoice::Transfer,
                 (None, None) => MethodChoice::Scene,
             };
-            if let Some(s) = seconds {
-                if !(s.is_finite() && s > 0.0) {
-                    bail!("--seconds must be positive, got {s}");
-                }
-            }
+            desc.run_steps(seconds)
+                .map_err(|e| anyhow::anyhow!("scene {}: {e}", path.display()))?;
             let split = out.is_none() || matches!(dcr, OnOff::Both);
             let out_dir = out.unwrap_or_else(|| root.join("out").join(&desc.name));
             let bases_dir = bases.unwrap_or_else(|| root.join("out").join("bases"));
@@ -321,6 +319,35 @@ fn real_main() -> Result<()> {
                 OnOff::Off => &[false],
                 OnOff::Both => &[true, false],
             };
+            // Every output is checked against the inputs and the others before anything runs.
+            let mut plan = OutputPlan::new();
+            plan.input("the scene file", &path);
+            for e in &desc.elastic {
+                plan.input("the mesh", &root.join(&e.mesh));
+            }
+            plan.output_folder("--bases", &bases_dir)?;
+            for e in &desc.elastic {
+                plan.output("--bases", &base_path(&bases_dir, e))?;
+                plan.output("--bases", &transfer_base_path(&bases_dir, e))?;
+            }
+            plan.output_folder("--out", &out_dir)?;
+            for &on in runs {
+                let dir = if split {
+                    out_dir.join(if on { "on" } else { "off" })
+                } else {
+                    out_dir.clone()
+                };
+                plan.output_folder("--out", &dir)?;
+                for name in RUN_OUTPUTS {
+                    plan.output("--out", &dir.join(name))?;
+                }
+            }
+            if !desc.outcomes.is_empty() {
+                plan.output("--out", &out_dir.join("outcomes.svg"))?;
+            }
+            if let Some(path) = &gltf {
+                plan.output("--gltf", path)?;
+            }
             let mut reports = Vec::new();
             for &on in runs {
                 let dir = if split {
@@ -402,6 +429,13 @@ fn real_main() -> Result<()> {
                     bail!("unknown scene {s:?} (scenes: {})", SCENES.join(", "));
                 }
             }
+            if let Some(dir) = &gltf {
+                let mut plan = OutputPlan::new();
+                plan.output_folder("--gltf", dir)?;
+                for s in &scenes {
+                    plan.output("--gltf", &dir.join(format!("{s}.glb")))?;
+                }
+            }
             let (text, value) = table1(&Table1Params {
                 scenes,
                 seconds,
@@ -448,10 +482,13 @@ fn real_main() -> Result<()> {
 }
 
 fn main() -> ExitCode {
+    if let Err(e) = modal_bake::signals::remove_temporaries_on_signals() {
+        eprintln!("dcr-scenes: warning: cannot watch for signals ({e}); an interrupted write may leave a temporary file");
+    }
     match real_main() {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("dcr-scenes: error: {e:#}");
+            eprintln!("dcr-scenes: error: {}", modal_bake::args::error_line(&e));
             ExitCode::FAILURE
         }
     }

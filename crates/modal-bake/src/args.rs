@@ -286,3 +286,62 @@ fn list(s: &str) -> Result<Vec<f64>, String> {
         })
         .collect()
 }
+
+/// An error and its causes on one line, each cause once: a cause whose text the line already
+/// holds (a wrapper that prints its source, as `path: error` does) is not repeated. The error
+/// line of every tool (`modal-bake`, `dcr-lab`, `dcr-scenes`).
+pub fn error_line(e: &anyhow::Error) -> String {
+    let mut line = String::new();
+    for cause in e.chain() {
+        let text = cause.to_string();
+        if line.contains(&text) {
+            continue;
+        }
+        if !line.is_empty() {
+            line.push_str(": ");
+        }
+        line.push_str(&text);
+    }
+    line
+}
+
+/// The command line with every `--option -NUMBER` joined into `--option=-NUMBER`, so that a
+/// negative number (`-1`, `-1e-5`, a list `-1,0`) given to an option reaches the option's
+/// parser and is refused there with the option's range, instead of clap reading it as an
+/// unknown flag ("unexpected argument '-1' found"). Only long options without `=` followed by
+/// a value of comma-separated numbers starting with `-` are joined; everything else is kept.
+///
+/// ```
+/// let args = ["tool", "run", "--seconds", "-1", "--rayleigh", "-1,0", "--json", "x"];
+/// let joined = modal_bake::args::join_negative_values(args.iter().map(Into::into));
+/// let joined: Vec<String> = joined.into_iter().map(|s| s.into_string().unwrap()).collect();
+/// assert_eq!(joined, ["tool", "run", "--seconds=-1", "--rayleigh=-1,0", "--json", "x"]);
+/// ```
+pub fn join_negative_values(
+    args: impl IntoIterator<Item = std::ffi::OsString>,
+) -> Vec<std::ffi::OsString> {
+    let looks_negative = |s: &str| {
+        s.starts_with('-')
+            && s.split(',').all(|part| {
+                let body = part.strip_prefix('-').unwrap_or(part);
+                body.starts_with(|c: char| c.is_ascii_digit() || c == '.')
+                    && part.parse::<f64>().is_ok()
+            })
+    };
+    let mut out: Vec<std::ffi::OsString> = Vec::new();
+    for arg in args {
+        let joined = match (out.last().and_then(|p| p.to_str()), arg.to_str()) {
+            (Some(prev), Some(value))
+                if prev.starts_with("--") && prev.len() > 2 && !prev.contains('=') && looks_negative(value) =>
+            {
+                Some(format!("{prev}={value}"))
+            }
+            _ => None,
+        };
+        match joined {
+            Some(j) => *out.last_mut().expect("a previous argument") = j.into(),
+            None => out.push(arg),
+        }
+    }
+    out
+}

@@ -1,5 +1,6 @@
 //! Seeded mutation fuzzing of every reader of untrusted input: gmsh MSH (2.2 and 4.1, ASCII
-//! and binary), meshio JSON and `.modes` archives, on the stable toolchain, as part of
+//! and binary), meshio JSON, `.modes` archives and surface assets (OBJ, ASCII and binary STL,
+//! ASCII and binary PLY), on the stable toolchain, as part of
 //! `cargo test --release` (bounded: a few thousand inputs, well under a minute).
 //!
 //! Mutations: byte flips, truncations, duplicated and swapped sections, huge numbers (ASCII
@@ -27,6 +28,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 
 use dcr_runtime::format::ModesFile;
 use dcr_runtime::testing::SplitMix64;
+use modal_bake::mesh::surface::read_surface_bytes;
 use modal_bake::mesh::{read_mesh_bytes, Location, MeshErrorKind};
 
 struct Counting;
@@ -71,11 +73,17 @@ unsafe impl GlobalAlloc for Counting {
 #[global_allocator]
 static GLOBAL: Counting = Counting;
 
-/// Peak bytes a read of an `n`-byte input may allocate: a constant for set-up plus a multiple
-/// of the input (a meshio JSON document tree holds ~20 bytes per input byte, the canonical
-/// mesh and its sort buffers fewer).
-fn alloc_bound(n: usize) -> usize {
-    (4 << 20) + 48 * n
+/// Peak bytes a read of an `n`-byte input of `kind` may allocate: a constant for set-up plus a
+/// multiple of the input (a meshio JSON document tree holds ~20 bytes per input byte, the
+/// canonical mesh and its sort buffers fewer). The PLY parser reserves up to 65,536 elements of
+/// a declared count before reading them (≈ 4.7 MB for three `f64` properties), whatever the
+/// header claims: a larger constant for surface assets.
+fn alloc_bound(n: usize, kind: Kind) -> usize {
+    let setup = match kind {
+        Kind::SurfaceAscii | Kind::SurfaceBinary => 8 << 20,
+        _ => 4 << 20,
+    };
+    setup + 48 * n
 }
 
 fn data(rel: &str) -> PathBuf {
@@ -90,6 +98,10 @@ enum Kind {
     MshBinary,
     Json,
     Modes,
+    /// OBJ, ASCII STL, ASCII PLY.
+    SurfaceAscii,
+    /// Binary STL and PLY.
+    SurfaceBinary,
 }
 
 /// Random index below `n` (n > 0).
@@ -165,7 +177,7 @@ fn sections(b: &[u8]) -> Vec<(usize, usize)> {
 fn mutate(rng: &mut SplitMix64, seed: &[u8], kind: Kind) -> (Vec<u8>, String) {
     let mut b = seed.to_vec();
     let n = b.len().max(1);
-    let ascii = matches!(kind, Kind::MshAscii | Kind::Json);
+    let ascii = matches!(kind, Kind::MshAscii | Kind::Json | Kind::SurfaceAscii);
     let choice = below(rng, 9);
     match choice {
         0 => {
@@ -181,7 +193,7 @@ fn mutate(rng: &mut SplitMix64, seed: &[u8], kind: Kind) -> (Vec<u8>, String) {
             b.truncate(cut);
             (b, format!("truncated to {cut} bytes"))
         }
-        2 if kind != Kind::Json && kind != Kind::Modes => {
+        2 if matches!(kind, Kind::MshAscii | Kind::MshBinary) => {
             let secs = sections(&b);
             if secs.is_empty() {
                 return (b, "no section".into());
@@ -391,6 +403,12 @@ fn check_one(bytes: &[u8], name: &str, kind: Kind, what: &str) -> bool {
         Kind::Modes => ModesFile::read_from(Cursor::new(bytes), Path::new(name))
             .map(|_| ())
             .map_err(|e| (e.to_string(), true)),
+        // Surface readers: the whole check a bake makes before gmsh (read, then closed,
+        // manifold, one shell). The parsers' own messages (tobj, ply-rs) carry no line; the
+        // file is named.
+        Kind::SurfaceAscii | Kind::SurfaceBinary => read_surface_bytes(bytes, name)
+            .and_then(|mut s| s.check_closed(name).map(|_| ()))
+            .map_err(|e| (e.to_string(), true)),
         _ => read_mesh_bytes(bytes, name).map(|_| ()).map_err(|e| {
             let located = e.location != Location::None
                 || matches!(e.kind, MeshErrorKind::NoTets | MeshErrorKind::UnknownFormat);
@@ -402,10 +420,10 @@ fn check_one(bytes: &[u8], name: &str, kind: Kind, what: &str) -> bool {
         panic!("{name} ({what}): the reader panicked");
     };
     assert!(
-        peak <= alloc_bound(bytes.len()),
+        peak <= alloc_bound(bytes.len(), kind),
         "{name} ({what}): allocated {peak} bytes for a {}-byte input (bound {})",
         bytes.len(),
-        alloc_bound(bytes.len())
+        alloc_bound(bytes.len(), kind)
     );
     match result {
         Ok(()) => false,
@@ -442,6 +460,98 @@ fn modes_seeds() -> Vec<(String, Vec<u8>)> {
     ]
 }
 
+/// The surface seeds: a unit cube as OBJ (quads), ASCII STL (two solids, the second a shifted
+/// cube: refused as two shells unless a mutation breaks one), binary STL whose header starts
+/// with `solid`, ASCII PLY and binary PLY.
+fn surface_seeds() -> Vec<(String, Vec<u8>, Kind)> {
+    const V: [[f64; 3]; 8] = [
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [1.0, 0.0, 1.0],
+        [1.0, 1.0, 1.0],
+        [0.0, 1.0, 1.0],
+    ];
+    const Q: [[usize; 4]; 6] = [
+        [0, 3, 2, 1],
+        [4, 5, 6, 7],
+        [0, 1, 5, 4],
+        [2, 3, 7, 6],
+        [1, 2, 6, 5],
+        [0, 4, 7, 3],
+    ];
+    let tris: Vec<[usize; 3]> = Q
+        .iter()
+        .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
+        .collect();
+    let mut obj = String::from("o cube\n");
+    for p in V {
+        obj += &format!("v {} {} {}\n", p[0], p[1], p[2]);
+    }
+    for q in Q {
+        obj += &format!("f {} {} {} {}\n", q[0] + 1, q[1] + 1, q[2] + 1, q[3] + 1);
+    }
+    let mut stl = String::new();
+    for dx in [0.0, 3.0] {
+        stl += "solid cube\n";
+        for t in &tris {
+            stl += "facet normal 0 0 0\nouter loop\n";
+            for &i in t {
+                stl += &format!("vertex {} {} {}\n", V[i][0] + dx, V[i][1], V[i][2]);
+            }
+            stl += "endloop\nendfacet\n";
+        }
+        stl += "endsolid cube\n";
+    }
+    let mut stlb = b"solid binary".to_vec();
+    stlb.resize(80, 0);
+    stlb.extend_from_slice(&(tris.len() as u32).to_le_bytes());
+    for t in &tris {
+        stlb.extend_from_slice(&[0u8; 12]);
+        for &i in t {
+            for k in 0..3 {
+                stlb.extend_from_slice(&(V[i][k] as f32).to_le_bytes());
+            }
+        }
+        stlb.extend_from_slice(&[0u8; 2]);
+    }
+    let header = |enc: &str, faces: usize| {
+        format!(
+            "ply\nformat {enc} 1.0\nelement vertex 8\nproperty double x\nproperty double y\n\
+             property double z\nelement face {faces}\nproperty list uchar int vertex_indices\n\
+             end_header\n"
+        )
+    };
+    let mut ply = header("ascii", 6);
+    for p in V {
+        ply += &format!("{} {} {}\n", p[0], p[1], p[2]);
+    }
+    for q in Q {
+        ply += &format!("4 {} {} {} {}\n", q[0], q[1], q[2], q[3]);
+    }
+    let mut plyb = header("binary_little_endian", 12).into_bytes();
+    for p in V {
+        for x in p {
+            plyb.extend_from_slice(&x.to_le_bytes());
+        }
+    }
+    for t in &tris {
+        plyb.push(3);
+        for &i in t {
+            plyb.extend_from_slice(&(i as i32).to_le_bytes());
+        }
+    }
+    vec![
+        ("cube.obj".into(), obj.into_bytes(), Kind::SurfaceAscii),
+        ("two.stl".into(), stl.into_bytes(), Kind::SurfaceAscii),
+        ("cube_bin.stl".into(), stlb, Kind::SurfaceBinary),
+        ("cube.ply".into(), ply.into_bytes(), Kind::SurfaceAscii),
+        ("cube_bin.ply".into(), plyb, Kind::SurfaceBinary),
+    ]
+}
+
 #[test]
 fn mutated_inputs_never_panic_allocate_unboundedly_or_go_unlocated() {
     let iters: usize = std::env::var("DCR_FUZZ_ITERS")
@@ -470,6 +580,7 @@ fn mutated_inputs_never_panic_allocate_unboundedly_or_go_unlocated() {
     for (name, bytes) in modes_seeds() {
         seeds.push((name, bytes, Kind::Modes));
     }
+    seeds.extend(surface_seeds());
     let mut rng = SplitMix64(seed);
     let (mut total, mut refused) = (0, 0);
     for (name, bytes, kind) in &seeds {

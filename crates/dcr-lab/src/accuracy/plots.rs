@@ -7,13 +7,15 @@ use plotters::prelude::*;
 use super::study::{maxv, median, ObjectStudy, BASE_MODES};
 use super::{GOAL_MEDIAN_PCT, GOAL_WORST_PCT};
 
-/// Writes `summary.svg` (log scale, 0.01 … 100 %+).
+/// Writes `summary.svg` (log scale, 0.01 … 100 %+), creating its folder, through the one
+/// writer ([`dcr_runtime::format::write_atomic`]).
 ///
 /// # Errors
 /// The file cannot be written.
 pub fn summary(path: &Path, studies: &[ObjectStudy]) -> anyhow::Result<()> {
-    let draw = || -> Result<(), Box<dyn std::error::Error>> {
-        let root = SVGBackend::new(path, (760, 440)).into_drawing_area();
+    let mut svg = String::new();
+    let mut draw = || -> Result<(), Box<dyn std::error::Error>> {
+        let root = SVGBackend::with_string(&mut svg, (760, 440)).into_drawing_area();
         root.fill(&WHITE)?;
         let n = studies.len().max(1) as f64;
         let names: Vec<&str> = studies.iter().map(|s| s.spec.name).collect();
@@ -93,5 +95,10 @@ pub fn summary(path: &Path, studies: &[ObjectStudy]) -> anyhow::Result<()> {
         root.present()?;
         Ok(())
     };
-    draw().map_err(|e| anyhow::anyhow!("writing {}: {e}", path.display()))
+    draw().map_err(|e| anyhow::anyhow!("drawing {}: {e}", path.display()))?;
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).map_err(|e| anyhow::anyhow!("creating {}: {e}", dir.display()))?;
+    }
+    dcr_runtime::format::write_atomic(path, svg.as_bytes())?;
+    Ok(())
 }

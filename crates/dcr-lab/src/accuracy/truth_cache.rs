@@ -193,9 +193,6 @@ pub fn cached_converged_peaks(
 
 fn store(dir: &Path, path: &Path, e: &Entry) -> std::io::Result<()> {
     std::fs::create_dir_all(dir)?;
-    let tmp = path.with_extension(format!("json.tmp{}", std::process::id()));
-    std::fs::write(&tmp, serde_json::to_vec(e).map_err(std::io::Error::other)?)?;
-    std::fs::rename(&tmp, path).inspect_err(|_| {
-        let _ = std::fs::remove_file(&tmp);
-    })
+    let bytes = serde_json::to_vec(e).map_err(std::io::Error::other)?;
+    dcr_runtime::format::write_atomic(path, &bytes).map_err(std::io::Error::other)
 }

@@ -73,8 +73,23 @@ pub fn run(args: &AccuracyArgs) -> anyhow::Result<()> {
             known.join(", ")
         );
     }
+    // Inputs and outputs are checked before any work; folders are created only when the
+    // report is written.
+    let scenes = args.root.join("data").join("scenes");
+    if !scenes.is_dir() {
+        anyhow::bail!(
+            "--root {}: {} is not a folder (give the repository root, which holds data/scenes)",
+            args.root.display(),
+            scenes.display()
+        );
+    }
     let svg = args.out.join("accuracy");
-    std::fs::create_dir_all(&svg).with_context(|| format!("creating {}", svg.display()))?;
+    let path = args.out.join("accuracy.md");
+    let mut plan = dcr_runtime::format::OutputPlan::new();
+    plan.output_folder("--out", &args.out)?;
+    plan.output_folder("--out", &svg)?;
+    plan.output("--out", &path)?;
+    plan.output("--out", &svg.join("summary.svg"))?;
     let opts = AccuracyOptions {
         only: args.only.clone(),
         quick: args.quick,
@@ -84,12 +99,8 @@ pub fn run(args: &AccuracyArgs) -> anyhow::Result<()> {
         no_energy: args.no_energy,
     };
     let md = dcr_lab::accuracy::generate(&args.root, &args.out, &opts)?;
-    let path = args.out.join("accuracy.md");
-    let tmp = args
-        .out
-        .join(format!(".accuracy.md.tmp-{}", std::process::id()));
-    std::fs::write(&tmp, md).with_context(|| format!("writing {}", tmp.display()))?;
-    std::fs::rename(&tmp, &path).with_context(|| format!("writing {}", path.display()))?;
+    dcr_runtime::format::write_atomic(&path, md.as_bytes())
+        .with_context(|| format!("writing {}", path.display()))?;
     eprintln!(
         "wrote {} and {}",
         path.display(),

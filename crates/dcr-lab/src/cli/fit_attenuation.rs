@@ -47,7 +47,7 @@ pub struct FitAttenuationArgs {
     #[arg(long, value_enum, default_value_t = FitTruthArg::Auto)]
     pub truth: FitTruthArg,
     /// Largest number of free dofs for the dense eigensolve.
-    #[arg(long, value_name = "N", default_value_t = 6000)]
+    #[arg(long, value_name = "N", default_value_t = 6000, value_parser = super::truth::parse_max_dense_dofs)]
     pub max_dense_dofs: usize,
     /// Fix r0 (m) instead of fitting it.
     #[arg(long, value_name = "M")]

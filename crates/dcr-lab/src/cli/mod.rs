@@ -46,7 +46,10 @@ pub fn emit(s: &str) -> anyhow::Result<()> {
 }
 
 pub fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = Cli::parse_from(modal_bake::args::join_negative_values(std::env::args_os()));
+    if let Err(e) = modal_bake::signals::remove_temporaries_on_signals() {
+        eprintln!("warning: cannot watch for signals ({e}); an interrupted write may leave a temporary file");
+    }
     let result = match cli.command {
         Command::Truth(a) => truth::run(&a),
         Command::FitAttenuation(a) => fit_attenuation::run(&a).map(|()| ExitCode::SUCCESS),
@@ -55,7 +58,7 @@ pub fn main() -> ExitCode {
     match result {
         Ok(code) => code,
         Err(e) => {
-            eprintln!("error: {e:#}");
+            eprintln!("error: {}", modal_bake::args::error_line(&e));
             ExitCode::FAILURE
         }
     }

@@ -87,7 +87,7 @@ pub struct TruthArgs {
     #[arg(long, value_name = "N")]
     pub modes: Option<usize>,
     /// modal-all only: largest number of free dofs accepted for the dense eigensolve.
-    #[arg(long, value_name = "N", default_value_t = 6000)]
+    #[arg(long, value_name = "N", default_value_t = 6000, value_parser = parse_max_dense_dofs)]
     pub max_dense_dofs: usize,
     /// Print one JSON object on stdout (`{"contacts": [...], "info": {...}}`).
     #[arg(long)]
@@ -235,4 +235,24 @@ fn convergence_lines(c: &truth::TruthConvergence, max_refinements: usize) -> Str
         );
     }
     s
+}
+
+/// Largest `--max-dense-dofs`: a dense eigensolve of N free dofs holds several N × N `f64`
+/// matrices (K, M, the eigenvectors and the solver's workspace), about 2 GB at this N.
+pub const MAX_DENSE_DOFS_LIMIT: usize = 8000;
+
+/// `--max-dense-dofs N` with 1 ≤ N ≤ [`MAX_DENSE_DOFS_LIMIT`].
+pub fn parse_max_dense_dofs(s: &str) -> Result<usize, String> {
+    let n: usize = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("{s:?} is not a whole number of free dofs (1 to {MAX_DENSE_DOFS_LIMIT})"))?;
+    if !(1..=MAX_DENSE_DOFS_LIMIT).contains(&n) {
+        return Err(format!(
+            "{n} is outside 1 to {MAX_DENSE_DOFS_LIMIT}: a dense eigensolve of N dofs holds several \
+             N × N matrices (about 2 GB at {MAX_DENSE_DOFS_LIMIT}); larger meshes take the \
+             Newmark truth (--method newmark)"
+        ));
+    }
+    Ok(n)
 }

@@ -57,12 +57,20 @@ impl AttenuationResponse {
         match a.law {
             AttenuationLaw::Full { alpha, beta, r0 } => {
                 if !(finite_nonneg(alpha) && finite_nonneg(beta) && r0.is_finite() && r0 > 0.0) {
-                    return Err(invalid("attenuation law", format!("{:?}", a.law)));
+                    return Err(invalid(
+                        "attenuation law",
+                        format!(
+                            "α = {alpha} 1/m, β = {beta}, r0 = {r0} m (need α ≥ 0, β ≥ 0, r0 > 0, all finite)"
+                        ),
+                    ));
                 }
             }
             AttenuationLaw::Simplified { c, beta } => {
                 if !(finite_nonneg(c) && finite_nonneg(beta)) {
-                    return Err(invalid("attenuation law", format!("{:?}", a.law)));
+                    return Err(invalid(
+                        "attenuation law",
+                        format!("C = {c}, β = {beta} (need C ≥ 0 and β ≥ 0, both finite)"),
+                    ));
                 }
             }
         }

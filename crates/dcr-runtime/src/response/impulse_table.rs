@@ -2,7 +2,7 @@
 //! g_j(kT), k = 1..S (Eq. 10), shared by the methods' set-ups.
 
 use super::{ParamsError, ResponseParams};
-use crate::filter::{damping_ratio, samples_per_step, ModalBank};
+use crate::filter::{damping_ratio, samples_per_step, ModalBank, Sampling};
 use crate::model::ModalModel;
 
 /// Largest number of filter samples per step accepted.
@@ -39,7 +39,13 @@ impl ImpulseTable {
         if !(t_req.is_finite() && t_req > 0.0) {
             return Err(ParamsError::Invalid {
                 field: "sampling",
-                detail: format!("{:?} gives T = {t_req} s", p.sampling),
+                detail: match p.sampling {
+                    Sampling::PaperT => format!("the paper's T gives T = {t_req} s"),
+                    Sampling::Oversample(k) => {
+                        format!("oversampling K = {k} gives T = {t_req} s (need K ≥ 1, finite)")
+                    }
+                    Sampling::Substep(t) => format!("sub-step T = {t} s (need 0 < T ≤ h, finite)"),
+                },
             });
         }
         if p.h / t_req > MAX_SAMPLES {

@@ -14,7 +14,7 @@ pub use bases::{
 };
 pub use outcomes::{measure_outcome, unit_of};
 pub use run::{
-    run_scene, BodyReceived, MethodChoice, ModelReport, ModelStats, ResponseEvent, RunParams,
+    run_scene, BodyReceived, RUN_OUTPUTS, MethodChoice, ModelReport, ModelStats, ResponseEvent, RunParams,
     RunReport, StepTime,
 };
 pub use stress_bench::{stress_bench, StressBenchParams};

@@ -455,6 +455,9 @@ fn apply_drivers(drivers: &[(usize, DriverDesc)], built: &mut BuiltWorld, t: f64
     }
 }
 
+/// The files a run writes into its output folder.
+pub const RUN_OUTPUTS: [&str; 3] = ["trajectory.npz", "timings.npz", "summary.json"];
+
 /// Writes `trajectory.npz`, `timings.npz` (per-step rapier and adapter µs, whether the world
 /// stepped, each object's query µs and resting contacts) and `summary.json` into `dir`.
 ///
@@ -466,10 +469,9 @@ fn write_outputs(
     rapier_us: &[f64],
     adapter_us: &[f64],
 ) -> Result<()> {
-    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    report.trajectory.write_npz(&dir.join("trajectory.npz"))?;
-    let f = std::fs::File::create(dir.join("timings.npz"))?;
-    let mut npz = NpzWriter::new(f);
+    // Everything is encoded before the first file is written.
+    let trajectory = report.trajectory.to_npz()?;
+    let mut npz = NpzWriter::new(std::io::Cursor::new(Vec::new()));
     npz.add_array("rapier_us", &Array1::from(rapier_us.to_vec()))?;
     npz.add_array("adapter_us", &Array1::from(adapter_us.to_vec()))?;
     npz.add_array(
@@ -493,9 +495,14 @@ fn write_outputs(
         )?;
         npz.add_array(format!("query_us_resting_{}", m.model), &arr)?;
     }
-    npz.finish()?;
-    let json = serde_json::to_string_pretty(&report)?;
-    std::fs::write(dir.join("summary.json"), json + "\n")?;
+    let timings = npz.finish()?.into_inner();
+    let json = serde_json::to_string_pretty(&report)? + "\n";
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    for (name, bytes) in RUN_OUTPUTS.into_iter().zip([&trajectory[..], &timings[..], json.as_bytes()]) {
+        let path = dir.join(name);
+        dcr_runtime::format::write_atomic(&path, bytes)
+            .with_context(|| format!("writing {}", path.display()))?;
+    }
     Ok(())
 }
 
@@ -505,8 +512,12 @@ fn write_outputs(
 /// # Errors
 /// Bake, load, mesh or I/O failures.
 pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
+    desc.validate()
+        .map_err(|e| anyhow::anyhow!("scene {}: {e}", desc.name))?;
+    let steps = desc
+        .run_steps(params.seconds)
+        .map_err(|e| anyhow::anyhow!("scene {}: {e}", desc.name))?;
     let seconds = params.seconds.unwrap_or(desc.seconds);
-    let steps = (seconds / desc.h).round() as usize;
     let mut built = build_world(desc, &params.root)?;
 
     // The world and its elastic objects. Off runs measure only (impacts, what the responses

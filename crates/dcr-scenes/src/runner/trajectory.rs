@@ -57,16 +57,24 @@ impl Trajectory {
     }
 
     /// Writes `time` (n), `positions` (n × bodies × 3) and `rotations` (n × bodies × 4,
-    /// xyzw) to an NPZ file.
+    /// xyzw) to an NPZ file (through the one writer, [`dcr_runtime::format::write_atomic`]).
     ///
     /// # Errors
-    /// I/O errors.
+    /// I/O errors, or a destination the writer refuses (a device, FIFO or folder).
     pub fn write_npz(&self, path: &Path) -> Result<()> {
+        let bytes = self.to_npz()?;
+        dcr_runtime::format::write_atomic(path, &bytes)
+            .with_context(|| format!("writing {}", path.display()))
+    }
+
+    /// The NPZ file [`Trajectory::write_npz`] writes, in memory.
+    ///
+    /// # Errors
+    /// When the arrays do not match the names (a recorder bug).
+    pub fn to_npz(&self) -> Result<Vec<u8>> {
         let n = self.rows();
         let b = self.names.len();
-        let file =
-            std::fs::File::create(path).with_context(|| format!("creating {}", path.display()))?;
-        let mut npz = NpzWriter::new(file);
+        let mut npz = NpzWriter::new(std::io::Cursor::new(Vec::new()));
         npz.add_array("time", &Array1::from(self.time.clone()))?;
         npz.add_array(
             "positions",
@@ -76,7 +84,6 @@ impl Trajectory {
             "rotations",
             &Array3::from_shape_vec((n, b, 4), self.rotations.clone())?,
         )?;
-        npz.finish()?;
-        Ok(())
+        Ok(npz.finish()?.into_inner())
     }
 }

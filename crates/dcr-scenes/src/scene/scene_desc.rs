@@ -430,16 +430,33 @@ fn default_outcome_threshold() -> f64 {
 }
 
 impl SceneDesc {
-    /// Parses a scene file.
+    /// Largest scene file read (bytes).
+    pub const MAX_FILE_BYTES: u64 = 64 << 20;
+
+    /// Reads, parses and validates ([`SceneDesc::validate`]) a scene file. Only a regular file
+    /// (or a link to one) of at most [`SceneDesc::MAX_FILE_BYTES`] is opened.
     ///
     /// # Errors
-    /// I/O or JSON errors, with the path.
+    /// A message naming the file and, for a field out of range, the field and its range.
     pub fn read(path: &std::path::Path) -> anyhow::Result<SceneDesc> {
-        use anyhow::Context;
-        let text =
-            std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+        use std::io::Read;
+        let (file, len) = dcr_runtime::format::open_regular_file(path)
+            .map_err(|e| anyhow::anyhow!("scene {}: {e}", path.display()))?;
+        if len > Self::MAX_FILE_BYTES {
+            anyhow::bail!(
+                "scene {}: {len} bytes; a scene file holds at most {} bytes",
+                path.display(),
+                Self::MAX_FILE_BYTES
+            );
+        }
+        let mut text = String::new();
+        file.take(Self::MAX_FILE_BYTES)
+            .read_to_string(&mut text)
+            .map_err(|e| anyhow::anyhow!("scene {}: {e}", path.display()))?;
         let desc: SceneDesc = serde_json::from_str(&text)
-            .with_context(|| format!("parsing scene {}", path.display()))?;
+            .map_err(|e| anyhow::anyhow!("scene {}: {e}", path.display()))?;
+        desc.validate()
+            .map_err(|e| anyhow::anyhow!("scene {}: {e}", path.display()))?;
         Ok(desc)
     }
 }

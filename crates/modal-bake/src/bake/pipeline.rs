@@ -180,11 +180,32 @@ fn solve(
     });
     let res = res.map_err(|error| BakeError::Eigen {
         file: file.to_string(),
-        error,
+        error: explain_factorization(error, mat),
     })?;
     report.factor_s = res.info.factor_seconds;
     report.eigensolve_s = res.info.solve_seconds;
     Ok(Solved { map, res, surface })
+}
+
+/// A factorization failure with the material's part in it: a Poisson ratio near 0.5 (nearly
+/// incompressible: the volumetric stiffness is 2ν/(1 − 2ν) times the shear stiffness) or near
+/// −1 (the bulk modulus vanishes) makes K too ill-conditioned to factor in double precision,
+/// though ν is inside (−1, 0.5).
+fn explain_factorization(error: eigen::EigenError, mat: &fem::Material) -> eigen::EigenError {
+    let nu = mat.poisson;
+    match error {
+        eigen::EigenError::Factorization(msg) if nu > 0.45 || nu < -0.9 => {
+            eigen::EigenError::Factorization(format!(
+                "{msg}; the Poisson ratio --poisson {nu} is so close to {} that the stiffness \
+                 matrix cannot be factored in double precision (volumetric / shear stiffness \
+                 2ν/(1 − 2ν) = {:.3e}); use a ratio in −0.9 … 0.45 (rubber-like materials bake \
+                 well at 0.45)",
+                if nu > 0.0 { "0.5" } else { "−1" },
+                2.0 * nu / (1.0 - 2.0 * nu)
+            ))
+        }
+        other => other,
+    }
 }
 
 /// The indices of the elastic modes to keep: after exactly six rigid-body modes of a

@@ -38,7 +38,12 @@ pub fn run(args: &CheckArgs) -> ExitCode {
     };
     let file = args.mesh.display().to_string();
     let asset = super::bake::asset_for(&args.asset, args.transfer.transfer_h.is_some(), &args.mesh);
-    let status = super::bake::load_mesh(&args.mesh, &asset)
+    // The options are checked as `bake` checks them, naming the option.
+    let status = args
+        .options
+        .model
+        .check_ranges()
+        .and_then(|()| super::bake::load_mesh(&args.mesh, &asset))
         .and_then(|(mesh, _)| Ok(bake::mesh_base_status(mesh, &file, &params, &args.out)?));
     match status {
         Ok(status) => {

@@ -85,6 +85,13 @@ pub fn run(args: &ExportArgs) -> anyhow::Result<()> {
             "nothing to write: give at least one of --vtu OUT.vtu, --gltf OUT.glb, --png OUT.png"
         );
     }
+    let mut plan = dcr_runtime::format::OutputPlan::new();
+    plan.input("the base", &args.file);
+    for (option, path) in [("--vtu", &args.vtu), ("--gltf", &args.gltf), ("--png", &args.png)] {
+        if let Some(p) = path {
+            plan.output(option, p)?;
+        }
+    }
     let base = ModesFile::read(&args.file).map_err(|e| anyhow::anyhow!("{e}"))?;
     let modes = select_modes(&base, args.modes)?;
     if let Some(p) = &args.vtu {

@@ -106,38 +106,11 @@ fn stdout_failure() -> Option<&'static std::io::Error> {
 /// # Errors
 /// A one-line message naming `option` and the path.
 pub fn check_output(out: &Path, option: &str, inputs: &[&Path]) -> anyhow::Result<()> {
-    use dcr_runtime::format::{describe_file_type, same_file};
+    let mut plan = dcr_runtime::format::OutputPlan::new();
     for input in inputs {
-        if same_file(out, input) {
-            anyhow::bail!(
-                "{option} {} is the input {}; refusing to overwrite an input (choose another output path)",
-                out.display(),
-                input.display()
-            );
-        }
+        plan.input("the input", input);
     }
-    if let Ok(meta) = std::fs::metadata(out) {
-        if !meta.is_file() {
-            anyhow::bail!(
-                "{option} {} is {}; give the path of a file to write",
-                out.display(),
-                describe_file_type(meta.file_type())
-            );
-        }
-    }
-    let mut ancestor = out.parent();
-    while let Some(dir) = ancestor.filter(|d| !d.as_os_str().is_empty()) {
-        match std::fs::metadata(dir) {
-            Ok(meta) if meta.is_dir() => return Ok(()),
-            Ok(meta) => anyhow::bail!(
-                "{option} {}: {} is {}, not a folder",
-                out.display(),
-                dir.display(),
-                describe_file_type(meta.file_type())
-            ),
-            Err(_) => ancestor = dir.parent(),
-        }
-    }
+    plan.output(option, out)?;
     Ok(())
 }
 
@@ -157,7 +130,7 @@ pub fn create_parent(out: &Path) -> anyhow::Result<()> {
 }
 
 pub fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = Cli::parse_from(modal_bake::args::join_negative_values(std::env::args_os()));
     if let Err(e) = modal_bake::signals::remove_temporaries_on_signals() {
         eprintln!("warning: cannot watch for signals ({e}); an interrupted write may leave a temporary file");
     }
@@ -180,18 +153,7 @@ pub fn main() -> ExitCode {
 /// An error and its causes on one line, each cause once: a cause whose text the line already
 /// holds (a wrapper that prints its source, as `path: error` does) is not repeated.
 pub fn one_line(e: &anyhow::Error) -> String {
-    let mut line = String::new();
-    for cause in e.chain() {
-        let text = cause.to_string();
-        if line.contains(&text) {
-            continue;
-        }
-        if !line.is_empty() {
-            line.push_str(": ");
-        }
-        line.push_str(&text);
-    }
-    line
+    modal_bake::args::error_line(e)
 }
 
 fn run_command(command: Command) -> ExitCode {

@@ -234,7 +234,11 @@ impl ShiftInvert {
                 Spec::default(),
             )
             .map_err(|e| {
-                EigenError::Factorization(format!("matrix is not positive definite ({e:?})"))
+                let faer::linalg::cholesky::llt::factor::LltError::NonPositivePivot { index } = e;
+                EigenError::Factorization(format!(
+                    "the matrix is not positive definite to working precision (non-positive \
+                     pivot at free dof {index})"
+                ))
             })?;
         let panel = match symbolic.raw() {
             SymbolicCholeskyRaw::Supernodal(sym) => Some(PanelSolve::new(sym, &values)),

@@ -104,9 +104,11 @@ pub fn render_contact_sheet(base: &ModesFile, p: &SheetParams) -> Result<Pixmap,
             "the sheet needs at least one column and panels of at least 64 × 86 pixels".into(),
         ));
     }
-    if !(p.scale.is_finite() && p.scale > 0.0) {
+    if !(p.scale > 0.0 && p.scale <= super::MAX_SCALE) {
         return Err(ExportError::Invalid(format!(
-            "parameter `scale` must be positive, got {}",
+            "parameter `scale` (--scale) must be in (0, {}] (the largest displacement as a \
+             fraction of the bounding-box diagonal), got {}",
+            super::MAX_SCALE,
             p.scale
         )));
     }

@@ -41,6 +41,10 @@ pub use mode_onto::{
 };
 pub use mode_vtu::write_modes_vtu;
 
+/// Largest visual amplitude `scale` of the GLB morph targets and the PNG sheet: the largest
+/// displacement as a fraction of the bounding-box diagonal.
+pub const MAX_SCALE: f64 = 10.0;
+
 /// What went wrong writing an export.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
@@ -65,6 +69,9 @@ pub enum ExportError {
     /// non-positive scale...).
     #[error("{0}")]
     Invalid(String),
+    /// The writer refused or failed (the message names the path).
+    #[error(transparent)]
+    Write(dcr_runtime::format::FormatError),
 }
 
 /// The selected modes' label, e.g. `mode_01_12.3Hz`: 1-based mode number (two digits at
@@ -229,32 +236,15 @@ pub(crate) fn diagonal(points: &[[f64; 3]]) -> f64 {
     ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2) + (hi[2] - lo[2]).powi(2)).sqrt()
 }
 
-/// Writes `bytes` to `path` through a temporary file beside it (`tempfile`) and a rename: on
-/// failure nothing is left behind and an existing `path` is untouched.
+/// Writes `bytes` to `path` through the project's one writer
+/// ([`dcr_runtime::format::write_atomic`]): a unique temporary beside it, renamed over it when
+/// complete; a device, FIFO, socket or folder at `path` is refused, and on failure (or
+/// SIGINT/SIGTERM in a tool that installed [`crate::signals::remove_temporaries_on_signals`])
+/// nothing is left behind and an existing `path` is untouched. Check the command's outputs
+/// against its inputs first ([`dcr_runtime::format::OutputPlan`]).
 ///
 /// # Errors
-/// I/O errors, naming `path`.
+/// [`ExportError::Write`], naming `path`.
 pub fn write_file_atomic(path: &Path, bytes: &[u8]) -> Result<(), ExportError> {
-    use std::io::Write;
-    let io = |source| ExportError::Io {
-        path: path.to_path_buf(),
-        source,
-    };
-    let dir = path
-        .parent()
-        .filter(|d| !d.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    let mut builder = tempfile::Builder::new();
-    builder.prefix(".export-");
-    // Readable like any file the user creates (tempfile's default is owner-only).
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::PermissionsExt;
-        builder.permissions(std::fs::Permissions::from_mode(0o644));
-    }
-    let mut tmp = builder.tempfile_in(dir).map_err(io)?;
-    tmp.write_all(bytes).map_err(io)?;
-    tmp.as_file().sync_all().map_err(io)?;
-    tmp.persist(path).map_err(|e| io(e.error))?;
-    Ok(())
+    dcr_runtime::format::write_atomic(path, bytes).map_err(ExportError::Write)
 }

@@ -75,9 +75,11 @@ fn modes_glb_bytes(base: &ModesFile, params: &ModeGltfParams) -> Result<Vec<u8>,
             "cannot export {n} modes from a base with {m}"
         )));
     }
-    if !(params.scale.is_finite() && params.scale > 0.0) {
+    if !(params.scale > 0.0 && params.scale <= super::MAX_SCALE) {
         return Err(ExportError::Invalid(format!(
-            "parameter `scale` must be positive, got {}",
+            "parameter `scale` (--scale) must be in (0, {}] (the largest displacement as a \
+             fraction of the bounding-box diagonal), got {}",
+            super::MAX_SCALE,
             params.scale
         )));
     }

@@ -49,11 +49,20 @@ fn format_of(path: &Path) -> Option<Format> {
 /// [`SurfaceError`] naming the file: unreadable, unknown extension, parse errors, indices out of
 /// range, non-finite coordinates, no triangles.
 pub fn read_surface(path: &Path) -> Result<SurfaceMesh, SurfaceError> {
+    use dcr_runtime::format::open_regular_file;
+    use std::io::Read;
     let file = path.display().to_string();
-    let data = std::fs::read(path).map_err(|e| SurfaceError::Io {
+    let io = |detail: String| SurfaceError::Io {
         file: file.clone(),
-        detail: e.to_string(),
-    })?;
+        detail,
+    };
+    // Only a regular file is opened (a FIFO would block, `/dev/zero` never ends), and no more
+    // than its length when opened is read.
+    let (f, len) = open_regular_file(path).map_err(|e| io(e.to_string()))?;
+    let mut data = Vec::with_capacity(usize::try_from(len).unwrap_or(0));
+    f.take(len)
+        .read_to_end(&mut data)
+        .map_err(|e| io(e.to_string()))?;
     read_surface_bytes(&data, &file)
 }
 
@@ -167,51 +176,204 @@ fn read_obj(data: &[u8], name: &str) -> Result<Soup, SurfaceError> {
 }
 
 fn read_stl(data: &[u8], name: &str) -> Result<Soup, SurfaceError> {
-    // Binary STL: 80-byte header, u32 count, 50 bytes per triangle. Check the count against
-    // the bytes present before the parser allocates for it.
-    let ascii = data
+    // Binary STL: 80-byte header (which may itself start with `solid`), u32 count, 50 bytes
+    // per triangle. One decision: binary exactly when the length is 84 + 50·n.
+    let binary = data.len() >= 84 && {
+        let n = u32::from_le_bytes([data[80], data[81], data[82], data[83]]) as u64;
+        84 + 50 * n == data.len() as u64
+    };
+    if binary {
+        let mesh =
+            stl_io::read_stl(&mut Cursor::new(data)).map_err(|e| parse_err(name, "STL", e))?;
+        let positions = mesh.vertices.iter().map(|v| v.0.map(f64::from)).collect();
+        let faces = mesh
+            .faces
+            .iter()
+            .map(|f| f.vertices.iter().map(|&v| v as i64).collect())
+            .collect();
+        return Ok((positions, faces));
+    }
+    let starts_solid = data
         .iter()
         .skip_while(|b| b.is_ascii_whitespace())
         .take(5)
-        .eq(b"solid".iter())
-        && data.windows(5).any(|w| w == b"facet");
-    if !ascii {
-        if data.len() < 84 {
-            return Err(parse_err(
-                name,
-                "STL",
-                "shorter than a binary STL header (84 bytes)",
-            ));
-        }
-        let n = u32::from_le_bytes([data[80], data[81], data[82], data[83]]) as u64;
-        if 84 + 50 * n != data.len() as u64 {
-            return Err(parse_err(
-                name,
-                "STL",
-                format!(
-                    "binary header declares {n} triangles ({} bytes) but the file has {} bytes",
-                    84 + 50 * n,
-                    data.len()
-                ),
-            ));
+        .map(u8::to_ascii_lowercase)
+        .eq(b"solid".iter().copied());
+    if !starts_solid {
+        let detail = if data.len() >= 84 {
+            let n = u32::from_le_bytes([data[80], data[81], data[82], data[83]]) as u64;
+            format!(
+                "neither ASCII (no leading `solid`) nor binary: the binary header declares {n} \
+                 triangles ({} bytes) but the file has {} bytes",
+                84 + 50 * n,
+                data.len()
+            )
+        } else {
+            format!(
+                "neither ASCII (no leading `solid`) nor binary ({} bytes, shorter than the \
+                 84-byte binary header)",
+                data.len()
+            )
+        };
+        return Err(parse_err(name, "STL", detail));
+    }
+    read_ascii_stl(data, name)
+}
+
+/// ASCII STL: every `solid … endsolid` block of the file (keywords in any case, the solid's
+/// name optional, blank lines anywhere), each facet `facet normal nx ny nz / outer loop /
+/// vertex x y z ×3 / endloop / endfacet`. Errors name the line.
+///
+/// Written here rather than through `stl_io`, whose ASCII reader stops at the first
+/// `endsolid` and refuses a missing name, upper-case keywords and leading blank lines.
+fn read_ascii_stl(data: &[u8], name: &str) -> Result<Soup, SurfaceError> {
+    let text = std::str::from_utf8(data).map_err(|e| {
+        let line = data[..e.valid_up_to()].iter().filter(|&&b| b == b'\n').count() + 1;
+        parse_err(name, "STL", format!("line {line}: not ASCII text"))
+    })?;
+    let mut c = StlTokens {
+        tokens: text
+            .lines()
+            .enumerate()
+            .flat_map(|(i, l)| {
+                l.split_ascii_whitespace()
+                    .enumerate()
+                    .map(move |(k, t)| (i + 1, k, t))
+            })
+            .collect(),
+        at: 0,
+        name,
+    };
+    let mut positions: Vec<[f64; 3]> = Vec::new();
+    let mut faces: Vec<Vec<i64>> = Vec::new();
+    while let Some((line, _, _)) = c.peek() {
+        c.word("solid")?;
+        c.skip_rest_of_line(line);
+        loop {
+            match c.peek() {
+                None => return Err(c.err(line, "the solid opened here has no `endsolid`")),
+                Some((l, _, t)) if t.eq_ignore_ascii_case("endsolid") => {
+                    c.at += 1;
+                    c.skip_rest_of_line(l);
+                    break;
+                }
+                Some(_) => {}
+            }
+            c.word("facet")?;
+            c.word("normal")?;
+            for axis in ["nx", "ny", "nz"] {
+                c.number(axis)?;
+            }
+            c.word("outer")?;
+            c.word("loop")?;
+            let mut face = Vec::with_capacity(3);
+            for _ in 0..3 {
+                c.word("vertex")?;
+                let p = [c.number("x")?, c.number("y")?, c.number("z")?];
+                face.push(positions.len() as i64);
+                positions.push(p);
+            }
+            c.word("endloop")?;
+            c.word("endfacet")?;
+            faces.push(face);
         }
     }
-    let mesh = stl_io::read_stl(&mut Cursor::new(data)).map_err(|e| parse_err(name, "STL", e))?;
-    let positions = mesh.vertices.iter().map(|v| v.0.map(f64::from)).collect();
-    let faces = mesh
-        .faces
-        .iter()
-        .map(|f| f.vertices.iter().map(|&v| v as i64).collect())
-        .collect();
     Ok((positions, faces))
 }
 
+/// The tokens of an ASCII STL: (line, position on the line, text), and the next one's index.
+struct StlTokens<'a> {
+    tokens: Vec<(usize, usize, &'a str)>,
+    at: usize,
+    name: &'a str,
+}
+
+impl<'a> StlTokens<'a> {
+    fn peek(&self) -> Option<(usize, usize, &'a str)> {
+        self.tokens.get(self.at).copied()
+    }
+
+    fn err(&self, line: usize, what: &str) -> SurfaceError {
+        parse_err(self.name, "STL", format!("line {line}: {what}"))
+    }
+
+    fn next(&mut self, what: &str) -> Result<(usize, &'a str), SurfaceError> {
+        match self.peek() {
+            Some((l, _, t)) => {
+                self.at += 1;
+                Ok((l, t))
+            }
+            None => {
+                let last = self.tokens.last().map_or(1, |t| t.0);
+                Err(self.err(last, &format!("the file ends where {what} was expected")))
+            }
+        }
+    }
+
+    /// The keyword `w` (any case).
+    fn word(&mut self, w: &str) -> Result<(), SurfaceError> {
+        let (l, t) = self.next(&format!("`{w}`"))?;
+        if t.eq_ignore_ascii_case(w) {
+            Ok(())
+        } else {
+            Err(self.err(l, &format!("expected `{w}`, found `{t}`")))
+        }
+    }
+
+    fn number(&mut self, what: &str) -> Result<f64, SurfaceError> {
+        let (l, t) = self.next(&format!("the number {what}"))?;
+        t.parse::<f64>()
+            .map_err(|_| self.err(l, &format!("expected the number {what}, found `{t}`")))
+    }
+
+    /// Skips the tokens after the first on `line` (a solid's name).
+    fn skip_rest_of_line(&mut self, line: usize) {
+        while self.peek().is_some_and(|(l, k, _)| l == line && k > 0) {
+            self.at += 1;
+        }
+    }
+}
+
 fn read_ply(data: &[u8], name: &str) -> Result<Soup, SurfaceError> {
-    use ply_rs_bw::parser::Parser;
-    use ply_rs_bw::ply::{DefaultElement, Property};
-    let ply = Parser::<DefaultElement>::new()
-        .read_ply(&mut Cursor::new(data))
+    use ply_rs_bw::parser::{Parser, Reader};
+    use ply_rs_bw::ply::{DefaultElement, Encoding, Property};
+    let parser = Parser::<DefaultElement>::new();
+    let mut reader = Reader::new(Cursor::new(data));
+    let header = parser
+        .read_header(&mut reader)
         .map_err(|e| parse_err(name, "PLY", e))?;
+    let payload = parser
+        .read_payload(&mut reader, &header)
+        .map_err(|e| parse_err(name, "PLY", e))?;
+    // Everything the header declares has been read: anything but white space after it is
+    // data the header does not count (more faces than declared), refused rather than dropped.
+    let consumed = usize::try_from(reader.get_ref().position()).map_or(data.len(), |p| p.min(data.len()));
+    if let Some(off) = data[consumed..]
+        .iter()
+        .position(|b| !b.is_ascii_whitespace())
+    {
+        let at = consumed + off;
+        let declared: Vec<String> = header
+            .elements
+            .iter()
+            .map(|(n, e)| format!("{} {n}", e.count))
+            .collect();
+        let place = match header.encoding {
+            Encoding::Ascii => format!(
+                "line {}",
+                data[..at].iter().filter(|&&b| b == b'\n').count() + 1
+            ),
+            _ => format!("byte {at}"),
+        };
+        return Err(parse_err(
+            name,
+            "PLY",
+            format!(
+                "{place}: data after the elements the header declares ({}); fix the element counts in the header",
+                declared.join(", ")
+            ),
+        ));
+    }
     let scalar = |p: &Property| -> Option<f64> {
         Some(match p {
             Property::Char(x) => *x as f64,
@@ -236,8 +398,7 @@ fn read_ply(data: &[u8], name: &str) -> Result<Soup, SurfaceError> {
             _ => return None,
         })
     };
-    let vertices = ply
-        .payload
+    let vertices = payload
         .get("vertex")
         .ok_or_else(|| parse_err(name, "PLY", "no `vertex` element"))?;
     let mut positions = Vec::with_capacity(vertices.len());
@@ -250,8 +411,7 @@ fn read_ply(data: &[u8], name: &str) -> Result<Soup, SurfaceError> {
         }
         positions.push(p);
     }
-    let faces_el = ply
-        .payload
+    let faces_el = payload
         .get("face")
         .ok_or_else(|| parse_err(name, "PLY", "no `face` element"))?;
     let mut faces = Vec::with_capacity(faces_el.len());

@@ -1,0 +1,327 @@
+//! The output policy every writing command applies before it writes anything: all of a
+//! command's outputs are declared together with its inputs in an [`OutputPlan`], which refuses
+//! (naming the option and the path)
+//! - an output that is one of the inputs (same device and inode: a hard link, a symbolic link
+//!   to it or another spelling such as `./sub/../BASE` count),
+//! - an output that exists as anything but a regular file (a folder, a device, a FIFO, a
+//!   socket: renaming a file over a device node would replace the node),
+//! - a path that names no file (`.`, `..`, a trailing `/`) or whose nearest existing ancestor
+//!   is not a folder,
+//! - two outputs on one path (both options named), existing or not.
+//!
+//! The files themselves are then written through [`super::AtomicFile`], which checks the type
+//! of the destination again at the rename.
+
+use std::path::{Component, Path, PathBuf};
+
+use super::regular_file::{describe_file_type, same_file};
+
+/// Why an output path is refused ([`OutputPlan::output`]).
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum OutputError {
+    /// The output is one of the command's inputs.
+    #[error("{option} {path} is {what} {input}; refusing to overwrite an input (choose another output path)")]
+    IsInput {
+        /// The option (or role) that names the output (`--vtu`, `-o`).
+        option: String,
+        /// The output path.
+        path: PathBuf,
+        /// What the input is (`the input`, `the base`, `the scene file`).
+        what: String,
+        /// The input path.
+        input: PathBuf,
+    },
+    /// The output exists and is not a regular file.
+    #[error("{option} {path} is {what}; give the path of a file to write")]
+    NotRegular {
+        /// The option.
+        option: String,
+        /// The output path.
+        path: PathBuf,
+        /// What it is ("a directory", "a FIFO", ...).
+        what: &'static str,
+    },
+    /// The path names no file (`.`, `..`, empty, or ends in `/`).
+    #[error("{option} {path:?} names a folder, not a file; give the path of a file to write (e.g. {example})")]
+    NoFileName {
+        /// The option.
+        option: String,
+        /// The output path.
+        path: PathBuf,
+        /// An example path of the right kind.
+        example: String,
+    },
+    /// A folder the outputs go into exists as something else.
+    #[error("{option} {path} is {what}; give the path of a folder (created when missing)")]
+    NotAFolder {
+        /// The option.
+        option: String,
+        /// The path.
+        path: PathBuf,
+        /// What it is ("a regular file", "a FIFO", ...).
+        what: &'static str,
+    },
+    /// An ancestor of the output exists and is not a folder.
+    #[error("{option} {path}: {ancestor} is {what}, not a folder")]
+    AncestorNotFolder {
+        /// The option.
+        option: String,
+        /// The output path.
+        path: PathBuf,
+        /// The ancestor.
+        ancestor: PathBuf,
+        /// What it is.
+        what: &'static str,
+    },
+    /// Two outputs of the command name one file.
+    #[error("{option} {path} and {other_option} {other} name the same file; give each output its own path")]
+    SamePath {
+        /// The option declared second.
+        option: String,
+        /// Its path.
+        path: PathBuf,
+        /// The option declared first.
+        other_option: String,
+        /// Its path.
+        other: PathBuf,
+    },
+}
+
+/// The inputs and outputs of one command, checked against each other before anything is
+/// written (see the module docs).
+///
+/// ```
+/// use dcr_runtime::format::OutputPlan;
+/// let dir = tempfile::tempdir().unwrap();
+/// let base = dir.path().join("a.modes");
+/// std::fs::write(&base, b"base").unwrap();
+/// let mut plan = OutputPlan::new();
+/// plan.input("the base", &base);
+/// assert!(plan.output("--vtu", &dir.path().join("a.vtu")).is_ok());
+/// assert!(plan.output("--gltf", &base).is_err()); // the input
+/// assert!(plan.output("--png", &dir.path().join("./a.vtu")).is_err()); // --vtu's path
+/// ```
+#[derive(Clone, Debug, Default)]
+pub struct OutputPlan {
+    inputs: Vec<(String, PathBuf)>,
+    /// (option, path as given, normalised path).
+    outputs: Vec<(String, PathBuf, PathBuf)>,
+}
+
+impl OutputPlan {
+    /// An empty plan.
+    pub fn new() -> OutputPlan {
+        OutputPlan::default()
+    }
+
+    /// Declares an input the outputs must not overwrite; `what` says what it is in messages
+    /// (`the input`, `the base`, `the scene file`). Declare the inputs before the outputs.
+    pub fn input(&mut self, what: &str, path: &Path) -> &mut OutputPlan {
+        self.inputs.push((what.to_string(), path.to_path_buf()));
+        self
+    }
+
+    /// Declares and checks an output named by `option`.
+    ///
+    /// # Errors
+    /// [`OutputError`]: the output is an input, exists as a non-regular file, names no file,
+    /// sits under a non-folder, or is the path of an output declared before.
+    pub fn output(&mut self, option: &str, path: &Path) -> Result<(), OutputError> {
+        check_output_path(option, path, &self.inputs)?;
+        let norm = normalise(path);
+        for (other_option, other, other_norm) in &self.outputs {
+            if *other_norm == norm || same_file(other, path) {
+                return Err(OutputError::SamePath {
+                    option: option.to_string(),
+                    path: path.to_path_buf(),
+                    other_option: other_option.clone(),
+                    other: other.clone(),
+                });
+            }
+        }
+        self.outputs
+            .push((option.to_string(), path.to_path_buf(), norm));
+        Ok(())
+    }
+
+    /// Declares and checks a folder named by `option` that outputs will be written into
+    /// (created when missing): it must not exist as anything but a folder, and its nearest
+    /// existing ancestor must be a folder.
+    ///
+    /// # Errors
+    /// [`OutputError::NotAFolder`] or [`OutputError::AncestorNotFolder`].
+    pub fn output_folder(&mut self, option: &str, dir: &Path) -> Result<(), OutputError> {
+        match std::fs::metadata(dir) {
+            Ok(meta) if meta.is_dir() => return Ok(()),
+            Ok(meta) => {
+                return Err(OutputError::NotAFolder {
+                    option: option.to_string(),
+                    path: dir.to_path_buf(),
+                    what: describe_file_type(meta.file_type()),
+                })
+            }
+            Err(_) => {}
+        }
+        check_ancestors(option, dir, dir.parent())
+    }
+
+    /// The outputs declared so far: (option, path).
+    pub fn outputs(&self) -> impl Iterator<Item = (&str, &Path)> {
+        self.outputs.iter().map(|(o, p, _)| (o.as_str(), p.as_path()))
+    }
+}
+
+/// Checks one output path against `inputs` (what, path): not an input, not an existing
+/// non-regular file, names a file, its nearest existing ancestor a folder.
+fn check_output_path(
+    option: &str,
+    path: &Path,
+    inputs: &[(String, PathBuf)],
+) -> Result<(), OutputError> {
+    let names_file = !path.as_os_str().is_empty()
+        && !path.as_os_str().to_string_lossy().ends_with('/')
+        && matches!(path.components().next_back(), Some(Component::Normal(_)));
+    if !names_file {
+        return Err(OutputError::NoFileName {
+            option: option.to_string(),
+            path: path.to_path_buf(),
+            example: "out/result.ext".into(),
+        });
+    }
+    for (what, input) in inputs {
+        if same_file(path, input) {
+            return Err(OutputError::IsInput {
+                option: option.to_string(),
+                path: path.to_path_buf(),
+                what: what.clone(),
+                input: input.clone(),
+            });
+        }
+    }
+    if let Ok(meta) = std::fs::metadata(path) {
+        if !meta.is_file() {
+            return Err(OutputError::NotRegular {
+                option: option.to_string(),
+                path: path.to_path_buf(),
+                what: describe_file_type(meta.file_type()),
+            });
+        }
+    }
+    check_ancestors(option, path, path.parent())
+}
+
+/// The nearest existing ancestor of `path` (from `first` up) must be a folder.
+fn check_ancestors(option: &str, path: &Path, first: Option<&Path>) -> Result<(), OutputError> {
+    let mut ancestor = first;
+    while let Some(dir) = ancestor.filter(|d| !d.as_os_str().is_empty()) {
+        match std::fs::metadata(dir) {
+            Ok(meta) if meta.is_dir() => return Ok(()),
+            Ok(meta) => {
+                return Err(OutputError::AncestorNotFolder {
+                    option: option.to_string(),
+                    path: path.to_path_buf(),
+                    ancestor: dir.to_path_buf(),
+                    what: describe_file_type(meta.file_type()),
+                })
+            }
+            Err(_) => ancestor = dir.parent(),
+        }
+    }
+    Ok(())
+}
+
+/// `path` made absolute with its longest existing ancestor canonicalised (links and `..`
+/// resolved by the file system) and the rest resolved lexically, so two spellings of one
+/// file not yet written compare equal.
+fn normalise(path: &Path) -> PathBuf {
+    let abs = if path.is_absolute() {
+        path.to_path_buf()
+    } else {
+        std::env::current_dir()
+            .unwrap_or_else(|_| PathBuf::from("/"))
+            .join(path)
+    };
+    let mut existing = abs.as_path();
+    let mut rest = Vec::new();
+    loop {
+        if let Ok(c) = existing.canonicalize() {
+            let mut out = c;
+            for part in rest.iter().rev() {
+                match part {
+                    Component::ParentDir => {
+                        out.pop();
+                    }
+                    Component::CurDir => {}
+                    other => out.push(other.as_os_str()),
+                }
+            }
+            return out;
+        }
+        match (existing.parent(), existing.components().next_back()) {
+            (Some(parent), Some(last)) => {
+                rest.push(last);
+                existing = parent;
+            }
+            _ => return abs,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn spellings_of_one_new_file_collide() {
+        let dir = tempfile::tempdir().unwrap();
+        let d = dir.path();
+        std::fs::create_dir(d.join("sub")).unwrap();
+        let mut plan = OutputPlan::new();
+        plan.output("--vtu", &d.join("x")).unwrap();
+        let e = plan.output("--gltf", &d.join("sub/../x")).unwrap_err();
+        assert!(e.to_string().contains("--vtu") && e.to_string().contains("--gltf"), "{e}");
+        let e = plan.output("--png", &d.join("./new/../x")).unwrap_err();
+        assert!(matches!(e, OutputError::SamePath { .. }), "{e}");
+        plan.output("--png", &d.join("y")).unwrap();
+    }
+
+    #[test]
+    fn inputs_folders_and_fifos_are_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let d = dir.path();
+        let base = d.join("b.modes");
+        std::fs::write(&base, b"x").unwrap();
+        std::fs::create_dir(d.join("sub")).unwrap();
+        let mut plan = OutputPlan::new();
+        plan.input("the base", &base);
+        for p in [d.join("sub/../b.modes"), d.join("sub/./../b.modes")] {
+            assert!(matches!(
+                plan.output("-o", &p),
+                Err(OutputError::IsInput { .. })
+            ));
+        }
+        assert!(matches!(
+            plan.output("-o", &d.join("sub")),
+            Err(OutputError::NotRegular { .. })
+        ));
+        assert!(matches!(
+            plan.output("-o", Path::new(".")),
+            Err(OutputError::NoFileName { .. })
+        ));
+        assert!(matches!(
+            plan.output("-o", &d.join("b.modes/x")),
+            Err(OutputError::AncestorNotFolder { .. })
+        ));
+        #[cfg(unix)]
+        {
+            std::os::unix::fs::symlink(&base, d.join("link")).unwrap();
+            assert!(matches!(
+                plan.output("-o", &d.join("link")),
+                Err(OutputError::IsInput { .. })
+            ));
+        }
+        assert!(plan.output_folder("--out", &base).is_err());
+        assert!(plan.output_folder("--out", &d.join("new/deeper")).is_ok());
+    }
+}
