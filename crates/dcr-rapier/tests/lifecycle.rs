@@ -99,14 +99,19 @@ macro_rules! backend_tests {
                     ball
                 }
 
-                /// A heavy ball falling on the plate at (0.25, 0.3) from 0.3 m at 3 m/s.
-                fn drop_ball(&mut self) -> RigidBodyHandle {
+                /// A heavy ball falling on the plate at (x, 0.3) from 0.3 m at 3 m/s.
+                fn drop_ball_at(&mut self, x: Real) -> RigidBodyHandle {
                     let b = self.add(
-                        Vector::new(0.25, 0.3, 0.3),
+                        Vector::new(x, 0.3, 0.3),
                         ColliderBuilder::ball(0.1).density(5000.0),
                     );
                     self.world.bodies[b].set_linvel(Vector::new(0.0, 0.0, -3.0), true);
                     b
+                }
+
+                /// [`Scene::drop_ball_at`] x = 0.25 m.
+                fn drop_ball(&mut self) -> RigidBodyHandle {
+                    self.drop_ball_at(0.25)
                 }
 
                 fn step(&mut self) -> usize {
@@ -161,7 +166,7 @@ macro_rules! backend_tests {
                 s.drop_ball();
                 assert!(s.until_event(ball).is_none(), "disabled: no events");
                 s.dcr.set_object_enabled(h, true).unwrap();
-                s.drop_ball();
+                s.drop_ball_at(0.5);
                 assert!(s.until_event(ball).is_some(), "enabled again: events");
                 s.dcr.set_object_gain(h, 0.5).unwrap();
                 s.dcr.set_object_threshold(h, 0.2).unwrap();
@@ -173,7 +178,7 @@ macro_rules! backend_tests {
                 assert!(s.dcr.set_object_threshold(h, 1.0).is_err());
                 assert_eq!(s.dcr.object_of_body(s.plate), None);
                 // No object: stepping reads nothing and issues nothing.
-                s.drop_ball();
+                s.drop_ball_at(0.1);
                 assert!(s.until_event(ball).is_none());
                 let h2 = s
                     .dcr
@@ -189,7 +194,7 @@ macro_rules! backend_tests {
                 for _ in 0..30 {
                     s.step();
                 }
-                s.drop_ball();
+                s.drop_ball_at(0.65);
                 let e = s.until_event(ball).expect("the new object answers");
                 assert_eq!(e.object, h2);
             }

@@ -215,25 +215,6 @@ pub struct DcrRapier {
     step: u64,
     /// The last dt whose re-derivation was refused (reported once per value).
     refused_dt: Option<f64>,
-    /// Tells the world rapier's gravity (m/s², world frame) for the support compensation of
-    /// [`ApplyMode::AfterStep`] ([`dcr_runtime::WorldParams::gravity`]): a resting body pushed
-    /// after the step also gets the support its contact would have given it during the next
-    /// step, so it ends that step with the response's Δv rather than Δv − g h. Ignored (zero) in
-    /// the other modes, where rapier's contact carries the body. O(1); [`DcrRapier::step`]
-    /// calls it with `PhysicsWorld::gravity`, callers of [`DcrRapier::after_step`] call it at
-    /// set-up and when gravity changes.
-    pub fn set_gravity(&mut self, gravity: Vector) {
-        let g = if self.params.apply == ApplyMode::AfterStep {
-            arr(gravity)
-        } else {
-            [0.0; 3]
-        };
-        if g != self.world.params().gravity {
-            // Finite gravity only; rapier's own step fails on a non-finite one anyway.
-            let _ = self.world.set_gravity(g);
-        }
-    }
-
     /// Steps the world took with an h other than rapier's dt.
     h_mismatch_steps: u64,
     /// Whether the coming `after_step` runs with an h other than rapier's dt.
@@ -483,6 +464,25 @@ impl DcrRapier {
                 self.h_mismatch_steps += 1;
                 self.pending_mismatch = true;
             }
+        }
+    }
+
+    /// Tells the world rapier's gravity (m/s², world frame) for the support compensation of
+    /// [`ApplyMode::AfterStep`] ([`dcr_runtime::WorldParams::gravity`]): a resting body pushed
+    /// after the step also gets the support its contact would have given it during the next
+    /// step, so it ends that step with the response's Δv rather than Δv − g h. Ignored (zero) in
+    /// the other modes, where rapier's contact carries the body. O(1); [`DcrRapier::step`]
+    /// calls it with `PhysicsWorld::gravity`, callers of [`DcrRapier::after_step`] call it at
+    /// set-up and when gravity changes.
+    pub fn set_gravity(&mut self, gravity: Vector) {
+        let g = if self.params.apply == ApplyMode::AfterStep {
+            arr(gravity)
+        } else {
+            [0.0; 3]
+        };
+        if g != self.world.params().gravity {
+            // Finite gravity only; rapier's own step fails on a non-finite one anyway.
+            let _ = self.world.set_gravity(g);
         }
     }
 
