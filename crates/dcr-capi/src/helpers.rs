@@ -15,8 +15,8 @@ use crate::status::{DcrStatus, Failure};
 /// inertia). Rotate an object-frame `DcrContactResponse.normal` to the world frame first.
 ///
 /// # Errors
-/// `DCR_STATUS_INVALID_ARGUMENT` for a negative or non-finite `inv_mass`;
-/// `DCR_STATUS_NULL_POINTER`.
+/// `DCR_STATUS_INVALID_ARGUMENT` for a negative or non-finite `inv_mass`, or a non-finite
+/// element of `inv_inertia`, `r` or `n`; `DCR_STATUS_NULL_POINTER`.
 ///
 /// # Safety
 /// `inv_inertia` must be NULL or 9 readable doubles; `r`, `n` NULL or 3 readable doubles;
@@ -37,9 +37,12 @@ pub unsafe extern "C" fn dcr_effective_mass(
         }
         // SAFETY: caller contract (9 readable doubles; NULL is checked).
         let i = unsafe { arg_slice(inv_inertia, 9, "inv_inertia")? };
+        check_finite(i, "inv_inertia", "1/(kg·m²)")?;
         let inv_inertia = [[i[0], i[1], i[2]], [i[3], i[4], i[5]], [i[6], i[7], i[8]]];
         // SAFETY: caller contract (3 readable doubles each; NULL is checked).
         let (r, n) = unsafe { (read_vec3(r, "r")?, read_vec3(n, "n")?) };
+        check_finite(&r, "r", "m")?;
+        check_finite(&n, "n", "")?;
         // SAFETY: caller contract (NULL is checked).
         unsafe { write_out(out, effective_mass(inv_mass, inv_inertia, r, n), "out") }
     })
@@ -50,7 +53,8 @@ pub unsafe extern "C" fn dcr_effective_mass(
 /// n`. Apply it at the contact point with the engine's apply-impulse-at-point.
 ///
 /// # Errors
-/// `DCR_STATUS_NULL_POINTER` for a NULL `n` or `out`.
+/// `DCR_STATUS_INVALID_ARGUMENT` for a negative or non-finite `m_eff`, a non-finite `delta_v`
+/// or a non-finite element of `n`; `DCR_STATUS_NULL_POINTER` for a NULL `n` or `out`.
 ///
 /// # Safety
 /// `n` must be NULL or 3 readable doubles; `out` NULL or 3 writable doubles.
@@ -62,11 +66,33 @@ pub unsafe extern "C" fn dcr_response_impulse(
     out: *mut f64,
 ) -> DcrStatus {
     guard("dcr_response_impulse", || {
+        if !(m_eff >= 0.0 && m_eff.is_finite()) {
+            return Err(Failure::invalid(format!(
+                "`m_eff` is {m_eff} kg (must be finite and ≥ 0)"
+            )));
+        }
+        if !delta_v.is_finite() {
+            return Err(Failure::invalid(format!(
+                "`delta_v` is {delta_v} m/s (must be finite)"
+            )));
+        }
         // SAFETY: caller contract (3 readable doubles; NULL is checked).
         let n = unsafe { read_vec3(n, "n")? };
+        check_finite(&n, "n", "")?;
         let j = response_impulse(m_eff, delta_v, n);
         crate::ptr::check_ptr(out, "out")?;
         // SAFETY: `out` is non-null and aligned (checked), 3 writable doubles per contract.
         unsafe { write_out(out.cast::<[f64; 3]>(), j, "out") }
     })
+}
+
+/// `DCR_STATUS_INVALID_ARGUMENT` unless every element of `v` is finite.
+fn check_finite(v: &[f64], name: &str, unit: &str) -> Result<(), Failure> {
+    match v.iter().position(|x| !x.is_finite()) {
+        None => Ok(()),
+        Some(k) => Err(Failure::invalid(format!(
+            "`{name}[{k}]` is {} {unit} (must be finite)",
+            v[k]
+        ))),
+    }
 }

@@ -5,8 +5,8 @@ use std::mem::{align_of, offset_of, size_of};
 use std::sync::Arc;
 
 use dcr_runtime::{
-    BodyState, ContactReport, DcrWorld as RtWorld, ElasticHandle, ElasticObjectDesc, ImpulseEvent,
-    ObjectStepInfo, WorldStepInfo,
+    BaseSupport, BodyState, ContactReport, DcrWorld as RtWorld, ElasticHandle, ElasticObjectDesc,
+    ImpulseEvent, ObjectStepInfo, ObjectTotals, WorldStepInfo,
 };
 
 use crate::guard::guard;
@@ -151,7 +151,7 @@ const EVENT_ZERO_COPY: bool = size_of::<ImpulseEvent>() == size_of::<DcrImpulseE
     && offset_of!(ImpulseEvent, object) == offset_of!(DcrImpulseEvent, object)
     && offset_of!(ImpulseEvent, served_by) == offset_of!(DcrImpulseEvent, served_by)
     && offset_of!(ImpulseEvent, chained) == offset_of!(DcrImpulseEvent, chained)
-    // A 4-byte handle holding one u32 (its index) has that u32 at offset 0.
+    // An 8-byte handle holding one u64 (index and generation).
     && size_of::<ElasticHandle>() == size_of::<DcrElasticHandle>()
     && SERVED_BY_CODES;
 
@@ -169,7 +169,7 @@ fn event(e: &ImpulseEvent) -> DcrImpulseEvent {
         normal: e.normal,
         delta_v: e.delta_v,
         contact: e.contact,
-        object: e.object.index(),
+        object: e.object.to_bits(),
         served_by: served_by_code(e.served_by),
         chained: e.chained,
     }
@@ -288,18 +288,70 @@ fn object_step_info(i: &ObjectStepInfo) -> DcrObjectStepInfo {
     }
 }
 
-/// The world's handle for `handle`, or `DCR_STATUS_INVALID_HANDLE`.
+/// The world's handle for `handle`, or `DCR_STATUS_INVALID_HANDLE` (removed or never issued).
 fn handle_of(world: &RtWorld, handle: DcrElasticHandle) -> Result<ElasticHandle, Failure> {
-    if (handle as usize) < world.num_objects() {
-        Ok(ElasticHandle::from_index(handle))
+    let h = ElasticHandle::from_bits(handle);
+    if world.contains(h) {
+        Ok(h)
     } else {
         Err(Failure::new(
             DcrStatus::InvalidHandle,
             format!(
-                "elastic object {handle} does not exist (the world has {} objects)",
+                "elastic object {handle} (slot {}, generation {}) does not exist: removed, or \
+                 not from this world (it has {} objects)",
+                h.index(),
+                h.generation(),
                 world.num_objects()
             ),
         ))
+    }
+}
+
+/// Running totals of one elastic object since it was added (`dcr_world_object_totals`), apart
+/// from the per-step counters of `DcrObjectStepInfo`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct DcrObjectTotals {
+    /// Engine impacts on the object.
+    pub impacts: u64,
+    /// Chained impacts on the object.
+    pub chained_impacts: u64,
+    /// Steps on which the object's response ran.
+    pub queries: u64,
+    /// Impulse events the object's response issued.
+    pub events: u64,
+    /// Resting contacts farther than `max_map_distance` from the base's surface (no response):
+    /// a contact in another frame than the base's, or far from its mesh.
+    pub contacts_unmapped: u64,
+    /// Impacts farther than `max_map_distance` from the surface (ignored).
+    pub impacts_unmapped: u64,
+    /// Resting contacts a transfer-table response served with the modal method instead.
+    pub contacts_table_fallback: u64,
+    /// Steps the object spent disabled.
+    pub disabled_steps: u64,
+}
+
+/// How an object's base is held compared with its body (`dcr_world_object_base_support`).
+pub type DcrBaseSupport = u32;
+/// A static body with fixed nodes, or a dynamic body with a free-floating base.
+pub const DCR_BASE_SUPPORT_CONSISTENT: DcrBaseSupport = 0;
+/// A dynamic body with a base baked with fixed nodes: right for an object standing on what
+/// holds those nodes (a table on a floor), wrong for one in flight.
+pub const DCR_BASE_SUPPORT_DYNAMIC_BODY_FIXED_BASE: DcrBaseSupport = 1;
+/// A static body with a free-floating base: where the object is held, its response is that of
+/// a floating object (bake with fixed nodes at its supports).
+pub const DCR_BASE_SUPPORT_STATIC_BODY_FREE_BASE: DcrBaseSupport = 2;
+
+fn object_totals(t: &ObjectTotals) -> DcrObjectTotals {
+    DcrObjectTotals {
+        impacts: t.impacts,
+        chained_impacts: t.chained_impacts,
+        queries: t.queries,
+        events: t.events,
+        contacts_unmapped: t.contacts_unmapped,
+        impacts_unmapped: t.impacts_unmapped,
+        contacts_table_fallback: t.contacts_table_fallback,
+        disabled_steps: t.disabled_steps,
     }
 }
 
@@ -366,14 +418,17 @@ pub unsafe extern "C" fn dcr_world_free(world: *mut DcrWorld) {
 }
 
 /// Adds an elastic object built from `desc` (its model, response parameters, engine body,
-/// static or dynamic, gain, pose). `*out` receives its handle: the number of objects added
-/// before it. Add a dynamic object after the one it rests on (chains only go forward).
+/// static or dynamic, gain, pose). `*out` receives its handle (a free slot of a removed object
+/// with that slot's next generation, else a new slot: k for the k-th object while nothing is
+/// removed). Add a dynamic object after the one it rests on (chains only go forward). How the
+/// base is held against the body is checked (`dcr_world_object_base_support`).
 ///
 /// # Errors
 /// `DCR_STATUS_INVALID_ARGUMENT` for a response parameter out of range, a negative or
-/// non-finite gain, a body that already carries an object, a transfer table refused by its
-/// policy, or a wrong `struct_size` (the message says which); `DCR_STATUS_NULL_POINTER` for a
-/// NULL argument or `desc->model`.
+/// non-finite gain, a pose translation that is not finite or beyond `DCR_MAX_TRANSLATION`, a
+/// body that already carries an object, a transfer table refused by its policy, or a wrong
+/// `struct_size` (the message says which); `DCR_STATUS_NULL_POINTER` for a NULL argument or
+/// `desc->model`.
 ///
 /// # Safety
 /// `world` must be NULL or a live handle not used by another thread during the call; `desc`
@@ -409,13 +464,13 @@ pub unsafe extern "C" fn dcr_world_add_object(
         rd.response = response;
         rd.dynamic = d.dynamic;
         rd.gain = d.gain;
-        rd.pose = d.pose.into();
+        rd.pose = d.pose.checked("desc.pose")?;
         let h = w
             .world
             .add_object(rd)
             .map_err(|e| Failure::invalid(e.to_string()))?;
         // SAFETY: `out` was checked above.
-        unsafe { out.write(h.index()) };
+        unsafe { out.write(h.to_bits()) };
         Ok(())
     })
 }
@@ -424,7 +479,9 @@ pub unsafe extern "C" fn dcr_world_add_object(
 /// body's pose after the rigid-body step.
 ///
 /// # Errors
-/// `DCR_STATUS_INVALID_HANDLE` for a handle not from this world; `DCR_STATUS_NULL_POINTER`.
+/// `DCR_STATUS_INVALID_HANDLE` for a removed handle or one not from this world;
+/// `DCR_STATUS_INVALID_ARGUMENT` for a translation component that is not finite or beyond
+/// `DCR_MAX_TRANSLATION` (the pose is unchanged); `DCR_STATUS_NULL_POINTER`.
 ///
 /// # Safety
 /// `world` must be NULL or a live handle not used by another thread; `pose` NULL or valid.
@@ -440,7 +497,7 @@ pub unsafe extern "C" fn dcr_world_set_pose(
         // SAFETY: caller contract (NULL is checked).
         let pose = unsafe { *arg_ref(pose, "pose")? };
         let h = handle_of(&w.world, object)?;
-        w.world.set_pose(h, pose.into());
+        w.world.set_pose(h, pose.checked("pose")?);
         Ok(())
     })
 }
@@ -713,6 +770,196 @@ pub unsafe extern "C" fn dcr_world_object_response_info(
     })
 }
 
+/// Removes an elastic object: its response and counters are dropped, its body may carry
+/// another object, and `object` becomes stale (every call with it returns
+/// `DCR_STATUS_INVALID_HANDLE`, even after its slot is reused). Event arrays already returned
+/// keep their values until the next step. Not a per-step call (it re-indexes the objects).
+///
+/// # Errors
+/// `DCR_STATUS_INVALID_HANDLE` for an already removed or foreign handle;
+/// `DCR_STATUS_NULL_POINTER`.
+///
+/// # Safety
+/// `world` must be NULL or a live handle not used by another thread during the call.
+#[no_mangle]
+pub unsafe extern "C" fn dcr_world_remove_object(
+    world: *mut DcrWorld,
+    object: DcrElasticHandle,
+) -> DcrStatus {
+    guard("dcr_world_remove_object", || {
+        // SAFETY: caller contract (NULL is checked).
+        let w = unsafe { arg_mut(world, "world")? };
+        let h = handle_of(&w.world, object)?;
+        w.world
+            .remove_object(h)
+            .map_err(|e| Failure::new(DcrStatus::InvalidHandle, e.to_string()))
+    })
+}
+
+/// Enables (`enabled` true) or disables an object from the next step on. A disabled object's
+/// contacts are ignored, it issues no events, impulses on its body do not chain into it, and
+/// its filters restart at rest when it is enabled again; its handle and settings are kept.
+///
+/// # Errors
+/// `DCR_STATUS_INVALID_HANDLE`; `DCR_STATUS_NULL_POINTER`.
+///
+/// # Safety
+/// `world` must be NULL or a live handle not used by another thread during the call.
+#[no_mangle]
+pub unsafe extern "C" fn dcr_world_set_object_enabled(
+    world: *mut DcrWorld,
+    object: DcrElasticHandle,
+    enabled: bool,
+) -> DcrStatus {
+    guard("dcr_world_set_object_enabled", || {
+        // SAFETY: caller contract (NULL is checked).
+        let w = unsafe { arg_mut(world, "world")? };
+        let h = handle_of(&w.world, object)?;
+        w.world
+            .set_enabled(h, enabled)
+            .map_err(|e| Failure::invalid(e.to_string()))
+    })
+}
+
+/// Sets an object's gain (dimensionless, ≥ 0: the scale of the velocity changes its responses
+/// ask for) from the next step on.
+///
+/// # Errors
+/// `DCR_STATUS_INVALID_HANDLE`; `DCR_STATUS_INVALID_ARGUMENT` for a negative or non-finite
+/// gain (the old one is kept); `DCR_STATUS_NULL_POINTER`.
+///
+/// # Safety
+/// `world` must be NULL or a live handle not used by another thread during the call.
+#[no_mangle]
+pub unsafe extern "C" fn dcr_world_set_object_gain(
+    world: *mut DcrWorld,
+    object: DcrElasticHandle,
+    gain: f64,
+) -> DcrStatus {
+    guard("dcr_world_set_object_gain", || {
+        // SAFETY: caller contract (NULL is checked).
+        let w = unsafe { arg_mut(world, "world")? };
+        let h = handle_of(&w.world, object)?;
+        w.world
+            .set_gain(h, gain)
+            .map_err(|e| Failure::invalid(e.to_string()))
+    })
+}
+
+/// Sets an object's impact threshold (N·s, ≥ 0: smaller impacts are ignored) from the next
+/// step on, for the classification and the response.
+///
+/// # Errors
+/// `DCR_STATUS_INVALID_HANDLE`; `DCR_STATUS_INVALID_ARGUMENT` for a negative or non-finite
+/// threshold (the old one is kept); `DCR_STATUS_NULL_POINTER`.
+///
+/// # Safety
+/// `world` must be NULL or a live handle not used by another thread during the call.
+#[no_mangle]
+pub unsafe extern "C" fn dcr_world_set_object_threshold(
+    world: *mut DcrWorld,
+    object: DcrElasticHandle,
+    threshold: f64,
+) -> DcrStatus {
+    guard("dcr_world_set_object_threshold", || {
+        // SAFETY: caller contract (NULL is checked).
+        let w = unsafe { arg_mut(world, "world")? };
+        let h = handle_of(&w.world, object)?;
+        w.world
+            .set_impact_threshold(h, threshold)
+            .map_err(|e| Failure::invalid(e.to_string()))
+    })
+}
+
+/// Changes the world's rigid-body step h (s) when the engine's step changes: every object's
+/// response is rebuilt for it (the filters' exact coefficients re-derived; a transfer table
+/// baked for another h refused or replaced by the modal method by its policy). Not a per-step
+/// call: compare the engine's step with the world's h and call it on change.
+///
+/// # Errors
+/// `DCR_STATUS_INVALID_ARGUMENT` for a non-positive or non-finite h, or when a response cannot
+/// serve it (a transfer table under `DCR_TABLE_POLICY_REFUSE`); the world is unchanged then.
+/// `DCR_STATUS_NULL_POINTER`.
+///
+/// # Safety
+/// `world` must be NULL or a live handle not used by another thread during the call.
+#[no_mangle]
+pub unsafe extern "C" fn dcr_world_set_h(world: *mut DcrWorld, h: f64) -> DcrStatus {
+    guard("dcr_world_set_h", || {
+        // SAFETY: caller contract (NULL is checked).
+        let w = unsafe { arg_mut(world, "world")? };
+        w.world.set_h(h).map_err(|e| Failure::invalid(e.to_string()))
+    })
+}
+
+/// `*out` = the world's rigid-body step h (s).
+///
+/// # Errors
+/// `DCR_STATUS_NULL_POINTER` for a NULL argument.
+///
+/// # Safety
+/// `world` must be NULL or a live handle; `out` NULL or valid for a write.
+#[no_mangle]
+pub unsafe extern "C" fn dcr_world_h(world: *const DcrWorld, out: *mut f64) -> DcrStatus {
+    guard("dcr_world_h", || {
+        // SAFETY: caller contract (NULL is checked).
+        let w = unsafe { arg_ref(world, "world")? };
+        // SAFETY: caller contract (NULL is checked).
+        unsafe { write_out(out, w.world.params().h, "out") }
+    })
+}
+
+/// Fills `out` with an object's running totals since it was added (impacts, queries, events,
+/// unmapped contacts, table fallbacks, disabled steps).
+///
+/// # Errors
+/// `DCR_STATUS_INVALID_HANDLE`; `DCR_STATUS_NULL_POINTER`.
+///
+/// # Safety
+/// `world` must be NULL or a live handle; `out` NULL or valid for a write.
+#[no_mangle]
+pub unsafe extern "C" fn dcr_world_object_totals(
+    world: *const DcrWorld,
+    object: DcrElasticHandle,
+    out: *mut DcrObjectTotals,
+) -> DcrStatus {
+    guard("dcr_world_object_totals", || {
+        // SAFETY: caller contract (NULL is checked).
+        let w = unsafe { arg_ref(world, "world")? };
+        let h = handle_of(&w.world, object)?;
+        // SAFETY: caller contract (NULL is checked).
+        unsafe { write_out(out, object_totals(&w.world.object_totals(h)), "out") }
+    })
+}
+
+/// `*out` = how an object's base is held compared with its body, `DCR_BASE_SUPPORT_*` (checked
+/// at `dcr_world_add_object`; not refused either way).
+///
+/// # Errors
+/// `DCR_STATUS_INVALID_HANDLE`; `DCR_STATUS_NULL_POINTER`.
+///
+/// # Safety
+/// `world` must be NULL or a live handle; `out` NULL or valid for a write.
+#[no_mangle]
+pub unsafe extern "C" fn dcr_world_object_base_support(
+    world: *const DcrWorld,
+    object: DcrElasticHandle,
+    out: *mut DcrBaseSupport,
+) -> DcrStatus {
+    guard("dcr_world_object_base_support", || {
+        // SAFETY: caller contract (NULL is checked).
+        let w = unsafe { arg_ref(world, "world")? };
+        let h = handle_of(&w.world, object)?;
+        let code = match w.world.base_support(h) {
+            BaseSupport::Consistent => DCR_BASE_SUPPORT_CONSISTENT,
+            BaseSupport::DynamicBodyFixedBase { .. } => DCR_BASE_SUPPORT_DYNAMIC_BODY_FIXED_BASE,
+            BaseSupport::StaticBodyFreeBase => DCR_BASE_SUPPORT_STATIC_BODY_FREE_BASE,
+        };
+        // SAFETY: caller contract (NULL is checked).
+        unsafe { write_out(out, code, "out") }
+    })
+}
+
 /// `*out` = the number of elastic objects in the world.
 ///
 /// # Errors
@@ -757,7 +1004,7 @@ pub unsafe extern "C" fn dcr_world_object_of_body(
             )
         })?;
         // SAFETY: caller contract (NULL is checked).
-        unsafe { write_out(out, h.index(), "out") }
+        unsafe { write_out(out, h.to_bits(), "out") }
     })
 }
 

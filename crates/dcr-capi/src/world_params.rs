@@ -9,9 +9,11 @@ use crate::ptr::{check_struct_size, write_out};
 use crate::response_params::DcrResponseParams;
 use crate::status::{DcrStatus, Failure};
 
-/// An elastic object of a world: the number of objects added before it (0, 1, 2, …). Handles
-/// are never reused (objects are not removed).
-pub type DcrElasticHandle = u32;
+/// An elastic object of a world: a slot index (low 32 bits) and the slot's generation (high 32
+/// bits). While nothing is removed, the k-th object added has handle k. `dcr_world_remove_object`
+/// bumps the slot's generation: the removed object's handle is stale for ever (every call with
+/// it returns `DCR_STATUS_INVALID_HANDLE`), even after the slot is reused by a later object.
+pub type DcrElasticHandle = u64;
 
 /// A rigid transform from an object's frame (the frame of the mesh its base was baked from) to
 /// the world frame: `x_world = R(rotation) x_object + translation`.
@@ -24,6 +26,26 @@ pub struct DcrPose {
     pub rotation: [f64; 4],
     /// Position of the object frame's origin in the world (m).
     pub translation: [f64; 3],
+}
+
+/// Largest |translation| component a pose may have (m): beyond it an f64 position resolves
+/// less than 0.1 µm, and products with it overflow sooner.
+pub const DCR_MAX_TRANSLATION: f64 = 1e9;
+
+impl DcrPose {
+    /// The runtime's pose, or `DCR_STATUS_INVALID_ARGUMENT` for a translation component that is
+    /// not finite or beyond `DCR_MAX_TRANSLATION` (a non-finite or zero quaternion is the
+    /// identity rotation, documented on the field).
+    pub(crate) fn checked(&self, name: &str) -> Result<Pose, crate::status::Failure> {
+        for (k, &t) in self.translation.iter().enumerate() {
+            if !(t.abs() <= DCR_MAX_TRANSLATION) {
+                return Err(crate::status::Failure::invalid(format!(
+                    "`{name}.translation[{k}]` is {t} m (must be finite and within ±{DCR_MAX_TRANSLATION:e} m)"
+                )));
+            }
+        }
+        Ok(Pose::new(self.rotation, self.translation))
+    }
 }
 
 impl From<DcrPose> for Pose {

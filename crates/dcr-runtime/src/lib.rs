@@ -106,5 +106,5 @@ pub use response::{
 pub use response::{peak_abs_projection, peak_abs_rows};
 pub use world::{
     BodyState, ClassifyParams, ContactReport, DcrWorld, ElasticHandle, ElasticObjectDesc,
-    EnergyInfo, ImpulseEvent, ObjectStepInfo, Pose, WorldError, WorldParams, WorldStepInfo,
+    BaseSupport, EnergyInfo, ImpulseEvent, ObjectStepInfo, ObjectTotals, Pose, WorldError, WorldParams, WorldStepInfo,
 };

@@ -64,6 +64,10 @@ pub struct AdapterStepInfo {
     /// hook (the bodies parted before the solve); their responses were applied after the step
     /// instead, as [`ApplyMode::AfterStep`] does.
     pub replay_missed: u32,
+    /// Whether the world stepped with an h other than rapier's dt because re-deriving the
+    /// responses for dt was refused (a transfer table under `TablePolicy::Refuse`; logged once
+    /// per dt as an error). See [`DcrRapier::sync_timestep`].
+    pub h_mismatch: bool,
 }
 
 /// Errors of [`DcrRapier::add_object`].
@@ -86,7 +90,7 @@ pub enum AdapterError {
         /// Generation of the handle.
         generation: u32,
     },
-    /// The world refused the object.
+    /// The world refused the object, the handle or the value.
     #[error(transparent)]
     World(#[from] WorldError),
 }
@@ -99,6 +103,23 @@ struct ObjectSlot {
     dynamic: bool,
     /// Impact threshold (N·s).
     threshold: f64,
+    /// Whether the object takes part in the steps.
+    enabled: bool,
+    /// Whether its unmapped contacts were reported (once per object).
+    warned_unmapped: bool,
+}
+
+impl ObjectSlot {
+    /// The threshold the impact-step gate uses: infinite while disabled (its points are still
+    /// recorded, so enabling it does not make its resting contacts look new).
+    #[inline]
+    fn gate_threshold(&self) -> f64 {
+        if self.enabled {
+            self.threshold
+        } else {
+            f64::INFINITY
+        }
+    }
 }
 
 /// A response replayed through the solver ([`ApplyMode::InSolver`]).
@@ -192,6 +213,12 @@ pub struct DcrRapier {
     replays: Vec<Replay>,
     info: AdapterStepInfo,
     step: u64,
+    /// The last dt whose re-derivation was refused (reported once per value).
+    refused_dt: Option<f64>,
+    /// Steps the world took with an h other than rapier's dt.
+    h_mismatch_steps: u64,
+    /// Whether the coming `after_step` runs with an h other than rapier's dt.
+    pending_mismatch: bool,
 }
 
 impl DcrRapier {
@@ -225,6 +252,9 @@ impl DcrRapier {
             replays: Vec::new(),
             info: AdapterStepInfo::default(),
             step: 0,
+            refused_dt: None,
+            h_mismatch_steps: 0,
+            pending_mismatch: false,
         })
     }
 
@@ -263,6 +293,8 @@ impl DcrRapier {
             body,
             dynamic: rb.is_dynamic(),
             threshold,
+            enabled: true,
+            warned_unmapped: false,
         });
         for &c in rb.colliders() {
             self.colliders.push((c, obj));
@@ -273,6 +305,12 @@ impl DcrRapier {
                 co.set_active_hooks(co.active_hooks() | ActiveHooks::MODIFY_SOLVER_CONTACTS);
             }
         }
+        self.rank_colliders();
+        Ok(handle)
+    }
+
+    /// Sorts `colliders` by handle and rebuilds `collider_rank` (set-up only).
+    fn rank_colliders(&mut self) {
         self.colliders.sort_by_key(|(c, _)| c.into_raw_parts());
         self.collider_rank.clear();
         for (k, &(c, _)) in self.colliders.iter().enumerate() {
@@ -282,7 +320,176 @@ impl DcrRapier {
             }
             self.collider_rank[i] = k as u32;
         }
-        Ok(handle)
+        // Graph nodes are searched again on the next pass.
+        self.nodes.clear();
+    }
+
+    /// The position of `handle` in `objects`, or the world's stale-handle error.
+    fn slot_of(&self, handle: ElasticHandle) -> Result<usize, AdapterError> {
+        self.objects
+            .iter()
+            .position(|o| o.handle == handle)
+            .filter(|_| self.world.contains(handle))
+            .ok_or_else(|| {
+                AdapterError::World(WorldError::StaleHandle {
+                    handle,
+                    why: "the object was removed or is not from this adapter",
+                })
+            })
+    }
+
+    /// Removes an elastic object (its world object, see [`DcrWorld::remove_object`]): its
+    /// handle becomes stale, its body's contacts are no longer read. The rigid body and its
+    /// colliders stay in rapier (remove them there if they go too). Responses of the last step
+    /// already replayed or applied are kept. Set-up-time call; the step after it does not
+    /// allocate.
+    ///
+    /// Removing rapier bodies needs no call here: the adapter reads only the contacts rapier
+    /// still has after its step, skips impulse events and in-solver replays for bodies no
+    /// longer in the body set, and an elastic object whose body was removed from rapier simply
+    /// has no contacts (remove it here to free its slot).
+    ///
+    /// # Errors
+    /// [`AdapterError::World`] with [`WorldError::StaleHandle`] for a removed or foreign handle.
+    pub fn remove_object(&mut self, handle: ElasticHandle) -> Result<(), AdapterError> {
+        let k = self.slot_of(handle)?;
+        self.world.remove_object(handle)?;
+        self.objects.remove(k);
+        let k = k as u32;
+        self.colliders.retain(|&(_, o)| o != k);
+        for (_, o) in &mut self.colliders {
+            if *o > k {
+                *o -= 1;
+            }
+        }
+        self.rank_colliders();
+        Ok(())
+    }
+
+    /// Enables or disables an elastic object from the next step on
+    /// ([`DcrWorld::set_enabled`]): a disabled object's contacts are not read, it issues no
+    /// events, and its filters restart at rest when it is enabled again. O(1).
+    ///
+    /// # Errors
+    /// [`AdapterError::World`] with [`WorldError::StaleHandle`].
+    pub fn set_object_enabled(
+        &mut self,
+        handle: ElasticHandle,
+        enabled: bool,
+    ) -> Result<(), AdapterError> {
+        let k = self.slot_of(handle)?;
+        self.world.set_enabled(handle, enabled)?;
+        self.objects[k].enabled = enabled;
+        Ok(())
+    }
+
+    /// Sets an elastic object's gain (dimensionless, ≥ 0) from the next step on
+    /// ([`DcrWorld::set_gain`]).
+    ///
+    /// # Errors
+    /// [`AdapterError::World`]: a stale handle or a negative or non-finite gain.
+    pub fn set_object_gain(&mut self, handle: ElasticHandle, gain: f64) -> Result<(), AdapterError> {
+        self.slot_of(handle)?;
+        self.world.set_gain(handle, gain)?;
+        Ok(())
+    }
+
+    /// Sets an elastic object's impact threshold (N·s, ≥ 0) from the next step on, for the
+    /// adapter's impact-step gate, the world's classification and the response
+    /// ([`DcrWorld::set_impact_threshold`]).
+    ///
+    /// # Errors
+    /// [`AdapterError::World`]: a stale handle or a negative or non-finite threshold.
+    pub fn set_object_threshold(
+        &mut self,
+        handle: ElasticHandle,
+        threshold: f64,
+    ) -> Result<(), AdapterError> {
+        let k = self.slot_of(handle)?;
+        self.world.set_impact_threshold(handle, threshold)?;
+        self.objects[k].threshold = threshold;
+        Ok(())
+    }
+
+    /// Changes the world's rigid-body step h to rapier's `dt` (s): every response re-derives
+    /// its filters for it ([`DcrWorld::set_h`]). Call it at set-up, or whenever
+    /// `integration_parameters.dt` changes; [`DcrRapier::sync_timestep`] is the per-step form.
+    ///
+    /// # Errors
+    /// [`AdapterError::World`] when a response cannot serve `dt` (a transfer table baked for
+    /// another h under `TablePolicy::Refuse`) or `dt` is not finite and > 0; nothing changes.
+    pub fn set_timestep(&mut self, dt: f64) -> Result<(), AdapterError> {
+        self.world.set_h(dt)?;
+        Ok(())
+    }
+
+    /// The per-step rail: when rapier's `dt` (s) differs from the world's h, re-derives every
+    /// response for it ([`DcrRapier::set_timestep`]; a warning through `log` once per new dt,
+    /// since the world was set up for another h). When that is refused (a transfer table
+    /// under `TablePolicy::Refuse`), logs an error once per dt, keeps the old h and counts the
+    /// step in [`AdapterStepInfo::h_mismatch`] and [`DcrRapier::h_mismatch_steps`]: never
+    /// silently. O(1) when dt equals h. [`DcrRapier::step`] calls it with
+    /// `integration_parameters.dt`; callers of [`DcrRapier::after_step`] call it before.
+    pub fn sync_timestep(&mut self, dt: f64) {
+        let h = self.world.params().h;
+        if dt == h {
+            self.refused_dt = None;
+            return;
+        }
+        // rapier's f32 dt widened: equal to h to f32 precision is the same step.
+        if (dt - h).abs() <= 1e-6 * h && super::from_f64(h) == super::from_f64(dt) {
+            return;
+        }
+        if self.refused_dt == Some(dt) {
+            self.h_mismatch_steps += 1;
+            self.pending_mismatch = true;
+            return;
+        }
+        match self.world.set_h(dt) {
+            Ok(()) => {
+                log::warn!(
+                    target: "dcr_rapier",
+                    "rapier's dt = {dt} s differs from the world's h = {h} s: the responses \
+                     were re-derived for dt (set WorldParams::h to rapier's dt to avoid this)"
+                );
+                self.refused_dt = None;
+            }
+            Err(e) => {
+                log::error!(
+                    target: "dcr_rapier",
+                    "rapier's dt = {dt} s differs from the world's h = {h} s and the responses \
+                     cannot be re-derived for it ({e}); they keep stepping with h"
+                );
+                self.refused_dt = Some(dt);
+                self.h_mismatch_steps += 1;
+                self.pending_mismatch = true;
+            }
+        }
+    }
+
+    /// Tells the world rapier's gravity (m/s², world frame) for the support compensation of
+    /// [`ApplyMode::AfterStep`] ([`dcr_runtime::WorldParams::gravity`]): a resting body pushed
+    /// after the step also gets the support its contact would have given it during the next
+    /// step, so it ends that step with the response's Δv rather than Δv − g h. Ignored (zero) in
+    /// the other modes, where rapier's contact carries the body. O(1); [`DcrRapier::step`]
+    /// calls it with `PhysicsWorld::gravity`, callers of [`DcrRapier::after_step`] call it at
+    /// set-up and when gravity changes.
+    pub fn set_gravity(&mut self, gravity: Vector) {
+        let g = if self.params.apply == ApplyMode::AfterStep {
+            arr(gravity)
+        } else {
+            [0.0; 3]
+        };
+        if g != self.world.params().gravity {
+            // Finite gravity only; rapier's own step fails on a non-finite one anyway.
+            let _ = self.world.set_gravity(g);
+        }
+    }
+
+    /// Steps the world took with an h other than rapier's dt because re-deriving was refused
+    /// ([`DcrRapier::sync_timestep`]).
+    pub fn h_mismatch_steps(&self) -> u64 {
+        self.h_mismatch_steps
     }
 
     /// The world (its objects, parameters, counters and energy accounts).
@@ -353,6 +560,7 @@ impl DcrRapier {
     ) -> &[ImpulseEvent] {
         self.info = AdapterStepInfo {
             step: self.step,
+            h_mismatch: std::mem::take(&mut self.pending_mismatch),
             ..Default::default()
         };
         self.step += 1;
@@ -368,7 +576,7 @@ impl DcrRapier {
         }
         self.info.world_stepped = true;
         for o in &self.objects {
-            if o.dynamic {
+            if o.dynamic && o.enabled {
                 if let Some(rb) = bodies.get(o.body) {
                     self.world.set_pose(o.handle, pose_of(rb.position()));
                 }
@@ -379,6 +587,7 @@ impl DcrRapier {
         self.info.reports = self.reports.len() as u32;
         self.info.bodies = self.states.len() as u32;
         self.info.events = n as u32;
+        self.warn_unmapped();
         match self.params.apply {
             ApplyMode::AfterStep => {
                 // A body's events come together (its contacts are reported together): look
@@ -402,9 +611,41 @@ impl DcrRapier {
     /// One full step of `world`: [`DcrRapier::before_step`], `step_with_events` with
     /// [`DcrRapier::hooks`], [`DcrRapier::after_step`].
     pub fn step(&mut self, world: &mut PhysicsWorld) -> &[ImpulseEvent] {
+        self.sync_timestep(to_f64(world.integration_parameters.dt));
+        self.set_gravity(world.gravity);
         self.before_step(&mut world.bodies);
         world.step_with_events(&self.hooks, &());
         self.after_step(&mut world.bodies, &world.colliders, &world.narrow_phase)
+    }
+
+    /// Logs, once per object, that some of its contacts could not be mapped onto its base
+    /// (farther than `max_map_distance` from the surface: usually a base in another frame than
+    /// the body, e.g. baked y-up on a z-up body, or a collider far from the mesh).
+    fn warn_unmapped(&mut self) {
+        for o in &mut self.objects {
+            if o.warned_unmapped || !o.enabled {
+                continue;
+            }
+            let info = self.world.object_info(o.handle).response;
+            if info.contacts_unmapped + info.impacts_unmapped == 0 {
+                continue;
+            }
+            o.warned_unmapped = true;
+            let t = self.world.object_totals(o.handle);
+            let r = self.world.response(o.handle);
+            log::warn!(
+                target: "dcr_rapier",
+                "elastic object {} (rapier body {:?}): {} contact(s) and {} impact(s) farther \
+                 than max_map_distance = {} m from its base's surface were ignored; check that \
+                 the base's object frame is the body's local frame (up axis, units) and the \
+                 colliders match the mesh (counted in DcrWorld::object_totals; reported once)",
+                o.handle,
+                o.body.into_raw_parts(),
+                t.contacts_unmapped,
+                t.impacts_unmapped,
+                r.max_map_distance()
+            );
+        }
     }
 
     /// Whether the world must be stepped with contacts whatever the light pass says: while a
@@ -452,7 +693,7 @@ impl DcrRapier {
         let graph = np.contact_graph().raw_graph();
         for k in 0..self.colliders.len() {
             let (ec, obj) = self.colliders[k];
-            let own = self.objects[obj as usize].threshold;
+            let own = self.objects[obj as usize].gate_threshold();
             for edge in graph.edges(ColliderGraphIndex::new(self.nodes[k])) {
                 let pair = edge.weight();
                 let mut threshold = own;
@@ -465,7 +706,7 @@ impl DcrRapier {
                     if j < k {
                         continue;
                     }
-                    threshold = threshold.min(self.objects[self.colliders[j].1 as usize].threshold);
+                    threshold = threshold.min(self.objects[self.colliders[j].1 as usize].gate_threshold());
                 }
                 hot |= scan_pair(pair, threshold, &mut self.memory);
             }

@@ -194,6 +194,19 @@ impl DistantResponse {
         &self.params
     }
 
+    /// Sets the impact threshold (N·s) from the next step on: impacts below it are ignored
+    /// ([`ResponseParams::impact_threshold`]).
+    ///
+    /// # Errors
+    /// [`ParamsError::Invalid`] for a negative or non-finite threshold (the old one is kept).
+    pub fn set_impact_threshold(&mut self, threshold: f64) -> Result<(), ParamsError> {
+        if !(threshold >= 0.0 && threshold.is_finite()) {
+            return Err(invalid("impact_threshold", format!("{threshold} N·s")));
+        }
+        self.params.impact_threshold = threshold;
+        Ok(())
+    }
+
     /// Filter samples per rigid-body step, S = ⌈h/T⌉ (relative tolerance 1e-9).
     pub fn samples_per_step(&self) -> usize {
         self.samples

@@ -25,8 +25,8 @@ impl ImpulseTable {
     /// The filters for `p.h` and `p.sampling` with Rayleigh damping `rayleigh`.
     ///
     /// # Errors
-    /// [`ParamsError`] when the sampling gives a non-positive or non-finite period or more than
-    /// 10⁶ samples per step.
+    /// [`ParamsError`] for an oversampling factor below 1 or not finite, a sampling that gives a
+    /// non-positive or non-finite period, or more than 10⁶ samples per step.
     pub fn new(
         model: &ModalModel,
         p: &ResponseParams,
@@ -35,6 +35,14 @@ impl ImpulseTable {
         let omega = model.omega();
         let m = omega.len();
         let omega_max = omega[m - 1];
+        if let Sampling::Oversample(k) = p.sampling {
+            if !(k >= 1.0 && k.is_finite()) {
+                return Err(ParamsError::Invalid {
+                    field: "sampling",
+                    detail: format!("oversampling factor K = {k} (must be finite and ≥ 1)"),
+                });
+            }
+        }
         let t_req = p.sampling.period(omega_max);
         if !(t_req.is_finite() && t_req > 0.0) {
             return Err(ParamsError::Invalid {

@@ -4,8 +4,8 @@ use std::collections::HashMap;
 
 use super::pose::{rotate, rotate_back};
 use super::{
-    BodyState, ContactReport, ElasticHandle, ElasticObjectDesc, EnergyInfo, ImpulseEvent,
-    ObjectStepInfo, Pose, WorldError, WorldParams, WorldStepInfo,
+    BaseSupport, BodyState, ContactReport, ElasticHandle, ElasticObjectDesc, EnergyInfo,
+    ImpulseEvent, ObjectStepInfo, ObjectTotals, Pose, WorldError, WorldParams, WorldStepInfo,
 };
 use crate::mapping::BuildIdHasher;
 use crate::math::{add, cross, dot, norm, scale, sub};
@@ -32,6 +32,14 @@ struct Source {
 /// One elastic object.
 #[derive(Debug)]
 struct Object {
+    /// Its handle (slot and generation).
+    handle: ElasticHandle,
+    /// Whether it takes part in the steps ([`DcrWorld::set_enabled`]).
+    enabled: bool,
+    /// World step from which it is disabled (for [`ObjectTotals::disabled_steps`]).
+    disabled_since: u64,
+    support: BaseSupport,
+    totals: ObjectTotals,
     body: u64,
     dynamic: bool,
     gain: f64,
@@ -57,6 +65,14 @@ struct Tracked {
     dang: [f64; 3],
     /// Index into `touched` while the current object is processed, else `u32::MAX`.
     touch: u32,
+}
+
+/// A slot of the handle table: its generation and the object's index in `objects`
+/// (`u32::MAX`: free).
+#[derive(Clone, Copy, Debug)]
+struct Slot {
+    generation: u32,
+    dense: u32,
 }
 
 /// A body pushed by the current object: its velocity change before the object and the
@@ -202,7 +218,15 @@ struct Touched {
 #[derive(Debug)]
 pub struct DcrWorld {
     params: WorldParams,
+    /// The objects, densely packed (removal swaps the last into the hole).
     objects: Vec<Object>,
+    /// Handle table: slot index → generation and position in `objects`.
+    slots: Vec<Slot>,
+    /// Free slots (reused last-in first-out).
+    free: Vec<u32>,
+    /// Whether the last rigid-body step was passed with [`DcrWorld::advance`] (the per-step
+    /// counters then read as zeros).
+    quiet: bool,
     /// Processing order (indices into `objects`): static, then dynamic, each in order added.
     order: Vec<u32>,
     /// Position of each object in `order`.
@@ -239,13 +263,19 @@ impl DcrWorld {
     /// An empty world.
     ///
     /// # Errors
-    /// [`WorldError::Params`] for a non-positive or non-finite `h`, or `energy_eta` outside
-    /// [0, 1].
+    /// [`WorldError::Params`] for a non-positive or non-finite `h`, a non-finite gravity, or
+    /// `energy_eta` outside [0, 1].
     pub fn new(params: WorldParams) -> Result<DcrWorld, WorldError> {
         if !(params.h.is_finite() && params.h > 0.0) {
             return Err(invalid(
                 "h",
                 format!("{} s (must be finite and > 0)", params.h),
+            ));
+        }
+        if !params.gravity.iter().all(|g| g.is_finite()) {
+            return Err(invalid(
+                "gravity",
+                format!("{:?} m/s² (must be finite)", params.gravity),
             ));
         }
         if let Some(eta) = params.energy_eta {
@@ -256,6 +286,9 @@ impl DcrWorld {
         Ok(DcrWorld {
             params,
             objects: Vec::new(),
+            slots: Vec::new(),
+            free: Vec::new(),
+            quiet: false,
             order: Vec::new(),
             rank: Vec::new(),
             object_bodies: Vec::new(),
@@ -274,7 +307,13 @@ impl DcrWorld {
         })
     }
 
-    /// Adds an elastic object; its response uses the world's `h`.
+    /// Adds an elastic object; its response uses the world's `h`. Its handle takes a free slot
+    /// (the most recently freed) with that slot's current generation, or a new slot.
+    ///
+    /// Checks how the base is held against the body ([`BaseSupport`]): a dynamic body with a
+    /// base baked with fixed nodes, or a static body with a free-floating base, is logged as a
+    /// warning (`log` crate, target `dcr_runtime::world`) and readable with
+    /// [`DcrWorld::base_support`]; neither is refused.
     ///
     /// # Errors
     /// [`WorldError::DuplicateBody`] if another object is on the same body,
@@ -285,7 +324,7 @@ impl DcrWorld {
         if let Some(&existing) = self.by_body.get(&desc.body) {
             return Err(WorldError::DuplicateBody {
                 body: desc.body,
-                existing,
+                existing: self.objects[existing as usize].handle.index(),
             });
         }
         if !(desc.gain.is_finite() && desc.gain >= 0.0) {
@@ -303,8 +342,47 @@ impl DcrWorld {
                 body: desc.body,
                 source,
             })?;
-        let idx = self.objects.len() as u32;
+        let fixed_nodes = response.model().base().fixed_nodes.len();
+        let support = match (desc.dynamic, fixed_nodes) {
+            (true, n) if n > 0 => BaseSupport::DynamicBodyFixedBase { fixed_nodes: n },
+            (false, 0) => BaseSupport::StaticBodyFreeBase,
+            _ => BaseSupport::Consistent,
+        };
+        match support {
+            BaseSupport::DynamicBodyFixedBase { fixed_nodes } => log::warn!(
+                target: "dcr_runtime::world",
+                "elastic object on body {}: the body is dynamic but its base was baked with \
+                 {fixed_nodes} fixed nodes; its modes assume those nodes held (right for a \
+                 table standing on a floor, wrong for an object in flight: bake a free-floating \
+                 base, without --fixed, for that)",
+                desc.body
+            ),
+            BaseSupport::StaticBodyFreeBase => log::warn!(
+                target: "dcr_runtime::world",
+                "elastic object on body {}: the body is static but its base is free-floating \
+                 (baked without fixed nodes); where the object is held (feet on the ground) its \
+                 response is that of a floating object: bake with --fixed for its supports",
+                desc.body
+            ),
+            BaseSupport::Consistent => {}
+        }
+        let slot = match self.free.pop() {
+            Some(i) => i,
+            None => {
+                self.slots.push(Slot {
+                    generation: 0,
+                    dense: u32::MAX,
+                });
+                (self.slots.len() - 1) as u32
+            }
+        };
+        let handle = ElasticHandle::from_raw_parts(slot, self.slots[slot as usize].generation);
         self.objects.push(Object {
+            handle,
+            enabled: true,
+            disabled_since: 0,
+            support,
+            totals: ObjectTotals::default(),
             body: desc.body,
             dynamic: desc.dynamic,
             gain: desc.gain,
@@ -319,27 +397,240 @@ impl DcrWorld {
             depth: 0,
             info: ObjectStepInfo::default(),
         });
-        self.by_body.insert(desc.body, idx);
-        self.any_dynamic |= desc.dynamic;
-        self.object_bodies.push(desc.body);
-        self.order = (0..self.objects.len() as u32)
-            .filter(|&o| !self.objects[o as usize].dynamic)
-            .chain((0..self.objects.len() as u32).filter(|&o| self.objects[o as usize].dynamic))
+        self.reindex();
+        Ok(handle)
+    }
+
+    /// Rebuilds everything indexed by position in `objects` (set-up and removal only).
+    fn reindex(&mut self) {
+        self.by_body.clear();
+        self.object_bodies.clear();
+        self.any_dynamic = false;
+        for (i, o) in self.objects.iter().enumerate() {
+            self.by_body.insert(o.body, i as u32);
+            self.object_bodies.push(o.body);
+            self.any_dynamic |= o.dynamic;
+            self.slots[o.handle.index() as usize].dense = i as u32;
+        }
+        let n = self.objects.len() as u32;
+        let objects = &self.objects;
+        self.order = (0..n)
+            .filter(|&o| !objects[o as usize].dynamic)
+            .chain((0..n).filter(|&o| objects[o as usize].dynamic))
             .collect();
         self.rank = vec![0; self.objects.len()];
         for (r, &o) in self.order.iter().enumerate() {
             self.rank[o as usize] = r as u32;
         }
-        Ok(ElasticHandle(idx))
+    }
+
+    /// Position in `objects` of the object `handle` names.
+    ///
+    /// # Errors
+    /// [`WorldError::StaleHandle`] for a removed object or a handle not from this world.
+    fn resolve(&self, handle: ElasticHandle) -> Result<usize, WorldError> {
+        let Some(slot) = self.slots.get(handle.index() as usize) else {
+            return Err(WorldError::StaleHandle {
+                handle,
+                why: "no such slot in this world",
+            });
+        };
+        if slot.generation != handle.generation() || slot.dense == u32::MAX {
+            return Err(WorldError::StaleHandle {
+                handle,
+                why: "the object was removed",
+            });
+        }
+        Ok(slot.dense as usize)
+    }
+
+    /// [`DcrWorld::resolve`] for the accessors that panic.
+    #[track_caller]
+    fn dense(&self, handle: ElasticHandle) -> usize {
+        match self.resolve(handle) {
+            Ok(o) => o,
+            Err(e) => panic!("{e}"),
+        }
+    }
+
+    /// Whether `handle` names an object of this world (not removed).
+    pub fn contains(&self, handle: ElasticHandle) -> bool {
+        self.resolve(handle).is_ok()
+    }
+
+    /// The handles of the world's objects (in storage order, which removal changes).
+    pub fn handles(&self) -> impl Iterator<Item = ElasticHandle> + '_ {
+        self.objects.iter().map(|o| o.handle)
+    }
+
+    /// Removes an elastic object: its response, cached contacts and counters are dropped, its
+    /// body is free to carry another object, and `handle` (and every copy of it) becomes
+    /// stale: every call with it fails, even after its slot is reused by a later
+    /// [`DcrWorld::add_object`] (with the next generation). Impulse events already returned
+    /// keep their values. Set-up-time call (it re-indexes the objects; the step after it does
+    /// not allocate).
+    ///
+    /// # Errors
+    /// [`WorldError::StaleHandle`] when `handle` was already removed or is not from this world.
+    pub fn remove_object(&mut self, handle: ElasticHandle) -> Result<(), WorldError> {
+        let o = self.resolve(handle)?;
+        self.objects.swap_remove(o);
+        let slot = &mut self.slots[handle.index() as usize];
+        slot.generation = slot.generation.wrapping_add(1);
+        slot.dense = u32::MAX;
+        self.free.push(handle.index());
+        self.reindex();
+        Ok(())
+    }
+
+    /// Enables or disables an object from the next step on. A disabled object is as if absent
+    /// from the steps: its contacts are neither classified nor answered, impulses on its body
+    /// do not chain into it, it issues no events, and its filters are returned to rest (a
+    /// re-enabled object starts quiet). Its handle, pose, parameters and totals are kept.
+    /// O(1), no allocation.
+    ///
+    /// # Errors
+    /// [`WorldError::StaleHandle`].
+    pub fn set_enabled(&mut self, handle: ElasticHandle, enabled: bool) -> Result<(), WorldError> {
+        let o = self.resolve(handle)?;
+        let step = self.step;
+        let obj = &mut self.objects[o];
+        if obj.enabled == enabled {
+            return Ok(());
+        }
+        if enabled {
+            obj.totals.disabled_steps += step - obj.disabled_since;
+        } else {
+            obj.disabled_since = step;
+            obj.response.reset();
+        }
+        obj.enabled = enabled;
+        Ok(())
+    }
+
+    /// Whether the object takes part in the steps ([`DcrWorld::set_enabled`]).
+    ///
+    /// # Panics
+    /// If `handle` is stale or not from this world.
+    pub fn is_enabled(&self, handle: ElasticHandle) -> bool {
+        self.objects[self.dense(handle)].enabled
+    }
+
+    /// Sets the object's gain (dimensionless, ≥ 0; [`ElasticObjectDesc::gain`]) from the next
+    /// step on. O(1), no allocation.
+    ///
+    /// # Errors
+    /// [`WorldError::StaleHandle`]; [`WorldError::Object`] for a negative or non-finite gain
+    /// (the old one is kept).
+    pub fn set_gain(&mut self, handle: ElasticHandle, gain: f64) -> Result<(), WorldError> {
+        let o = self.resolve(handle)?;
+        if !(gain.is_finite() && gain >= 0.0) {
+            return Err(WorldError::Object {
+                body: self.objects[o].body,
+                field: "gain",
+                detail: format!("{gain} (must be finite and ≥ 0)"),
+            });
+        }
+        self.objects[o].gain = gain;
+        Ok(())
+    }
+
+    /// The object's gain.
+    ///
+    /// # Panics
+    /// If `handle` is stale or not from this world.
+    pub fn gain(&self, handle: ElasticHandle) -> f64 {
+        self.objects[self.dense(handle)].gain
+    }
+
+    /// Sets the object's impact threshold (N·s, ≥ 0; [`crate::ResponseParams::impact_threshold`]):
+    /// both the impact classification and the response use it from the next step on. O(1), no
+    /// allocation.
+    ///
+    /// # Errors
+    /// [`WorldError::StaleHandle`]; [`WorldError::Response`] for a negative or non-finite
+    /// threshold (the old one is kept).
+    pub fn set_impact_threshold(
+        &mut self,
+        handle: ElasticHandle,
+        threshold: f64,
+    ) -> Result<(), WorldError> {
+        let o = self.resolve(handle)?;
+        let obj = &mut self.objects[o];
+        obj.response
+            .set_impact_threshold(threshold)
+            .map_err(|source| WorldError::Response {
+                body: obj.body,
+                source,
+            })?;
+        obj.threshold = threshold;
+        Ok(())
+    }
+
+    /// The object's impact threshold (N·s).
+    ///
+    /// # Panics
+    /// If `handle` is stale or not from this world.
+    pub fn impact_threshold(&self, handle: ElasticHandle) -> f64 {
+        self.objects[self.dense(handle)].threshold
+    }
+
+    /// How the object's base is held compared with its body (checked at
+    /// [`DcrWorld::add_object`]).
+    ///
+    /// # Panics
+    /// If `handle` is stale or not from this world.
+    pub fn base_support(&self, handle: ElasticHandle) -> BaseSupport {
+        self.objects[self.dense(handle)].support
+    }
+
+    /// Changes the rigid-body step h (s) of the world and every object: each response is
+    /// rebuilt for the new h — the modal filters' exact impulse-invariant coefficients (Eq. 10)
+    /// and samples per step re-derived, a transfer table (baked for one h) re-checked under
+    /// its [`crate::TablePolicy`] (refused, or served by the modal method and counted in
+    /// [`crate::StepInfo::contacts_table_fallback`]). Filters restart at rest and resting
+    /// contacts are mapped again on their next step. Costs a set-up per object (an
+    /// attenuation response refactors its heat-method operators): call it when the engine's
+    /// step changes, not every step. Nothing changes when `h` is the current one.
+    ///
+    /// # Errors
+    /// [`WorldError::Params`] for a non-positive or non-finite h; [`WorldError::Response`]
+    /// when an object's response cannot be set up for it (e.g. a table refused under
+    /// [`crate::TablePolicy::Refuse`]). The world is unchanged then.
+    pub fn set_h(&mut self, h: f64) -> Result<(), WorldError> {
+        if !(h.is_finite() && h > 0.0) {
+            return Err(invalid("h", format!("{h} s (must be finite and > 0)")));
+        }
+        if h == self.params.h {
+            return Ok(());
+        }
+        let mut rebuilt = Vec::with_capacity(self.objects.len());
+        for o in &self.objects {
+            let mut rp = o.response.params().clone();
+            rp.h = h;
+            let r = DistantResponse::new(o.response.model().clone(), rp).map_err(|source| {
+                WorldError::Response {
+                    body: o.body,
+                    source,
+                }
+            })?;
+            rebuilt.push(r);
+        }
+        for (o, r) in self.objects.iter_mut().zip(rebuilt) {
+            o.response = r;
+        }
+        self.params.h = h;
+        Ok(())
     }
 
     /// Sets an object's pose (object frame → world) for the coming [`DcrWorld::step`]: the
     /// body's pose after the rigid-body step. Static objects keep the pose they were added with.
     ///
     /// # Panics
-    /// If `handle` is not from this world.
+    /// If `handle` is stale or not from this world (see [`DcrWorld::contains`]).
     pub fn set_pose(&mut self, handle: ElasticHandle, pose: Pose) {
-        let o = &mut self.objects[handle.0 as usize];
+        let o = self.dense(handle);
+        let o = &mut self.objects[o];
         o.pose = pose;
         o.rot = pose.rotation_matrix();
     }
@@ -347,54 +638,109 @@ impl DcrWorld {
     /// The object's current pose.
     ///
     /// # Panics
-    /// If `handle` is not from this world.
+    /// If `handle` is stale or not from this world (see [`DcrWorld::contains`]).
     pub fn pose(&self, handle: ElasticHandle) -> Pose {
-        self.objects[handle.0 as usize].pose
+        self.objects[self.dense(handle)].pose
     }
 
-    /// The parameters the world was built with.
+    /// Sets the gravity of the support compensation ([`WorldParams::gravity`], m/s², world
+    /// frame; zero: none). O(1).
+    ///
+    /// # Errors
+    /// [`WorldError::Params`] for a non-finite component (the old value is kept).
+    pub fn set_gravity(&mut self, gravity: [f64; 3]) -> Result<(), WorldError> {
+        if !gravity.iter().all(|g| g.is_finite()) {
+            return Err(invalid(
+                "gravity",
+                format!("{gravity:?} m/s² (must be finite)"),
+            ));
+        }
+        self.params.gravity = gravity;
+        Ok(())
+    }
+
+    /// The parameters the world was built with (with `h` and `gravity` as last set).
     pub fn params(&self) -> &WorldParams {
         &self.params
     }
 
-    /// Number of elastic objects.
+    /// Number of elastic objects (removed ones not counted).
     pub fn num_objects(&self) -> usize {
         self.objects.len()
     }
 
     /// The object on engine body `body`, if any.
     pub fn object_of_body(&self, body: u64) -> Option<ElasticHandle> {
-        self.by_body.get(&body).map(|&o| ElasticHandle(o))
+        self.by_body
+            .get(&body)
+            .map(|&o| self.objects[o as usize].handle)
     }
 
     /// Engine body id of an object.
     ///
     /// # Panics
-    /// If `handle` is not from this world.
+    /// If `handle` is stale or not from this world (see [`DcrWorld::contains`]).
     pub fn body_of(&self, handle: ElasticHandle) -> u64 {
-        self.objects[handle.0 as usize].body
+        self.objects[self.dense(handle)].body
     }
 
     /// An object's response (its method, transfer-table status, cached contacts, …).
     ///
     /// # Panics
-    /// If `handle` is not from this world.
+    /// If `handle` is stale or not from this world (see [`DcrWorld::contains`]).
     pub fn response(&self, handle: ElasticHandle) -> &DistantResponse {
-        &self.objects[handle.0 as usize].response
+        &self.objects[self.dense(handle)].response
     }
 
-    /// What the last step did, all objects.
+    /// What the last rigid-body step did, all objects (zeros but the step index after
+    /// [`DcrWorld::advance`]).
     pub fn step_info(&self) -> WorldStepInfo {
-        self.info
+        if self.quiet {
+            WorldStepInfo {
+                step: self.step.saturating_sub(1),
+                ..Default::default()
+            }
+        } else {
+            self.info
+        }
     }
 
     /// What the last step did for one object (counters, the response's [`crate::StepInfo`],
     /// energy account).
     ///
     /// # Panics
-    /// If `handle` is not from this world.
+    /// If `handle` is stale or not from this world (see [`DcrWorld::contains`]).
     pub fn object_info(&self, handle: ElasticHandle) -> ObjectStepInfo {
-        self.objects[handle.0 as usize].info
+        let info = self.objects[self.dense(handle)].info;
+        if self.quiet {
+            let e = info.energy;
+            ObjectStepInfo {
+                energy: EnergyInfo {
+                    scale: 1.0,
+                    total_dissipated: e.total_dissipated,
+                    total_received: e.total_received,
+                    total_injected: e.total_injected,
+                    ..Default::default()
+                },
+                ..Default::default()
+            }
+        } else {
+            info
+        }
+    }
+
+    /// Running totals of one object since it was added (impacts, queries, events, unmapped
+    /// contacts, table fallbacks, disabled steps).
+    ///
+    /// # Panics
+    /// If `handle` is stale or not from this world (see [`DcrWorld::contains`]).
+    pub fn object_totals(&self, handle: ElasticHandle) -> ObjectTotals {
+        let o = &self.objects[self.dense(handle)];
+        let mut t = o.totals;
+        if !o.enabled {
+            t.disabled_steps += self.step - o.disabled_since;
+        }
+        t
     }
 
     /// The last step's impulse events (as returned by [`DcrWorld::step`]).
@@ -405,18 +751,21 @@ impl DcrWorld {
     /// Counts `steps` rigid-body steps that passed without [`DcrWorld::step`] (quiet steps: no
     /// contact to report, nothing ringing — see [`DcrWorld::needs_step`]). Step counts (settle
     /// window, ages, cache eviction) stay in engine steps. O(1), no allocation; clears the
-    /// event buffer; [`DcrWorld::step_info`] and [`DcrWorld::object_info`] still describe the
-    /// last call of `step`. Callers that skip steps should classify with
+    /// event buffer; [`DcrWorld::step_info`] and [`DcrWorld::object_info`] then read as zeros
+    /// (a quiet step did nothing), so summing them per step counts each event once. Callers that skip steps should classify with
     /// [`crate::ClassifyParams::engine_newness`]: ages count a contact unseen for a while as new.
     pub fn advance(&mut self, steps: u64) {
         self.step += steps;
         self.events.clear();
+        self.quiet = steps > 0 || self.quiet;
     }
 
     /// Whether the next step must call [`DcrWorld::step`] even without impacts to report: an
     /// object's carry-over filters still ring. `false` with the default parameters.
     pub fn needs_step(&self) -> bool {
-        self.objects.iter().any(|o| o.response.needs_step())
+        self.objects
+            .iter()
+            .any(|o| o.enabled && o.response.needs_step())
     }
 
     /// One rigid-body step: classifies `contacts` (world frame, see [`ContactReport`] for the
@@ -428,6 +777,7 @@ impl DcrWorld {
     pub fn step(&mut self, contacts: &[ContactReport], bodies: &[BodyState]) -> &[ImpulseEvent] {
         let step = self.step;
         self.step += 1;
+        self.quiet = false;
         self.info = WorldStepInfo {
             step,
             ..Default::default()
@@ -475,6 +825,15 @@ impl DcrWorld {
             self.respond(o, bodies);
         }
         for o in &mut self.objects {
+            let t = &mut o.totals;
+            let i = &o.info;
+            t.impacts += u64::from(i.impacts);
+            t.chained_impacts += u64::from(i.chained_impacts);
+            t.queries += u64::from(i.queried);
+            t.events += u64::from(i.events);
+            t.contacts_unmapped += u64::from(i.response.contacts_unmapped);
+            t.impacts_unmapped += u64::from(i.response.impacts_unmapped);
+            t.contacts_table_fallback += u64::from(i.response.contacts_table_fallback);
             let e = &mut o.info.energy;
             e.total_dissipated += e.dissipated;
             e.total_received += e.received;
@@ -500,7 +859,7 @@ impl DcrWorld {
         // (an engine reports a pair's points together).
         let mut memo: [Option<(u64, Option<u32>)>; 2] = [None; 2];
         for c in contacts {
-            let objs = [self.object_at(c.body1), self.object_at(c.body2)];
+            let objs = [self.enabled_at(c.body1), self.enabled_at(c.body2)];
             if objs == [None, None] || c.body1 == c.body2 {
                 continue;
             }
@@ -598,7 +957,7 @@ impl DcrWorld {
     fn respond(&mut self, o: usize, bodies: &[BodyState]) {
         let step = self.step - 1;
         let obj = &mut self.objects[o];
-        if obj.impacts.is_empty() && !obj.response.needs_step() {
+        if !obj.enabled || (obj.impacts.is_empty() && !obj.response.needs_step()) {
             return;
         }
         if let Some(last) = obj.last_called {
@@ -625,11 +984,16 @@ impl DcrWorld {
             let mut j = [0.0; 3];
             let mut need = 0.0;
             let achieved = dot(add(t.dlin, cross(t.dang, r)), n);
-            let want = obj.gain * resp.delta_v - achieved;
+            let support = if resp.delta_v > 0.0 {
+                (-dot(self.params.gravity, n)).max(0.0) * self.params.h
+            } else {
+                0.0
+            };
+            let want = obj.gain * resp.delta_v + support - achieved;
             if want > 0.0 {
                 let m_eff = effective_mass(b.inv_mass, b.inv_inertia, r, n);
                 if m_eff > 0.0 {
-                    need = want;
+                    need = (want - support).max(0.0);
                     j = scale(n, m_eff * want);
                 }
             }
@@ -671,7 +1035,7 @@ impl DcrWorld {
                 impulse: j,
                 normal: n,
                 delta_v: need,
-                object: ElasticHandle(o as u32),
+                object: obj.handle,
                 served_by: resp.served_by,
                 contact: resp.id,
                 chained: obj.depth > 0,
@@ -778,10 +1142,18 @@ impl DcrWorld {
         }
     }
 
+    /// The enabled object on engine body `body`.
+    #[inline]
+    fn enabled_at(&self, body: u64) -> Option<u32> {
+        self.object_at(body)
+            .filter(|&o| self.objects[o as usize].enabled)
+    }
+
     /// Whether an impulse from object `from` (at chain depth `depth`) on object `to`'s body
     /// chains: `to` is dynamic, later in the order, and the chain is not at its limit.
     fn forward(&self, from: usize, to: usize, depth: u32) -> bool {
         self.objects[to].dynamic
+            && self.objects[to].enabled
             && self.rank[to] > self.rank[from]
             && depth < self.params.max_chain_depth
     }

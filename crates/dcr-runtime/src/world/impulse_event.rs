@@ -23,9 +23,11 @@ pub struct ImpulseEvent {
     /// Unit outward normal of the elastic object at the contact (world frame): the direction
     /// the body is pushed.
     pub normal: [f64; 3],
-    /// Velocity change this impulse gives the body at `point` along `normal` (m/s): the
+    /// Velocity change the response asks of this impulse at `point` along `normal` (m/s): the
     /// response's Δv × the object's gain, less what earlier impulses of the step already gave
-    /// it there (one Gauss–Seidel pass), × the energy-bound scale.
+    /// the body there (one Gauss–Seidel pass), × the energy-bound scale. The impulse also
+    /// carries the support compensation of [`crate::WorldParams::gravity`] when it is set, which
+    /// this figure leaves out.
     pub delta_v: f64,
     /// The resting contact's id ([`crate::ContactReport::id`]).
     pub contact: u64,

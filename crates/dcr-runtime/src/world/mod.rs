@@ -9,6 +9,7 @@
 //! engine's math types convert cheaply.
 //! See [`DcrWorld`] for the rules and their reasons.
 
+mod base_support;
 mod body_state;
 mod contact_report;
 mod dcr_world;
@@ -20,6 +21,7 @@ mod world_error;
 mod world_info;
 mod world_params;
 
+pub use base_support::BaseSupport;
 pub use body_state::BodyState;
 pub use contact_report::ContactReport;
 pub use dcr_world::DcrWorld;
@@ -28,5 +30,5 @@ pub use elastic_object_desc::ElasticObjectDesc;
 pub use impulse_event::ImpulseEvent;
 pub use pose::Pose;
 pub use world_error::WorldError;
-pub use world_info::{EnergyInfo, ObjectStepInfo, WorldStepInfo};
+pub use world_info::{EnergyInfo, ObjectStepInfo, ObjectTotals, WorldStepInfo};
 pub use world_params::{ClassifyParams, WorldParams};

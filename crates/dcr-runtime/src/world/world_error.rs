@@ -2,8 +2,9 @@
 
 use crate::response::ParamsError;
 
-/// Invalid world parameters or elastic-object definitions, reported by [`crate::DcrWorld::new`]
-/// and [`crate::DcrWorld::add_object`].
+/// Invalid world parameters, elastic-object definitions or handles, reported by
+/// [`crate::DcrWorld::new`], [`crate::DcrWorld::add_object`], [`crate::DcrWorld::set_h`] and the
+/// run-time setters ([`crate::DcrWorld::remove_object`], [`crate::DcrWorld::set_enabled`], …).
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum WorldError {
@@ -41,5 +42,14 @@ pub enum WorldError {
         body: u64,
         /// Index of the object already on it.
         existing: u32,
+    },
+    /// The handle is not an object of this world: removed (stale: its slot's generation moved
+    /// on) or never issued.
+    #[error("elastic object {handle} does not exist: {why}")]
+    StaleHandle {
+        /// The handle given.
+        handle: super::ElasticHandle,
+        /// Why (removed, or the slot index is past the world's slots).
+        why: &'static str,
     },
 }

@@ -2,7 +2,9 @@
 
 use crate::response::StepInfo;
 
-/// Counters of the last [`crate::DcrWorld::step`], all objects.
+/// Counters of the last rigid-body step, all objects: the last [`crate::DcrWorld::step`], or
+/// zeros (but `step`) after [`crate::DcrWorld::advance`] — summing them over steps counts each
+/// event once. Running totals are in [`ObjectTotals`].
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct WorldStepInfo {
     /// Index of the step (0 for the first call).
@@ -60,7 +62,11 @@ pub struct EnergyInfo {
     pub total_injected: f64,
 }
 
-/// What the last step did for one elastic object.
+/// What the last rigid-body step did for one elastic object: the last
+/// [`crate::DcrWorld::step`], or zeros after [`crate::DcrWorld::advance`] (the energy totals
+/// `energy.total_*` are kept). Per-step counters only: summing them over steps counts each
+/// impact once. Running totals since the object was added are [`ObjectTotals`]
+/// ([`crate::DcrWorld::object_totals`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct ObjectStepInfo {
     /// Engine impacts on the object.
@@ -82,4 +88,28 @@ pub struct ObjectStepInfo {
     pub response: StepInfo,
     /// The energy account.
     pub energy: EnergyInfo,
+}
+
+/// Running totals of one elastic object since it was added ([`crate::DcrWorld::object_totals`]),
+/// kept apart from the per-step counters of [`ObjectStepInfo`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ObjectTotals {
+    /// Engine impacts on the object.
+    pub impacts: u64,
+    /// Chained impacts on the object.
+    pub chained_impacts: u64,
+    /// Steps on which the object's response ran.
+    pub queries: u64,
+    /// Impulse events the object's response issued.
+    pub events: u64,
+    /// Resting contacts the response found farther than its `max_map_distance` from the
+    /// surface (zero response): a contact in the wrong frame or far from the base's surface.
+    pub contacts_unmapped: u64,
+    /// Impacts farther than `max_map_distance` from the surface (ignored).
+    pub impacts_unmapped: u64,
+    /// Resting contacts a transfer-table response served with the modal method instead
+    /// ([`crate::StepInfo::contacts_table_fallback`]).
+    pub contacts_table_fallback: u64,
+    /// Steps the object spent disabled ([`crate::DcrWorld::set_enabled`]).
+    pub disabled_steps: u64,
 }

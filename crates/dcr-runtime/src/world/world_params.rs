@@ -55,6 +55,14 @@ pub struct WorldParams {
     /// Longest chain of responses through dynamic elastic objects in one step (an impulse on an
     /// elastic object's body becomes an impact on it): 0 disables chains. Default 4.
     pub max_chain_depth: u32,
+    /// Gravity (m/s², world frame) for the support compensation of impulses applied after the
+    /// step: a resting body pushed along n also gets `max(0, −g·n) h` of normal velocity, the
+    /// support its contact would have given it during the next step, so that it leaves with
+    /// the response's Δv at the end of that step instead of Δv − g h (see [`crate::DcrWorld`],
+    /// "Impulses"). Zero (the default): no compensation — for engines that replay the
+    /// responses inside their contact solver, where the contact itself carries the body.
+    /// `dcr-rapier` sets it from rapier's gravity under its after-step application.
+    pub gravity: [f64; 3],
 }
 
 impl Default for WorldParams {
@@ -64,6 +72,7 @@ impl Default for WorldParams {
             classify: ClassifyParams::default(),
             energy_eta: Some(1.0),
             max_chain_depth: 4,
+            gravity: [0.0; 3],
         }
     }
 }
