@@ -237,7 +237,15 @@ fn record_before_response(
 /// that received impulses, its velocities.
 #[allow(clippy::type_complexity)]
 fn record_after_writeback(
-    plates: Query<(Entity, &Transform, Option<&Velocity>, &RapierRigidBodyHandle), With<Plate>>,
+    plates: Query<
+        (
+            Entity,
+            &Transform,
+            Option<&Velocity>,
+            &RapierRigidBodyHandle,
+        ),
+        With<Plate>,
+    >,
     context: ReadRapierContext,
     mut messages: MessageReader<DcrResponse>,
     mut records: ResMut<Records>,
@@ -405,9 +413,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             return Ok(());
         }
         #[cfg(not(feature = "window"))]
-        return Err("--window needs the `window` feature: cargo run --release -p dcr-bevy \
+        return Err(
+            "--window needs the `window` feature: cargo run --release -p dcr-bevy \
                     --features window --example dinner -- --window"
-            .into());
+                .into(),
+        );
     }
     let steps = 150;
     eprintln!("[dinner] with DcrPlugin");

@@ -9,12 +9,21 @@ use dcr_bevy::{DcrElastic, DcrPlugin, DcrPluginError, DcrResponse, DcrSet, Modes
 
 fn main() -> Result<(), DcrPluginError> {
     // The world's step h (s): the plugin makes it bevy_rapier's fixed dt and Time<Fixed>'s period.
-    let dcr = DcrPlugin::new(WorldParams { h: 0.01, ..default() }, default())?;
+    let dcr = DcrPlugin::new(
+        WorldParams {
+            h: 0.01,
+            ..default()
+        },
+        default(),
+    )?;
     App::new()
         .add_plugins((
             MinimalPlugins, // or DefaultPlugins
             TransformPlugin,
-            AssetPlugin { file_path: "out/bases".into(), ..default() },
+            AssetPlugin {
+                file_path: "out/bases".into(),
+                ..default()
+            },
             // Required: bevy_rapier in FixedUpdate (one rapier step per fixed update).
             RapierPhysicsPlugin::<NoUserData>::default().in_fixed_schedule(),
             dcr,
@@ -30,12 +39,19 @@ fn spawn(mut commands: Commands, assets: Res<AssetServer>) {
     // The elastic table: a fixed body placed where the baked mesh is (the base's object frame
     // is the body's local frame), its collision shapes in that frame, and its base.
     let mut table = DcrElastic::new(assets.load::<ModesAsset>("table.modes"));
-    table.response = ResponseParams { impact_threshold: 0.5, max_map_distance: 0.1, ..default() };
+    table.response = ResponseParams {
+        impact_threshold: 0.5,
+        max_map_distance: 0.1,
+        ..default()
+    };
     commands.spawn((
         RigidBody::Fixed,
         Transform::IDENTITY,
         table,
-        children![(Collider::cuboid(0.8, 0.02, 0.45), Transform::from_xyz(0.0, 0.73, 0.0))],
+        children![(
+            Collider::cuboid(0.8, 0.02, 0.45),
+            Transform::from_xyz(0.0, 0.73, 0.0)
+        )],
     ));
     // A plate resting on it (a Velocity component is fine), and a pot dropped elsewhere.
     commands.spawn((
@@ -57,7 +73,10 @@ fn spawn(mut commands: Commands, assets: Res<AssetServer>) {
 // Each response impulse the plugin applied in this fixed update (already in the velocities).
 fn print_responses(mut responses: MessageReader<DcrResponse>) {
     for r in responses.read() {
-        println!("{} pushed by {} N·s at {} (Δv {} m/s)", r.body, r.impulse, r.point, r.delta_v);
+        println!(
+            "{} pushed by {} N·s at {} (Δv {} m/s)",
+            r.body, r.impulse, r.point, r.delta_v
+        );
     }
 }
 

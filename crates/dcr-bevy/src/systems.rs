@@ -71,9 +71,7 @@ pub(crate) fn dcr_before_step(
     for (entity, elastic, body, has_rigid_body) in &pending {
         let fail = |commands: &mut Commands, reason: String| {
             log::error!("dcr-bevy: elastic entity {entity}: {reason}");
-            commands
-                .entity(entity)
-                .insert(DcrElasticFailed { reason });
+            commands.entity(entity).insert(DcrElasticFailed { reason });
         };
         if !has_rigid_body {
             fail(
@@ -93,7 +91,13 @@ pub(crate) fn dcr_before_step(
         let mut desc = ElasticObjectDesc::new(base.model.clone(), 0);
         desc.response = elastic.response.clone();
         desc.gain = elastic.gain;
-        match dcr.add_object(&bodies.bodies, &mut colliders.colliders, body.0, entity, desc) {
+        match dcr.add_object(
+            &bodies.bodies,
+            &mut colliders.colliders,
+            body.0,
+            entity,
+            desc,
+        ) {
             Ok(handle) => {
                 commands.entity(entity).insert(DcrObject(handle));
             }

@@ -40,7 +40,10 @@ fn app(assets: &Path) -> App {
 /// Spawns a fixed slab with a `DcrElastic` of asset `path` (with a rigid body or not) and
 /// updates until the plugin decided; returns the entity.
 fn attach(app: &mut App, path: &str, rigid_body: bool) -> Entity {
-    let base = app.world().resource::<AssetServer>().load::<ModesAsset>(path);
+    let base = app
+        .world()
+        .resource::<AssetServer>()
+        .load::<ModesAsset>(path);
     let mut e = app.world_mut().spawn((
         Collider::cuboid(0.5, 0.3, 0.05),
         Transform::IDENTITY,
@@ -71,7 +74,11 @@ fn a_valid_base_loads_and_becomes_an_elastic_object() {
     let mut app = app(dir.path());
     let e = attach(&mut app, "plate.modes", true);
     let w = app.world();
-    assert!(w.get::<DcrElasticFailed>(e).is_none(), "{:?}", w.get::<DcrElasticFailed>(e));
+    assert!(
+        w.get::<DcrElasticFailed>(e).is_none(),
+        "{:?}",
+        w.get::<DcrElasticFailed>(e)
+    );
     let handle = w.get::<DcrObject>(e).expect("attached").0;
     let ctx = w.resource::<DcrContext>();
     assert_eq!(ctx.entity_of(handle), Some(e));
@@ -87,7 +94,9 @@ fn a_corrupt_or_missing_base_is_reported_on_the_entity() {
     std::fs::write(dir.path().join("bad.modes"), b"not a zip archive at all").unwrap();
     let mut bytes = Vec::new();
     let full = dir.path().join("full.modes");
-    dcr_runtime::testing::plate_base().write_atomic(&full).unwrap();
+    dcr_runtime::testing::plate_base()
+        .write_atomic(&full)
+        .unwrap();
     bytes.extend(std::fs::read(&full).unwrap());
     bytes.truncate(bytes.len() / 2);
     std::fs::write(dir.path().join("truncated.modes"), &bytes).unwrap();
@@ -101,7 +110,10 @@ fn a_corrupt_or_missing_base_is_reported_on_the_entity() {
         assert!(failed.reason.contains(name), "{name}: {}", failed.reason);
         assert!(app.world().get::<DcrObject>(e).is_none());
     }
-    assert_eq!(app.world().resource::<DcrContext>().world().num_objects(), 0);
+    assert_eq!(
+        app.world().resource::<DcrContext>().world().num_objects(),
+        0
+    );
 }
 
 #[test]

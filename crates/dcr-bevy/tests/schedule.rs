@@ -54,7 +54,13 @@ fn a_fixed_one_step_schedule_is_accepted() {
             substeps: 1
         }
     );
-    assert_eq!(app.world().resource::<Time<Fixed>>().timestep().as_secs_f64(), H);
+    assert_eq!(
+        app.world()
+            .resource::<Time<Fixed>>()
+            .timestep()
+            .as_secs_f64(),
+        H
+    );
 }
 
 #[test]
