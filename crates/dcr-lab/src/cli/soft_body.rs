@@ -85,6 +85,14 @@ pub struct CompareArgs {
     /// The sweep stops once doubling the substeps changes every outcome by less than this (%).
     #[arg(long, value_name = "PCT", default_value_t = 2.0)]
     pub tolerance_pct: f64,
+    /// CG iteration cap of the sweep's rows (rapier's `SoftFemParameters::max_linear_iterations`).
+    /// Default rapier's (20).
+    #[arg(long, value_name = "N")]
+    pub cg_iterations: Option<usize>,
+    /// Extra rapier-fem rows after the sweep, SUBSTEPS:CG (repeatable), e.g. `4:1000` for rapier's
+    /// default substeps with a conjugate gradient run to its tolerance.
+    #[arg(long, value_name = "SUBSTEPS:CG", value_parser = parse_extra)]
+    pub extra: Vec<(usize, usize)>,
     /// Simulated time of every row (s). Default each scene's `seconds`.
     #[arg(long, value_name = "S")]
     pub seconds: Option<f64>,
@@ -95,8 +103,27 @@ pub struct CompareArgs {
     #[arg(long, value_name = "FILE", default_value = "out/soft_body/compare.md")]
     pub md: PathBuf,
     /// JSON output (every row, every scene).
-    #[arg(long, value_name = "FILE", default_value = "out/soft_body/compare.json")]
+    #[arg(
+        long,
+        value_name = "FILE",
+        default_value = "out/soft_body/compare.json"
+    )]
     pub json: PathBuf,
+}
+
+/// `SUBSTEPS:CG`, both at least 1.
+fn parse_extra(s: &str) -> Result<(usize, usize), String> {
+    let (a, b) = s
+        .split_once(':')
+        .ok_or_else(|| format!("{s:?}: expected SUBSTEPS:CG, e.g. 4:1000"))?;
+    let n = |x: &str| -> Result<usize, String> {
+        x.trim()
+            .parse::<usize>()
+            .ok()
+            .filter(|&v| v >= 1)
+            .ok_or_else(|| format!("{s:?}: SUBSTEPS and CG must be whole numbers ≥ 1"))
+    };
+    Ok((n(a)?, n(b)?))
 }
 
 fn scene_path(root: &Path, s: &str) -> PathBuf {
@@ -173,7 +200,12 @@ fn summary(r: &SideRow) -> String {
 }
 
 /// Runs one row in a child process of this binary (`soft-body run … --json -`).
-fn run_child(root: &Path, scene: &str, method: &SideMethod, seconds: Option<f64>) -> Result<SideRow> {
+fn run_child(
+    root: &Path,
+    scene: &str,
+    method: &SideMethod,
+    seconds: Option<f64>,
+) -> Result<SideRow> {
     let exe = std::env::current_exe().context("locating the dcr-lab binary")?;
     let mut cmd = Command::new(exe);
     cmd.arg("soft-body")
@@ -213,7 +245,11 @@ fn run_child(root: &Path, scene: &str, method: &SideMethod, seconds: Option<f64>
         .output()
         .context("running a dcr-lab soft-body child")?;
     if !out.status.success() {
-        bail!("{scene}: the {} run failed ({})", method.label(), out.status);
+        bail!(
+            "{scene}: the {} run failed ({})",
+            method.label(),
+            out.status
+        );
     }
     let row: SideRow = serde_json::from_slice(&out.stdout)
         .with_context(|| format!("{scene}: reading the {} row", method.label()))?;
@@ -242,9 +278,19 @@ fn compare(a: &CompareArgs) -> Result<()> {
             tolerance: a.tolerance_pct / 100.0,
             ..SweepParams::default()
         };
-        let (soft, end) =
-            sweep_substeps(&params, |m| run_child(&a.root, scene, m, a.seconds))?;
+        let params = SweepParams {
+            cg_iterations: a.cg_iterations.unwrap_or(params.cg_iterations),
+            ..params
+        };
+        let (soft, end) = sweep_substeps(&params, |m| run_child(&a.root, scene, m, a.seconds))?;
         let mut all = soft;
+        for &(substeps, cg_iterations) in &a.extra {
+            let m = SideMethod::RapierFem {
+                substeps,
+                cg_iterations,
+            };
+            all.push(run_child(&a.root, scene, &m, a.seconds)?);
+        }
         all.extend(rows);
         out.push(SceneComparison {
             scene: all[0].scene.clone(),

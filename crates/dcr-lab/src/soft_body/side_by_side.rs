@@ -171,8 +171,7 @@ pub fn run_side(
                 steps: r.steps,
                 step_ms_median: percentile(&whole, 50.0),
                 step_ms_p99: percentile(&whole, 99.0),
-                response_ms: dcr
-                    .then(|| [percentile(&adapter, 50.0), percentile(&adapter, 99.0)]),
+                response_ms: dcr.then(|| [percentile(&adapter, 50.0), percentile(&adapter, 99.0)]),
                 peak_rss_mib: None,
                 wall_s: 0.0,
                 outcomes: r.outcomes.into_iter().collect(),

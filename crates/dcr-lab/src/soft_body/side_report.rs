@@ -96,10 +96,11 @@ pub fn render_markdown(scenes: &[SceneComparison]) -> String {
                     label.push_str(" (converged)");
                 }
             }
-            let ratio = table_step.map_or("–".into(), |t| format!("{:.0}×", r.step_ms_median / t));
-            let response = r
-                .response_ms
-                .map_or("–".into(), |[a, b]| format!("{} / {}", fmt_sig(a), fmt_sig(b)));
+            let ratio =
+                table_step.map_or("–".into(), |t| format!("{:.0}×", r.step_ms_median / t));
+            let response = r.response_ms.map_or("–".into(), |[a, b]| {
+                format!("{} / {}", fmt_sig(a), fmt_sig(b))
+            });
             let _ = write!(
                 s,
                 "| {label} | {} | {} | {ratio} | {response} | {} |",

@@ -221,8 +221,7 @@ pub fn tet_soft_body(mesh: &TetMesh, desc: &TetSoftBodyDesc) -> Result<TetSoftBo
 
     // ζ from α1 at the median cell (see `TetSoftBodyDesc::rayleigh`).
     let mu = desc.youngs / (2.0 * (1.0 + desc.poisson));
-    let lambda =
-        desc.youngs * desc.poisson / ((1.0 + desc.poisson) * (1.0 - 2.0 * desc.poisson));
+    let lambda = desc.youngs * desc.poisson / ((1.0 + desc.poisson) * (1.0 - 2.0 * desc.poisson));
     let mut is_pinned = vec![false; particle_node.len()];
     for &p in &pinned {
         is_pinned[p as usize] = true;
