@@ -4,7 +4,7 @@
 //! own solver) instead of a rigid body with dcr's distant response — and what that costs and
 //! shows, side by side with dcr on the same scene.
 //!
-//! - [`tet_soft_body`]: a soft body from the baker's tetrahedral mesh, material, fixed groups and
+//! - [`tet_soft_body()`]: a soft body from the baker's tetrahedral mesh, material, fixed groups and
 //!   Rayleigh damping;
 //! - [`run_soft_scene`]: a scene run with its elastic objects as soft bodies, the rest of the
 //!   world as `dcr-scenes run` builds it, the same outcome figures;

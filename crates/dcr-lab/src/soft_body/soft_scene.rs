@@ -120,7 +120,7 @@ pub struct SoftRunReport {
 }
 
 /// Runs `desc` with every elastic object a rapier FEM soft body (see
-/// [`super::tet_soft_body`]): the world `dcr_scenes::scene::build_world` builds, the rigid
+/// [`tet_soft_body()`](fn@super::tet_soft_body)): the world `dcr_scenes::scene::build_world` builds, the rigid
 /// bodies of the elastic objects (and their proxy colliders) replaced by their tetrahedral
 /// meshes, pinned at their `fixed` groups, with the scene's material and Rayleigh damping.
 ///

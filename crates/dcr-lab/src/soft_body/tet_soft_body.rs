@@ -291,10 +291,10 @@ pub fn tet_soft_body(mesh: &TetMesh, desc: &TetSoftBodyDesc) -> Result<TetSoftBo
     })
 }
 
-/// Reads `path` with the baker's mesh reader and builds its soft body (see [`tet_soft_body`]).
+/// Reads `path` with the baker's mesh reader and builds its soft body (see [`tet_soft_body()`]).
 ///
 /// # Errors
-/// The mesh cannot be read, or [`tet_soft_body`] refuses it (the message names the file).
+/// The mesh cannot be read, or [`tet_soft_body()`] refuses it (the message names the file).
 pub fn tet_soft_body_from_file(
     path: &std::path::Path,
     desc: &TetSoftBodyDesc,
