@@ -46,13 +46,9 @@ impl SceneComparison {
 
     /// The last row of the sweep (the converged one when the sweep converged).
     pub fn last_soft(&self) -> Option<&SideRow> {
-        self.rows
-            .iter()
-            .filter(|r| matches!(r.method, SideMethod::RapierFem { .. }))
-            .filter(|r| {
-                matches!(r.method, SideMethod::RapierFem { substeps, .. } if substeps == self.sweep.last_substeps)
-            })
-            .last()
+        self.rows.iter().rev().find(|r| {
+            matches!(r.method, SideMethod::RapierFem { substeps, .. } if substeps == self.sweep.last_substeps)
+        })
     }
 }
 

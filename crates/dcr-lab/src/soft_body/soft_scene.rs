@@ -260,7 +260,7 @@ pub fn run_soft_scene(desc: &SceneDesc, params: &SoftSceneParams) -> Result<Soft
             );
         }
     }
-    for (h, _) in soft.iter().zip(&objects) {
+    for h in &soft {
         let sb = &built.world.soft_bodies[*h];
         if sb.particle_positions().any(|p| !p.is_finite()) {
             bail!(

@@ -141,7 +141,11 @@ fn cell_mean_omega(x: [[f64; 3]; 4], w: [f64; 4], mu: f64, lambda: f64) -> Optio
             count += 1;
         }
     }
-    (count > 0).then(|| sum / count as f64)
+    if count > 0 {
+        Some(sum / count as f64)
+    } else {
+        None
+    }
 }
 
 /// Builds the rapier FEM soft body of `mesh` (object frame) placed at `desc.pose`:
