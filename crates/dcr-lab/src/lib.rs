@@ -7,8 +7,11 @@
 //!   `modal-bake probe`'s shape (`dcr-lab truth`);
 //! - [`attenuation_fit`]: Eq. 14 and the §4.5 law fitted to the full-order response at random
 //!   surface pairs (`dcr-lab fit-attenuation`);
-//! - [`accuracy`]: the report `docs/accuracy.md` and its plots (`dcr-lab accuracy --out docs`).
+//! - [`accuracy`]: the report `docs/accuracy.md` and its plots (`dcr-lab accuracy --out docs`);
+//! - [`soft_body`]: the elastic objects as rapier FEM soft bodies instead, side by side with dcr
+//!   (`dcr-lab soft-body run|compare`).
 
 pub mod accuracy;
 pub mod attenuation_fit;
+pub mod soft_body;
 pub mod truth;

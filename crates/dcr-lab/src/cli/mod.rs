@@ -3,6 +3,7 @@
 mod accuracy;
 mod fit_attenuation;
 mod progress;
+mod soft_body;
 mod truth;
 
 use std::process::ExitCode;
@@ -30,6 +31,8 @@ enum Command {
     FitAttenuation(fit_attenuation::FitAttenuationArgs),
     /// Regenerate the accuracy report (OUT/accuracy.md and OUT/accuracy/*.svg).
     Accuracy(accuracy::AccuracyArgs),
+    /// A scene's elastic objects as rapier FEM soft bodies, and side by side with dcr.
+    SoftBody(soft_body::SoftBodyArgs),
 }
 
 /// Writes `s` to stdout. A closed pipe (`dcr-lab truth … | head`) is not an error; any other
@@ -54,6 +57,7 @@ pub fn main() -> ExitCode {
         Command::Truth(a) => truth::run(&a),
         Command::FitAttenuation(a) => fit_attenuation::run(&a).map(|()| ExitCode::SUCCESS),
         Command::Accuracy(a) => accuracy::run(&a).map(|()| ExitCode::SUCCESS),
+        Command::SoftBody(a) => soft_body::run(&a).map(|()| ExitCode::SUCCESS),
     };
     match result {
         Ok(code) => code,

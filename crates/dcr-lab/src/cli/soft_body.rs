@@ -1,0 +1,322 @@
+//! `dcr-lab soft-body`: a scene with its elastic objects as rapier FEM soft bodies, and the
+//! side-by-side comparison with dcr (see [`dcr_lab::soft_body`]).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+
+use anyhow::{bail, Context, Result};
+use clap::{Args, Subcommand, ValueEnum};
+use dcr_lab::soft_body::{
+    render_markdown, run_side, sweep_substeps, SceneComparison, SideMethod, SideRow,
+    SoftSceneParams, SweepParams,
+};
+use dcr_scenes::scene::SceneDesc;
+
+#[derive(Args, Clone, Debug)]
+pub struct SoftBodyArgs {
+    #[command(subcommand)]
+    pub command: SoftBodyCommand,
+}
+
+#[derive(Subcommand, Clone, Debug)]
+pub enum SoftBodyCommand {
+    /// One run of a scene: its elastic objects as rapier FEM soft bodies (`--method
+    /// rapier-fem`, the default), or rigid with dcr (`modal`, `transfer`) or without (`off`).
+    Run(RunArgs),
+    /// Every method side by side on each scene, one process per row (its peak memory is the
+    /// row's): rapier-FEM at 1, 2, 4, … substeps until the outcomes settle, dcr with 20 modes
+    /// and with the ★ table, no response. Writes a markdown table and the rows as JSON.
+    Compare(CompareArgs),
+}
+
+#[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
+pub enum MethodArg {
+    /// The elastic objects as rapier FEM soft bodies.
+    RapierFem,
+    /// Rigid elastic objects, dcr over the 20-mode base.
+    Modal,
+    /// Rigid elastic objects, dcr from the bake-time transfer table (★).
+    Transfer,
+    /// Rigid elastic objects, no response.
+    Off,
+}
+
+#[derive(Args, Clone, Debug)]
+pub struct RunArgs {
+    /// Scene name (`dinner`, read from ROOT/scenes/dinner.json) or a path to a scene file.
+    pub scene: String,
+    /// What the elastic objects are.
+    #[arg(long, value_enum, default_value = "rapier-fem")]
+    pub method: MethodArg,
+    /// rapier-fem: solver substeps per step. Default rapier's (4).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..=4096))]
+    pub substeps: Option<u64>,
+    /// rapier-fem: cap on the conjugate-gradient iterations of each substep's elastic solve.
+    /// Default rapier's (20).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..=100000))]
+    pub cg_iterations: Option<u64>,
+    /// Simulated time (s). Default the scene's `seconds`.
+    #[arg(long, value_name = "S")]
+    pub seconds: Option<f64>,
+    /// Repository root (scenes, meshes, `out/bases`).
+    #[arg(long, value_name = "DIR", default_value = ".")]
+    pub root: PathBuf,
+    /// Write the row as JSON to FILE (`-`: stdout, instead of the summary line).
+    #[arg(long, value_name = "FILE")]
+    pub json: Option<PathBuf>,
+    /// Progress lines on stderr every 5 s.
+    #[arg(long)]
+    pub progress: bool,
+}
+
+#[derive(Args, Clone, Debug)]
+pub struct CompareArgs {
+    /// Scene names (or paths). Scenes with scripted drivers or dynamic elastic objects are
+    /// refused by the soft-body run.
+    #[arg(required = true)]
+    pub scenes: Vec<String>,
+    /// Wall-time budget of each scene's substep sweep (minutes): no row starts that would
+    /// likely end past it (estimated as twice the previous row).
+    #[arg(long, value_name = "MIN", default_value_t = 20.0)]
+    pub budget_min: f64,
+    /// Largest substep count of the sweep.
+    #[arg(long, value_name = "N", default_value_t = 256)]
+    pub max_substeps: usize,
+    /// The sweep stops once doubling the substeps changes every outcome by less than this (%).
+    #[arg(long, value_name = "PCT", default_value_t = 2.0)]
+    pub tolerance_pct: f64,
+    /// CG iteration cap of the sweep's rows (rapier's `SoftFemParameters::max_linear_iterations`).
+    /// Default rapier's (20).
+    #[arg(long, value_name = "N")]
+    pub cg_iterations: Option<usize>,
+    /// Extra rapier-fem rows after the sweep, SUBSTEPS:CG (repeatable), e.g. `4:1000` for rapier's
+    /// default substeps with a conjugate gradient run to its tolerance.
+    #[arg(long, value_name = "SUBSTEPS:CG", value_parser = parse_extra)]
+    pub extra: Vec<(usize, usize)>,
+    /// Simulated time of every row (s). Default each scene's `seconds`.
+    #[arg(long, value_name = "S")]
+    pub seconds: Option<f64>,
+    /// Repository root.
+    #[arg(long, value_name = "DIR", default_value = ".")]
+    pub root: PathBuf,
+    /// Markdown table output.
+    #[arg(long, value_name = "FILE", default_value = "out/soft_body/compare.md")]
+    pub md: PathBuf,
+    /// JSON output (every row, every scene).
+    #[arg(
+        long,
+        value_name = "FILE",
+        default_value = "out/soft_body/compare.json"
+    )]
+    pub json: PathBuf,
+}
+
+/// `SUBSTEPS:CG`, both at least 1.
+fn parse_extra(s: &str) -> Result<(usize, usize), String> {
+    let (a, b) = s
+        .split_once(':')
+        .ok_or_else(|| format!("{s:?}: expected SUBSTEPS:CG, e.g. 4:1000"))?;
+    let n = |x: &str| -> Result<usize, String> {
+        x.trim()
+            .parse::<usize>()
+            .ok()
+            .filter(|&v| v >= 1)
+            .ok_or_else(|| format!("{s:?}: SUBSTEPS and CG must be whole numbers ≥ 1"))
+    };
+    Ok((n(a)?, n(b)?))
+}
+
+fn scene_path(root: &Path, s: &str) -> PathBuf {
+    if s.ends_with(".json") {
+        PathBuf::from(s)
+    } else {
+        root.join("scenes").join(format!("{s}.json"))
+    }
+}
+
+fn write_file(path: &Path, text: &str) -> Result<()> {
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    }
+    dcr_runtime::format::write_atomic(path, text.as_bytes())
+        .with_context(|| format!("writing {}", path.display()))
+}
+
+fn side_method(a: &RunArgs) -> SideMethod {
+    let d = SoftSceneParams::new(PathBuf::new());
+    match a.method {
+        MethodArg::RapierFem => SideMethod::RapierFem {
+            substeps: a.substeps.map_or(d.substeps, |n| n as usize),
+            cg_iterations: a.cg_iterations.map_or(d.cg_iterations, |n| n as usize),
+        },
+        MethodArg::Modal => SideMethod::Modal,
+        MethodArg::Transfer => SideMethod::Transfer,
+        MethodArg::Off => SideMethod::Off,
+    }
+}
+
+fn run_one(a: &RunArgs) -> Result<()> {
+    if a.method != MethodArg::RapierFem && (a.substeps.is_some() || a.cg_iterations.is_some()) {
+        bail!("--substeps and --cg-iterations apply to --method rapier-fem only");
+    }
+    if let Some(s) = a.seconds {
+        if !(s > 0.0 && s.is_finite()) {
+            bail!("--seconds {s}: must be a positive number of seconds");
+        }
+    }
+    let path = scene_path(&a.root, &a.scene);
+    let desc = SceneDesc::read(&path)?;
+    let method = side_method(a);
+    let row = run_side(&desc, &method, a.root.clone(), a.seconds, a.progress)?;
+    let json = serde_json::to_string_pretty(&row)? + "\n";
+    match &a.json {
+        Some(p) if p.as_os_str() == "-" => crate::cli::emit(&json)?,
+        Some(p) => {
+            write_file(p, &json)?;
+            crate::cli::emit(&summary(&row))?;
+        }
+        None => crate::cli::emit(&summary(&row))?,
+    }
+    Ok(())
+}
+
+fn summary(r: &SideRow) -> String {
+    let outcomes: Vec<String> = r
+        .outcomes
+        .iter()
+        .map(|(n, (v, u))| format!("{n} {v:.4} {u}"))
+        .collect();
+    format!(
+        "{} {}: {} steps, step median {:.3} ms, p99 {:.3} ms, peak RSS {} MiB, {:.1} s; {}\n",
+        r.scene,
+        r.method.label(),
+        r.steps,
+        r.step_ms_median,
+        r.step_ms_p99,
+        r.peak_rss_mib.map_or("?".into(), |m| format!("{m:.0}")),
+        r.wall_s,
+        outcomes.join(", ")
+    )
+}
+
+/// Runs one row in a child process of this binary (`soft-body run … --json -`).
+fn run_child(
+    root: &Path,
+    scene: &str,
+    method: &SideMethod,
+    seconds: Option<f64>,
+) -> Result<SideRow> {
+    let exe = std::env::current_exe().context("locating the dcr-lab binary")?;
+    let mut cmd = Command::new(exe);
+    cmd.arg("soft-body")
+        .arg("run")
+        .arg(scene)
+        .arg("--root")
+        .arg(root)
+        .arg("--json")
+        .arg("-")
+        .arg("--progress");
+    match method {
+        SideMethod::RapierFem {
+            substeps,
+            cg_iterations,
+        } => {
+            cmd.args(["--method", "rapier-fem", "--substeps"])
+                .arg(substeps.to_string())
+                .arg("--cg-iterations")
+                .arg(cg_iterations.to_string());
+        }
+        SideMethod::Modal => {
+            cmd.args(["--method", "modal"]);
+        }
+        SideMethod::Transfer => {
+            cmd.args(["--method", "transfer"]);
+        }
+        SideMethod::Off => {
+            cmd.args(["--method", "off"]);
+        }
+    }
+    if let Some(s) = seconds {
+        cmd.arg("--seconds").arg(s.to_string());
+    }
+    eprintln!("[dcr-lab] {scene}: {} …", method.label());
+    let out = cmd
+        .stderr(Stdio::inherit())
+        .output()
+        .context("running a dcr-lab soft-body child")?;
+    if !out.status.success() {
+        bail!(
+            "{scene}: the {} run failed ({})",
+            method.label(),
+            out.status
+        );
+    }
+    let row: SideRow = serde_json::from_slice(&out.stdout)
+        .with_context(|| format!("{scene}: reading the {} row", method.label()))?;
+    eprint!("[dcr-lab]   {}", summary(&row));
+    Ok(row)
+}
+
+fn compare(a: &CompareArgs) -> Result<()> {
+    if !(a.budget_min > 0.0) {
+        bail!("--budget-min {}: must be positive", a.budget_min);
+    }
+    if !(a.tolerance_pct > 0.0) {
+        bail!("--tolerance-pct {}: must be positive", a.tolerance_pct);
+    }
+    let mut out = Vec::new();
+    for scene in &a.scenes {
+        // Read (and check) the scene before spending minutes on it.
+        SceneDesc::read(&scene_path(&a.root, scene))?;
+        // Bake the bases first, in a row of their own that is not kept: a row whose process
+        // bakes would report the eigensolver's memory and time, not the run's.
+        for m in [SideMethod::Modal, SideMethod::Transfer] {
+            run_child(&a.root, scene, &m, Some(0.01))?;
+        }
+        let mut rows = Vec::new();
+        for m in [SideMethod::Off, SideMethod::Modal, SideMethod::Transfer] {
+            rows.push(run_child(&a.root, scene, &m, a.seconds)?);
+        }
+        let params = SweepParams {
+            budget_s: a.budget_min * 60.0,
+            max_substeps: a.max_substeps,
+            tolerance: a.tolerance_pct / 100.0,
+            ..SweepParams::default()
+        };
+        let params = SweepParams {
+            cg_iterations: a.cg_iterations.unwrap_or(params.cg_iterations),
+            ..params
+        };
+        let (soft, end) = sweep_substeps(&params, |m| run_child(&a.root, scene, m, a.seconds))?;
+        let mut all = soft;
+        for &(substeps, cg_iterations) in &a.extra {
+            let m = SideMethod::RapierFem {
+                substeps,
+                cg_iterations,
+            };
+            all.push(run_child(&a.root, scene, &m, a.seconds)?);
+        }
+        all.extend(rows);
+        out.push(SceneComparison {
+            scene: all[0].scene.clone(),
+            default_substeps: SoftSceneParams::new(PathBuf::new()).substeps,
+            rows: all,
+            sweep: end,
+        });
+    }
+    write_file(&a.md, &render_markdown(&out))?;
+    write_file(&a.json, &(serde_json::to_string_pretty(&out)? + "\n"))?;
+    crate::cli::emit(&format!(
+        "wrote {} and {}\n",
+        a.md.display(),
+        a.json.display()
+    ))?;
+    Ok(())
+}
+
+pub fn run(a: &SoftBodyArgs) -> Result<()> {
+    match &a.command {
+        SoftBodyCommand::Run(r) => run_one(r),
+        SoftBodyCommand::Compare(c) => compare(c),
+    }
+}

@@ -1,0 +1,298 @@
+//! One scene, side by side: rapier FEM soft bodies at increasing substeps against the distant
+//! response (20 modes, the ★ transfer table) on rigid objects and against no response — cost
+//! per step, peak memory and the scene's outcome figures.
+
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+use std::time::Instant;
+
+use anyhow::Result;
+use dcr_scenes::runner::{run_scene, MethodChoice, RunParams};
+use dcr_scenes::scene::{MethodDesc, SceneDesc, TransferDesc};
+use serde::{Deserialize, Serialize};
+
+use super::peak_rss::peak_rss_bytes;
+use super::soft_scene::{run_soft_scene, SoftSceneParams};
+
+/// What a row of the comparison runs.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SideMethod {
+    /// The elastic objects as rapier FEM soft bodies (see [`run_soft_scene`]).
+    RapierFem {
+        /// Substeps per step.
+        substeps: usize,
+        /// CG iteration cap per substep.
+        cg_iterations: usize,
+    },
+    /// Rigid objects, the distant response over the 20-mode base (`--method modal`).
+    Modal,
+    /// Rigid objects, the distant response from the bake-time transfer table (`--method
+    /// transfer`; objects without table settings get the accuracy study's region, the faces
+    /// within 60° of the mesh's +y).
+    Transfer,
+    /// Rigid objects, no response.
+    Off,
+}
+
+impl SideMethod {
+    /// A short label for tables (`rapier-fem 8 substeps`, `dcr 20 modes`, ...).
+    pub fn label(&self) -> String {
+        match self {
+            SideMethod::RapierFem {
+                substeps,
+                cg_iterations,
+            } => {
+                let cg = SoftSceneParams::new(PathBuf::new()).cg_iterations;
+                if *cg_iterations == cg {
+                    format!("rapier-fem, {substeps} substeps")
+                } else {
+                    format!("rapier-fem, {substeps} substeps, CG ≤ {cg_iterations}")
+                }
+            }
+            SideMethod::Modal => "dcr, 20 modes (rigid table)".into(),
+            SideMethod::Transfer => "dcr, ★ table (rigid table)".into(),
+            SideMethod::Off => "no response (rigid table)".into(),
+        }
+    }
+}
+
+/// One row: a method's cost and outcomes on a scene.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct SideRow {
+    /// Scene name.
+    pub scene: String,
+    /// What ran.
+    pub method: SideMethod,
+    /// Steps (at the scene's h).
+    pub steps: usize,
+    /// Median and 99th percentile wall time of a whole step (ms): rapier's step, plus the
+    /// adapter's calls for the dcr rows.
+    pub step_ms_median: f64,
+    /// 99th percentile (ms).
+    pub step_ms_p99: f64,
+    /// The response's own share of a step for the dcr rows: median and 99th percentile of the
+    /// adapter's calls (ms); `None` for the others.
+    pub response_ms: Option<[f64; 2]>,
+    /// Peak resident set size of the process that ran the row (MiB), if the OS says.
+    pub peak_rss_mib: Option<f64>,
+    /// Wall time of the whole run (s).
+    pub wall_s: f64,
+    /// Outcome figures: name → (value, unit).
+    pub outcomes: BTreeMap<String, (f64, String)>,
+    /// Soft rows: the largest displacement of the soft surface under a watched body (mm).
+    pub surface_peak_mm: Option<f64>,
+}
+
+fn percentile(v: &[f64], p: f64) -> f64 {
+    if v.is_empty() {
+        return f64::NAN;
+    }
+    let mut s = v.to_vec();
+    s.sort_by(f64::total_cmp);
+    let i = ((p / 100.0) * (s.len() - 1) as f64).round() as usize;
+    s[i.min(s.len() - 1)]
+}
+
+/// `desc` with every elastic object that has no transfer-table settings given the accuracy
+/// study's region (faces within 60° of the mesh's +y, defaults otherwise), so `--method
+/// transfer` runs on it.
+pub fn with_transfer_region(desc: &SceneDesc) -> SceneDesc {
+    let mut d = desc.clone();
+    for e in &mut d.elastic {
+        if e.transfer.is_none() && !matches!(e.method, MethodDesc::Transfer(_)) {
+            e.transfer = Some(TransferDesc {
+                up: Some([0.0, 1.0, 0.0]),
+                ..TransferDesc::default()
+            });
+        }
+    }
+    d
+}
+
+/// Runs one row in this process (its peak memory is this process's).
+///
+/// # Errors
+/// What [`run_soft_scene`] or `dcr_scenes::runner::run_scene` report.
+pub fn run_side(
+    desc: &SceneDesc,
+    method: &SideMethod,
+    root: PathBuf,
+    seconds: Option<f64>,
+    progress: bool,
+) -> Result<SideRow> {
+    let wall = Instant::now();
+    let row = match method {
+        SideMethod::RapierFem {
+            substeps,
+            cg_iterations,
+        } => {
+            let mut p = SoftSceneParams::new(root);
+            p.substeps = *substeps;
+            p.cg_iterations = *cg_iterations;
+            p.seconds = seconds;
+            p.progress = progress;
+            let r = run_soft_scene(desc, &p)?;
+            SideRow {
+                scene: desc.name.clone(),
+                method: method.clone(),
+                steps: r.steps,
+                step_ms_median: percentile(&r.step_ms, 50.0),
+                step_ms_p99: percentile(&r.step_ms, 99.0),
+                response_ms: None,
+                peak_rss_mib: None,
+                wall_s: 0.0,
+                outcomes: r.outcomes,
+                surface_peak_mm: r.surface_peak_mm.values().copied().reduce(f64::max),
+            }
+        }
+        SideMethod::Modal | SideMethod::Transfer | SideMethod::Off => {
+            let dcr = *method != SideMethod::Off;
+            let mut p = RunParams::new(root, dcr);
+            p.seconds = seconds;
+            p.progress = progress;
+            let desc = if *method == SideMethod::Transfer {
+                p.method = MethodChoice::Transfer;
+                with_transfer_region(desc)
+            } else {
+                p.method = MethodChoice::Modal;
+                desc.clone()
+            };
+            let r = run_scene(&desc, &p)?;
+            let whole: Vec<f64> = r
+                .step_times
+                .iter()
+                .map(|t| (t.rapier_us + if dcr { t.adapter_us } else { 0.0 }) / 1e3)
+                .collect();
+            let adapter: Vec<f64> = r.step_times.iter().map(|t| t.adapter_us / 1e3).collect();
+            SideRow {
+                scene: desc.name.clone(),
+                method: method.clone(),
+                steps: r.steps,
+                step_ms_median: percentile(&whole, 50.0),
+                step_ms_p99: percentile(&whole, 99.0),
+                response_ms: dcr.then(|| [percentile(&adapter, 50.0), percentile(&adapter, 99.0)]),
+                peak_rss_mib: None,
+                wall_s: 0.0,
+                outcomes: r.outcomes.into_iter().collect(),
+                surface_peak_mm: None,
+            }
+        }
+    };
+    Ok(SideRow {
+        peak_rss_mib: peak_rss_bytes().map(|b| b as f64 / (1024.0 * 1024.0)),
+        wall_s: wall.elapsed().as_secs_f64(),
+        ..row
+    })
+}
+
+/// The largest relative change of the outcome figures between two rows:
+/// `|a − b| / max(|a|, |b|)` over the outcomes, a pair both below `floor` counting as no change
+/// (figures that small — 1 µm of lift, 0.001° of tilt — are at rapier's contact noise).
+pub fn outcome_change(a: &SideRow, b: &SideRow, floor: f64) -> f64 {
+    let mut worst: f64 = 0.0;
+    for (name, (va, _)) in &a.outcomes {
+        let Some((vb, _)) = b.outcomes.get(name) else {
+            return f64::INFINITY;
+        };
+        let scale = va.abs().max(vb.abs());
+        if scale < floor {
+            continue;
+        }
+        worst = worst.max((va - vb).abs() / scale);
+    }
+    worst
+}
+
+/// How the substep sweep of the soft rows ends.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct SweepEnd {
+    /// Substeps of the last row run.
+    pub last_substeps: usize,
+    /// Whether the last doubling changed every outcome by less than the tolerance.
+    pub converged: bool,
+    /// The largest outcome change of the last doubling (fraction).
+    pub last_change: f64,
+    /// Why the sweep stopped (`converged`, `time budget`, `substep cap`).
+    pub reason: String,
+}
+
+/// Settings of the substep sweep.
+#[derive(Clone, Debug)]
+pub struct SweepParams {
+    /// First substep count (doubled each row). Default 1.
+    pub first: usize,
+    /// Largest substep count. Default 256.
+    pub max_substeps: usize,
+    /// The sweep stops once a doubling changes every outcome by less than this (fraction).
+    /// Default 0.02.
+    pub tolerance: f64,
+    /// Outcomes below this in both rows count as unchanged (mm or deg). Default 0.001.
+    pub floor: f64,
+    /// Wall-time budget of the sweep (s): no row starts whose estimated time (twice the last
+    /// row's) would end past it. Default 1200.
+    pub budget_s: f64,
+    /// CG iteration cap of the sweep's rows. Default rapier's (20).
+    pub cg_iterations: usize,
+}
+
+impl Default for SweepParams {
+    fn default() -> Self {
+        SweepParams {
+            first: 1,
+            max_substeps: 256,
+            tolerance: 0.02,
+            floor: 1e-3,
+            budget_s: 1200.0,
+            cg_iterations: SoftSceneParams::new(PathBuf::new()).cg_iterations,
+        }
+    }
+}
+
+/// Runs rapier-FEM rows at `first`, 2·`first`, 4·`first`, … substeps with `run` until a
+/// doubling changes every outcome by less than the tolerance, the budget would be exceeded or
+/// the cap is reached. Returns the rows in order and how the sweep ended.
+///
+/// # Errors
+/// The first error `run` returns.
+pub fn sweep_substeps(
+    params: &SweepParams,
+    mut run: impl FnMut(&SideMethod) -> Result<SideRow>,
+) -> Result<(Vec<SideRow>, SweepEnd)> {
+    let start = Instant::now();
+    let mut rows: Vec<SideRow> = Vec::new();
+    let mut n = params.first.max(1);
+    let mut end = SweepEnd {
+        last_substeps: n,
+        converged: false,
+        last_change: f64::INFINITY,
+        reason: "substep cap".into(),
+    };
+    loop {
+        let row = run(&SideMethod::RapierFem {
+            substeps: n,
+            cg_iterations: params.cg_iterations,
+        })?;
+        if let Some(prev) = rows.last() {
+            end.last_change = outcome_change(prev, &row, params.floor);
+        }
+        end.last_substeps = n;
+        let wall = row.wall_s;
+        rows.push(row);
+        if end.last_change < params.tolerance {
+            end.converged = true;
+            end.reason = "converged".into();
+            break;
+        }
+        if n * 2 > params.max_substeps {
+            end.reason = "substep cap".into();
+            break;
+        }
+        if start.elapsed().as_secs_f64() + 2.0 * wall > params.budget_s {
+            end.reason = "time budget".into();
+            break;
+        }
+        n *= 2;
+    }
+    Ok((rows, end))
+}
