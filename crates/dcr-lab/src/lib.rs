@@ -7,8 +7,11 @@
 //!   `modal-bake probe`'s shape (`dcr-lab truth`);
 //! - [`attenuation_fit`]: Eq. 14 and the §4.5 law fitted to the full-order response at random
 //!   surface pairs (`dcr-lab fit-attenuation`);
-//! - [`accuracy`]: the report `docs/accuracy.md` and its plots (`dcr-lab accuracy --out docs`).
+//! - [`accuracy`]: the report `docs/accuracy.md` and its plots (`dcr-lab accuracy --out docs`);
+//! - [`scene_truth`]: the coupled elastic–rigid reference of whole scenes and the outcomes page
+//!   `docs/outcomes.md` (`dcr-lab scene-truth`).
 
 pub mod accuracy;
 pub mod attenuation_fit;
+pub mod scene_truth;
 pub mod truth;

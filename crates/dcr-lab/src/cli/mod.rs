@@ -3,6 +3,7 @@
 mod accuracy;
 mod fit_attenuation;
 mod progress;
+mod scene_truth;
 mod truth;
 
 use std::process::ExitCode;
@@ -30,6 +31,8 @@ enum Command {
     FitAttenuation(fit_attenuation::FitAttenuationArgs),
     /// Regenerate the accuracy report (OUT/accuracy.md and OUT/accuracy/*.svg).
     Accuracy(accuracy::AccuracyArgs),
+    /// Coupled elastic–rigid reference of whole scenes; with --page, docs/outcomes.md.
+    SceneTruth(scene_truth::SceneTruthArgs),
 }
 
 /// Writes `s` to stdout. A closed pipe (`dcr-lab truth … | head`) is not an error; any other
@@ -51,6 +54,7 @@ pub fn main() -> ExitCode {
         Command::Truth(a) => truth::run(&a),
         Command::FitAttenuation(a) => fit_attenuation::run(&a).map(|()| ExitCode::SUCCESS),
         Command::Accuracy(a) => accuracy::run(&a).map(|()| ExitCode::SUCCESS),
+        Command::SceneTruth(a) => scene_truth::run(&a),
     };
     match result {
         Ok(code) => code,
