@@ -46,6 +46,10 @@ pub struct CoupledRun {
     /// Work (J) the elastic surface's motion did on each prop, largest over time of the
     /// running sum, by body name.
     pub delivered: BTreeMap<String, f64>,
+    /// Largest upward speed (m/s, along the contact normal) of the elastic surface under each
+    /// prop's contacts while they touch, by body name: what the distant response's Δv (Eq. 12)
+    /// stands for.
+    pub surface_speed: BTreeMap<String, f64>,
     /// Largest penetration of a penalty contact (m).
     pub max_penetration: f64,
     /// Energy at each recorded row (J): rigid kinetic + gravity potential + elastic + penalty
@@ -156,6 +160,7 @@ pub fn run_coupled(
     let mut work = vec![0.0f64; built.bodies.len()];
     let mut work_max = vec![0.0f64; built.bodies.len()];
     let mut max_pen = 0.0f64;
+    let mut speed = vec![0.0f64; built.bodies.len()];
     let gravity = Vector::new(desc.gravity[0], desc.gravity[1], desc.gravity[2]);
     let mut energy = vec![0.0];
     let mut spring_energy = 0.0;
@@ -280,6 +285,7 @@ pub fn run_coupled(
                 }
                 // Work of the surface's elastic motion on the prop: f_n v_n dt.
                 if let Some(&b) = body_of.get(&ob) {
+                    speed[b] = speed[b].max(v_n);
                     work[b] += fn_ * v_n * p.dt;
                     work_max[b] = work_max[b].max(work[b]);
                 }
@@ -323,7 +329,15 @@ pub fn run_coupled(
         .filter(|(i, _)| work_max[*i] > 0.0)
         .map(|(i, b)| (b.name.clone(), work_max[i]))
         .collect();
+    let surface_speed = built
+        .bodies
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| speed[*i] > 0.0)
+        .map(|(i, b)| (b.name.clone(), speed[i]))
+        .collect();
     Ok(CoupledRun {
+        surface_speed,
         trajectory: traj,
         outcomes,
         delivered,

@@ -23,6 +23,9 @@ pub struct MethodOutcome {
     /// Kinetic energy the responses gave the props (J, the world's account; the reference: the
     /// work of the elastic surface's motion on the props).
     pub delivered_j: f64,
+    /// Largest Δv (m/s, along the normal) given to each body: the response events' for the
+    /// methods, the elastic surface's upward speed under the body's contacts for the reference.
+    pub delta_v: BTreeMap<String, f64>,
     /// Trajectory at the scene's h.
     pub trajectory: Trajectory,
 }
@@ -53,6 +56,7 @@ pub fn compare_scene(
         label: "coupled reference".into(),
         outcomes: truth.run.outcomes.clone(),
         delivered_j: truth.run.delivered.values().sum(),
+        delta_v: truth.run.surface_speed.clone(),
         trajectory: truth.run.trajectory.clone(),
     }];
     // The ★ table over the object's upward faces (as docs/accuracy.md builds it) where the
@@ -83,6 +87,14 @@ pub fn compare_scene(
             label: label.to_string(),
             outcomes: r.outcomes,
             delivered_j: r.injected_ke,
+            delta_v: if on {
+                r.received
+                    .iter()
+                    .map(|(k, v)| (k.clone(), v.max_delta_v))
+                    .collect()
+            } else {
+                BTreeMap::new()
+            },
             trajectory: r.trajectory,
         });
     }
@@ -284,6 +296,22 @@ pub fn write_outcomes_page(out: &Path, scenes: &[SceneComparison], header: &str)
             write!(md, " {} |", fmt(m.delivered_j))?;
         }
         writeln!(md)?;
+        // Δv per outcome's bodies: the largest over the matching bodies.
+        let mut patterns: Vec<&str> = c.desc.outcomes.iter().map(|o| o.bodies.as_str()).collect();
+        patterns.dedup();
+        for pat in patterns {
+            write!(md, "| largest Δv, {pat} (m/s) |")?;
+            for m in &c.methods {
+                let v = m
+                    .delta_v
+                    .iter()
+                    .filter(|(k, _)| name_matches(pat, k))
+                    .map(|(_, v)| *v)
+                    .fold(0.0, f64::max);
+                write!(md, " {} |", fmt(v))?;
+            }
+            writeln!(md)?;
+        }
         if let Some(svg) = lift_svg(c)? {
             let file = format!("{}_lift.svg", c.desc.name);
             write_atomic(&dir.join(&file), svg.as_bytes())
@@ -308,5 +336,5 @@ paper's Eq. 12 unscaled) with 20 modes, with the transfer table (★, the peak o
 with spatial attenuation (the scene's settings). Errors are against the reference (absolute \
 differences where the reference is near zero). Energy delivered: for the methods the kinetic \
 energy the responses gave the props (the world's account); for the reference the work the \
-elastic surface's motion did on them (largest running sum per prop, summed).
+elastic surface's motion did on them (largest running sum per prop, summed). Largest Δv: for the methods the largest response velocity change given to the bodies (Eq. 12, 17–18, after gain and Gauss–Seidel); for the reference the largest upward speed of the elastic surface under the bodies' contacts while they touch — the quantity Δv = peak/h stands for.
 ";
