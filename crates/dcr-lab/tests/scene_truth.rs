@@ -29,7 +29,10 @@ fn scene(
     vel: [f64; 3],
 ) -> SceneDesc {
     let (body, fixed) = if body_dynamic {
-        (serde_json::json!({"dynamic": {"mass": 10.0}}), serde_json::json!([]))
+        (
+            serde_json::json!({"dynamic": {"mass": 10.0}}),
+            serde_json::json!([]),
+        )
     } else {
         (serde_json::json!("static"), serde_json::json!(["clamp"]))
     };
@@ -103,9 +106,14 @@ fn free_floating_conserves_momentum() {
     let (t, b) = (&r.trajectory, 0usize);
     let ball = t.names.iter().position(|n| n == "ball").expect("ball");
     let y_end = t.pos(t.rows() - 1, ball)[1];
-    let y_min = (0..t.rows()).map(|k| t.pos(k, ball)[1]).fold(f64::INFINITY, f64::min);
+    let y_min = (0..t.rows())
+        .map(|k| t.pos(k, ball)[1])
+        .fold(f64::INFINITY, f64::min);
     let _ = b;
-    assert!(y_end > y_min + 1e-3, "the ball should rebound: min {y_min}, end {y_end}");
+    assert!(
+        y_end > y_min + 1e-3,
+        "the ball should rebound: min {y_min}, end {y_end}"
+    );
 }
 
 /// Energy drift |E_end − E_0| / E_0 of a run (damping off: should vanish with the step).
@@ -125,14 +133,25 @@ fn energy_conserved_undamped_dissipated_damped() {
     let fine = run(&desc, 1.0, &params(1e-5, 0.1, [0.0, 0.0], 1.0));
     let (dc, df) = (drift(&coarse), drift(&fine));
     assert!(dc < 0.02, "undamped energy drift {dc} at 2e-5 s");
-    assert!(df < 0.67 * dc, "drift should shrink with the step: {dc} → {df}");
+    assert!(
+        df < 0.67 * dc,
+        "drift should shrink with the step: {dc} → {df}"
+    );
     let damped = run(&desc, 1.0, &params(1e-5, 0.1, [200.0, 1e-5], 1.0));
     let e = &damped.energy;
     let lost = 1.0 - e[e.len() - 1] / e[0];
-    assert!(lost > 10.0 * df, "damping should dissipate energy: lost {lost}, drift {df}");
+    assert!(
+        lost > 10.0 * df,
+        "damping should dissipate energy: lost {lost}, drift {df}"
+    );
     // After the contact (the last 5 rows: the ball has left) energy only decreases.
     for k in e.len() - 5..e.len() {
-        assert!(e[k] <= e[k - 1] * (1.0 + 1e-12), "energy grew at row {k}: {} → {}", e[k - 1], e[k]);
+        assert!(
+            e[k] <= e[k - 1] * (1.0 + 1e-12),
+            "energy grew at row {k}: {} → {}",
+            e[k - 1],
+            e[k]
+        );
     }
 }
 
@@ -166,10 +185,12 @@ fn very_stiff_object_reduces_to_rigid_contact() {
     let hf = rebound(&soft.trajectory);
     eprintln!("rebound: rigid {hr} m, stiff {hs} m, scene stiffness {hf} m");
     assert!(hr > 1e-3, "the rigid ball should rebound, got {hr}");
-    assert!((hs - hr).abs() < 0.15 * hr, "stiff rebound {hs} vs rigid {hr}");
+    assert!(
+        (hs - hr).abs() < 0.15 * hr,
+        "stiff rebound {hs} vs rigid {hr}"
+    );
     assert!(
         (hs - hr).abs() < (hf - hr).abs(),
         "the stiff beam should be closer to rigid than the scene's: {hs}, {hf} vs {hr}"
     );
 }
-

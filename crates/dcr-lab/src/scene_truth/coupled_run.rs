@@ -255,8 +255,8 @@ pub fn run_coupled(
                                 continue;
                             }
                             max_pen = max_pen.max(-gap);
-                            let v_surf = built.world.bodies[e_handle].velocity_at_point(x_e)
-                                + n * v_n;
+                            let v_surf =
+                                built.world.bodies[e_handle].velocity_at_point(x_e) + n * v_n;
                             let v_o = built.world.bodies[ob].velocity_at_point(x_o);
                             let rel = v_o - v_surf;
                             let vn = rel.dot(n);
@@ -414,8 +414,14 @@ fn clamped_restitution(zeta: f64) -> f64 {
     let (mut p, mut v, dt) = (0.0f64, 1.0f64, 1e-3);
     for _ in 0..200_000 {
         let (k1p, k1v) = (v, f(p, v));
-        let (k2p, k2v) = (v + 0.5 * dt * k1v, f(p + 0.5 * dt * k1p, v + 0.5 * dt * k1v));
-        let (k3p, k3v) = (v + 0.5 * dt * k2v, f(p + 0.5 * dt * k2p, v + 0.5 * dt * k2v));
+        let (k2p, k2v) = (
+            v + 0.5 * dt * k1v,
+            f(p + 0.5 * dt * k1p, v + 0.5 * dt * k1v),
+        );
+        let (k3p, k3v) = (
+            v + 0.5 * dt * k2v,
+            f(p + 0.5 * dt * k2p, v + 0.5 * dt * k2v),
+        );
         let (k4p, k4v) = (v + dt * k3v, f(p + dt * k3p, v + dt * k3v));
         p += dt / 6.0 * (k1p + 2.0 * k2p + 2.0 * k3p + k4p);
         v += dt / 6.0 * (k1v + 2.0 * k2v + 2.0 * k3v + k4v);

@@ -39,9 +39,7 @@ impl ElasticBody {
         rayleigh: [f64; 2],
         dt: f64,
     ) -> ElasticBody {
-        let m = modes
-            .unwrap_or(usize::MAX)
-            .min(all.eigenvalues.len());
+        let m = modes.unwrap_or(usize::MAX).min(all.eigenvalues.len());
         let omega: Vec<f64> = all.eigenvalues[..m]
             .iter()
             .map(|l| l.max(0.0).sqrt())

@@ -153,7 +153,11 @@ impl SceneTruth {
     /// The estimated error: the last change between two successive steps (and the mode check,
     /// whichever is larger).
     pub fn estimated_error(&self) -> f64 {
-        let step = self.levels.last().and_then(|l| l.change).unwrap_or(f64::NAN);
+        let step = self
+            .levels
+            .last()
+            .and_then(|l| l.change)
+            .unwrap_or(f64::NAN);
         match &self.half_modes {
             Some(h) => step.max(h.change.unwrap_or(0.0)),
             None => step,
@@ -301,7 +305,9 @@ pub fn scene_truth(desc: &SceneDesc, root: &Path, params: &SceneTruthParams) -> 
     let mut converged = false;
     loop {
         run = run_coupled(desc, root, &prep, &coupled(dt, modes))?;
-        let change = levels.last().map(|l| outcome_change(&l.outcomes, &run.outcomes));
+        let change = levels
+            .last()
+            .map(|l| outcome_change(&l.outcomes, &run.outcomes));
         if params.progress {
             eprintln!(
                 "[scene-truth] {}: dt {:.3e} s, {} modes: {:?} (change {}) in {:.0} s",

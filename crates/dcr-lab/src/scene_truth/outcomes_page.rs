@@ -64,7 +64,9 @@ pub fn compare_scene(
     let mut desc = desc.clone();
     for e in &mut desc.elastic {
         if e.transfer.is_none() {
-            e.transfer = Some(serde_json::from_value(serde_json::json!({"up": [0.0, 1.0, 0.0]}))?);
+            e.transfer = Some(serde_json::from_value(
+                serde_json::json!({"up": [0.0, 1.0, 0.0]}),
+            )?);
         }
     }
     let desc = &desc;
@@ -152,7 +154,10 @@ fn lift_svg(c: &SceneComparison) -> Result<Option<String>> {
             root.fill(&WHITE)?;
             let mut chart = ChartBuilder::on(&root)
                 .caption(
-                    format!("{}: largest {} lift over time (gain 1)", c.desc.name, o.bodies),
+                    format!(
+                        "{}: largest {} lift over time (gain 1)",
+                        c.desc.name, o.bodies
+                    ),
                     ("sans-serif", 18),
                 )
                 .margin(12)
@@ -219,7 +224,10 @@ pub fn write_outcomes_page(out: &Path, scenes: &[SceneComparison], header: &str)
     let dir = out.join("outcomes");
     std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
     let mut md = String::new();
-    writeln!(md, "# Outcomes: the distant response vs a coupled elastic–rigid reference\n")?;
+    writeln!(
+        md,
+        "# Outcomes: the distant response vs a coupled elastic–rigid reference\n"
+    )?;
     writeln!(md, "{header}\n")?;
     md.push_str(PAGE_INTRO);
     for c in scenes {
