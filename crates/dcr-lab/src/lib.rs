@@ -8,10 +8,13 @@
 //! - [`attenuation_fit`]: Eq. 14 and the §4.5 law fitted to the full-order response at random
 //!   surface pairs (`dcr-lab fit-attenuation`);
 //! - [`accuracy`]: the report `docs/accuracy.md` and its plots (`dcr-lab accuracy --out docs`);
+//! - [`scene_truth`]: the coupled elastic–rigid reference of whole scenes and the outcomes page
+//!   `docs/outcomes.md` (`dcr-lab scene-truth`);
 //! - [`soft_body`]: the elastic objects as rapier FEM soft bodies instead, side by side with dcr
 //!   (`dcr-lab soft-body run|compare`).
 
 pub mod accuracy;
 pub mod attenuation_fit;
+pub mod scene_truth;
 pub mod soft_body;
 pub mod truth;

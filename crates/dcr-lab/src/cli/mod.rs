@@ -4,6 +4,7 @@ mod accuracy;
 mod fit_attenuation;
 mod progress;
 mod soft_body;
+mod scene_truth;
 mod truth;
 
 use std::process::ExitCode;
@@ -33,6 +34,8 @@ enum Command {
     Accuracy(accuracy::AccuracyArgs),
     /// A scene's elastic objects as rapier FEM soft bodies, and side by side with dcr.
     SoftBody(soft_body::SoftBodyArgs),
+    /// Coupled elastic–rigid reference of whole scenes; with --page, docs/outcomes.md.
+    SceneTruth(scene_truth::SceneTruthArgs),
 }
 
 /// Writes `s` to stdout. A closed pipe (`dcr-lab truth … | head`) is not an error; any other
@@ -58,6 +61,7 @@ pub fn main() -> ExitCode {
         Command::FitAttenuation(a) => fit_attenuation::run(&a).map(|()| ExitCode::SUCCESS),
         Command::Accuracy(a) => accuracy::run(&a).map(|()| ExitCode::SUCCESS),
         Command::SoftBody(a) => soft_body::run(&a).map(|()| ExitCode::SUCCESS),
+        Command::SceneTruth(a) => scene_truth::run(&a),
     };
     match result {
         Ok(code) => code,

@@ -1,0 +1,148 @@
+//! `dcr-lab scene-truth`: the coupled elastic–rigid reference of whole scenes and, with
+//! `--page`, the outcomes page comparing the distant response's methods with it (see
+//! [`dcr_lab::scene_truth`]).
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::Args;
+use dcr_lab::scene_truth::{
+    compare_scene, load_scene, scene_truth, write_outcomes_page, SceneTruthParams,
+};
+
+/// Exit status when a reference did not converge (its outcomes are still printed and written).
+pub const EXIT_NOT_CONVERGED: u8 = 3;
+
+/// The coupled elastic–rigid reference of a scene: its one elastic object as every elastic mode
+/// of its mesh (dense eigensolve, exact per-mode integration), coupled to the scene's rapier
+/// bodies by penalty contacts at a small step, the step halved until no outcome moves by more
+/// than --tol. Exit status: 0 converged, 1 error, 3 not converged (results still printed).
+#[derive(Args, Clone, Debug)]
+pub struct SceneTruthArgs {
+    /// Scene names (scenes/NAME.json) or .json paths relative to the repository root.
+    #[arg(required = true)]
+    pub scenes: Vec<String>,
+    /// First coupling step (s); the scene's h must be a whole multiple of it.
+    #[arg(long, value_name = "S", default_value_t = 2e-5)]
+    pub dt: f64,
+    /// Most halvings of the step.
+    #[arg(long, value_name = "N", default_value_t = 3)]
+    pub max_halvings: usize,
+    /// Convergence tolerance (%) on every outcome between two successive steps.
+    #[arg(long, value_name = "PCT", default_value_t = 2.0)]
+    pub tol: f64,
+    /// Simulated seconds (default: the scene's `seconds`).
+    #[arg(long, value_name = "S")]
+    pub seconds: Option<f64>,
+    /// Elastic modes summed (default: every mode).
+    #[arg(long, value_name = "N")]
+    pub modes: Option<usize>,
+    /// Skip the check with half the modes at the finest step.
+    #[arg(long)]
+    pub no_mode_check: bool,
+    /// Penalty stiffness per contact point (N/m).
+    #[arg(long, value_name = "N_PER_M", default_value_t = 1e7)]
+    pub contact_stiffness: f64,
+    /// Largest free dofs of the dense eigensolve (memory ~ 3·n²·8 bytes).
+    #[arg(long, value_name = "N", default_value_t = 6000)]
+    pub max_dense_dofs: usize,
+    /// Largest coupling steps × modes × props of one run.
+    #[arg(long, value_name = "W", default_value_t = 2e11)]
+    pub max_work: f64,
+    /// Also run the distant response's methods at gain 1 and write DIR/outcomes.md and
+    /// DIR/outcomes/SCENE_lift.svg.
+    #[arg(long, value_name = "DIR")]
+    pub page: Option<PathBuf>,
+    /// Line under the page's title (the command, date and load); `scripts/outcomes.sh` sets it.
+    #[arg(long, value_name = "TEXT", default_value = "")]
+    pub page_header: String,
+}
+
+/// Runs `dcr-lab scene-truth`.
+///
+/// # Errors
+/// Invalid options, an unknown scene, a failed run.
+pub fn run(a: &SceneTruthArgs) -> anyhow::Result<ExitCode> {
+    if !(a.dt > 0.0 && a.dt.is_finite()) {
+        anyhow::bail!("--dt must be a positive step in seconds, got {}", a.dt);
+    }
+    if !(a.tol > 0.0 && a.contact_stiffness > 0.0) {
+        anyhow::bail!("--tol and --contact-stiffness must be positive");
+    }
+    if let Some(s) = a.seconds {
+        if !(s > 0.0 && s.is_finite()) {
+            anyhow::bail!("--seconds must be positive, got {s}");
+        }
+    }
+    let root = dcr_scenes::repo_root();
+    let params = SceneTruthParams {
+        dt: a.dt,
+        max_halvings: a.max_halvings,
+        tolerance: a.tol / 100.0,
+        seconds: a.seconds,
+        modes: a.modes,
+        check_modes: !a.no_mode_check,
+        contact_stiffness: a.contact_stiffness,
+        max_dense_dofs: a.max_dense_dofs,
+        max_work: a.max_work,
+        progress: true,
+        ..SceneTruthParams::default()
+    };
+    // The scenes run side by side (one thread each); results are reported in the given order.
+    let results: Vec<anyhow::Result<(bool, String, Option<_>)>> = std::thread::scope(|scope| {
+        let jobs: Vec<_> = a
+            .scenes
+            .iter()
+            .map(|s| {
+                let (root, params) = (&root, &params);
+                scope.spawn(move || -> anyhow::Result<(bool, String, Option<_>)> {
+                    let desc = load_scene(root, s)?;
+                    let truth = scene_truth(&desc, root, params)?;
+                    let ok = truth.converged && truth.estimated_error() < params.tolerance;
+                    let last = truth.levels.last().map_or(f64::NAN, |l| l.dt);
+                    let mut out = format!(
+                        "{}: {} at dt {:.3e} s, {} modes, estimated error {:.2} %\n",
+                        truth.scene,
+                        if ok { "converged" } else { "NOT converged" },
+                        last,
+                        truth.levels.last().map_or(0, |l| l.modes),
+                        100.0 * truth.estimated_error()
+                    );
+                    for (k, (v, u)) in &truth.run.outcomes {
+                        out.push_str(&format!("  {k}: {v:.4} {u}\n"));
+                    }
+                    let cmp = if a.page.is_some() {
+                        Some(compare_scene(&desc, root, truth, true)?)
+                    } else {
+                        None
+                    };
+                    Ok((ok, out, cmp))
+                })
+            })
+            .collect();
+        jobs.into_iter()
+            .map(|j| {
+                j.join()
+                    .unwrap_or_else(|_| Err(anyhow::anyhow!("a scene's run panicked")))
+            })
+            .collect()
+    });
+    let mut all_converged = true;
+    let mut comparisons = Vec::new();
+    for r in results {
+        let (ok, out, cmp) = r?;
+        all_converged &= ok;
+        super::emit(&out)?;
+        comparisons.extend(cmp);
+    }
+    if let Some(dir) = &a.page {
+        write_outcomes_page(dir, &comparisons, &a.page_header)?;
+        eprintln!("[scene-truth] wrote {}", dir.join("outcomes.md").display());
+    }
+    Ok(if all_converged {
+        ExitCode::SUCCESS
+    } else {
+        eprintln!("error: a reference did not converge within --max-halvings (see above)");
+        ExitCode::from(EXIT_NOT_CONVERGED)
+    })
+}

@@ -1,0 +1,467 @@
+//! One coupled elastic–rigid run of a scene at a fixed coupling step (see the module doc of
+//! [`super`] for the coupling and why).
+
+use std::collections::{BTreeMap, HashMap};
+use std::path::Path;
+use std::time::Instant;
+
+use anyhow::{bail, Context, Result};
+use dcr_scenes::runner::{measure_outcome, unit_of, Trajectory};
+use dcr_scenes::scene::{build_world, BodyKind, BuiltWorld, SceneDesc};
+use modal_bake::full_order::{FullOrderSystem, ModalAll};
+use rapier3d_f64::math::Vector;
+use rapier3d_f64::prelude::*;
+
+use super::elastic_body::ElasticBody;
+
+/// Settings of one coupled run.
+#[derive(Clone, Debug)]
+pub struct CoupledParams {
+    /// Coupling step (s): rapier's step and the sampling of the contact forces. Must divide the
+    /// scene's h into a whole number of steps.
+    pub dt: f64,
+    /// Simulated time (s).
+    pub seconds: f64,
+    /// Elastic modes summed (`None`: every mode of the dense solve).
+    pub modes: Option<usize>,
+    /// Normal penalty stiffness per contact point (N/m).
+    pub contact_stiffness: f64,
+    /// Slip speed (m/s) below which Coulomb friction is regularised (viscous).
+    pub friction_velocity: f64,
+    /// Rayleigh damping [α0 (1/s), α1 (s)] of the elastic object.
+    pub rayleigh: [f64; 2],
+    /// Restitution the contact dashpot reproduces against a rigid surface (the scene's).
+    pub restitution: f64,
+    /// Progress lines on stderr.
+    pub progress: bool,
+}
+
+/// What a coupled run measured.
+#[derive(Clone, Debug)]
+pub struct CoupledRun {
+    /// The trajectory at the scene's step h (rows t = k·h), dynamic bodies as `dcr-scenes run`.
+    pub trajectory: Trajectory,
+    /// Outcome figures: name → (value, unit).
+    pub outcomes: BTreeMap<String, (f64, String)>,
+    /// Work (J) the elastic surface's motion did on each prop, largest over time of the
+    /// running sum, by body name.
+    pub delivered: BTreeMap<String, f64>,
+    /// Largest upward speed (m/s, along the contact normal) of the elastic surface under each
+    /// prop's contacts while they touch, by body name: what the distant response's Δv (Eq. 12)
+    /// stands for.
+    pub surface_speed: BTreeMap<String, f64>,
+    /// Largest penetration of a penalty contact (m).
+    pub max_penetration: f64,
+    /// Energy at each recorded row (J): rigid kinetic + gravity potential + elastic + penalty
+    /// springs.
+    pub energy: Vec<f64>,
+    /// Linear momentum Σ m v of the dynamic bodies at the start and at the end (N·s, world).
+    pub momentum: [[f64; 3]; 2],
+    /// Coupling steps taken.
+    pub steps: usize,
+    /// Wall time (s).
+    pub wall_s: f64,
+}
+
+/// The prepared elastic object: the full-order system and every mode of it.
+pub struct ElasticPrep {
+    /// The full-order system (object frame = the mesh frame = the body frame).
+    pub sys: FullOrderSystem,
+    /// Every elastic mode (dense solve).
+    pub all: ModalAll,
+}
+
+/// Surface points cached beyond this many are dropped (memory: 3 rows of the modes each).
+const CACHE_MAX: usize = 4096;
+
+fn arr(v: Vector) -> [f64; 3] {
+    [v.x, v.y, v.z]
+}
+
+/// Runs `desc` with its elastic object coupled to the rigid bodies through penalty contacts.
+///
+/// # Errors
+/// The scene has not exactly one elastic object, `dt` does not divide h, the world cannot be
+/// built, or the run blows up (non-finite state).
+pub fn run_coupled(
+    desc: &SceneDesc,
+    root: &Path,
+    prep: &ElasticPrep,
+    p: &CoupledParams,
+) -> Result<CoupledRun> {
+    if desc.elastic.len() != 1 {
+        bail!(
+            "scene {}: the coupled reference takes exactly one elastic object, the scene has {}",
+            desc.name,
+            desc.elastic.len()
+        );
+    }
+    let sub = (desc.h / p.dt).round() as usize;
+    if sub == 0 || ((sub as f64) * p.dt - desc.h).abs() > 1e-9 * desc.h {
+        bail!(
+            "coupling step {} s must divide the scene's h = {} s into whole steps",
+            p.dt,
+            desc.h
+        );
+    }
+    let steps_h = (p.seconds / desc.h).round() as usize;
+    let mut built: BuiltWorld = build_world(desc, root)?;
+    built.world.integration_parameters.dt = p.dt;
+    let eb = built.elastic_body[0];
+    let e_handle = built.bodies[eb].handle;
+    let e_dynamic = matches!(desc.elastic[0].body, BodyKind::Dynamic { .. });
+    // Rapier detects the elastic object's contacts but does not solve them: the penalty
+    // coupling below does.
+    let mut e_colliders = Vec::new();
+    for (&ch, &b) in &built.collider_body {
+        if b == eb {
+            e_colliders.push(ch);
+        }
+    }
+    e_colliders.sort_by_key(|c| c.into_raw_parts());
+    for &ch in &e_colliders {
+        built.world.colliders[ch].set_solver_groups(InteractionGroups::none());
+    }
+    // Small steps resolve every contact; continuous collision detection would act on the
+    // unsolved pairs' geometry only.
+    let handles: Vec<RigidBodyHandle> = built.bodies.iter().map(|b| b.handle).collect();
+    for &h in &handles {
+        built.world.bodies[h].enable_ccd(false);
+    }
+
+    let mut elastic = ElasticBody::new(&prep.sys, &prep.all, p.modes, p.rayleigh, p.dt);
+    let surface = &prep.sys.surface;
+    let mut cache: HashMap<[i64; 3], Vec<f64>> = HashMap::new();
+    let zeta = dashpot_ratio(p.restitution);
+    let rec: Vec<usize> = (0..built.bodies.len())
+        .filter(|&i| built.bodies[i].dynamic)
+        .collect();
+    let mut traj = Trajectory {
+        names: rec.iter().map(|&i| built.bodies[i].name.clone()).collect(),
+        ..Default::default()
+    };
+    let record = |built: &BuiltWorld, traj: &mut Trajectory, t: f64| {
+        traj.time.push(t);
+        for &i in &rec {
+            let pos = built.world.bodies[built.bodies[i].handle].position();
+            traj.positions
+                .extend([pos.translation.x, pos.translation.y, pos.translation.z]);
+            traj.rotations.extend([
+                pos.rotation.x,
+                pos.rotation.y,
+                pos.rotation.z,
+                pos.rotation.w,
+            ]);
+        }
+    };
+    record(&built, &mut traj, 0.0);
+    let body_of: HashMap<RigidBodyHandle, usize> =
+        handles.iter().enumerate().map(|(i, &h)| (h, i)).collect();
+    let mut work = vec![0.0f64; built.bodies.len()];
+    let mut work_max = vec![0.0f64; built.bodies.len()];
+    let mut max_pen = 0.0f64;
+    let mut speed = vec![0.0f64; built.bodies.len()];
+    let gravity = Vector::new(desc.gravity[0], desc.gravity[1], desc.gravity[2]);
+    let mut energy = vec![0.0];
+    let mut spring_energy = 0.0;
+
+    let drivers: Vec<(RigidBodyHandle, dcr_scenes::scene::DriverDesc)> = desc
+        .drivers
+        .iter()
+        .map(|d| {
+            built
+                .body_index(&d.body)
+                .map(|i| (built.bodies[i].handle, d.clone()))
+                .with_context(|| format!("driver: no body {}", d.body))
+        })
+        .collect::<Result<_>>()?;
+
+    let momentum0 = momentum(&built);
+    let wall = Instant::now();
+    let mut last = Instant::now();
+    let mut forces: Vec<(RigidBodyHandle, Vector, Vector, Vector, f64, f64)> = Vec::new();
+    let energy0 = total_energy(&built, gravity, &elastic, 0.0);
+    energy[0] = energy0;
+    for kh in 0..steps_h {
+        let t_h = kh as f64 * desc.h;
+        apply_drivers(&drivers, &mut built, t_h);
+        for ks in 0..sub {
+            forces.clear();
+            spring_energy = 0.0;
+            let e_pose = *built.world.bodies[e_handle].position();
+            for &ech in &e_colliders {
+                for pair in built.world.narrow_phase.contact_pairs_with(ech) {
+                    let PairContacts::Rigid(rc) = &pair.contacts else {
+                        continue;
+                    };
+                    let e_first = pair.collider1 == ech;
+                    let other = if e_first {
+                        pair.collider2
+                    } else {
+                        pair.collider1
+                    };
+                    let (Some(co_e), Some(co_o)) = (
+                        built.world.colliders.get(ech),
+                        built.world.colliders.get(other),
+                    ) else {
+                        continue;
+                    };
+                    let Some(ob) = co_o.parent() else { continue };
+                    if !built.world.bodies[ob].is_dynamic() {
+                        continue;
+                    }
+                    let mu = 0.5 * (co_e.friction() + co_o.friction());
+                    let (pe, po) = (*co_e.position(), *co_o.position());
+                    let prop_mass = built.world.bodies[ob].mass();
+                    for m in &rc.manifolds {
+                        let npts = m.points.len().max(1) as f64;
+                        let (ln_e, _) = if e_first {
+                            (m.local_n1, m.local_n2)
+                        } else {
+                            (m.local_n2, m.local_n1)
+                        };
+                        let n = (pe.rotation * ln_e).normalize();
+                        let damp = 2.0 * zeta * (p.contact_stiffness * prop_mass / npts).sqrt();
+                        for c in &m.points {
+                            let (lp_e, lp_o) = if e_first {
+                                (c.local_p1, c.local_p2)
+                            } else {
+                                (c.local_p2, c.local_p1)
+                            };
+                            let x_e = pe.transform_point(lp_e);
+                            let x_o = po.transform_point(lp_o);
+                            let dist = (x_o - x_e).dot(n);
+                            if dist > 1e-3 {
+                                continue;
+                            }
+                            // The contact on the elastic surface, in the object frame.
+                            let xl = e_pose.inverse_transform_point(x_e);
+                            let key = [xl.x, xl.y, xl.z].map(|v| (v * 2e3).round() as i64);
+                            if !cache.contains_key(&key) {
+                                if cache.len() >= CACHE_MAX {
+                                    cache.clear();
+                                }
+                                let sp = surface
+                                    .project(arr(xl))
+                                    .context("contact point off the elastic surface")?;
+                                let verts = surface.triangles[sp.triangle as usize];
+                                cache.insert(key, elastic.axis_rows(verts, sp.bary));
+                            }
+                            let rows = &cache[&key];
+                            let nl = e_pose.rotation.inverse() * n;
+                            let (u_n, v_n) = elastic.motion_along(rows, arr(nl));
+                            let gap = dist - u_n;
+                            if gap >= 0.0 {
+                                continue;
+                            }
+                            max_pen = max_pen.max(-gap);
+                            let v_surf =
+                                built.world.bodies[e_handle].velocity_at_point(x_e) + n * v_n;
+                            let v_o = built.world.bodies[ob].velocity_at_point(x_o);
+                            let rel = v_o - v_surf;
+                            let vn = rel.dot(n);
+                            let fn_ = (p.contact_stiffness * (-gap) - damp * vn).max(0.0);
+                            spring_energy += 0.5 * p.contact_stiffness * gap * gap;
+                            let vt = rel - n * vn;
+                            let s = vt.length();
+                            let ft = if s > 0.0 {
+                                vt * (-mu * fn_ / s.max(p.friction_velocity))
+                            } else {
+                                Vector::ZERO
+                            };
+                            let f = n * fn_ + ft;
+                            forces.push((ob, f, x_o, x_e, v_n, fn_));
+                            // On the elastic modes: −f at the surface point (object frame).
+                            let fl = e_pose.rotation.inverse() * (-f);
+                            elastic.add_force_rows(rows, arr(fl));
+                        }
+                    }
+                }
+            }
+            for &(ob, f, x_o, x_e, v_n, fn_) in &forces {
+                built.world.bodies[ob].apply_impulse_at_point(f * p.dt, x_o, true);
+                if e_dynamic {
+                    built.world.bodies[e_handle].apply_impulse_at_point(-f * p.dt, x_e, true);
+                }
+                // Work of the surface's elastic motion on the prop: f_n v_n dt.
+                if let Some(&b) = body_of.get(&ob) {
+                    speed[b] = speed[b].max(v_n);
+                    work[b] += fn_ * v_n * p.dt;
+                    work_max[b] = work_max[b].max(work[b]);
+                }
+            }
+            built.world.step_with_events(&(), &());
+            elastic.step();
+            if !elastic.energy().is_finite() {
+                bail!(
+                    "the coupled run blew up at t = {:.6} s (coupling step {} s): lower \
+                     --contact-stiffness or the step",
+                    t_h + (ks + 1) as f64 * p.dt,
+                    p.dt
+                );
+            }
+        }
+        let t = (kh + 1) as f64 * desc.h;
+        record(&built, &mut traj, t);
+        energy.push(total_energy(&built, gravity, &elastic, spring_energy));
+        if p.progress && last.elapsed().as_secs_f64() > 10.0 {
+            last = Instant::now();
+            eprintln!(
+                "[scene-truth] {} dt {:.2e} s: t = {:.3}/{:.3} s ({:.0} s wall)",
+                desc.name,
+                p.dt,
+                t,
+                p.seconds,
+                wall.elapsed().as_secs_f64()
+            );
+        }
+    }
+    let mut outcomes = BTreeMap::new();
+    for o in &desc.outcomes {
+        if let Some(v) = measure_outcome(o, &traj) {
+            outcomes.insert(o.name.clone(), (v, unit_of(&o.kind).to_string()));
+        }
+    }
+    let delivered = built
+        .bodies
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| work_max[*i] > 0.0)
+        .map(|(i, b)| (b.name.clone(), work_max[i]))
+        .collect();
+    let surface_speed = built
+        .bodies
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| speed[*i] > 0.0)
+        .map(|(i, b)| (b.name.clone(), speed[i]))
+        .collect();
+    Ok(CoupledRun {
+        surface_speed,
+        trajectory: traj,
+        outcomes,
+        delivered,
+        max_penetration: max_pen,
+        energy,
+        momentum: [momentum0, momentum(&built)],
+        steps: steps_h * sub,
+        wall_s: wall.elapsed().as_secs_f64(),
+    })
+}
+
+/// Kinetic energy of every body + gravity potential (−m g·x, J) + elastic energy + `springs`.
+fn total_energy(built: &BuiltWorld, gravity: Vector, elastic: &ElasticBody, springs: f64) -> f64 {
+    let mut e = elastic.energy() + springs;
+    for b in &built.bodies {
+        let rb = &built.world.bodies[b.handle];
+        if rb.is_dynamic() {
+            e += rb.kinetic_energy() - rb.mass() * gravity.dot(rb.center_of_mass());
+        }
+    }
+    e
+}
+
+/// Applies the scene's scripted impulses due at `t` (s), as `dcr-scenes run` does.
+fn apply_drivers(
+    drivers: &[(RigidBodyHandle, dcr_scenes::scene::DriverDesc)],
+    built: &mut BuiltWorld,
+    t: f64,
+) {
+    for (h, d) in drivers {
+        if t + 1e-9 < d.start || t > d.stop {
+            continue;
+        }
+        let phase = (t - d.start) / d.period;
+        if (phase - phase.round()).abs() > 1e-6 {
+            continue;
+        }
+        let mut j = Vector::new(d.impulse[0], d.impulse[1], d.impulse[2]);
+        if let Some(ax) = d.rotate_axis {
+            let axis = Vector::new(ax[0], ax[1], ax[2]).normalize();
+            let q = rapier3d_f64::math::Rotation::from_axis_angle(
+                axis,
+                std::f64::consts::TAU * d.hz * (t - d.start),
+            );
+            j = q * j;
+        }
+        let rb = &mut built.world.bodies[*h];
+        match d.point {
+            Some(p) => {
+                let wp = rb.position().transform_point(Vector::new(p[0], p[1], p[2]));
+                rb.apply_impulse_at_point(j, wp, true);
+            }
+            None => rb.apply_impulse(j, true),
+        }
+    }
+}
+
+/// Σ m v over the dynamic bodies (N·s, world).
+fn momentum(built: &BuiltWorld) -> [f64; 3] {
+    let mut p = Vector::ZERO;
+    for b in &built.bodies {
+        let rb = &built.world.bodies[b.handle];
+        if rb.is_dynamic() {
+            p += rb.linvel() * rb.mass();
+        }
+    }
+    arr(p)
+}
+
+/// Rebound ratio of a unit spring–dashpot contact with damping ratio ζ whose force is clamped
+/// at zero (no pull): p̈ = −max(0, p + 2ζ ṗ) from p = 0, ṗ = 1 until p < 0 (RK4).
+fn clamped_restitution(zeta: f64) -> f64 {
+    let f = |p: f64, v: f64| -(p + 2.0 * zeta * v).max(0.0);
+    let (mut p, mut v, dt) = (0.0f64, 1.0f64, 1e-3);
+    for _ in 0..200_000 {
+        let (k1p, k1v) = (v, f(p, v));
+        let (k2p, k2v) = (
+            v + 0.5 * dt * k1v,
+            f(p + 0.5 * dt * k1p, v + 0.5 * dt * k1v),
+        );
+        let (k3p, k3v) = (
+            v + 0.5 * dt * k2v,
+            f(p + 0.5 * dt * k2p, v + 0.5 * dt * k2v),
+        );
+        let (k4p, k4v) = (v + dt * k3v, f(p + dt * k3p, v + dt * k3v));
+        p += dt / 6.0 * (k1p + 2.0 * k2p + 2.0 * k3p + k4p);
+        v += dt / 6.0 * (k1v + 2.0 * k2v + 2.0 * k3v + k4v);
+        if p < 0.0 {
+            break;
+        }
+    }
+    (-v).max(0.0)
+}
+
+/// The damping ratio ζ whose clamped spring–dashpot contact rebounds with ratio `e` (bisection
+/// on [`clamped_restitution`], which decreases with ζ); 0 for e ≥ 1.
+pub(crate) fn dashpot_ratio(e: f64) -> f64 {
+    if e >= 1.0 {
+        return 0.0;
+    }
+    let (mut lo, mut hi) = (0.0f64, 20.0f64);
+    for _ in 0..60 {
+        let mid = 0.5 * (lo + hi);
+        if clamped_restitution(mid) > e {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    0.5 * (lo + hi)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The calibrated dashpot rebounds with the restitution asked for, and an undamped contact
+    /// is elastic.
+    #[test]
+    fn dashpot_gives_the_restitution() {
+        for e in [0.05, 0.15, 0.5, 0.9] {
+            let z = dashpot_ratio(e);
+            assert!((clamped_restitution(z) - e).abs() < 1e-6, "e {e}: ζ {z}");
+        }
+        assert!((clamped_restitution(0.0) - 1.0).abs() < 1e-6);
+    }
+}

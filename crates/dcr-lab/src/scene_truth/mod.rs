@@ -1,0 +1,368 @@
+//! The coupled elastic–rigid reference of a whole scene: what a plate *should* do when the pot
+//! lands on the table, against which the distant response's outcomes are measured.
+//!
+//! # Model
+//! The scene is built exactly as `dcr-scenes run` builds it (`dcr_scenes::scene::build_world`:
+//! the same bodies, colliders, masses, friction, restitution, joints and drivers on
+//! rapier3d-f64), but stepped at a small coupling step Δt that divides the scene's h. The one
+//! elastic object is a linear elastic body (paper Eq. 5, P1 tets, Rayleigh damping) on top of
+//! its rigid motion: the sum over *every* elastic mode of the dense generalized eigensolve
+//! ([`modal_bake::full_order::ModalAll`]), each mode advanced exactly over Δt under the force
+//! held during the step ([`ElasticBody`]), so the elastic side adds no time-discretisation error.
+//!
+//! # Coupling: penalty contacts at small steps
+//! Rapier still detects the elastic object's contacts (its narrow phase, the scene's colliders)
+//! but does not solve them (the object's colliders get empty solver groups). At each coupling
+//! step every contact point between a prop and the object is mapped to the object's surface in
+//! the object's frame (closest point, barycentric weights — the mapping the runtime uses), and
+//! gets a spring–dashpot normal force
+//! f_n = max(0, k (−g) − c v_n,rel), g = d − u_n,
+//! where d is the rigid gap along the contact normal, u_n the elastic surface displacement at
+//! the point along the normal (so the surface *moves* under the contact), v_n,rel the prop's
+//! normal velocity relative to the moving surface, k the stiffness per point and c the dashpot
+//! that gives the scene's restitution e against a rigid surface (c = 2ζ√(k m/points), ζ such
+//! that the clamped spring–dashpot rebounds with ratio e); Coulomb friction (the colliders' mean coefficient) is regularised below
+//! a slip speed. The prop receives f Δt at its contact point; the elastic modes receive −f at
+//! the surface point (Eq. 9 with the force), and, for a dynamic object, its rigid body −f Δt.
+//! Every other contact (prop on prop) stays rapier's.
+//!
+//! Why not rapier's rigid contact with a moving surface (solver hooks setting the contact's
+//! target velocity from the surface velocity): that staggers an *explicit* surface velocity
+//! against an implicit rigid contact, and the surface's response to the contact impulse within
+//! one step is that of the nodal mass under the point — far below a plate's or a pot's mass —
+//! so the exchange diverges (the added-mass instability of partitioned schemes). The penalty
+//! force keeps the exchange stable when k is below the surface's local stiffness and Δt resolves
+//! √(k/m); its compliance is part of the model (the largest penetration is reported) and its
+//! limit for a very stiff object is rigid contact with restitution e (tested).
+//!
+//! # Convergence
+//! [`scene_truth`] runs the scene at Δt, Δt/2, … until no outcome changes by more than the
+//! tolerance (2 %) between two successive steps, then checks the modes: the same run with half
+//! the modes must also be within the tolerance, else the reference is reported as not converged
+//! in modes. The work is bounded before it starts (dense size, steps × modes × bodies).
+
+mod coupled_run;
+mod elastic_body;
+mod outcomes_page;
+
+pub use coupled_run::{run_coupled, CoupledParams, CoupledRun, ElasticPrep};
+pub use elastic_body::ElasticBody;
+pub use outcomes_page::{compare_scene, write_outcomes_page, MethodOutcome, SceneComparison};
+
+use std::collections::BTreeMap;
+use std::path::Path;
+use std::time::Instant;
+
+use anyhow::{bail, Context, Result};
+use dcr_scenes::scene::SceneDesc;
+use modal_bake::full_order::{FullOrderSystem, MaterialSi, ModalAll, SystemParams};
+
+/// Settings of [`scene_truth`] (defaults in [`SceneTruthParams::default`]).
+#[derive(Clone, Debug)]
+pub struct SceneTruthParams {
+    /// First coupling step (s). Default 2e-5 s (the scene's h must be a whole multiple).
+    pub dt: f64,
+    /// Largest number of halvings of the step. Default 3.
+    pub max_halvings: usize,
+    /// Largest change of an outcome between two successive steps (fraction). Default 0.02.
+    pub tolerance: f64,
+    /// Simulated time (s); `None`: the scene's `seconds`.
+    pub seconds: Option<f64>,
+    /// Modes summed (`None`: every mode).
+    pub modes: Option<usize>,
+    /// Check the modes (the converged step with half the modes). Default true.
+    pub check_modes: bool,
+    /// Penalty stiffness per contact point (N/m). Default 1e7.
+    pub contact_stiffness: f64,
+    /// Slip speed of the friction regularisation (m/s). Default 1e-3.
+    pub friction_velocity: f64,
+    /// Scale on the elastic object's Young's modulus (1 = the scene's). Default 1.
+    pub youngs_scale: f64,
+    /// Rayleigh damping override [α0, α1] (`None`: the scene's).
+    pub rayleigh: Option<[f64; 2]>,
+    /// Largest free dofs of the dense eigensolve. Default 6000.
+    pub max_dense_dofs: usize,
+    /// Largest coupling steps × modes × bodies of one run. Default 2e11.
+    pub max_work: f64,
+    /// Progress on stderr.
+    pub progress: bool,
+}
+
+impl Default for SceneTruthParams {
+    fn default() -> Self {
+        SceneTruthParams {
+            dt: 2e-5,
+            max_halvings: 3,
+            tolerance: 0.02,
+            seconds: None,
+            modes: None,
+            check_modes: true,
+            contact_stiffness: 1e7,
+            friction_velocity: 1e-3,
+            youngs_scale: 1.0,
+            rayleigh: None,
+            max_dense_dofs: 6000,
+            max_work: 2e11,
+            progress: false,
+        }
+    }
+}
+
+/// One level of the refinement: its step, modes and outcomes.
+#[derive(Clone, Debug)]
+pub struct TruthLevel {
+    /// Coupling step (s).
+    pub dt: f64,
+    /// Modes summed.
+    pub modes: usize,
+    /// Outcomes: name → (value, unit).
+    pub outcomes: BTreeMap<String, (f64, String)>,
+    /// Largest relative change of an outcome from the previous level (`None` for the first).
+    pub change: Option<f64>,
+    /// Largest penetration (m).
+    pub max_penetration: f64,
+    /// Wall time (s).
+    pub wall_s: f64,
+}
+
+/// The converged (or not) coupled reference of a scene.
+pub struct SceneTruth {
+    /// Scene name.
+    pub scene: String,
+    /// Free dofs and elastic modes of the object, and the eigensolve's wall time (s).
+    pub free_dofs: usize,
+    /// Elastic modes available.
+    pub modes_available: usize,
+    /// Dense eigensolve wall time (s).
+    pub eigen_s: f64,
+    /// Levels, coarse to fine.
+    pub levels: Vec<TruthLevel>,
+    /// The half-mode check at the finest step (its change from the full run), if run.
+    pub half_modes: Option<TruthLevel>,
+    /// Whether the step converged (last change < tolerance).
+    pub converged: bool,
+    /// The finest run (its trajectory and energies).
+    pub run: CoupledRun,
+    /// Simulated seconds.
+    pub seconds: f64,
+    /// The settings.
+    pub params: SceneTruthParams,
+}
+
+impl SceneTruth {
+    /// The estimated error: the last change between two successive steps (and the mode check,
+    /// whichever is larger).
+    pub fn estimated_error(&self) -> f64 {
+        let step = self
+            .levels
+            .last()
+            .and_then(|l| l.change)
+            .unwrap_or(f64::NAN);
+        match &self.half_modes {
+            Some(h) => step.max(h.change.unwrap_or(0.0)),
+            None => step,
+        }
+    }
+}
+
+/// Loads `scenes/NAME.json` (or a path) under `root`.
+///
+/// # Errors
+/// Unknown scene or unreadable file.
+pub fn load_scene(root: &Path, scene: &str) -> Result<SceneDesc> {
+    let p = if scene.ends_with(".json") {
+        root.join(scene)
+    } else {
+        root.join("scenes").join(format!("{scene}.json"))
+    };
+    if !p.is_file() {
+        bail!(
+            "scene {scene}: no file {} (give a scene name of scenes/ or a .json path)",
+            p.display()
+        );
+    }
+    SceneDesc::read(&p)
+}
+
+/// The full-order system and every mode of the scene's one elastic object (Young's modulus
+/// scaled by `youngs_scale`).
+///
+/// # Errors
+/// No or several elastic objects, a mesh error, more free dofs than `max_dense_dofs`.
+pub fn prepare_elastic(
+    desc: &SceneDesc,
+    root: &Path,
+    youngs_scale: f64,
+    max_dense_dofs: usize,
+) -> Result<ElasticPrep> {
+    if desc.elastic.len() != 1 {
+        bail!(
+            "scene {}: the coupled reference takes exactly one elastic object, the scene has {}",
+            desc.name,
+            desc.elastic.len()
+        );
+    }
+    let e = &desc.elastic[0];
+    let path = root.join(&e.mesh);
+    let mesh = modal_bake::mesh::read_mesh(&path)
+        .with_context(|| format!("reading mesh {}", path.display()))?;
+    let params = SystemParams {
+        material: MaterialSi {
+            youngs: e.material.youngs * youngs_scale,
+            poisson: e.material.poisson,
+            density: e.material.density,
+        },
+        fixed: e.fixed.clone(),
+        rayleigh: e.rayleigh,
+        lumped: false,
+    };
+    let sys = FullOrderSystem::new(mesh, &params, &path.display().to_string())?;
+    if sys.n() > max_dense_dofs {
+        bail!(
+            "elastic object {}: {} free dofs, above the dense limit {max_dense_dofs} of the \
+             coupled reference (raise --max-dense-dofs if the machine has the memory: the \
+             solve needs about 3·n²·8 bytes and O(n³) time)",
+            e.name,
+            sys.n()
+        );
+    }
+    let all = ModalAll::new(&sys, max_dense_dofs)?;
+    // Every elastic eigenvalue must be positive; a non-positive one is a lost mode (the dense
+    // solve at an extreme stiffness or a mesh with a mechanism), which would let the surface
+    // drift under a held load.
+    if let Some(l) = all.eigenvalues.iter().find(|l| **l <= 0.0) {
+        bail!(
+            "elastic object {}: the dense eigensolve returned a non-positive elastic eigenvalue              {l:.3e} rad²/s² (largest {:.3e}); the object is too stiff for a dense solve in              double precision or has a mechanism (lower --youngs-scale or check the fixed groups)",
+            e.name,
+            all.eigenvalues.last().copied().unwrap_or(0.0)
+        );
+    }
+    Ok(ElasticPrep { sys, all })
+}
+
+/// The largest relative change between two outcome sets (a floor of 0.01 in each outcome's
+/// unit keeps figures near zero from dominating).
+pub fn outcome_change(
+    a: &BTreeMap<String, (f64, String)>,
+    b: &BTreeMap<String, (f64, String)>,
+) -> f64 {
+    let mut worst = 0.0f64;
+    for (k, (vb, _)) in b {
+        let va = a.get(k).map_or(0.0, |x| x.0);
+        worst = worst.max((va - vb).abs() / vb.abs().max(0.01));
+    }
+    worst
+}
+
+/// Runs the coupled reference of `desc` with its step halved until converged (module doc).
+///
+/// # Errors
+/// As [`prepare_elastic`] and [`run_coupled`]; a run over the work budget.
+pub fn scene_truth(desc: &SceneDesc, root: &Path, params: &SceneTruthParams) -> Result<SceneTruth> {
+    let t0 = Instant::now();
+    let prep = prepare_elastic(desc, root, params.youngs_scale, params.max_dense_dofs)?;
+    let eigen_s = t0.elapsed().as_secs_f64();
+    let seconds = params.seconds.unwrap_or(desc.seconds);
+    let modes = params
+        .modes
+        .unwrap_or(usize::MAX)
+        .min(prep.all.eigenvalues.len());
+    let bodies = desc.props.len().max(1) as f64;
+    let finest = params.dt / 2f64.powi(params.max_halvings as i32);
+    let work = seconds / finest * modes as f64 * bodies;
+    if work > params.max_work {
+        bail!(
+            "scene {}: the finest run would take {:.2e} steps × {modes} modes × {bodies} prop \
+             descriptions = {work:.2e}, above the budget {:.2e} (lower --seconds, \
+             --max-halvings or --modes, or raise --max-work)",
+            desc.name,
+            seconds / finest,
+            params.max_work
+        );
+    }
+    if params.progress {
+        eprintln!(
+            "[scene-truth] {}: {} free dofs, {} elastic modes, eigensolve {:.1} s",
+            desc.name,
+            prep.sys.n(),
+            prep.all.eigenvalues.len(),
+            eigen_s
+        );
+    }
+    let coupled = |dt: f64, modes: usize| CoupledParams {
+        dt,
+        seconds,
+        modes: Some(modes),
+        contact_stiffness: params.contact_stiffness,
+        friction_velocity: params.friction_velocity,
+        rayleigh: params.rayleigh.unwrap_or(desc.elastic[0].rayleigh),
+        restitution: desc.restitution,
+        progress: params.progress,
+    };
+    let mut levels: Vec<TruthLevel> = Vec::new();
+    let mut dt = params.dt;
+    let mut run;
+    let mut converged = false;
+    loop {
+        run = run_coupled(desc, root, &prep, &coupled(dt, modes))?;
+        let change = levels
+            .last()
+            .map(|l| outcome_change(&l.outcomes, &run.outcomes));
+        if params.progress {
+            eprintln!(
+                "[scene-truth] {}: dt {:.3e} s, {} modes: {:?} (change {}) in {:.0} s",
+                desc.name,
+                dt,
+                modes,
+                run.outcomes
+                    .iter()
+                    .map(|(k, v)| format!("{k} {:.4}", v.0))
+                    .collect::<Vec<_>>(),
+                change.map_or("–".into(), |c| format!("{:.2} %", 100.0 * c)),
+                run.wall_s
+            );
+        }
+        levels.push(TruthLevel {
+            dt,
+            modes,
+            outcomes: run.outcomes.clone(),
+            change,
+            max_penetration: run.max_penetration,
+            wall_s: run.wall_s,
+        });
+        if change.is_some_and(|c| c < params.tolerance) {
+            converged = true;
+            break;
+        }
+        if levels.len() > params.max_halvings {
+            break;
+        }
+        dt /= 2.0;
+    }
+    let half_modes = if params.check_modes && modes >= 2 {
+        let h = run_coupled(desc, root, &prep, &coupled(dt, modes / 2))?;
+        let change = outcome_change(&h.outcomes, &run.outcomes);
+        Some(TruthLevel {
+            dt,
+            modes: modes / 2,
+            outcomes: h.outcomes,
+            change: Some(change),
+            max_penetration: h.max_penetration,
+            wall_s: h.wall_s,
+        })
+    } else {
+        None
+    };
+    Ok(SceneTruth {
+        scene: desc.name.clone(),
+        free_dofs: prep.sys.n(),
+        modes_available: prep.all.eigenvalues.len(),
+        eigen_s,
+        levels,
+        half_modes,
+        converged,
+        run,
+        seconds,
+        params: params.clone(),
+    })
+}
