@@ -514,3 +514,50 @@ fn sigterm_while_meshing_removes_the_work_folder() {
     assert!(!status.success());
     assert!(work_dirs(&tmp).is_empty(), "{:?}", work_dirs(&tmp));
 }
+
+/// `auto` on a clean cube with a gmsh that fails: fTetWild runs instead, and the report names
+/// the fallback and gmsh's error.
+#[cfg(unix)]
+#[test]
+fn auto_falls_back_to_ftetwild_when_gmsh_fails() {
+    use std::os::unix::fs::PermissionsExt;
+    if !have_ftetwild("auto_falls_back_to_ftetwild_when_gmsh_fails") {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let fake = dir.path().join("failing-gmsh");
+    std::fs::write(
+        &fake,
+        "#!/bin/sh\nif [ \"$1\" = \"--version\" ]; then echo 4.99.0; exit 0; fi\necho 'Error   : No tetrahedra (a fake gmsh)'; exit 1\n",
+    )
+    .unwrap();
+    std::fs::set_permissions(&fake, std::fs::Permissions::from_mode(0o755)).unwrap();
+    let asset = write_obj(dir.path(), "cube.obj", &surface(&[cube([0.0; 3], 0.1)]));
+    let out = bin()
+        .arg("mesh")
+        .arg(&asset)
+        .arg("-o")
+        .arg(dir.path().join("cube.msh"))
+        .arg("--json")
+        .arg("--gmsh")
+        .arg(&fake)
+        .output()
+        .unwrap();
+    let r = json_of(&out);
+    assert_eq!(r["backend"], "ftetwild");
+    let fallback = r["report"]["fallback_from"].as_str().unwrap();
+    assert!(
+        fallback.starts_with("gmsh failed") && fallback.contains("No tetrahedra (a fake gmsh)"),
+        "{fallback}"
+    );
+    assert!(
+        r["reason"]
+            .as_str()
+            .unwrap()
+            .contains("gmsh failed, so fTetWild ran"),
+        "{}",
+        r["reason"]
+    );
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("falling back to fTetWild"), "{stderr}");
+}
