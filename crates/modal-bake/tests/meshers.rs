@@ -14,7 +14,10 @@ use std::process::{Command, Output};
 
 use modal_bake::mesh::surface::{inspect_surface, DefectKind, SurfaceMesh};
 
-fn cube(offset: [f64; 3], side: f64) -> (Vec<[f64; 3]>, Vec<[usize; 3]>) {
+/// Positions and triangles of one part.
+type Part = (Vec<[f64; 3]>, Vec<[usize; 3]>);
+
+fn cube(offset: [f64; 3], side: f64) -> Part {
     let mut v = Vec::new();
     for k in 0..8 {
         v.push([
@@ -40,7 +43,7 @@ fn cube(offset: [f64; 3], side: f64) -> (Vec<[f64; 3]>, Vec<[usize; 3]>) {
 }
 
 /// Several parts in one surface, coincident positions welded (as the readers do).
-fn surface(parts: &[(Vec<[f64; 3]>, Vec<[usize; 3]>)]) -> SurfaceMesh {
+fn surface(parts: &[Part]) -> SurfaceMesh {
     let mut v = Vec::new();
     let mut t = Vec::new();
     for (pv, pt) in parts {
@@ -167,7 +170,10 @@ fn inspection_counts_constructed_defects() {
         .iter()
         .filter(|d| d.kind == DefectKind::SelfIntersection)
     {
-        assert!(d.at[2].abs() < 1e-12 && d.at[0] > 0.1 && d.at[1] > 0.1, "{d}");
+        assert!(
+            d.at[2].abs() < 1e-12 && d.at[0] > 0.1 && d.at[1] > 0.1,
+            "{d}"
+        );
     }
 
     // Inconsistent orientation: one triangle reversed → its three edges.
@@ -292,11 +298,7 @@ fn ftetwild_is_reproducible_at_order_2_and_auto_picks_gmsh_for_a_clean_cube() {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
-    let asset = write_obj(
-        dir.path(),
-        "cube.obj",
-        &surface(&[cube([0.0; 3], 0.1)]),
-    );
+    let asset = write_obj(dir.path(), "cube.obj", &surface(&[cube([0.0; 3], 0.1)]));
     let run = |name: &str, extra: &[&str]| {
         let msh = dir.path().join(name);
         let out = bin()
@@ -363,7 +365,10 @@ fn forced_gmsh_on_a_non_manifold_vertex_is_refused_with_position_and_fix() {
             && err.contains("use --mesher ftetwild or --mesher auto"),
         "{err}"
     );
-    assert!(!err.contains("gmsh not found"), "refused before gmsh: {err}");
+    assert!(
+        !err.contains("gmsh not found"),
+        "refused before gmsh: {err}"
+    );
     assert!(!msh.exists());
 }
 
@@ -380,7 +385,12 @@ fn out_of_range_vertex_and_too_fine_size_are_refused_before_meshing() {
         .arg(&far)
         .arg("-o")
         .arg(dir.path().join("far.msh"))
-        .args(["--gmsh", "/nonexistent/gmsh", "--ftetwild", "/nonexistent/ftetwild"])
+        .args([
+            "--gmsh",
+            "/nonexistent/gmsh",
+            "--ftetwild",
+            "/nonexistent/ftetwild",
+        ])
         .output()
         .unwrap();
     assert!(!out.status.success());
@@ -455,7 +465,9 @@ fn a_hanging_mesher_times_out_and_leaves_nothing() {
     assert!(!out.status.success());
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(
-        err.contains("did not finish meshing") && err.contains("within 1 s") && err.contains("--mesher-timeout"),
+        err.contains("did not finish meshing")
+            && err.contains("within 1 s")
+            && err.contains("--mesher-timeout"),
         "{err}"
     );
     assert!(work_dirs(&tmp).is_empty(), "{:?}", work_dirs(&tmp));
@@ -501,4 +513,51 @@ fn sigterm_while_meshing_removes_the_work_folder() {
     let status = child.wait().unwrap();
     assert!(!status.success());
     assert!(work_dirs(&tmp).is_empty(), "{:?}", work_dirs(&tmp));
+}
+
+/// `auto` on a clean cube with a gmsh that fails: fTetWild runs instead, and the report names
+/// the fallback and gmsh's error.
+#[cfg(unix)]
+#[test]
+fn auto_falls_back_to_ftetwild_when_gmsh_fails() {
+    use std::os::unix::fs::PermissionsExt;
+    if !have_ftetwild("auto_falls_back_to_ftetwild_when_gmsh_fails") {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let fake = dir.path().join("failing-gmsh");
+    std::fs::write(
+        &fake,
+        "#!/bin/sh\nif [ \"$1\" = \"--version\" ]; then echo 4.99.0; exit 0; fi\necho 'Error   : No tetrahedra (a fake gmsh)'; exit 1\n",
+    )
+    .unwrap();
+    std::fs::set_permissions(&fake, std::fs::Permissions::from_mode(0o755)).unwrap();
+    let asset = write_obj(dir.path(), "cube.obj", &surface(&[cube([0.0; 3], 0.1)]));
+    let out = bin()
+        .arg("mesh")
+        .arg(&asset)
+        .arg("-o")
+        .arg(dir.path().join("cube.msh"))
+        .arg("--json")
+        .arg("--gmsh")
+        .arg(&fake)
+        .output()
+        .unwrap();
+    let r = json_of(&out);
+    assert_eq!(r["backend"], "ftetwild");
+    let fallback = r["report"]["fallback_from"].as_str().unwrap();
+    assert!(
+        fallback.starts_with("gmsh failed") && fallback.contains("No tetrahedra (a fake gmsh)"),
+        "{fallback}"
+    );
+    assert!(
+        r["reason"]
+            .as_str()
+            .unwrap()
+            .contains("gmsh failed, so fTetWild ran"),
+        "{}",
+        r["reason"]
+    );
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("falling back to fTetWild"), "{stderr}");
 }

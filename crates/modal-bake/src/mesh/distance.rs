@@ -93,10 +93,7 @@ fn trimesh(vertices: &[[f64; 3]], triangles: &[[usize; 3]]) -> Option<TriMesh> {
         .iter()
         .map(|p| Vector::new(p[0], p[1], p[2]))
         .collect();
-    let t = triangles
-        .iter()
-        .map(|t| t.map(|i| i as u32))
-        .collect();
+    let t = triangles.iter().map(|t| t.map(|i| i as u32)).collect();
     TriMesh::new(v, t).ok()
 }
 
@@ -146,8 +143,11 @@ pub fn surface_distance(asset: &SurfaceMesh, mesh: &TetMesh) -> SurfaceDistance 
         .sum::<f64>()
         .sqrt();
     let mut h = diag / 200.0;
-    let most = count_samples(&asset.vertices, &asset.triangles, h)
-        .max(count_samples(&mesh.nodes, &boundary, h));
+    let most = count_samples(&asset.vertices, &asset.triangles, h).max(count_samples(
+        &mesh.nodes,
+        &boundary,
+        h,
+    ));
     if most > MAX_SAMPLES as f64 {
         h *= (most / MAX_SAMPLES as f64).sqrt();
     }

@@ -233,7 +233,11 @@ pub fn tetrahedralize(
     if reproducible {
         std::fs::write(&shim, SHIM).map_err(io)?;
     }
-    let shim_arg = if reproducible { shim.clone() } else { PathBuf::new() };
+    let shim_arg = if reproducible {
+        shim.clone()
+    } else {
+        PathBuf::new()
+    };
     let (mut cmd, program) = match &params.program {
         None => {
             let mut v = Vec::with_capacity(24 * surface.vertices.len());
@@ -269,11 +273,18 @@ pub fn tetrahedralize(
             }
             std::fs::write(dir.path().join("surface.obj"), s).map_err(io)?;
             let mut c = Command::new(bin);
-            c.args(["-i", "surface.obj", "-o", "volume.msh", "--max-threads", "1"])
-                .args(["--level", "6", "--no-color", "-a"])
-                .arg(format!("{size:?}"))
-                .arg("-e")
-                .arg(format!("{:?}", envelope / diag));
+            c.args([
+                "-i",
+                "surface.obj",
+                "-o",
+                "volume.msh",
+                "--max-threads",
+                "1",
+            ])
+            .args(["--level", "6", "--no-color", "-a"])
+            .arg(format!("{size:?}"))
+            .arg("-e")
+            .arg(format!("{:?}", envelope / diag));
             if reproducible {
                 c.env("LD_PRELOAD", &shim);
             }
@@ -299,7 +310,10 @@ pub fn tetrahedralize(
     if !status.success() {
         let lines: Vec<&str> = out.text.lines().rev().take(4).collect();
         let lines: Vec<&str> = lines.into_iter().rev().collect();
-        return Err(failed(format!("exit status {status}: {}", lines.join(" | "))));
+        return Err(failed(format!(
+            "exit status {status}: {}",
+            lines.join(" | ")
+        )));
     }
     let mesh = if params.program.is_some() {
         let msh = std::fs::read(dir.path().join("volume.msh")).map_err(io)?;
@@ -329,7 +343,7 @@ pub fn tetrahedralize(
 /// A linear mesh from pytetwild's arrays (little-endian f64 positions, i32 tetrahedra),
 /// every tetrahedron positively oriented.
 fn from_arrays(v: &[u8], t: &[u8]) -> Result<TetMesh, String> {
-    if v.len() % 24 != 0 || t.len() % 16 != 0 {
+    if !v.len().is_multiple_of(24) || !t.len().is_multiple_of(16) {
         return Err("truncated output arrays".into());
     }
     let nodes: Vec<[f64; 3]> = v

@@ -176,7 +176,9 @@ pub enum AssetError {
         max: f64,
     },
     /// The asset is too small.
-    #[error("{file}: the surface is {extent:e} m across, below the supported {min:e} m; check --units")]
+    #[error(
+        "{file}: the surface is {extent:e} m across, below the supported {min:e} m; check --units"
+    )]
     TooSmall {
         /// The asset.
         file: String,
@@ -373,7 +375,11 @@ pub fn mesh_surface(
             match run_backend(other, surface, &inspection, params, file, progress) {
                 Ok((m, mut r)) => {
                     r.fallback_from = Some(format!("{} failed: {e}", backend.name()));
-                    r.reason = format!("{reason}; {} failed, so {} ran", backend.name(), other.name());
+                    r.reason = format!(
+                        "{reason}; {} failed, so {} ran",
+                        backend.name(),
+                        other.name()
+                    );
                     (m, r)
                 }
                 Err(e2) => {

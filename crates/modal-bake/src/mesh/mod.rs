@@ -41,11 +41,11 @@ use std::path::Path;
 
 pub use asset::mesh_asset;
 pub use distance::{surface_distance, SurfaceDistance};
+pub use mesh_error::{Location, MeshError, MeshErrorKind};
 pub use mesher::{
     mesh_surface, AssetError, Backend, MeshParams, MeshReport, MeshedAsset, MesherChoice,
 };
 pub use msh_writer::msh41_bytes;
-pub use mesh_error::{Location, MeshError, MeshErrorKind};
 pub(crate) use tet_mesh::tet_faces;
 pub use tet_mesh::{signed_volume, TetMesh, TET10_EDGES};
 pub use validate::{DEFAULT_DEGENERATE_REL_TOL, DEFAULT_STRAIGHT_REL_TOL};

@@ -111,8 +111,18 @@ pub fn run_child(
             buf
         })
     };
-    let out = drain(child.stdout.take().map(|s| Box::new(s) as Box<dyn Read + Send>));
-    let err = drain(child.stderr.take().map(|s| Box::new(s) as Box<dyn Read + Send>));
+    let out = drain(
+        child
+            .stdout
+            .take()
+            .map(|s| Box::new(s) as Box<dyn Read + Send>),
+    );
+    let err = drain(
+        child
+            .stderr
+            .take()
+            .map(|s| Box::new(s) as Box<dyn Read + Send>),
+    );
     let id = child.id();
     lock(&CHILDREN).push(child);
     let mut next_note = 15.0;
@@ -124,7 +134,8 @@ pub fn run_child(
             };
             match children[i].try_wait() {
                 Ok(Some(s)) => {
-                    children.remove(i);
+                    // Already reaped by try_wait; wait returns its status at once.
+                    let _ = children.remove(i).wait();
                     break Some(s);
                 }
                 Ok(None) if t.elapsed() >= timeout => {

@@ -428,11 +428,7 @@ fn orient(a: [f64; 3], b: [f64; 3], c: [f64; 3], d: [f64; 3]) -> f64 {
 
 /// Where the closed segment `p q` meets the closed triangle `a b c` (a non-coplanar meeting),
 /// exactly decided; the point is computed in floating point.
-fn segment_meets_triangle(
-    p: [f64; 3],
-    q: [f64; 3],
-    [a, b, c]: [[f64; 3]; 3],
-) -> Option<[f64; 3]> {
+fn segment_meets_triangle(p: [f64; 3], q: [f64; 3], [a, b, c]: [[f64; 3]; 3]) -> Option<[f64; 3]> {
     let op = orient(a, b, c, p);
     let oq = orient(a, b, c, q);
     if (op > 0.0 && oq > 0.0) || (op < 0.0 && oq < 0.0) || (op == 0.0 && oq == 0.0) {
