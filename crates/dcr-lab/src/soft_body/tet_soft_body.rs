@@ -162,7 +162,7 @@ pub fn tet_soft_body(mesh: &TetMesh, desc: &TetSoftBodyDesc) -> Result<TetSoftBo
     if mesh.tets.is_empty() {
         bail!("the mesh has no tetrahedra");
     }
-    if !(desc.youngs > 0.0 && desc.density > 0.0) || !(0.0..0.5).contains(&desc.poisson) {
+    if !(desc.youngs > 0.0 && desc.density > 0.0 && (0.0..0.5).contains(&desc.poisson)) {
         bail!(
             "material: need E > 0, ρ > 0 and 0 ≤ ν < 0.5 (got E = {}, ν = {}, ρ = {})",
             desc.youngs,
