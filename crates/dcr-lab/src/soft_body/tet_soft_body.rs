@@ -158,11 +158,25 @@ fn cell_mean_omega(x: [[f64; 3]; 4], w: [f64; 4], mu: f64, lambda: f64) -> Optio
 /// # Errors
 /// An unknown fixed group (the message lists the mesh's groups), a fixed group without a
 /// corner node, non-positive material constants, or a mesh without tetrahedra.
+///
+/// ```
+/// use dcr_lab::soft_body::{tet_soft_body, TetSoftBodyDesc};
+/// use modal_bake::mesh::TetMesh;
+/// let mesh = TetMesh::structured_box([4, 1, 1], [1.0, 0.25, 0.25]);
+/// let desc = TetSoftBodyDesc { fixed: vec!["xmin".into()], density: 500.0, ..Default::default() };
+/// let body = tet_soft_body(&mesh, &desc).unwrap();
+/// assert_eq!(body.particle_node.len(), mesh.nodes.len());
+/// assert_eq!(body.pinned.len(), 4); // the 2 × 2 nodes at x = 0
+/// assert!((body.mass - 500.0 * 0.0625).abs() < 1e-9);
+/// let mut world = rapier3d_f64::prelude::PhysicsWorld::new();
+/// world.insert_soft_body(body.builder);
+/// world.step();
+/// ```
 pub fn tet_soft_body(mesh: &TetMesh, desc: &TetSoftBodyDesc) -> Result<TetSoftBody> {
     if mesh.tets.is_empty() {
         bail!("the mesh has no tetrahedra");
     }
-    if !(desc.youngs > 0.0 && desc.density > 0.0) || !(0.0..0.5).contains(&desc.poisson) {
+    if !(desc.youngs > 0.0 && desc.density > 0.0 && (0.0..0.5).contains(&desc.poisson)) {
         bail!(
             "material: need E > 0, ρ > 0 and 0 ≤ ν < 0.5 (got E = {}, ν = {}, ρ = {})",
             desc.youngs,
