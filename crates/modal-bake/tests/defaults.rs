@@ -501,8 +501,7 @@ fn target_error_refines_the_mesh_of_a_surface_asset() {
     // The base is the last (finest) mesh's: its tetrahedra are the last step's.
     let last_tets: u64 = e
         .lines()
-        .filter(|l| l.starts_with("  size "))
-        .last()
+        .rfind(|l| l.starts_with("  size "))
         .and_then(|l| l.split(": ").nth(1))
         .and_then(|l| l.split(' ').next())
         .unwrap()
