@@ -48,9 +48,15 @@ fn removed_handles_are_stale_and_setters_check_values() {
         let mut a = 0;
         assert_eq!(dcr_world_add_object(w, &desc, &mut a), DcrStatus::Ok);
         assert_eq!(a, 0);
-        assert_eq!(dcr_world_set_object_gain(w, a, -1.0), DcrStatus::InvalidArgument);
+        assert_eq!(
+            dcr_world_set_object_gain(w, a, -1.0),
+            DcrStatus::InvalidArgument
+        );
         assert!(last_error().contains("gain"), "{}", last_error());
-        assert_eq!(dcr_world_set_object_threshold(w, a, f64::NAN), DcrStatus::InvalidArgument);
+        assert_eq!(
+            dcr_world_set_object_threshold(w, a, f64::NAN),
+            DcrStatus::InvalidArgument
+        );
         assert_eq!(dcr_world_set_object_gain(w, a, 2.0), DcrStatus::Ok);
         assert_eq!(dcr_world_set_object_enabled(w, a, false), DcrStatus::Ok);
         assert_eq!(dcr_world_remove_object(w, a), DcrStatus::Ok);
@@ -68,7 +74,10 @@ fn removed_handles_are_stale_and_setters_check_values() {
             assert_eq!(st, DcrStatus::InvalidHandle);
         }
         let mut t = DcrObjectTotals::default();
-        assert_eq!(dcr_world_object_totals(w, a, &mut t), DcrStatus::InvalidHandle);
+        assert_eq!(
+            dcr_world_object_totals(w, a, &mut t),
+            DcrStatus::InvalidHandle
+        );
         assert_eq!(dcr_world_object_totals(w, b, &mut t), DcrStatus::Ok);
         // Ranges of the pose.
         for bad in [f64::NAN, 1e308, f64::INFINITY] {
@@ -81,7 +90,10 @@ fn removed_handles_are_stale_and_setters_check_values() {
             desc.pose = pose;
             desc.body = 5;
             let mut c = 0;
-            assert_eq!(dcr_world_add_object(w, &desc, &mut c), DcrStatus::InvalidArgument);
+            assert_eq!(
+                dcr_world_add_object(w, &desc, &mut c),
+                DcrStatus::InvalidArgument
+            );
         }
         assert_eq!(dcr_world_set_h(w, 1.0 / 60.0), DcrStatus::Ok);
         let mut h = 0.0;
@@ -104,7 +116,11 @@ fn out_of_range_arguments_are_refused_with_a_message() {
             p.sampling = DCR_SAMPLING_OVERSAMPLE;
             p.sampling_value = k;
             let mut r = std::ptr::null_mut();
-            assert_eq!(dcr_response_create(m, &p, &mut r), DcrStatus::InvalidArgument, "K = {k}");
+            assert_eq!(
+                dcr_response_create(m, &p, &mut r),
+                DcrStatus::InvalidArgument,
+                "K = {k}"
+            );
             assert!(last_error().contains("oversampling"), "{}", last_error());
             assert!(r.is_null());
         }

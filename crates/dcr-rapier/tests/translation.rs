@@ -346,7 +346,12 @@ macro_rules! backend_tests {
                         // The responses that move a box visibly (≥ 1 mm/s): the hopping boxes'
                         // landings may add µm/s responses on which the two classifications can
                         // differ (ages vs engine newness, see StepGate::ImpactSteps).
-                        for e in s.dcr.step(&mut s.world).iter().filter(|e| e.delta_v >= 1e-3) {
+                        for e in s
+                            .dcr
+                            .step(&mut s.world)
+                            .iter()
+                            .filter(|e| e.delta_v >= 1e-3)
+                        {
                             events.push((k, e.body, e.delta_v));
                         }
                         stepped += usize::from(s.dcr.step_info().world_stepped);

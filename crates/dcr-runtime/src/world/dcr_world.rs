@@ -888,8 +888,7 @@ impl DcrWorld {
                 let age = self.ages.entry(c.id).or_insert(fresh);
                 // Absent for a while, or touching with zero impulse: its age restarts — but not
                 // in the step after a response pushed it off (see `recently_pushed`).
-                if age.last_step + cp.new_after_missing_steps < step || (!(lambda > 0.0) && !hop)
-                {
+                if age.last_step + cp.new_after_missing_steps < step || (!(lambda > 0.0) && !hop) {
                     *age = fresh;
                 }
                 age.last_step = step;
@@ -1201,7 +1200,10 @@ impl DcrWorld {
 /// events of two steps.
 #[inline]
 fn recently_pushed(pushed: &[(u64, u64)], id: u64, step: u64) -> bool {
-    !pushed.is_empty() && pushed.iter().any(|&(c, s)| c == id && s + 2 >= step && s < step)
+    !pushed.is_empty()
+        && pushed
+            .iter()
+            .any(|&(c, s)| c == id && s + 2 >= step && s < step)
 }
 
 /// `M v` for a row-major 3 × 3 matrix.
