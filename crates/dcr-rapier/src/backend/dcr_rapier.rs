@@ -330,12 +330,10 @@ impl DcrRapier {
             .iter()
             .position(|o| o.handle == handle)
             .filter(|_| self.world.contains(handle))
-            .ok_or_else(|| {
-                AdapterError::World(WorldError::StaleHandle {
-                    handle,
-                    why: "the object was removed or is not from this adapter",
-                })
-            })
+            .ok_or(AdapterError::World(WorldError::StaleHandle {
+                handle,
+                why: "the object was removed or is not from this adapter",
+            }))
     }
 
     /// Removes an elastic object (its world object, see [`DcrWorld::remove_object`]): its
