@@ -32,7 +32,13 @@
  * signature or an enumeration code changes. Compare it with `DcrVersion.abi` from
  * `dcr_version` at start-up to catch a header and a library that do not belong together.
  */
-#define DCR_ABI_VERSION 1
+#define DCR_ABI_VERSION 2
+
+/**
+ * Largest |translation| component a pose may have (m): beyond it an f64 position resolves
+ * less than 0.1 µm, and products with it overflow sooner.
+ */
+#define DCR_MAX_TRANSLATION 1e9
 
 /**
  * Outcome of a dcr call. `DCR_STATUS_OK` (0) is success; on any other value the call changed
@@ -612,6 +618,15 @@ typedef struct DcrWorldParams {
    * an elastic object's body becomes an impact on it); 0 disables chains. Default 4.
    */
   uint32_t max_chain_depth;
+  /**
+   * Gravity (m/s², world frame) for the support compensation of impulses applied after the
+   * step: a body a response lifts off (Δv ≥ g·h along the normal) also gets, at its centre
+   * of mass, the normal velocity gravity takes off during the next step, so that it ends
+   * that step with Δv. Default zero (no compensation): set it to the engine's gravity when
+   * the events are applied after the step; leave it zero when the engine replays them in
+   * its contact solver.
+   */
+  double gravity[3];
 } DcrWorldParams;
 
 /**
@@ -672,10 +687,12 @@ typedef struct DcrElasticObjectDesc {
 } DcrElasticObjectDesc;
 
 /**
- * An elastic object of a world: the number of objects added before it (0, 1, 2, …). Handles
- * are never reused (objects are not removed).
+ * An elastic object of a world: a slot index (low 32 bits) and the slot's generation (high 32
+ * bits). While nothing is removed, the k-th object added has handle k. `dcr_world_remove_object`
+ * bumps the slot's generation: the removed object's handle is stale for ever (every call with
+ * it returns `DCR_STATUS_INVALID_HANDLE`), even after the slot is reused by a later object.
  */
-typedef uint32_t DcrElasticHandle;
+typedef uint64_t DcrElasticHandle;
 
 /**
  * One contact point between two engine bodies after a rigid-body step (world frame). Report
@@ -929,6 +946,51 @@ typedef struct DcrObjectStepInfo {
 } DcrObjectStepInfo;
 
 /**
+ * Running totals of one elastic object since it was added (`dcr_world_object_totals`), apart
+ * from the per-step counters of `DcrObjectStepInfo`.
+ */
+typedef struct DcrObjectTotals {
+  /**
+   * Engine impacts on the object.
+   */
+  uint64_t impacts;
+  /**
+   * Chained impacts on the object.
+   */
+  uint64_t chained_impacts;
+  /**
+   * Steps on which the object's response ran.
+   */
+  uint64_t queries;
+  /**
+   * Impulse events the object's response issued.
+   */
+  uint64_t events;
+  /**
+   * Resting contacts farther than `max_map_distance` from the base's surface (no response):
+   * a contact in another frame than the base's, or far from its mesh.
+   */
+  uint64_t contacts_unmapped;
+  /**
+   * Impacts farther than `max_map_distance` from the surface (ignored).
+   */
+  uint64_t impacts_unmapped;
+  /**
+   * Resting contacts a transfer-table response served with the modal method instead.
+   */
+  uint64_t contacts_table_fallback;
+  /**
+   * Steps the object spent disabled.
+   */
+  uint64_t disabled_steps;
+} DcrObjectTotals;
+
+/**
+ * How an object's base is held compared with its body (`dcr_world_object_base_support`).
+ */
+typedef uint32_t DcrBaseSupport;
+
+/**
  * The truncated modal base (Eq. 9–13).
  */
 #define DCR_SERVED_BY_MODAL 0
@@ -1099,6 +1161,23 @@ typedef struct DcrObjectStepInfo {
  */
 #define DCR_AMPLITUDE_MEAN_OVER 2
 
+/**
+ * A static body with fixed nodes, or a dynamic body with a free-floating base.
+ */
+#define DCR_BASE_SUPPORT_CONSISTENT 0
+
+/**
+ * A dynamic body with a base baked with fixed nodes: right for an object standing on what
+ * holds those nodes (a table on a floor), wrong for one in flight.
+ */
+#define DCR_BASE_SUPPORT_DYNAMIC_BODY_FIXED_BASE 1
+
+/**
+ * A static body with a free-floating base: where the object is held, its response is that of
+ * a floating object (bake with fixed nodes at its supports).
+ */
+#define DCR_BASE_SUPPORT_STATIC_BODY_FREE_BASE 2
+
 #ifdef __cplusplus
 extern "C" {
 #endif // __cplusplus
@@ -1113,8 +1192,8 @@ extern "C" {
  * inertia). Rotate an object-frame `DcrContactResponse.normal` to the world frame first.
  *
  * # Errors
- * `DCR_STATUS_INVALID_ARGUMENT` for a negative or non-finite `inv_mass`;
- * `DCR_STATUS_NULL_POINTER`.
+ * `DCR_STATUS_INVALID_ARGUMENT` for a negative or non-finite `inv_mass`, or a non-finite
+ * element of `inv_inertia`, `r` or `n`; `DCR_STATUS_NULL_POINTER`.
  *
  * # Safety
  * `inv_inertia` must be NULL or 9 readable doubles; `r`, `n` NULL or 3 readable doubles;
@@ -1132,7 +1211,8 @@ enum DcrStatus dcr_effective_mass(double inv_mass,
  * n`. Apply it at the contact point with the engine's apply-impulse-at-point.
  *
  * # Errors
- * `DCR_STATUS_NULL_POINTER` for a NULL `n` or `out`.
+ * `DCR_STATUS_INVALID_ARGUMENT` for a negative or non-finite `m_eff`, a non-finite `delta_v`
+ * or a non-finite element of `n`; `DCR_STATUS_NULL_POINTER` for a NULL `n` or `out`.
  *
  * # Safety
  * `n` must be NULL or 3 readable doubles; `out` NULL or 3 writable doubles.
@@ -1433,14 +1513,17 @@ void dcr_world_free(struct DcrWorld *world);
 
 /**
  * Adds an elastic object built from `desc` (its model, response parameters, engine body,
- * static or dynamic, gain, pose). `*out` receives its handle: the number of objects added
- * before it. Add a dynamic object after the one it rests on (chains only go forward).
+ * static or dynamic, gain, pose). `*out` receives its handle (a free slot of a removed object
+ * with that slot's next generation, else a new slot: k for the k-th object while nothing is
+ * removed). Add a dynamic object after the one it rests on (chains only go forward). How the
+ * base is held against the body is checked (`dcr_world_object_base_support`).
  *
  * # Errors
  * `DCR_STATUS_INVALID_ARGUMENT` for a response parameter out of range, a negative or
- * non-finite gain, a body that already carries an object, a transfer table refused by its
- * policy, or a wrong `struct_size` (the message says which); `DCR_STATUS_NULL_POINTER` for a
- * NULL argument or `desc->model`.
+ * non-finite gain, a pose translation that is not finite or beyond `DCR_MAX_TRANSLATION`, a
+ * body that already carries an object, a transfer table refused by its policy, or a wrong
+ * `struct_size` (the message says which); `DCR_STATUS_NULL_POINTER` for a NULL argument or
+ * `desc->model`.
  *
  * # Safety
  * `world` must be NULL or a live handle not used by another thread during the call; `desc`
@@ -1456,7 +1539,9 @@ enum DcrStatus dcr_world_add_object(struct DcrWorld *world,
  * body's pose after the rigid-body step.
  *
  * # Errors
- * `DCR_STATUS_INVALID_HANDLE` for a handle not from this world; `DCR_STATUS_NULL_POINTER`.
+ * `DCR_STATUS_INVALID_HANDLE` for a removed handle or one not from this world;
+ * `DCR_STATUS_INVALID_ARGUMENT` for a translation component that is not finite or beyond
+ * `DCR_MAX_TRANSLATION` (the pose is unchanged); `DCR_STATUS_NULL_POINTER`.
  *
  * # Safety
  * `world` must be NULL or a live handle not used by another thread; `pose` NULL or valid.
@@ -1586,6 +1671,124 @@ enum DcrStatus dcr_world_object_info(const struct DcrWorld *world,
 enum DcrStatus dcr_world_object_response_info(const struct DcrWorld *world,
                                               DcrElasticHandle object,
                                               struct DcrResponseInfo *out);
+
+/**
+ * Removes an elastic object: its response and counters are dropped, its body may carry
+ * another object, and `object` becomes stale (every call with it returns
+ * `DCR_STATUS_INVALID_HANDLE`, even after its slot is reused). Event arrays already returned
+ * keep their values until the next step. Not a per-step call (it re-indexes the objects).
+ *
+ * # Errors
+ * `DCR_STATUS_INVALID_HANDLE` for an already removed or foreign handle;
+ * `DCR_STATUS_NULL_POINTER`.
+ *
+ * # Safety
+ * `world` must be NULL or a live handle not used by another thread during the call.
+ */
+enum DcrStatus dcr_world_remove_object(struct DcrWorld *world,
+                                       DcrElasticHandle object);
+
+/**
+ * Enables (`enabled` true) or disables an object from the next step on. A disabled object's
+ * contacts are ignored, it issues no events, impulses on its body do not chain into it, and
+ * its filters restart at rest when it is enabled again; its handle and settings are kept.
+ *
+ * # Errors
+ * `DCR_STATUS_INVALID_HANDLE`; `DCR_STATUS_NULL_POINTER`.
+ *
+ * # Safety
+ * `world` must be NULL or a live handle not used by another thread during the call.
+ */
+enum DcrStatus dcr_world_set_object_enabled(struct DcrWorld *world,
+                                            DcrElasticHandle object,
+                                            bool enabled);
+
+/**
+ * Sets an object's gain (dimensionless, ≥ 0: the scale of the velocity changes its responses
+ * ask for) from the next step on.
+ *
+ * # Errors
+ * `DCR_STATUS_INVALID_HANDLE`; `DCR_STATUS_INVALID_ARGUMENT` for a negative or non-finite
+ * gain (the old one is kept); `DCR_STATUS_NULL_POINTER`.
+ *
+ * # Safety
+ * `world` must be NULL or a live handle not used by another thread during the call.
+ */
+enum DcrStatus dcr_world_set_object_gain(struct DcrWorld *world,
+                                         DcrElasticHandle object,
+                                         double gain);
+
+/**
+ * Sets an object's impact threshold (N·s, ≥ 0: smaller impacts are ignored) from the next
+ * step on, for the classification and the response.
+ *
+ * # Errors
+ * `DCR_STATUS_INVALID_HANDLE`; `DCR_STATUS_INVALID_ARGUMENT` for a negative or non-finite
+ * threshold (the old one is kept); `DCR_STATUS_NULL_POINTER`.
+ *
+ * # Safety
+ * `world` must be NULL or a live handle not used by another thread during the call.
+ */
+enum DcrStatus dcr_world_set_object_threshold(struct DcrWorld *world,
+                                              DcrElasticHandle object,
+                                              double threshold);
+
+/**
+ * Changes the world's rigid-body step h (s) when the engine's step changes: every object's
+ * response is rebuilt for it (the filters' exact coefficients re-derived; a transfer table
+ * baked for another h refused or replaced by the modal method by its policy). Not a per-step
+ * call: compare the engine's step with the world's h and call it on change.
+ *
+ * # Errors
+ * `DCR_STATUS_INVALID_ARGUMENT` for a non-positive or non-finite h, or when a response cannot
+ * serve it (a transfer table under `DCR_TABLE_POLICY_REFUSE`); the world is unchanged then.
+ * `DCR_STATUS_NULL_POINTER`.
+ *
+ * # Safety
+ * `world` must be NULL or a live handle not used by another thread during the call.
+ */
+enum DcrStatus dcr_world_set_h(struct DcrWorld *world,
+                               double h);
+
+/**
+ * `*out` = the world's rigid-body step h (s).
+ *
+ * # Errors
+ * `DCR_STATUS_NULL_POINTER` for a NULL argument.
+ *
+ * # Safety
+ * `world` must be NULL or a live handle; `out` NULL or valid for a write.
+ */
+enum DcrStatus dcr_world_h(const struct DcrWorld *world,
+                           double *out);
+
+/**
+ * Fills `out` with an object's running totals since it was added (impacts, queries, events,
+ * unmapped contacts, table fallbacks, disabled steps).
+ *
+ * # Errors
+ * `DCR_STATUS_INVALID_HANDLE`; `DCR_STATUS_NULL_POINTER`.
+ *
+ * # Safety
+ * `world` must be NULL or a live handle; `out` NULL or valid for a write.
+ */
+enum DcrStatus dcr_world_object_totals(const struct DcrWorld *world,
+                                       DcrElasticHandle object,
+                                       struct DcrObjectTotals *out);
+
+/**
+ * `*out` = how an object's base is held compared with its body, `DCR_BASE_SUPPORT_*` (checked
+ * at `dcr_world_add_object`; not refused either way).
+ *
+ * # Errors
+ * `DCR_STATUS_INVALID_HANDLE`; `DCR_STATUS_NULL_POINTER`.
+ *
+ * # Safety
+ * `world` must be NULL or a live handle; `out` NULL or valid for a write.
+ */
+enum DcrStatus dcr_world_object_base_support(const struct DcrWorld *world,
+                                             DcrElasticHandle object,
+                                             DcrBaseSupport *out);
 
 /**
  * `*out` = the number of elastic objects in the world.

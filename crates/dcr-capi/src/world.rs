@@ -888,7 +888,9 @@ pub unsafe extern "C" fn dcr_world_set_h(world: *mut DcrWorld, h: f64) -> DcrSta
     guard("dcr_world_set_h", || {
         // SAFETY: caller contract (NULL is checked).
         let w = unsafe { arg_mut(world, "world")? };
-        w.world.set_h(h).map_err(|e| Failure::invalid(e.to_string()))
+        w.world
+            .set_h(h)
+            .map_err(|e| Failure::invalid(e.to_string()))
     })
 }
 

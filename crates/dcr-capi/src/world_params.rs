@@ -107,6 +107,13 @@ pub struct DcrWorldParams {
     /// Longest chain of responses through dynamic elastic objects in one step (an impulse on
     /// an elastic object's body becomes an impact on it); 0 disables chains. Default 4.
     pub max_chain_depth: u32,
+    /// Gravity (m/s², world frame) for the support compensation of impulses applied after the
+    /// step: a body a response lifts off (Δv ≥ g·h along the normal) also gets, at its centre
+    /// of mass, the normal velocity gravity takes off during the next step, so that it ends
+    /// that step with Δv. Default zero (no compensation): set it to the engine's gravity when
+    /// the events are applied after the step; leave it zero when the engine replays them in
+    /// its contact solver.
+    pub gravity: [f64; 3],
 }
 
 impl DcrWorldParams {
@@ -125,6 +132,7 @@ impl DcrWorldParams {
             energy_bound: w.energy_eta.is_some(),
             energy_eta: w.energy_eta.unwrap_or(1.0),
             max_chain_depth: w.max_chain_depth,
+            gravity: w.gravity,
         }
     }
 
@@ -140,6 +148,7 @@ impl DcrWorldParams {
             },
             energy_eta: self.energy_bound.then_some(self.energy_eta),
             max_chain_depth: self.max_chain_depth,
+            gravity: self.gravity,
         })
     }
 }

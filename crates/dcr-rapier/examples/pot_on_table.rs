@@ -154,12 +154,12 @@ pub fn run(model: &Arc<ModalModel>, on: bool) -> Result<RunOutcome, Box<dyn std:
             .iter()
             .filter(|e| plate_ids.contains(&e.body))
             .count() as u32;
-        out.impacts += dcr.world().object_info(handle).impacts;
         for (i, &p) in plates.iter().enumerate() {
             let lift = (f64::from(world.bodies[p].translation().y) - y0[i]) * 1e3;
             out.lift_mm = out.lift_mm.max(lift);
         }
     }
+    out.impacts = dcr.world().object_totals(handle).impacts as u32;
     Ok(out)
 }
 

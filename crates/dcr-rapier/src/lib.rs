@@ -23,6 +23,11 @@ pub mod f32;
 #[cfg(feature = "f64")]
 pub mod f64;
 
+/// docs/engine-integration.md, compiled: its Rust snippets run as this crate's doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../../../docs/engine-integration.md")]
+pub struct EngineIntegrationGuide;
+
 pub use dcr_runtime;
 pub use dcr_runtime::{
     BodyState, ContactReport, DcrWorld, ElasticHandle, ElasticObjectDesc, ImpulseEvent, ModalModel,

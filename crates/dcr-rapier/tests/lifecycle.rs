@@ -41,7 +41,11 @@ macro_rules! backend_tests {
 
             /// The plate base on a fixed body (face z = 0, outward +z), a slab under it,
             /// gravity −z, the world's h = `h`, rapier's dt = 0.01 s.
-            fn scene_with(apply: ApplyMode, h: f64, desc: impl Fn(&mut ElasticObjectDesc)) -> Scene {
+            fn scene_with(
+                apply: ApplyMode,
+                h: f64,
+                desc: impl Fn(&mut ElasticObjectDesc),
+            ) -> Scene {
                 let mut world = PhysicsWorld::default();
                 world.integration_parameters.dt = H as Real;
                 world.gravity = Vector::new(0.0, 0.0, -9.81);
@@ -119,11 +123,13 @@ macro_rules! backend_tests {
                 }
 
                 /// Steps until an event reaches `body`; returns it (`None` after 40 steps).
-                fn until_event(&mut self, body: RigidBodyHandle) -> Option<dcr_rapier::ImpulseEvent> {
+                fn until_event(
+                    &mut self,
+                    body: RigidBodyHandle,
+                ) -> Option<dcr_rapier::ImpulseEvent> {
                     for _ in 0..40 {
                         self.step();
-                        if let Some(e) =
-                            self.dcr.events().iter().find(|e| e.body == body_id(body))
+                        if let Some(e) = self.dcr.events().iter().find(|e| e.body == body_id(body))
                         {
                             return Some(*e);
                         }
@@ -189,8 +195,14 @@ macro_rules! backend_tests {
                         ElasticObjectDesc::new(model(), 0),
                     )
                     .unwrap();
-                assert_eq!((h2.index(), h2.generation()), (h.index(), h.generation() + 1));
-                assert!(s.dcr.set_object_gain(h, 1.0).is_err(), "the old handle stays stale");
+                assert_eq!(
+                    (h2.index(), h2.generation()),
+                    (h.index(), h.generation() + 1)
+                );
+                assert!(
+                    s.dcr.set_object_gain(h, 1.0).is_err(),
+                    "the old handle stays stale"
+                );
                 for _ in 0..30 {
                     s.step();
                 }
@@ -274,8 +286,11 @@ macro_rules! backend_tests {
                     // Removed between rapier's step and the adapter's read.
                     s.world.step();
                     s.world.remove_body(other);
-                    s.dcr
-                        .after_step(&mut s.world.bodies, &s.world.colliders, &s.world.narrow_phase);
+                    s.dcr.after_step(
+                        &mut s.world.bodies,
+                        &s.world.colliders,
+                        &s.world.narrow_phase,
+                    );
                     // The elastic body itself.
                     s.world.remove_body(s.plate);
                     s.drop_ball();

@@ -8,7 +8,7 @@
 //! - contact ids are distinct and stay the same from step to step while a body rests;
 //! - after the step, each event's impulse changes the receiving body's velocity at the contact
 //!   along the object's outward normal by the event's Δv (Eq. 17–18, pushed away from the
-//!   surface);
+//!   surface) plus the support g·h along it that the contact no longer gives;
 //! - in the solver, the replay gives a single contact the requested separation velocity by the
 //!   end of the next step, to the solver's tolerance;
 //! - the f32 and f64 backends give the same outcome on the same small scene (largest lift of
@@ -252,8 +252,11 @@ macro_rules! backend_tests {
                         if events.is_empty() {
                             continue;
                         }
-                        assert_eq!(events.len(), 1, "one contact, one event");
+                        // The response's event, then its support at the centre of mass
+                        // (Δv ≥ g·h) when the push lifts the ball off.
                         let e = events[0];
+                        let support_given = events.len() == 2;
+                        assert!(events.len() == 1 || (support_given && events[1].delta_v == 0.0));
                         let rb = &s.world.bodies[ball];
                         assert_eq!(*rb.position(), p_before);
                         let p =
@@ -267,10 +270,14 @@ macro_rules! backend_tests {
                         let com = rb.center_of_mass();
                         let dv = (rb.linvel() - v_before) + (rb.angvel() - w_before).cross(p - com);
                         let got = dv.dot(n) as f64;
+                        // The support compensation: gravity's share along n over one step.
+                        let gh = 9.81 * H * (n.dot(up(&s.pose)) as f64).max(0.0);
+                        assert_eq!(support_given, e.delta_v >= gh, "support iff Δv ≥ g·h");
+                        let support = if support_given { gh } else { 0.0 };
                         assert!(e.delta_v > 0.0);
                         assert!(
-                            (got - e.delta_v).abs() < 1e-4 * e.delta_v.max(1e-3),
-                            "Δv along n {got} vs event {}",
+                            (got - support - e.delta_v).abs() < 1e-4 * (e.delta_v + support),
+                            "Δv along n {got} vs event {} + support {support}",
                             e.delta_v
                         );
                         checked += 1;
@@ -336,7 +343,15 @@ macro_rules! backend_tests {
                         if k == 30 || k == 120 {
                             s.drop_ball(0.35, 0.3);
                         }
-                        for e in s.dcr.step(&mut s.world) {
+                        // The responses that move a box visibly (≥ 1 mm/s): the hopping boxes'
+                        // landings may add µm/s responses on which the two classifications can
+                        // differ (ages vs engine newness, see StepGate::ImpactSteps).
+                        for e in s
+                            .dcr
+                            .step(&mut s.world)
+                            .iter()
+                            .filter(|e| e.delta_v >= 1e-3)
+                        {
                             events.push((k, e.body, e.delta_v));
                         }
                         stepped += usize::from(s.dcr.step_info().world_stepped);

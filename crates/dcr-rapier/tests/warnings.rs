@@ -70,7 +70,8 @@ fn unmapped_contacts_and_a_wrong_step_are_warned_once() {
             ElasticObjectDesc::new(model, 0),
         )
         .unwrap();
-    let b = world.insert_body(RigidBodyBuilder::dynamic().translation(Vector::new(0.85, 0.3, -0.47)));
+    let b =
+        world.insert_body(RigidBodyBuilder::dynamic().translation(Vector::new(0.85, 0.3, -0.47)));
     world.insert_collider(ColliderBuilder::ball(0.03).mass(0.2), Some(b));
     for _ in 0..30 {
         dcr.step(&mut world);

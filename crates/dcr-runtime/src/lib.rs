@@ -105,6 +105,7 @@ pub use response::{
 #[cfg(feature = "bench-internals")]
 pub use response::{peak_abs_projection, peak_abs_rows};
 pub use world::{
-    BodyState, ClassifyParams, ContactReport, DcrWorld, ElasticHandle, ElasticObjectDesc,
-    BaseSupport, EnergyInfo, ImpulseEvent, ObjectStepInfo, ObjectTotals, Pose, WorldError, WorldParams, WorldStepInfo,
+    BaseSupport, BodyState, ClassifyParams, ContactReport, DcrWorld, ElasticHandle,
+    ElasticObjectDesc, EnergyInfo, ImpulseEvent, ObjectStepInfo, ObjectTotals, Pose, WorldError,
+    WorldParams, WorldStepInfo,
 };

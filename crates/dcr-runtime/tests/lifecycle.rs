@@ -14,8 +14,8 @@ use std::sync::Arc;
 use dcr_runtime::format::{ModesFile, TransferTable};
 use dcr_runtime::testing::plate_base;
 use dcr_runtime::{
-    BaseSupport, BodyState, ContactReport, DcrWorld, ElasticHandle, ElasticObjectDesc, ImpulseEvent,
-    Method, ModalModel, ResponseParams, TablePolicy, WorldError, WorldParams,
+    BaseSupport, BodyState, ContactReport, DcrWorld, ElasticHandle, ElasticObjectDesc,
+    ImpulseEvent, Method, ModalModel, ResponseParams, TablePolicy, WorldError, WorldParams,
 };
 
 fn model_of(base: ModesFile) -> Arc<ModalModel> {
@@ -91,13 +91,22 @@ fn a_removed_handle_is_stale_even_after_its_slot_is_reused() {
         w.remove_object(a),
         Err(WorldError::StaleHandle { .. })
     ));
-    assert!(matches!(w.set_gain(a, 2.0), Err(WorldError::StaleHandle { .. })));
-    assert!(matches!(w.set_enabled(a, false), Err(WorldError::StaleHandle { .. })));
+    assert!(matches!(
+        w.set_gain(a, 2.0),
+        Err(WorldError::StaleHandle { .. })
+    ));
+    assert!(matches!(
+        w.set_enabled(a, false),
+        Err(WorldError::StaleHandle { .. })
+    ));
     // Body 1 is free again; the new object takes slot 0 with generation 1.
     let c = w.add_object(ElasticObjectDesc::new(m.clone(), 1)).unwrap();
     assert_eq!((c.index(), c.generation()), (0, 1));
     assert_ne!(c, a);
-    assert!(!w.contains(a), "the old handle must not name the new object");
+    assert!(
+        !w.contains(a),
+        "the old handle must not name the new object"
+    );
     assert!(matches!(
         w.set_impact_threshold(a, 1.0),
         Err(WorldError::StaleHandle { .. })
@@ -154,7 +163,12 @@ fn the_gain_scales_the_response_linearly() {
         }
         assert_eq!(ev.len(), 1);
         let rel = (ev[0].delta_v - g * base[0].delta_v).abs() / (g * base[0].delta_v);
-        assert!(rel < 1e-12, "gain {g}: Δv {} vs {}", ev[0].delta_v, base[0].delta_v);
+        assert!(
+            rel < 1e-12,
+            "gain {g}: Δv {} vs {}",
+            ev[0].delta_v,
+            base[0].delta_v
+        );
         for k in 0..3 {
             assert!((ev[0].impulse[k] - g * base[0].impulse[k]).abs() <= 1e-12 * g);
         }

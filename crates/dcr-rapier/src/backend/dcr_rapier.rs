@@ -330,12 +330,10 @@ impl DcrRapier {
             .iter()
             .position(|o| o.handle == handle)
             .filter(|_| self.world.contains(handle))
-            .ok_or_else(|| {
-                AdapterError::World(WorldError::StaleHandle {
-                    handle,
-                    why: "the object was removed or is not from this adapter",
-                })
-            })
+            .ok_or(AdapterError::World(WorldError::StaleHandle {
+                handle,
+                why: "the object was removed or is not from this adapter",
+            }))
     }
 
     /// Removes an elastic object (its world object, see [`DcrWorld::remove_object`]): its
@@ -388,7 +386,11 @@ impl DcrRapier {
     ///
     /// # Errors
     /// [`AdapterError::World`]: a stale handle or a negative or non-finite gain.
-    pub fn set_object_gain(&mut self, handle: ElasticHandle, gain: f64) -> Result<(), AdapterError> {
+    pub fn set_object_gain(
+        &mut self,
+        handle: ElasticHandle,
+        gain: f64,
+    ) -> Result<(), AdapterError> {
         self.slot_of(handle)?;
         self.world.set_gain(handle, gain)?;
         Ok(())
@@ -706,7 +708,8 @@ impl DcrRapier {
                     if j < k {
                         continue;
                     }
-                    threshold = threshold.min(self.objects[self.colliders[j].1 as usize].gate_threshold());
+                    threshold =
+                        threshold.min(self.objects[self.colliders[j].1 as usize].gate_threshold());
                 }
                 hot |= scan_pair(pair, threshold, &mut self.memory);
             }

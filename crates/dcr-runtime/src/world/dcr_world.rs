@@ -63,6 +63,9 @@ struct Object {
 struct Tracked {
     dlin: [f64; 3],
     dang: [f64; 3],
+    /// Support velocity (m/s, world) already in `dlin`: given once per body and step, at its
+    /// centre of mass, with its first response.
+    support: [f64; 3],
     /// Index into `touched` while the current object is processed, else `u32::MAX`.
     touch: u32,
 }
@@ -244,6 +247,8 @@ pub struct DcrWorld {
     tracked: Vec<Tracked>,
     touched: Vec<Touched>,
     events: Vec<ImpulseEvent>,
+    /// (contact id, world step) of the events of the last two steps (`recently_pushed`).
+    pushed: Vec<(u64, u64)>,
     /// Chained impacts produced by the current object: (target object, impact, depth).
     handed: Vec<(u32, Impact, u32)>,
     step: u64,
@@ -301,6 +306,7 @@ impl DcrWorld {
             touched: Vec::new(),
             events: Vec::new(),
             handed: Vec::new(),
+            pushed: Vec::new(),
             step: 0,
             next_purge: 0,
             info: WorldStepInfo::default(),
@@ -842,6 +848,9 @@ impl DcrWorld {
             self.info.dissipated += e.dissipated;
         }
         self.info.events = self.events.len() as u32;
+        self.pushed.retain(|&(_, s)| s + 2 > step);
+        self.pushed
+            .extend(self.events.iter().map(|e| (e.contact, step)));
         // Forget ids absent long enough to be new anyway (bounded table, no growth once warm).
         if step >= self.next_purge {
             self.next_purge = step + PURGE_EVERY;
@@ -868,16 +877,18 @@ impl DcrWorld {
             let valid = lambda.is_finite() && lambda > 0.0;
             let mut fired_before: Option<&mut [bool; 2]> = None;
             let fresh_age = if cp.engine_newness {
-                c.is_new && step >= cp.settle_steps
+                c.is_new && step >= cp.settle_steps && !recently_pushed(&self.pushed, c.id, step)
             } else {
+                let hop = !(lambda > 0.0) && recently_pushed(&self.pushed, c.id, step);
                 let fresh = ContactAge {
                     first_step: step,
                     last_step: step,
                     fired: [false; 2],
                 };
                 let age = self.ages.entry(c.id).or_insert(fresh);
-                // Absent for a while, or touching with zero impulse: its age restarts.
-                if age.last_step + cp.new_after_missing_steps < step || !(lambda > 0.0) {
+                // Absent for a while, or touching with zero impulse: its age restarts — but not
+                // in the step after a response pushed it off (see `recently_pushed`).
+                if age.last_step + cp.new_after_missing_steps < step || (!(lambda > 0.0) && !hop) {
                     *age = fresh;
                 }
                 age.last_step = step;
@@ -967,6 +978,7 @@ impl DcrWorld {
         obj.info.queried = true;
         self.info.queries += 1;
         let first_event = self.events.len();
+        let mut supports = 0;
         let t0 = std::time::Instant::now();
         let out = obj.response.step(&obj.impacts, &obj.resting);
         obj.info.response_time_ns = t0.elapsed().as_nanos() as u64;
@@ -983,17 +995,14 @@ impl DcrWorld {
             // Normal part: the Δv not yet produced at this point (one Gauss–Seidel pass).
             let mut j = [0.0; 3];
             let mut need = 0.0;
-            let achieved = dot(add(t.dlin, cross(t.dang, r)), n);
-            let support = if resp.delta_v > 0.0 {
-                (-dot(self.params.gravity, n)).max(0.0) * self.params.h
-            } else {
-                0.0
-            };
-            let want = obj.gain * resp.delta_v + support - achieved;
+            // The response's part of what earlier impulses gave the body here (their support
+            // is not a response).
+            let achieved = dot(sub(add(t.dlin, cross(t.dang, r)), t.support), n);
+            let want = obj.gain * resp.delta_v - achieved;
             if want > 0.0 {
                 let m_eff = effective_mass(b.inv_mass, b.inv_inertia, r, n);
                 if m_eff > 0.0 {
-                    need = (want - support).max(0.0);
+                    need = want;
                     j = scale(n, m_eff * want);
                 }
             }
@@ -1040,6 +1049,30 @@ impl DcrWorld {
                 contact: resp.id,
                 chained: obj.depth > 0,
             });
+            // Support compensation (WorldParams::gravity), once per body and step: the normal
+            // velocity gravity takes off during the next step, at the centre of mass — for a
+            // push that lifts the body off (Δv ≥ g_n h); a smaller one leaves it on its contact.
+            let g_n = -dot(self.params.gravity, n);
+            let gh = g_n * self.params.h;
+            if gh > 0.0 && need >= gh && t.support == [0.0; 3] && b.inv_mass > 0.0 {
+                let dv = scale(n, gh);
+                let js = scale(dv, 1.0 / b.inv_mass);
+                t.support = dv;
+                t.dlin = add(t.dlin, dv);
+                tc.p_lin = add(tc.p_lin, js);
+                self.events.push(ImpulseEvent {
+                    body: b.id,
+                    point: b.center_of_mass,
+                    impulse: js,
+                    normal: n,
+                    delta_v: 0.0,
+                    object: obj.handle,
+                    served_by: resp.served_by,
+                    contact: resp.id,
+                    chained: obj.depth > 0,
+                });
+                supports += 1;
+            }
         }
         obj.info.response = obj.response.last_step_info();
         // Energy of this object's impulses, E(s) = s A + s² B, and the bound.
@@ -1064,7 +1097,7 @@ impl DcrWorld {
         };
         obj.info.energy.requested = requested;
         obj.info.energy.scale = s;
-        obj.info.events = (self.events.len() - first_event) as u32;
+        obj.info.events = (self.events.len() - first_event - supports) as u32;
         if s != 1.0 {
             for e in &mut self.events[first_event..] {
                 e.impulse = scale(e.impulse, s);
@@ -1157,6 +1190,20 @@ impl DcrWorld {
             && self.rank[to] > self.rank[from]
             && depth < self.params.max_chain_depth
     }
+}
+
+/// Whether contact `id` received a response event one or two steps before `step`. A body
+/// pushed off its resting contact after step N (the support compensation gives it the
+/// response's Δv at the end of N+1, so its contact carries no impulse at N+1) and caught again
+/// by the same contact at N+1 or N+2 has hopped by at most Δv·h: that contact is neither new
+/// nor an impact. A body that stays off longer lands as a new contact. A short scan: the
+/// events of two steps.
+#[inline]
+fn recently_pushed(pushed: &[(u64, u64)], id: u64, step: u64) -> bool {
+    !pushed.is_empty()
+        && pushed
+            .iter()
+            .any(|&(c, s)| c == id && s + 2 >= step && s < step)
 }
 
 /// `M v` for a row-major 3 × 3 matrix.
