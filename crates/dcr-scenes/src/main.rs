@@ -6,11 +6,11 @@ use std::process::ExitCode;
 use anyhow::{bail, Context, Result};
 use clap::{Parser, Subcommand, ValueEnum};
 use dcr_rapier::f64::{ApplyMode, StepGate};
-use dcr_scenes::export::{side_label, write_outcomes_svg, write_scene_glb, Side};
 use dcr_runtime::format::OutputPlan;
+use dcr_scenes::export::{side_label, write_outcomes_svg, write_scene_glb, Side};
 use dcr_scenes::runner::{
-    base_path, run_scene, transfer_base_path, RUN_OUTPUTS, stress_bench, table1, MethodChoice, RunParams, RunReport, StressBenchParams,
-    Table1Params,
+    base_path, run_scene, stress_bench, table1, transfer_base_path, MethodChoice, RunParams,
+    RunReport, StressBenchParams, Table1Params, RUN_OUTPUTS,
 };
 use dcr_scenes::scene::SceneDesc;
 use dcr_scenes::{repo_root, SCENES};
