@@ -299,6 +299,11 @@ fn real_main() -> Result<()> {
                 );
             }
             let desc = SceneDesc::read(&path)?;
+            if let Some(b) = beta {
+                if !(b.is_finite() && (0.0..=10.0).contains(&b)) {
+                    bail!("--beta {b}: the attenuation exponent β must be in [0, 10]");
+                }
+            }
             let method = match (method, beta) {
                 (Some(MethodArg::Modal | MethodArg::Transfer), Some(_)) => {
                     bail!("--beta is the attenuation exponent: use it without --method or with --method attenuation")

@@ -138,13 +138,9 @@ fn ply_error(data: &[u8], name: &str, e: &dyn std::fmt::Display) -> SurfaceError
     let mut lines = text.lines();
     let first = lines.next().unwrap_or("").trim();
     let detail = if text.contains("valid UTF-8") {
-        let header_end = data
-            .windows(10)
-            .position(|w| w == b"end_header")
-            .map_or(data.len(), |p| p + 10);
-        match first_non_utf8_line(&data[..header_end]) {
-            Some(line) => format!("line {line}: the header is not ASCII text"),
-            None => "the header is not ASCII text".to_string(),
+        match first_non_utf8_line(data) {
+            Some(line) => format!("line {line}: not ASCII text"),
+            None => "not ASCII text".to_string(),
         }
     } else {
         let first = match first.strip_prefix("Line ") {
@@ -178,9 +174,10 @@ fn obj_error_line(data: &[u8]) -> Option<usize> {
         .position(|l| {
             let mut f = l.split_whitespace();
             match f.next() {
-                Some("v" | "vt" | "vn") => {
+                Some(key @ ("v" | "vt" | "vn")) => {
                     let nums: Vec<&str> = f.collect();
-                    nums.is_empty() || nums.iter().any(|x| x.parse::<f64>().is_err())
+                    let least = if key == "vt" { 1 } else { 3 };
+                    nums.len() < least || nums.iter().any(|x| x.parse::<f64>().is_err())
                 }
                 Some("f") => {
                     let idx: Vec<&str> = f.collect();
