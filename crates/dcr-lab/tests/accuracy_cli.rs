@@ -47,7 +47,10 @@ fn a_bad_root_or_output_folder_is_refused_and_leaves_nothing() {
     assert!(!out.exists(), "left {}", out.display());
     let file = dir.path().join("file");
     std::fs::write(&file, b"x").unwrap();
-    for (bad, says) in [(file.as_path(), "a regular file"), ("/dev/null".as_ref(), "a character device")] {
+    for (bad, says) in [
+        (file.as_path(), "a regular file"),
+        ("/dev/null".as_ref(), "a character device"),
+    ] {
         let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../..");
         let o = accuracy(bad, &["--quick", "--root", root]);
         let err = String::from_utf8_lossy(&o.stderr);
@@ -61,19 +64,35 @@ fn a_bad_root_or_output_folder_is_refused_and_leaves_nothing() {
 // on a failed allocation; `--dt -1e-5` was an "unexpected argument".
 #[test]
 fn dense_size_and_negative_steps_are_refused_by_option() {
-    let mesh = concat!(env!("CARGO_MANIFEST_DIR"), "/../../data/meshes/cube_v41.msh");
+    let mesh = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../data/meshes/cube_v41.msh"
+    );
     for (args, says) in [
-        (vec!["--max-dense-dofs", "1000000000", "--method", "modal-all"], "--max-dense-dofs"),
+        (
+            vec!["--max-dense-dofs", "1000000000", "--method", "modal-all"],
+            "--max-dense-dofs",
+        ),
         (vec!["--dt", "-1e-5"], "step dt must be finite and > 0 s"),
     ] {
         let o = Command::new(env!("CARGO_BIN_EXE_dcr-lab"))
-            .args(["truth", mesh, "--impact", "0.5,0.5,1", "--contact", "0.2,0.3,1"])
+            .args([
+                "truth",
+                mesh,
+                "--impact",
+                "0.5,0.5,1",
+                "--contact",
+                "0.2,0.3,1",
+            ])
             .args(["--impulse", "1"])
             .args(&args)
             .output()
             .unwrap();
         let err = String::from_utf8_lossy(&o.stderr);
         assert!(!o.status.success(), "{args:?}");
-        assert!(err.contains(says) && !err.contains("unexpected argument"), "{args:?}: {err}");
+        assert!(
+            err.contains(says) && !err.contains("unexpected argument"),
+            "{args:?}: {err}"
+        );
     }
 }

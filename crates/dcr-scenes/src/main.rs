@@ -6,11 +6,11 @@ use std::process::ExitCode;
 use anyhow::{bail, Context, Result};
 use clap::{Parser, Subcommand, ValueEnum};
 use dcr_rapier::f64::{ApplyMode, StepGate};
-use dcr_scenes::export::{side_label, write_outcomes_svg, write_scene_glb, Side};
 use dcr_runtime::format::OutputPlan;
+use dcr_scenes::export::{side_label, write_outcomes_svg, write_scene_glb, Side};
 use dcr_scenes::runner::{
-    base_path, run_scene, transfer_base_path, RUN_OUTPUTS, stress_bench, table1, MethodChoice, RunParams, RunReport, StressBenchParams,
-    Table1Params,
+    base_path, run_scene, stress_bench, table1, transfer_base_path, MethodChoice, RunParams,
+    RunReport, StressBenchParams, Table1Params, RUN_OUTPUTS,
 };
 use dcr_scenes::scene::SceneDesc;
 use dcr_scenes::{repo_root, SCENES};
@@ -299,6 +299,11 @@ fn real_main() -> Result<()> {
                 );
             }
             let desc = SceneDesc::read(&path)?;
+            if let Some(b) = beta {
+                if !(b.is_finite() && (0.0..=10.0).contains(&b)) {
+                    bail!("--beta {b}: the attenuation exponent β must be in [0, 10]");
+                }
+            }
             let method = match (method, beta) {
                 (Some(MethodArg::Modal | MethodArg::Transfer), Some(_)) => {
                     bail!("--beta is the attenuation exponent: use it without --method or with --method attenuation")

@@ -60,31 +60,141 @@ fn the_shipped_scenes_validate() {
 fn every_field_out_of_range_is_refused_naming_the_field() {
     let dir = tempfile::tempdir().unwrap();
     let cases: Vec<(&str, Vec<&str>, Value, &str)> = vec![
-        ("roof", vec!["restitution"], json!(5), "restitution must be in [0, 1]"),
-        ("roof", vec!["props", "1", "friction"], json!(-1), "props[1].friction must be in [0, 100]"),
+        (
+            "roof",
+            vec!["restitution"],
+            json!(5),
+            "restitution must be in [0, 1]",
+        ),
+        (
+            "roof",
+            vec!["props", "1", "friction"],
+            json!(-1),
+            "props[1].friction must be in [0, 100]",
+        ),
         ("roof", vec!["gravity"], json!([0, -1e300, 0]), "gravity[1]"),
-        ("roof", vec!["seconds"], json!(-1), "seconds must be a finite time > 0 s"),
+        (
+            "roof",
+            vec!["seconds"],
+            json!(-1),
+            "seconds must be a finite time > 0 s",
+        ),
         ("roof", vec!["seconds"], json!(1e7), "seconds 1e7 s"),
-        ("roof", vec!["h"], json!(1e-300), "h must be in [1e-5, 0.1] s"),
-        ("roof", vec!["props", "1", "mass"], json!(0), "props[1].mass must be in [1e-6, 1e9] kg"),
-        ("roof", vec!["props", "0", "pose", "translation"], json!([1e300, 0, 0]), "props[0].pose.translation[0]"),
-        ("roof", vec!["props", "0", "linvel"], json!([0, 1e300, 0]), "props[0].linvel[1]"),
-        ("dinner", vec!["props", "0", "colliders", "0", "shape"], json!({"ball": {"radius": -1}}), "props[0].colliders[0].shape.ball.radius"),
-        ("dinner", vec!["props", "0", "colliders", "0", "shape"], json!({"cuboid": {"half_extents": [0, 1, 1]}}), "half_extents[0]"),
-        ("washing", vec!["joints", "0", "axis"], json!([0, 0, 0]), "joints[0].axis must be a non-zero direction"),
-        ("washing", vec!["joints", "0", "stiffness"], json!(-1), "joints[0].stiffness"),
-        ("washing", vec!["joints", "0", "damping"], json!(-1), "joints[0].damping"),
-        ("lowrider", vec!["drivers", "0", "period"], json!(0), "drivers[0].period must be ≥ the step h"),
-        ("lowrider", vec!["drivers", "0", "body"], json!("nobody"), "drivers[0].body \"nobody\" names no dynamic body"),
-        ("roof", vec!["outcomes", "0", "kind"], json!("max_lfit"), "outcomes[0].kind \"max_lfit\" is unknown"),
-        ("roof", vec!["outcomes", "0", "bodies"], json!("ghost*"), "outcomes[0].bodies \"ghost*\" matches no dynamic body"),
-        ("roof", vec!["elastic", "0", "material", "poisson"], json!(0.5), "elastic[0].material.poisson must be in (-1, 0.5)"),
-        ("roof", vec!["elastic", "0", "modes"], json!(0), "elastic[0].modes must be in [1, 2000]"),
-        ("roof", vec!["elastic", "0", "rayleigh"], json!([-1, 0]), "elastic[0].rayleigh[0]"),
-        ("roof", vec!["name"], json!("../../x"), "name \"../../x\" must be a plain file name"),
+        (
+            "roof",
+            vec!["h"],
+            json!(1e-300),
+            "h must be in [1e-5, 0.1] s",
+        ),
+        (
+            "roof",
+            vec!["props", "1", "mass"],
+            json!(0),
+            "props[1].mass must be in [1e-6, 1e9] kg",
+        ),
+        (
+            "roof",
+            vec!["props", "0", "pose", "translation"],
+            json!([1e300, 0, 0]),
+            "props[0].pose.translation[0]",
+        ),
+        (
+            "roof",
+            vec!["props", "0", "linvel"],
+            json!([0, 1e300, 0]),
+            "props[0].linvel[1]",
+        ),
+        (
+            "dinner",
+            vec!["props", "0", "colliders", "0", "shape"],
+            json!({"ball": {"radius": -1}}),
+            "props[0].colliders[0].shape.ball.radius",
+        ),
+        (
+            "dinner",
+            vec!["props", "0", "colliders", "0", "shape"],
+            json!({"cuboid": {"half_extents": [0, 1, 1]}}),
+            "half_extents[0]",
+        ),
+        (
+            "washing",
+            vec!["joints", "0", "axis"],
+            json!([0, 0, 0]),
+            "joints[0].axis must be a non-zero direction",
+        ),
+        (
+            "washing",
+            vec!["joints", "0", "stiffness"],
+            json!(-1),
+            "joints[0].stiffness",
+        ),
+        (
+            "washing",
+            vec!["joints", "0", "damping"],
+            json!(-1),
+            "joints[0].damping",
+        ),
+        (
+            "lowrider",
+            vec!["drivers", "0", "period"],
+            json!(0),
+            "drivers[0].period must be ≥ the step h",
+        ),
+        (
+            "lowrider",
+            vec!["drivers", "0", "body"],
+            json!("nobody"),
+            "drivers[0].body \"nobody\" names no dynamic body",
+        ),
+        (
+            "roof",
+            vec!["outcomes", "0", "kind"],
+            json!("max_lfit"),
+            "outcomes[0].kind \"max_lfit\" is unknown",
+        ),
+        (
+            "roof",
+            vec!["outcomes", "0", "bodies"],
+            json!("ghost*"),
+            "outcomes[0].bodies \"ghost*\" matches no dynamic body",
+        ),
+        (
+            "roof",
+            vec!["elastic", "0", "material", "poisson"],
+            json!(0.5),
+            "elastic[0].material.poisson must be in (-1, 0.5)",
+        ),
+        (
+            "roof",
+            vec!["elastic", "0", "modes"],
+            json!(0),
+            "elastic[0].modes must be in [1, 2000]",
+        ),
+        (
+            "roof",
+            vec!["elastic", "0", "rayleigh"],
+            json!([-1, 0]),
+            "elastic[0].rayleigh[0]",
+        ),
+        (
+            "roof",
+            vec!["name"],
+            json!("../../x"),
+            "name \"../../x\" must be a plain file name",
+        ),
         ("roof", vec!["name"], json!(""), "must be a plain file name"),
-        ("roof", vec!["name"], json!("."), "must be a plain file name"),
-        ("roof", vec!["elastic", "0", "name"], json!("/tmp/abs"), "elastic[0].name \"/tmp/abs\" must be a plain file name"),
+        (
+            "roof",
+            vec!["name"],
+            json!("."),
+            "must be a plain file name",
+        ),
+        (
+            "roof",
+            vec!["elastic", "0", "name"],
+            json!("/tmp/abs"),
+            "elastic[0].name \"/tmp/abs\" must be a plain file name",
+        ),
     ];
     for (name, path, x, needle) in cases {
         let mut v = scene(name);
@@ -108,31 +218,47 @@ fn structural_errors_are_refused() {
     let mut v = scene("roof");
     let first = v["props"][0]["name"].clone();
     set(&mut v, &["props", "1", "name"], first);
-    let err = SceneDesc::read(&write(dir.path(), &v)).unwrap_err().to_string();
+    let err = SceneDesc::read(&write(dir.path(), &v))
+        .unwrap_err()
+        .to_string();
     assert!(err.contains("two bodies are named"), "{err}");
     // A joint from a body to itself.
     let mut v = scene("washing");
     let b1 = v["joints"][0]["body1"].clone();
     set(&mut v, &["joints", "0", "body2"], b1);
-    let err = SceneDesc::read(&write(dir.path(), &v)).unwrap_err().to_string();
+    let err = SceneDesc::read(&write(dir.path(), &v))
+        .unwrap_err()
+        .to_string();
     assert!(err.contains("jointed to itself"), "{err}");
     // Unknown fields (serde).
     let mut v = scene("roof");
     set(&mut v, &["props", "0", "mas"], json!(1));
-    let err = SceneDesc::read(&write(dir.path(), &v)).unwrap_err().to_string();
+    let err = SceneDesc::read(&write(dir.path(), &v))
+        .unwrap_err()
+        .to_string();
     assert!(err.contains("unknown field `mas`"), "{err}");
     // 1,000 copies of a prop 1 mm apart (aborted allocating 1.9 GB).
     let mut v = scene("roof");
     let copies: Vec<Value> = (0..1000).map(|i| json!([i as f64 * 1e-3, 0, 0])).collect();
     set(&mut v, &["props", "0", "copies"], Value::Array(copies));
-    let err = SceneDesc::read(&write(dir.path(), &v)).unwrap_err().to_string();
-    assert!(err.contains("props[0].copies[0] and props[0].copies[1] are 0.001 m apart"), "{err}");
+    let err = SceneDesc::read(&write(dir.path(), &v))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("props[0].copies[0] and props[0].copies[1] are 0.001 m apart"),
+        "{err}"
+    );
     // Copies: 200,000 bodies of one prop.
     let mut v = scene("roof");
     let copies: Vec<Value> = (0..200_001).map(|i| json!([i as f64, 0, 0])).collect();
     set(&mut v, &["props", "0", "copies"], Value::Array(copies));
-    let err = SceneDesc::read(&write(dir.path(), &v)).unwrap_err().to_string();
-    assert!(err.contains("bodies") && err.contains("at most 100000"), "{err}");
+    let err = SceneDesc::read(&write(dir.path(), &v))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("bodies") && err.contains("at most 100000"),
+        "{err}"
+    );
 }
 
 // Regression: `--seconds 1e300` panicked (capacity overflow), `seconds: 1e7` aborted on an
@@ -162,7 +288,11 @@ fn outputs_never_replace_the_scene_a_fifo_or_a_device_and_refusals_write_nothing
     let p = write(d, &scene("roof"));
     let before = std::fs::read(&p).unwrap();
     let fifo = d.join("fifo.glb");
-    assert!(Command::new("mkfifo").arg(&fifo).status().unwrap().success());
+    assert!(Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .unwrap()
+        .success());
     std::fs::create_dir(d.join("sub")).unwrap();
     let out = d.join("out");
     let bases = d.join("bases");
@@ -186,7 +316,10 @@ fn outputs_never_replace_the_scene_a_fifo_or_a_device_and_refusals_write_nothing
         ]);
         let err = String::from_utf8_lossy(&o.stderr);
         assert!(!o.status.success(), "{gltf}");
-        assert!(err.contains("--gltf") && err.contains(needle), "{gltf}: {err}");
+        assert!(
+            err.contains("--gltf") && err.contains(needle),
+            "{gltf}: {err}"
+        );
         assert_eq!(err.trim().lines().count(), 1, "{err}");
     }
     // The run's folder as a file, and a scene file as `--out`'s outputs.
@@ -203,7 +336,11 @@ fn outputs_never_replace_the_scene_a_fifo_or_a_device_and_refusals_write_nothing
 fn non_regular_scene_files_are_refused_before_opening() {
     let dir = tempfile::tempdir().unwrap();
     let fifo = dir.path().join("f.json");
-    assert!(Command::new("mkfifo").arg(&fifo).status().unwrap().success());
+    assert!(Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .unwrap()
+        .success());
     let zero = dir.path().join("z.json");
     std::os::unix::fs::symlink("/dev/zero", &zero).unwrap();
     for p in [&fifo, &zero] {

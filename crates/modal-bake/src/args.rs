@@ -332,7 +332,10 @@ pub fn join_negative_values(
     for arg in args {
         let joined = match (out.last().and_then(|p| p.to_str()), arg.to_str()) {
             (Some(prev), Some(value))
-                if prev.starts_with("--") && prev.len() > 2 && !prev.contains('=') && looks_negative(value) =>
+                if prev.starts_with("--")
+                    && prev.len() > 2
+                    && !prev.contains('=')
+                    && looks_negative(value) =>
             {
                 Some(format!("{prev}={value}"))
             }

@@ -84,19 +84,41 @@ fn every_exporter_refuses_the_input_a_fifo_and_a_shared_path() {
             &["export", s(&base), option, s(&d.join("sub"))],
             &[option, "a directory"],
         );
-        refused(&["export", s(&base), option, "."], &[option, "names a folder"]);
+        refused(
+            &["export", s(&base), option, "."],
+            &[option, "names a folder"],
+        );
     }
     let x = d.join("x");
     refused(
-        &["export", s(&base), "--vtu", s(&x), "--gltf", s(&x), "--png", s(&x)],
+        &[
+            "export",
+            s(&base),
+            "--vtu",
+            s(&x),
+            "--gltf",
+            s(&x),
+            "--png",
+            s(&x),
+        ],
         &["--vtu", "--gltf", "same file"],
     );
     refused(
-        &["export", s(&base), "--vtu", s(&x), "--png", s(&d.join("sub/../x"))],
+        &[
+            "export",
+            s(&base),
+            "--vtu",
+            s(&x),
+            "--png",
+            s(&d.join("sub/../x")),
+        ],
         &["--vtu", "--png", "same file"],
     );
     assert_eq!(std::fs::read(&base).unwrap(), before, "the base changed");
-    assert!(std::fs::symlink_metadata(&link).unwrap().file_type().is_symlink());
+    assert!(std::fs::symlink_metadata(&link)
+        .unwrap()
+        .file_type()
+        .is_symlink());
     assert!(std::fs::metadata(&fifo).unwrap().file_type().is_fifo());
     let mut left: Vec<String> = std::fs::read_dir(d)
         .unwrap()
@@ -140,11 +162,26 @@ fn negative_numbers_reach_the_options_range_check() {
     let mesh = repo_root().join("data/meshes/beam.msh");
     let out = dir.path().join("o.modes");
     for (args, needle) in [
-        (vec!["export", s(&base), "--gltf", s(&glb), "--scale", "-1e-3"], "--scale"),
-        (vec!["export", s(&base), "--gltf", s(&glb), "--scale", "1e308"], "--scale"),
-        (vec!["bake", s(&mesh), "-o", s(&out), "--youngs", "-1e9"], "--youngs"),
-        (vec!["bake", s(&mesh), "-o", s(&out), "--rayleigh", "-1,0"], "rayleigh"),
-        (vec!["check", s(&mesh), s(&out), "--poisson", "-1.5"], "--poisson"),
+        (
+            vec!["export", s(&base), "--gltf", s(&glb), "--scale", "-1e-3"],
+            "--scale",
+        ),
+        (
+            vec!["export", s(&base), "--gltf", s(&glb), "--scale", "1e308"],
+            "--scale",
+        ),
+        (
+            vec!["bake", s(&mesh), "-o", s(&out), "--youngs", "-1e9"],
+            "--youngs",
+        ),
+        (
+            vec!["bake", s(&mesh), "-o", s(&out), "--rayleigh", "-1,0"],
+            "rayleigh",
+        ),
+        (
+            vec!["check", s(&mesh), s(&out), "--poisson", "-1.5"],
+            "--poisson",
+        ),
     ] {
         let o = run(&args);
         let err = String::from_utf8_lossy(&o.stderr);

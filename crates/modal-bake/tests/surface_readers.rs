@@ -38,7 +38,11 @@ fn cube_tris() -> Vec<[usize; 3]> {
 fn solid(name: &str, k: f64, dx: f64, case: fn(&str) -> String) -> String {
     let mut s = format!("{} {name}\n", case("solid")).trim_end().to_string() + "\n";
     for t in cube_tris() {
-        s += &format!("  {} 0 0 0\n    {}\n", case("facet normal"), case("outer loop"));
+        s += &format!(
+            "  {} 0 0 0\n    {}\n",
+            case("facet normal"),
+            case("outer loop")
+        );
         for i in t {
             let p = CUBE_V[i];
             s += &format!(
@@ -100,13 +104,19 @@ fn stl_with_two_solids_reads_both_and_refuses_two_shells() {
 fn stl_ascii_and_binary_are_told_apart_by_length_and_exporter_variants_read() {
     let reference = read_surface_bytes(&stl_binary(b""), "plain.stl").unwrap();
     let variants: Vec<(&str, Vec<u8>)> = vec![
-        ("binary, header `solid`", stl_binary(b"solid exported by a CAD tool")),
+        (
+            "binary, header `solid`",
+            stl_binary(b"solid exported by a CAD tool"),
+        ),
         ("ascii, no name", solid("", 1.0, 0.0, lower).into_bytes()),
         (
             "ascii, leading blank lines",
             format!("\n\n  \n{}", solid("c", 1.0, 0.0, lower)).into_bytes(),
         ),
-        ("ascii, upper case", solid("C", 1.0, 0.0, upper).into_bytes()),
+        (
+            "ascii, upper case",
+            solid("C", 1.0, 0.0, upper).into_bytes(),
+        ),
         (
             "ascii, CRLF",
             solid("c", 1.0, 0.0, lower)
@@ -130,11 +140,7 @@ fn stl_ascii_and_binary_are_told_apart_by_length_and_exporter_variants_read() {
 #[test]
 fn stl_ascii_errors_name_the_line() {
     let text = solid("c", 1.0, 0.0, lower).replacen("vertex 1 0 0", "vertex 1 zero 0", 1);
-    let line = text
-        .lines()
-        .position(|l| l.contains("zero"))
-        .unwrap()
-        + 1;
+    let line = text.lines().position(|l| l.contains("zero")).unwrap() + 1;
     let err = read_surface_bytes(text.as_bytes(), "bad.stl")
         .unwrap_err()
         .to_string();

@@ -97,7 +97,8 @@ pub fn summary(path: &Path, studies: &[ObjectStudy]) -> anyhow::Result<()> {
     };
     draw().map_err(|e| anyhow::anyhow!("drawing {}: {e}", path.display()))?;
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).map_err(|e| anyhow::anyhow!("creating {}: {e}", dir.display()))?;
+        std::fs::create_dir_all(dir)
+            .map_err(|e| anyhow::anyhow!("creating {}: {e}", dir.display()))?;
     }
     dcr_runtime::format::write_atomic(path, svg.as_bytes())?;
     Ok(())

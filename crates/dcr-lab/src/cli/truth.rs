@@ -243,10 +243,9 @@ pub const MAX_DENSE_DOFS_LIMIT: usize = 8000;
 
 /// `--max-dense-dofs N` with 1 ≤ N ≤ [`MAX_DENSE_DOFS_LIMIT`].
 pub fn parse_max_dense_dofs(s: &str) -> Result<usize, String> {
-    let n: usize = s
-        .trim()
-        .parse()
-        .map_err(|_| format!("{s:?} is not a whole number of free dofs (1 to {MAX_DENSE_DOFS_LIMIT})"))?;
+    let n: usize = s.trim().parse().map_err(|_| {
+        format!("{s:?} is not a whole number of free dofs (1 to {MAX_DENSE_DOFS_LIMIT})")
+    })?;
     if !(1..=MAX_DENSE_DOFS_LIMIT).contains(&n) {
         return Err(format!(
             "{n} is outside 1 to {MAX_DENSE_DOFS_LIMIT}: a dense eigensolve of N dofs holds several \

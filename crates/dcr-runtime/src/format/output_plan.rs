@@ -107,6 +107,8 @@ pub struct OutputPlan {
     inputs: Vec<(String, PathBuf)>,
     /// (option, path as given, normalised path).
     outputs: Vec<(String, PathBuf, PathBuf)>,
+    /// Folders outputs go into: (option, path as given, normalised path).
+    folders: Vec<(String, PathBuf, PathBuf)>,
 }
 
 impl OutputPlan {
@@ -140,6 +142,16 @@ impl OutputPlan {
                 });
             }
         }
+        for (other_option, other, other_norm) in &self.folders {
+            if *other_norm == norm {
+                return Err(OutputError::SamePath {
+                    option: option.to_string(),
+                    path: path.to_path_buf(),
+                    other_option: format!("{other_option} (a folder)"),
+                    other: other.clone(),
+                });
+            }
+        }
         self.outputs
             .push((option.to_string(), path.to_path_buf(), norm));
         Ok(())
@@ -150,8 +162,23 @@ impl OutputPlan {
     /// existing ancestor must be a folder.
     ///
     /// # Errors
-    /// [`OutputError::NotAFolder`] or [`OutputError::AncestorNotFolder`].
+    /// [`OutputError::NotAFolder`], [`OutputError::AncestorNotFolder`], or
+    /// [`OutputError::SamePath`] when it is (or lies under) an output declared before; an
+    /// output declared later on the folder's path is refused the same way.
     pub fn output_folder(&mut self, option: &str, dir: &Path) -> Result<(), OutputError> {
+        let norm = normalise(dir);
+        for (other_option, other, other_norm) in &self.outputs {
+            if *other_norm == norm || norm.starts_with(other_norm) {
+                return Err(OutputError::SamePath {
+                    option: format!("{option} (a folder)"),
+                    path: dir.to_path_buf(),
+                    other_option: other_option.clone(),
+                    other: other.clone(),
+                });
+            }
+        }
+        self.folders
+            .push((option.to_string(), dir.to_path_buf(), norm));
         match std::fs::metadata(dir) {
             Ok(meta) if meta.is_dir() => return Ok(()),
             Ok(meta) => {
@@ -168,7 +195,9 @@ impl OutputPlan {
 
     /// The outputs declared so far: (option, path).
     pub fn outputs(&self) -> impl Iterator<Item = (&str, &Path)> {
-        self.outputs.iter().map(|(o, p, _)| (o.as_str(), p.as_path()))
+        self.outputs
+            .iter()
+            .map(|(o, p, _)| (o.as_str(), p.as_path()))
     }
 }
 
@@ -280,10 +309,17 @@ mod tests {
         let mut plan = OutputPlan::new();
         plan.output("--vtu", &d.join("x")).unwrap();
         let e = plan.output("--gltf", &d.join("sub/../x")).unwrap_err();
-        assert!(e.to_string().contains("--vtu") && e.to_string().contains("--gltf"), "{e}");
+        assert!(
+            e.to_string().contains("--vtu") && e.to_string().contains("--gltf"),
+            "{e}"
+        );
         let e = plan.output("--png", &d.join("./new/../x")).unwrap_err();
         assert!(matches!(e, OutputError::SamePath { .. }), "{e}");
         plan.output("--png", &d.join("y")).unwrap();
+        // A file output on the path of a folder that will be created, and the reverse.
+        plan.output_folder("--out", &d.join("run")).unwrap();
+        assert!(plan.output("--gltf", &d.join("./run")).is_err());
+        assert!(plan.output_folder("--out", &d.join("y/sub")).is_err());
     }
 
     #[test]

@@ -498,7 +498,11 @@ fn write_outputs(
     let timings = npz.finish()?.into_inner();
     let json = serde_json::to_string_pretty(&report)? + "\n";
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    for (name, bytes) in RUN_OUTPUTS.into_iter().zip([&trajectory[..], &timings[..], json.as_bytes()]) {
+    for (name, bytes) in
+        RUN_OUTPUTS
+            .into_iter()
+            .zip([&trajectory[..], &timings[..], json.as_bytes()])
+    {
         let path = dir.join(name);
         dcr_runtime::format::write_atomic(&path, bytes)
             .with_context(|| format!("writing {}", path.display()))?;

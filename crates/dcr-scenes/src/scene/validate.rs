@@ -6,8 +6,7 @@
 use std::collections::BTreeSet;
 
 use super::scene_desc::{
-    name_matches, BodyKind, ColliderDesc, MethodDesc, PoseDesc, SceneDesc, ShapeDesc,
-    TransferDesc,
+    name_matches, BodyKind, ColliderDesc, MethodDesc, PoseDesc, SceneDesc, ShapeDesc, TransferDesc,
 };
 
 /// Largest |coordinate| of a pose, copy, anchor or point (m).
@@ -116,7 +115,12 @@ fn pose(field: &str, p: &PoseDesc) -> Check {
         MAX_POSITION_M,
         " m",
     )?;
-    vec_in(&format!("{field}.rotation_deg"), p.rotation_deg, 3600.0, "°")
+    vec_in(
+        &format!("{field}.rotation_deg"),
+        p.rotation_deg,
+        3600.0,
+        "°",
+    )
 }
 
 /// Whether `name` is a plain file-name component: 1 to 100 bytes, no `/`, `\`, NUL or
@@ -142,7 +146,8 @@ fn plain_name(field: &str, name: &str) -> Check {
 }
 
 fn shape(field: &str, s: &ShapeDesc) -> Check {
-    let size = |f: &str, v: f64| finite_in(&format!("{field}.{f}"), v, MIN_SIZE_M, MAX_SIZE_M, " m");
+    let size =
+        |f: &str, v: f64| finite_in(&format!("{field}.{f}"), v, MIN_SIZE_M, MAX_SIZE_M, " m");
     match s {
         ShapeDesc::Cuboid { half_extents } => {
             for (k, &h) in half_extents.iter().enumerate() {
@@ -289,9 +294,9 @@ fn half_thickness(s: &ShapeDesc) -> f64 {
         } => half_height + radius,
         ShapeDesc::ConvexHull { points } => (0..3)
             .map(|k| {
-                let (lo, hi) = points
-                    .iter()
-                    .fold((f64::MAX, f64::MIN), |(lo, hi), p| (lo.min(p[k]), hi.max(p[k])));
+                let (lo, hi) = points.iter().fold((f64::MAX, f64::MIN), |(lo, hi), p| {
+                    (lo.min(p[k]), hi.max(p[k]))
+                });
                 0.5 * (hi - lo)
             })
             .fold(f64::MAX, f64::min),
@@ -364,7 +369,10 @@ impl SceneDesc {
             None => ("seconds", self.seconds),
         };
         if !(s.is_finite() && s > 0.0) {
-            return Err(format!("{field} must be a finite time > 0 s (got {})", N(s)));
+            return Err(format!(
+                "{field} must be a finite time > 0 s (got {})",
+                N(s)
+            ));
         }
         let steps = (s / self.h).round();
         let recorded = self.body_names().iter().filter(|(_, r)| *r).count().max(1) as f64;
@@ -422,10 +430,7 @@ impl SceneDesc {
             }
             positive_max(&format!("{f}.material.density"), m.density, 1e6, " kg/m³")?;
             if e.modes == 0 || e.modes > 2000 {
-                return Err(format!(
-                    "{f}.modes must be in [1, 2000] (got {})",
-                    e.modes
-                ));
+                return Err(format!("{f}.modes must be in [1, 2000] (got {})", e.modes));
             }
             finite_in(&format!("{f}.rayleigh[0]"), e.rayleigh[0], 0.0, 1e6, " 1/s")?;
             finite_in(&format!("{f}.rayleigh[1]"), e.rayleigh[1], 0.0, 1.0, " s")?;
@@ -487,7 +492,13 @@ impl SceneDesc {
             finite_in(&format!("{f}.friction"), p.friction, 0.0, 100.0, "")?;
             vec_in(&format!("{f}.linvel"), p.linvel, MAX_SPEED, " m/s")?;
             vec_in(&format!("{f}.angvel"), p.angvel, MAX_SPEED, " rad/s")?;
-            finite_in(&format!("{f}.linear_damping"), p.linear_damping, 0.0, 1e3, " 1/s")?;
+            finite_in(
+                &format!("{f}.linear_damping"),
+                p.linear_damping,
+                0.0,
+                1e3,
+                " 1/s",
+            )?;
             finite_in(
                 &format!("{f}.angular_damping"),
                 p.angular_damping,
@@ -498,9 +509,7 @@ impl SceneDesc {
             copies_apart(&f, p)?;
             if let Some(r) = &p.relative_to {
                 if !self.elastic.iter().any(|e| &e.name == r) {
-                    return Err(format!(
-                        "{f}.relative_to {r:?} names no elastic object"
-                    ));
+                    return Err(format!("{f}.relative_to {r:?} names no elastic object"));
                 }
             }
         }
@@ -532,18 +541,26 @@ impl SceneDesc {
                     j.body1, j.body2
                 ));
             }
-            vec_in(&format!("{f}.anchor_offset"), j.anchor_offset, MAX_POSITION_M, " m")?;
+            vec_in(
+                &format!("{f}.anchor_offset"),
+                j.anchor_offset,
+                MAX_POSITION_M,
+                " m",
+            )?;
             nonzero_axis(&format!("{f}.axis"), j.axis)?;
-            finite_in(&format!("{f}.stiffness"), j.stiffness, 0.0, 1e12, " N·m/rad")?;
+            finite_in(
+                &format!("{f}.stiffness"),
+                j.stiffness,
+                0.0,
+                1e12,
+                " N·m/rad",
+            )?;
             finite_in(&format!("{f}.damping"), j.damping, 0.0, 1e12, " N·m·s/rad")?;
         }
         for (i, d) in self.drivers.iter().enumerate() {
             let f = format!("drivers[{i}]");
             if !bodies.iter().any(|(n, r)| *r && n == &d.body) {
-                return Err(format!(
-                    "{f}.body {:?} names no dynamic body",
-                    d.body
-                ));
+                return Err(format!("{f}.body {:?} names no dynamic body", d.body));
             }
             finite_in(&format!("{f}.start"), d.start, 0.0, 1e9, " s")?;
             if d.stop.is_nan() || d.stop < d.start {
@@ -592,13 +609,14 @@ impl SceneDesc {
             positive_max(&format!("{f}.threshold"), o.threshold, 1e6, " m")?;
             if let Some(r) = &o.relative_to {
                 if !bodies.iter().any(|(n, rec)| *rec && n == r) {
-                    return Err(format!(
-                        "{f}.relative_to {r:?} names no dynamic body"
-                    ));
+                    return Err(format!("{f}.relative_to {r:?} names no dynamic body"));
                 }
             }
             if !(o.after.is_finite() && o.after >= 0.0) {
-                return Err(format!("{f}.after must be a finite time ≥ 0 s (got {})", o.after));
+                return Err(format!(
+                    "{f}.after must be a finite time ≥ 0 s (got {})",
+                    o.after
+                ));
             }
         }
         Ok(())

@@ -194,7 +194,7 @@ fn solve(
 fn explain_factorization(error: eigen::EigenError, mat: &fem::Material) -> eigen::EigenError {
     let nu = mat.poisson;
     match error {
-        eigen::EigenError::Factorization(msg) if nu > 0.45 || nu < -0.9 => {
+        eigen::EigenError::Factorization(msg) if !(-0.9..=0.45).contains(&nu) => {
             eigen::EigenError::Factorization(format!(
                 "{msg}; the Poisson ratio --poisson {nu} is so close to {} that the stiffness \
                  matrix cannot be factored in double precision (volumetric / shear stiffness \

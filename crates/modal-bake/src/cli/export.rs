@@ -87,7 +87,11 @@ pub fn run(args: &ExportArgs) -> anyhow::Result<()> {
     }
     let mut plan = dcr_runtime::format::OutputPlan::new();
     plan.input("the base", &args.file);
-    for (option, path) in [("--vtu", &args.vtu), ("--gltf", &args.gltf), ("--png", &args.png)] {
+    for (option, path) in [
+        ("--vtu", &args.vtu),
+        ("--gltf", &args.gltf),
+        ("--png", &args.png),
+    ] {
         if let Some(p) = path {
             plan.output(option, p)?;
         }

@@ -137,6 +137,80 @@ fn parse_err(name: &str, format: &'static str, detail: impl ToString) -> Surface
     }
 }
 
+/// The line (1-based) of the first byte of `data` that is not UTF-8, if any.
+fn first_non_utf8_line(data: &[u8]) -> Option<usize> {
+    std::str::from_utf8(data).err().map(|e| {
+        data[..e.valid_up_to()]
+            .iter()
+            .filter(|&&b| b == b'\n')
+            .count()
+            + 1
+    })
+}
+
+/// A PLY parser error as one line with its location: the parser's `Line N: what` and the
+/// offending text, without its grammar internals; a non-UTF-8 header located by line.
+fn ply_error(data: &[u8], name: &str, e: &dyn std::fmt::Display) -> SurfaceError {
+    let text = e.to_string();
+    let mut lines = text.lines();
+    let first = lines.next().unwrap_or("").trim();
+    let detail = if text.contains("valid UTF-8") {
+        match first_non_utf8_line(data) {
+            Some(line) => format!("line {line}: not ASCII text"),
+            None => "not ASCII text".to_string(),
+        }
+    } else {
+        let first = match first.strip_prefix("Line ") {
+            Some(rest) => format!("line {rest}"),
+            None => first.to_string(),
+        };
+        match lines
+            .map(str::trim)
+            .find_map(|l| l.strip_prefix("String: "))
+        {
+            Some(what) => format!(
+                "{}: `{}`",
+                first.trim_end_matches('.'),
+                what.trim().trim_matches('\'').trim()
+            ),
+            None => first,
+        }
+    };
+    parse_err(name, "PLY", detail)
+}
+
+/// Where an OBJ the `tobj` parser refused goes wrong (its messages carry no line): the first
+/// line that is not UTF-8 text, or the first `v`, `vt`, `vn` or `f` line whose fields do not
+/// parse.
+fn obj_error_line(data: &[u8]) -> Option<usize> {
+    if let Some(line) = first_non_utf8_line(data) {
+        return Some(line);
+    }
+    let text = std::str::from_utf8(data).ok()?;
+    text.lines()
+        .position(|l| {
+            let mut f = l.split_whitespace();
+            match f.next() {
+                Some(key @ ("v" | "vt" | "vn")) => {
+                    let nums: Vec<&str> = f.collect();
+                    let least = if key == "vt" { 1 } else { 3 };
+                    nums.len() < least || nums.iter().any(|x| x.parse::<f64>().is_err())
+                }
+                Some("f") => {
+                    let idx: Vec<&str> = f.collect();
+                    idx.len() < 3
+                        || idx.iter().any(|x| {
+                            x.split('/')
+                                .next()
+                                .is_none_or(|i| i.parse::<i64>().map_or(true, |i| i == 0))
+                        })
+                }
+                _ => false,
+            }
+        })
+        .map(|i| i + 1)
+}
+
 fn read_obj(data: &[u8], name: &str) -> Result<Soup, SurfaceError> {
     let opts = tobj::LoadOptions {
         triangulate: false,
@@ -147,7 +221,10 @@ fn read_obj(data: &[u8], name: &str) -> Result<Soup, SurfaceError> {
     let (models, _) = tobj::load_obj_buf(&mut BufReader::new(Cursor::new(data)), &opts, |_| {
         Ok(Default::default())
     })
-    .map_err(|e| parse_err(name, "OBJ", e))?;
+    .map_err(|e| match obj_error_line(data) {
+        Some(line) => parse_err(name, "OBJ", format!("line {line}: {e}")),
+        None => parse_err(name, "OBJ", e),
+    })?;
     let mut positions = Vec::new();
     let mut faces = Vec::new();
     for model in &models {
@@ -228,7 +305,11 @@ fn read_stl(data: &[u8], name: &str) -> Result<Soup, SurfaceError> {
 /// `endsolid` and refuses a missing name, upper-case keywords and leading blank lines.
 fn read_ascii_stl(data: &[u8], name: &str) -> Result<Soup, SurfaceError> {
     let text = std::str::from_utf8(data).map_err(|e| {
-        let line = data[..e.valid_up_to()].iter().filter(|&&b| b == b'\n').count() + 1;
+        let line = data[..e.valid_up_to()]
+            .iter()
+            .filter(|&&b| b == b'\n')
+            .count()
+            + 1;
         parse_err(name, "STL", format!("line {line}: not ASCII text"))
     })?;
     let mut c = StlTokens {
@@ -341,13 +422,14 @@ fn read_ply(data: &[u8], name: &str) -> Result<Soup, SurfaceError> {
     let mut reader = Reader::new(Cursor::new(data));
     let header = parser
         .read_header(&mut reader)
-        .map_err(|e| parse_err(name, "PLY", e))?;
+        .map_err(|e| ply_error(data, name, &e))?;
     let payload = parser
         .read_payload(&mut reader, &header)
-        .map_err(|e| parse_err(name, "PLY", e))?;
+        .map_err(|e| ply_error(data, name, &e))?;
     // Everything the header declares has been read: anything but white space after it is
     // data the header does not count (more faces than declared), refused rather than dropped.
-    let consumed = usize::try_from(reader.get_ref().position()).map_or(data.len(), |p| p.min(data.len()));
+    let consumed =
+        usize::try_from(reader.get_ref().position()).map_or(data.len(), |p| p.min(data.len()));
     if let Some(off) = data[consumed..]
         .iter()
         .position(|b| !b.is_ascii_whitespace())
