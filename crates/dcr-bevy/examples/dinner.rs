@@ -304,7 +304,8 @@ pub fn headless_app(assets_dir: &Path, response: bool) -> App {
             dt: H as f32,
             substeps: 1,
         })
-        .insert_resource(Time::<Fixed>::from_seconds(H));
+        .insert_resource(Time::<Fixed>::from_seconds(H))
+        .add_message::<DcrResponse>();
     }
     // Each update advances time by one fixed step: one rapier step per update.
     app.insert_resource(TimeUpdateStrategy::FixedTimesteps(1));

@@ -138,12 +138,22 @@ impl Plugin for DcrPlugin {
                     dcr_after_step.in_set(DcrSet::AfterStep),
                 ),
             );
+        if app.is_plugin_added::<AssetPlugin>() {
+            register_loader(app);
+        }
     }
 
     fn finish(&self, app: &mut App) {
         if !app.is_plugin_added::<AssetPlugin>() {
             app.add_plugins(AssetPlugin::default());
         }
+        register_loader(app);
+    }
+}
+
+/// Registers [`ModesAsset`] and its loader once.
+fn register_loader(app: &mut App) {
+    if !app.world().contains_resource::<Assets<ModesAsset>>() {
         app.init_asset::<ModesAsset>()
             .register_asset_loader(ModesLoader);
     }

