@@ -87,6 +87,9 @@ pub fn run(args: &ExportArgs) -> anyhow::Result<()> {
     }
     let mut plan = dcr_runtime::format::OutputPlan::new();
     plan.input("the base", &args.file);
+    if let Some(asset) = &args.onto {
+        plan.input("--onto", asset);
+    }
     for (option, path) in [
         ("--vtu", &args.vtu),
         ("--gltf", &args.gltf),
