@@ -31,6 +31,9 @@ fn app(rapier: RapierPhysicsPlugin<NoUserData>) -> App {
     let mut app = App::new();
     app.add_plugins((MinimalPlugins, TransformPlugin, rapier, plugin()))
         .insert_resource(TimeUpdateStrategy::FixedTimesteps(1));
+    // What `App::run` does first: the plugin adds bevy's AssetPlugin here when it is missing.
+    app.finish();
+    app.cleanup();
     app
 }
 
