@@ -3,8 +3,8 @@
 mod accuracy;
 mod fit_attenuation;
 mod progress;
-mod soft_body;
 mod scene_truth;
+mod soft_body;
 mod truth;
 
 use std::process::ExitCode;
