@@ -351,7 +351,7 @@ fn surface_assets_default_to_order_2_and_the_estimate_is_close() {
     let e = stderr(&o);
     assert!(e.contains("size estimate for"), "{e}");
     assert!(
-        e.contains("] meshing") && e.contains("with gmsh: done in"),
+        e.contains("] meshing") && e.contains(": done in") && e.contains("backend: gmsh"),
         "progress of the gmsh stage: {e}"
     );
     let estimate: f64 = e

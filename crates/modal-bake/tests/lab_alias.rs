@@ -34,9 +34,11 @@ fn aliases_forward_every_argument_and_the_exit_code() {
             .unwrap();
         let stdout = String::from_utf8_lossy(&out.stdout);
         let args: Vec<&str> = stdout.lines().collect();
+        // A negative value is joined to its option (`--impact=-1,0.5,0`: the same to clap, and
+        // never taken for an option of its own).
         assert_eq!(
             args,
-            [sub, "mesh.msh", "--impact", "-1,0.5,0", "--json", "--help"]
+            [sub, "mesh.msh", "--impact=-1,0.5,0", "--json", "--help"]
         );
         assert_eq!(out.status.code(), Some(code), "{sub}");
         let err = String::from_utf8_lossy(&out.stderr);
