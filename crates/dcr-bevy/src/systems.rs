@@ -43,6 +43,8 @@ fn same_step(dt: f64, h: f64) -> bool {
 
 /// Adds the elastic objects that are ready, then runs the adapter's before-step half.
 #[allow(clippy::type_complexity)]
+// A Bevy system takes each resource and query it reads as its own parameter.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn dcr_before_step(
     mut commands: Commands,
     mut dcr: ResMut<DcrContext>,
