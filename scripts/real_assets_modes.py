@@ -8,8 +8,9 @@ PyPI `bpy`, for Blender's primitives), this runs, each step under /usr/bin/time 
 
     modal-bake mesh ASSET -o ASSET.msh --json [--units mm]                # the defaults: order 2,
     modal-bake bake ASSET.msh -o ASSET.modes --material NAME --json       # size 1/20 of the diagonal
-    modal-bake mesh ASSET -o ASSET-ref.msh --json --size H/2               # refined reference:
-    modal-bake bake ASSET-ref.msh -o ASSET-ref.modes --material NAME --json  # order 2, half the size
+    modal-bake mesh ASSET -o ASSET-ref.msh --json --size H/2 --max-memory 8   # refined reference:
+    modal-bake bake ASSET-ref.msh -o ASSET-ref.modes --material NAME --json --max-memory 8
+                                                      # order 2, half the size, an 8 GB budget
 
 free-free (nothing fixed: the six rigid modes are dropped, the frequencies are the elastic
 ones), H being the default size (1/20 of the bounding-box diagonal in metres). It records the
@@ -20,7 +21,8 @@ asset. A step that runs past --step-timeout seconds (default 300) is stopped and
 reported as skipped. Outputs go to out/real-assets/modes/ (ignored by git): results.json and
 the markdown table, which is also printed.
 
-Usage: python3 scripts/real_assets_modes.py [--modal-bake PATH] [--only NAME,...]
+Usage: python3 scripts/real_assets_modes.py [--modal-bake PATH] [--only NAME,...] [--table-only]
+(--only re-runs the named assets and keeps the others' rows of results.json.)
 Needs what scripts/real_assets.py needs (node/npm, gmsh from PyPI, pytetwild) and `bpy`
 (PyPI bpy==4.5.7) for the Blender primitives.
 """
@@ -141,7 +143,7 @@ def run(cmd, timeout):
     return p.returncode == 0, out, err.strip()[-2000:], wall, peak
 
 
-def mesh_and_bake(binary, asset, tag, units, material, size, timeout):
+def mesh_and_bake(binary, asset, tag, units, material, size, timeout, extra=()):
     """One mesh + bake; returns a dict (ok, error, backend, dofs, frequencies, times, peaks)."""
     msh = asset.with_name(f"{asset.stem}{tag}.msh")
     modes = msh.with_suffix(".modes")
@@ -150,6 +152,7 @@ def mesh_and_bake(binary, asset, tag, units, material, size, timeout):
         cmd += ["--units", units]
     if size is not None:
         cmd += ["--size", repr(size)]
+    cmd += list(extra)
     ok, out, err, wall, peak = run(cmd, timeout)
     r = {"mesh_cmd": " ".join(str(c) for c in cmd[1:]), "mesh_s": round(wall, 1),
          "mesh_peak_mib": peak and round(peak, 1)}
@@ -157,9 +160,9 @@ def mesh_and_bake(binary, asset, tag, units, material, size, timeout):
         return {**r, "ok": False, "error": f"mesh: {err}"}
     m = json.loads(out)
     rep = m["report"]
-    r.update(backend=rep["backend"], fallback=rep["fallback_from"], tets=m["tets"],
+    r.update(backend=rep["backend"], fallback=rep["fallback_from"], tets=m["tets"], size_m=rep["size_m"],
              nodes=m["nodes"], dofs=m["dofs"], hausdorff_rel=rep["distance"]["relative"])
-    cmd = [binary, "bake", msh, "-o", modes, "--material", material, "--json"]
+    cmd = [binary, "bake", msh, "-o", modes, "--material", material, "--json", *extra]
     ok, out, err, wall, peak = run(cmd, timeout)
     r.update(bake_cmd=" ".join(str(c) for c in cmd[1:]), bake_s=round(wall, 1),
              bake_peak_mib=peak and round(peak, 1))
@@ -184,14 +187,23 @@ def main():
                     help="seconds after which one mesh or bake step is stopped (default 300)")
     ap.add_argument("--ref-factor", type=float, default=0.5,
                     help="reference --size as a fraction of the default size (default 0.5)")
+    ap.add_argument("--ref-max-memory", type=float, default=8,
+                    help="--max-memory (GB) of the reference's mesh and bake (default 8; the "
+                    "defaults' steps keep modal-bake's own budget)")
+    ap.add_argument("--table-only", action="store_true",
+                    help="print the table of out/real-assets/modes/results.json and exit")
     a = ap.parse_args()
+    if a.table_only:
+        print(render(json.loads((OUT / "results.json").read_text())))
+        return
     binary = Path(a.modal_bake).resolve()
     if not binary.is_file():
         sys.exit(f"error: --modal-bake {binary}: no such file; build it with "
                  "`cargo build --release -p modal-bake` or pass its path")
     OUT.mkdir(parents=True, exist_ok=True)
     names = [n for n in ASSETS if not a.only or n in a.only.split(",")]
-    rows = []
+    old = OUT / "results.json"
+    rows = json.loads(old.read_text()) if a.only and old.is_file() else []
     for n in names:
         src, size, units, material = ASSETS[n]
         row = {"name": n, "source": src, "size_m": size, "units": units, "material": material,
@@ -203,10 +215,12 @@ def main():
         row["default"] = mesh_and_bake(binary, asset, "", units, material, None, a.step_timeout)
         if row["default"]["ok"]:
             row["reference"] = mesh_and_bake(binary, asset, "-ref", units, material,
-                                             h * a.ref_factor, a.step_timeout)
+                                             h * a.ref_factor, a.step_timeout,
+                                             ["--max-memory", str(a.ref_max_memory)])
         row["load_after"] = uptime()
         print(json.dumps(row), file=sys.stderr)
-        rows.append(row)
+        rows = [r for r in rows if r["name"] != n] + [row]
+        rows.sort(key=lambda r: list(ASSETS).index(r["name"]))
         (OUT / "results.json").write_text(json.dumps(rows, indent=1))
     table = render(rows)
     (OUT / "table.md").write_text(table)
@@ -228,7 +242,11 @@ def render(rows):
         load = f"{load1(r['load_before'])} → {load1(r['load_after'])}"
         d, ref = r["default"], r.get("reference")
         if not d["ok"]:
-            lines.append(f"{head} | {d.get('backend', '—')} | skipped: {d['error'][:120]} | | | | | {load} |")
+            msg = d["error"].splitlines()[0][:200]
+            if "refused" in d["error"]:
+                msg = "refused by the default budget: " + msg.split(": ", 2)[-1]
+            meshed = f"meshed in {d['mesh_s']} s; " if "backend" in d else ""
+            lines.append(f"{head} | {d.get('backend', '—')} | {meshed}{msg} | | | | | {load} |")
             continue
         fb = " (fallback)" if d["fallback"] else ""
         peak = max(x for x in (d["mesh_peak_mib"], d["bake_peak_mib"]) if x)
