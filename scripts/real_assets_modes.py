@@ -251,7 +251,7 @@ def render(rows):
         fb = " (fallback)" if d["fallback"] else ""
         peak = max(x for x in (d["mesh_peak_mib"], d["bake_peak_mib"]) if x)
         f = d["frequencies_hz"][:5]
-        fs = ", ".join(f"{x:.4g}" for x in f)
+        fs = ", ".join(f"{x:.0f}" if x >= 100 else f"{x:.4g}" for x in f)
         if ref and ref["ok"]:
             fr = ref["frequencies_hz"][:5]
             errs = ", ".join(f"{100 * (x - y) / y:+.2f}" for x, y in zip(f, fr))
