@@ -128,11 +128,56 @@ fn modes_glb_bytes(base: &ModesFile, params: &ModeGltfParams) -> Result<Vec<u8>,
     }
 
     let mut b = GltfBuilder::new();
-    let material = b.material("surface", [0.75, 0.72, 0.68, 1.0], 0.6, false);
-    let mesh = b.triangle_mesh("surface", &positions, &surf.triangles, material, &targets)?;
+    morph_scene(
+        &mut b,
+        "surface",
+        &positions,
+        &surf.triangles,
+        false,
+        &targets,
+        (params.period_s, params.keyframes),
+    )?;
+    let fixed: std::collections::BTreeSet<u32> = base.fixed_nodes.iter().copied().collect();
+    let fixed_vertices: Vec<usize> = (0..ns)
+        .filter(|&v| fixed.contains(&surf.volume_node[v]))
+        .collect();
+    b.root.extras = extras_of(&serde_json::json!({
+        "dcr": {
+            "kind": "modes",
+            "scale": params.scale,
+            "diagonal_m": diag,
+            "period_s": params.period_s,
+            "fixed_vertices": fixed_vertices,
+            "source_hash": base.meta.source_hash,
+            "modes": info,
+        }
+    }));
+    b.to_glb()
+}
+
+/// Adds to `b` one mesh `name` (`positions` in m, `triangles`, a neutral material, one-sided
+/// unless `double_sided`) with `targets` as its morph targets (POSITION deltas, m), one node and
+/// scene holding it, and per target one animation (the last argument: its period in s and its
+/// keyframes) that drives its weight through one sine period (w = sin 2πt/period, the other
+/// weights 0) by linear keyframes. Shared by the base-surface and the `--onto` exports.
+///
+/// # Errors
+/// [`ExportError`] from the builder (non-finite positions or deltas).
+pub(super) fn morph_scene(
+    b: &mut GltfBuilder,
+    name: &str,
+    positions: &[[f32; 3]],
+    triangles: &[[u32; 3]],
+    double_sided: bool,
+    targets: &[(String, Vec<[f32; 3]>)],
+    (period_s, keyframes): (f64, usize),
+) -> Result<(), ExportError> {
+    let n = targets.len();
+    let material = b.material(name, [0.75, 0.72, 0.68, 1.0], 0.6, double_sided);
+    let mesh = b.triangle_mesh(name, positions, triangles, material, targets)?;
     let node = b.root.push(json::Node {
         mesh: Some(mesh),
-        name: Some("surface".into()),
+        name: Some(name.into()),
         weights: Some(vec![0.0; n]),
         ..Default::default()
     });
@@ -145,9 +190,9 @@ fn modes_glb_bytes(base: &ModesFile, params: &ModeGltfParams) -> Result<Vec<u8>,
     b.root.scene = Some(scene);
 
     // One shared time input; one weights output per mode.
-    let k = params.keyframes;
+    let k = keyframes;
     let times: Vec<f32> = (0..=k)
-        .map(|i| (params.period_s * i as f64 / k as f64) as f32)
+        .map(|i| (period_s * i as f64 / k as f64) as f32)
         .collect();
     let input = b.scalars(&times, true);
     for (j, (label, _)) in targets.iter().enumerate() {
@@ -180,20 +225,5 @@ fn modes_glb_bytes(base: &ModesFile, params: &ModeGltfParams) -> Result<Vec<u8>,
             }],
         });
     }
-    let fixed: std::collections::BTreeSet<u32> = base.fixed_nodes.iter().copied().collect();
-    let fixed_vertices: Vec<usize> = (0..ns)
-        .filter(|&v| fixed.contains(&surf.volume_node[v]))
-        .collect();
-    b.root.extras = extras_of(&serde_json::json!({
-        "dcr": {
-            "kind": "modes",
-            "scale": params.scale,
-            "diagonal_m": diag,
-            "period_s": params.period_s,
-            "fixed_vertices": fixed_vertices,
-            "source_hash": base.meta.source_hash,
-            "modes": info,
-        }
-    }));
-    b.to_glb()
+    Ok(())
 }

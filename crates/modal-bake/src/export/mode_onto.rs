@@ -18,9 +18,9 @@ use std::path::Path;
 use dcr_runtime::format::ModesFile;
 use dcr_runtime::model::quadratic_triangle_weights;
 use dcr_runtime::ModalModel;
-use gltf::json::{self, animation::Property, validation::Checked, Index};
 
 use super::gltf_builder::extras_of;
+use super::mode_gltf::morph_scene;
 use super::{diagonal, write_file_atomic, ExportError, GltfBuilder};
 use crate::mesh::surface::read_surface_unwelded;
 
@@ -401,56 +401,15 @@ fn onto_glb_bytes(
     let (max_d, worst) = map.max_distance();
 
     let mut b = GltfBuilder::new();
-    let material = b.material("asset", [0.75, 0.72, 0.68, 1.0], 0.6, true);
-    let mesh = b.triangle_mesh("asset", &positions, &asset.triangles, material, &targets)?;
-    let node = b.root.push(json::Node {
-        mesh: Some(mesh),
-        name: Some("asset".into()),
-        weights: Some(vec![0.0; n]),
-        ..Default::default()
-    });
-    let scene = b.root.push(json::Scene {
-        extensions: None,
-        extras: None,
-        name: Some("modes".into()),
-        nodes: vec![node],
-    });
-    b.root.scene = Some(scene);
-    let k = params.keyframes;
-    let times: Vec<f32> = (0..=k)
-        .map(|i| (params.period_s * i as f64 / k as f64) as f32)
-        .collect();
-    let input = b.scalars(&times, true);
-    for (j, (name, _)) in targets.iter().enumerate() {
-        let mut w = vec![0.0f32; (k + 1) * n];
-        for i in 0..=k {
-            w[i * n + j] = (std::f64::consts::TAU * i as f64 / k as f64).sin() as f32;
-        }
-        let output = b.scalars(&w, false);
-        b.root.push(json::Animation {
-            extensions: None,
-            extras: None,
-            name: Some(name.clone()),
-            samplers: vec![json::animation::Sampler {
-                extensions: None,
-                extras: None,
-                input,
-                interpolation: Checked::Valid(json::animation::Interpolation::Linear),
-                output,
-            }],
-            channels: vec![json::animation::Channel {
-                sampler: Index::new(0),
-                target: json::animation::Target {
-                    extensions: None,
-                    extras: None,
-                    node,
-                    path: Checked::Valid(Property::MorphTargetWeights),
-                },
-                extensions: None,
-                extras: None,
-            }],
-        });
-    }
+    morph_scene(
+        &mut b,
+        "asset",
+        &positions,
+        &asset.triangles,
+        true,
+        &targets,
+        (params.period_s, params.keyframes),
+    )?;
     b.root.extras = extras_of(&serde_json::json!({
         "dcr": {
             "kind": "modes_onto",
