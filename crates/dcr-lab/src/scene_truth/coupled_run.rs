@@ -368,30 +368,7 @@ fn apply_drivers(
     t: f64,
 ) {
     for (h, d) in drivers {
-        if t + 1e-9 < d.start || t > d.stop {
-            continue;
-        }
-        let phase = (t - d.start) / d.period;
-        if (phase - phase.round()).abs() > 1e-6 {
-            continue;
-        }
-        let mut j = Vector::new(d.impulse[0], d.impulse[1], d.impulse[2]);
-        if let Some(ax) = d.rotate_axis {
-            let axis = Vector::new(ax[0], ax[1], ax[2]).normalize();
-            let q = rapier3d_f64::math::Rotation::from_axis_angle(
-                axis,
-                std::f64::consts::TAU * d.hz * (t - d.start),
-            );
-            j = q * j;
-        }
-        let rb = &mut built.world.bodies[*h];
-        match d.point {
-            Some(p) => {
-                let wp = rb.position().transform_point(Vector::new(p[0], p[1], p[2]));
-                rb.apply_impulse_at_point(j, wp, true);
-            }
-            None => rb.apply_impulse(j, true),
-        }
+        dcr_scenes::runner::apply_driver(d, &mut built.world.bodies[*h], t);
     }
 }
 

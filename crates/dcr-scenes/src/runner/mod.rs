@@ -14,8 +14,8 @@ pub use bases::{
 };
 pub use outcomes::{measure_outcome, unit_of};
 pub use run::{
-    run_scene, BodyReceived, MethodChoice, ModelReport, ModelStats, ResponseEvent, RunParams,
-    RunReport, StepTime, RUN_OUTPUTS,
+    apply_driver, run_scene, BodyReceived, MethodChoice, ModelReport, ModelStats, ResponseEvent,
+    RunParams, RunReport, StepTime, RUN_OUTPUTS,
 };
 pub use stress_bench::{stress_bench, StressBenchParams};
 pub use table1::{paper_rows, table1, PaperRow, Table1Params};

@@ -423,35 +423,39 @@ fn elastic_method(
     Ok((method, method_name))
 }
 
-/// Applies the impulses of the `drivers` (body index, description) due at time `t` (s): each
-/// fires at `start + n·period` within [start, stop], its impulse (N·s, world frame) turned
-/// about `rotate_axis` at `hz` when given, at a body-frame point or the centre of mass.
+/// Applies the impulses of the `drivers` (body index, description) due at time `t` (s).
 fn apply_drivers(drivers: &[(usize, DriverDesc)], built: &mut BuiltWorld, t: f64) {
     for (b, d) in drivers {
-        if t + 1e-9 < d.start || t > d.stop {
-            continue;
+        apply_driver(d, &mut built.world.bodies[built.bodies[*b].handle], t);
+    }
+}
+
+/// Applies driver `d`'s impulse to `rb` when one is due at time `t` (s): it fires at
+/// `start + n·period` within [start, stop], its impulse (N·s, world frame) turned about
+/// `rotate_axis` at `hz` when given, at a body-frame point or the centre of mass.
+pub fn apply_driver(d: &DriverDesc, rb: &mut rapier3d_f64::dynamics::RigidBody, t: f64) {
+    if t + 1e-9 < d.start || t > d.stop {
+        return;
+    }
+    let phase = (t - d.start) / d.period;
+    if (phase - phase.round()).abs() > 1e-6 {
+        return;
+    }
+    let mut j = Vector::new(d.impulse[0], d.impulse[1], d.impulse[2]);
+    if let Some(ax) = d.rotate_axis {
+        let axis = Vector::new(ax[0], ax[1], ax[2]).normalize();
+        let q = rapier3d_f64::math::Rotation::from_axis_angle(
+            axis,
+            std::f64::consts::TAU * d.hz * (t - d.start),
+        );
+        j = q * j;
+    }
+    match d.point {
+        Some(p) => {
+            let wp = rb.position().transform_point(Vector::new(p[0], p[1], p[2]));
+            rb.apply_impulse_at_point(j, wp, true);
         }
-        let phase = (t - d.start) / d.period;
-        if (phase - phase.round()).abs() > 1e-6 {
-            continue;
-        }
-        let mut j = Vector::new(d.impulse[0], d.impulse[1], d.impulse[2]);
-        if let Some(ax) = d.rotate_axis {
-            let axis = Vector::new(ax[0], ax[1], ax[2]).normalize();
-            let q = rapier3d_f64::math::Rotation::from_axis_angle(
-                axis,
-                std::f64::consts::TAU * d.hz * (t - d.start),
-            );
-            j = q * j;
-        }
-        let rb = &mut built.world.bodies[built.bodies[*b].handle];
-        match d.point {
-            Some(p) => {
-                let wp = rb.position().transform_point(Vector::new(p[0], p[1], p[2]));
-                rb.apply_impulse_at_point(j, wp, true);
-            }
-            None => rb.apply_impulse(j, true),
-        }
+        None => rb.apply_impulse(j, true),
     }
 }
 
