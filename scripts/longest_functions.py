@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
 """List the longest Rust functions (lines from `fn` to its closing brace) under the given folders.
 
-Usage: python3 scripts/longest_functions.py [--top=N] [DIR ...]   (default: --top=10 crates)
-Prints `lines  name  file:line` longest first, then how many functions have 100 lines or more.
+Usage: python3 scripts/longest_functions.py [--top=N] [--min=L] [DIR ...]
+(default: --top=10 --min=100 crates)
+Prints `lines  name  file:line` longest first, then how many functions have L lines or more.
 A text scan (braces outside strings and line comments), good enough to find what to split.
 """
 import re, sys, pathlib
@@ -35,13 +36,20 @@ def fns(path):
     return out
 res = []
 roots = sys.argv[1:] or ['crates']
-n = 10
-if roots and roots[0].startswith('--top='):
-    n = int(roots[0][6:]); roots = roots[1:] or ['crates']
+n, least = 10, 100
+while roots and roots[0].startswith('--'):
+    opt = roots.pop(0)
+    if opt.startswith('--top='):
+        n = int(opt[6:])
+    elif opt.startswith('--min='):
+        least = int(opt[6:])
+    else:
+        sys.exit(f"unknown option {opt}; usage: longest_functions.py [--top=N] [--min=L] [DIR ...]")
+roots = roots or ['crates']
 for r in roots:
     for p in pathlib.Path(r).rglob('*.rs'):
         if 'target' in p.parts: continue
         res += fns(p)
 res.sort(reverse=True)
 for l, loc, name in res[:n]: print(f"{l:5d}  {name:32s} {loc}")
-print(f"functions >= 100 lines: {sum(1 for r in res if r[0] >= 100)}")
+print(f"functions >= {least} lines: {sum(1 for r in res if r[0] >= least)}")

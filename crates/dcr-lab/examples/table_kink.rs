@@ -25,9 +25,8 @@ use dcr_lab::accuracy::{
 use dcr_runtime::{Method, ModalModel, RestingContact};
 use modal_bake::full_order::{FullOrderSystem, ModalAll};
 use modal_bake::target_error::ReferencePairs;
-use modal_bake::transfer::{
-    build_transfer_table, mode_set_from_dense, TransferModes, TransferParams, DENSE_MAX_DOFS,
-};
+use modal_bake::bake::mode_set_from_dense;
+use modal_bake::transfer::{build_transfer_table, TransferModes, TransferParams, DENSE_MAX_DOFS};
 
 fn main() -> anyhow::Result<()> {
     let name = std::env::args()

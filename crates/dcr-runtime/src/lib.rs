@@ -90,6 +90,7 @@ mod math;
 pub mod model;
 pub mod response;
 pub mod rng;
+mod surface_point;
 #[cfg(any(test, feature = "testing"))]
 pub mod testing;
 pub mod world;

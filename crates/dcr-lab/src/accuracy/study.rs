@@ -15,9 +15,9 @@ use modal_bake::full_order::{
 };
 use modal_bake::mesh::TetMesh;
 use modal_bake::target_error::{PairsParams, ReferencePairs};
+use modal_bake::bake::{mode_set_from_dense, mode_set_lanczos};
 use modal_bake::transfer::{
-    build_transfer_table, mode_set_from_dense, mode_set_lanczos, select_region, TableOrder,
-    TransferModes, TransferParams, AUTO_LANCZOS_MODES, DENSE_MAX_DOFS, UP_MIN_COS,
+    build_transfer_table, select_region, TableOrder, TransferModes, TransferParams, AUTO_LANCZOS_MODES, DENSE_MAX_DOFS, UP_MIN_COS,
 };
 
 use super::objects::ObjectSpec;

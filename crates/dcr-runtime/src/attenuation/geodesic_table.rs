@@ -17,7 +17,7 @@
 use rayon::prelude::*;
 
 use super::HeatGeodesic;
-use crate::model::SurfacePoint;
+use crate::surface_point::SurfacePoint;
 
 /// All-pairs heat-method distances over a surface's vertices (m).
 #[derive(Debug)]

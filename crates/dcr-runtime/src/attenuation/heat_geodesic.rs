@@ -30,7 +30,7 @@ use faer::Side;
 
 use super::sparse_llt::{merge_top, Direction, Layout, Pattern};
 use crate::math::{cross, dot, norm, sub};
-use crate::model::SurfacePoint;
+use crate::surface_point::SurfacePoint;
 
 /// Why a [`HeatGeodesic`] could not be built.
 #[derive(Debug, thiserror::Error)]

@@ -7,11 +7,10 @@
 
 mod load_error;
 mod modal_model;
-mod surface_point;
 
 pub use load_error::LoadError;
 pub use modal_model::ModalModel;
-pub use surface_point::{
+pub use crate::surface_point::{
     area_weighted_normals, quadratic_triangle_weights, surface_point_on, SurfacePoint,
 };
 

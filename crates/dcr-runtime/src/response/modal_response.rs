@@ -152,7 +152,20 @@ impl ModalResponse {
         forces: &[ForceInput],
         resting: &[RestingContact],
     ) {
-        let m = self.m;
+        // Eq. 9: the step's impacts (and forces) as one reduced impulse r (and force f).
+        let have_impulse = self.reduce_impacts(ctx, impacts);
+        let have_force = self.reduce_forces(ctx, forces);
+        // The channels whose peaks Eq. 11 takes, and their weights n_cᵀU_c.
+        let nch = self.build_channels(ctx);
+        // Eq. 10–11: the filters' response over the step and each channel's peak |w_c · q(k)|.
+        self.peak_displacements(ctx, nch, have_impulse, have_force);
+        // Eq. 12–13: Δv = d/h per resting contact.
+        self.velocity_changes(ctx, resting);
+    }
+
+    /// Eq. 9: `self.r = Σ Uᵀ H_c n_c λ_c` over the accepted impacts that map to the surface.
+    /// Returns whether any did.
+    fn reduce_impacts(&mut self, ctx: &mut StepCtx<'_>, impacts: &[Impact]) -> bool {
         let model = ctx.model;
         self.r.iter_mut().for_each(|x| *x = 0.0);
         let mut have_impulse = false;
@@ -174,6 +187,13 @@ impl ModalResponse {
                 None => ctx.info.impacts_unmapped += 1,
             }
         }
+        have_impulse
+    }
+
+    /// The reduced force `self.f = Σ Uᵀ H_c F_c` of the non-zero, finite forces that map to the
+    /// surface (held constant over the step). Returns whether any did.
+    fn reduce_forces(&mut self, ctx: &mut StepCtx<'_>, forces: &[ForceInput]) -> bool {
+        let model = ctx.model;
         self.f.iter_mut().for_each(|x| *x = 0.0);
         let mut have_force = false;
         for fi in forces {
@@ -189,8 +209,16 @@ impl ModalResponse {
                 None => ctx.info.forces_ignored += 1,
             }
         }
+        have_force
+    }
 
-        // Channels: one per mapped contact (PerContact) or one per corner vertex (PerNode).
+    /// Assigns the channels, one per mapped contact (`PerContact`) or one per corner vertex of
+    /// its triangle (`PerNode`), and rebuilds their weights `w_step` (mode-major, m × nch) when
+    /// the contact list or the cache changed (steady state: resting contacts repeat step after
+    /// step). Returns the number of channels nch.
+    fn build_channels(&mut self, ctx: &StepCtx<'_>) -> usize {
+        let m = self.m;
+        let model = ctx.model;
         let contacts = ctx.contacts;
         let slots = contacts.slots();
         let per_node = ctx.params.variant == Variant::PerNode;
@@ -209,8 +237,6 @@ impl ModalResponse {
         if self.peaks.len() < nch {
             self.peaks.resize(nch, 0.0);
         }
-        // Rebuild the step's channel weights only when the contact list or the cache changed
-        // (steady state: resting contacts repeat step after step).
         if self.w_key.0 != contacts.generation() || self.w_key.1 != slots {
             self.w_key.0 = contacts.generation();
             self.w_key.1.clear();
@@ -239,7 +265,20 @@ impl ModalResponse {
                 }
             }
         }
+        nch
+    }
 
+    /// Eq. 10–11: runs the filters over the step (from rest through the impulse-response
+    /// table, or sample by sample with carry-over or forces) and fills `peaks[..nch]` with each
+    /// channel's `max_k |w_c · q(k)|` (zeros when nothing moves); then the sleep test of the
+    /// carried-over state.
+    fn peak_displacements(
+        &mut self,
+        ctx: &mut StepCtx<'_>,
+        nch: usize,
+        have_impulse: bool,
+        have_force: bool,
+    ) {
         let carry = ctx.params.carry_over;
         if !carry {
             self.bank.reset();
@@ -249,63 +288,10 @@ impl ModalResponse {
         let mut peaks_buf = std::mem::take(&mut self.peaks);
         let peaks = &mut peaks_buf[..nch];
         if active {
-            let s = self.samples;
-            let stride = self.stride;
             if !carry && !have_force {
-                // Reset path: q(k) = g(kT) ∘ r. Fold r into whichever operand is smaller:
-                // the S × m table or the m × nch channel weights. (The comparison uses nch
-                // rounded up to 8, as the earlier 8-channel-panel kernel did, so each
-                // workload keeps its rounding: results are bit-identical to that kernel.)
-                if nch > 0 && s > nch.div_ceil(8) * 8 {
-                    if self.w_scaled.len() < nch * m {
-                        self.w_scaled.resize(nch * m, 0.0);
-                    }
-                    let ws = &mut self.w_scaled[..nch * m];
-                    for ((dst, src), r) in ws
-                        .chunks_exact_mut(nch)
-                        .zip(self.w_step.chunks_exact(nch))
-                        .zip(&self.r)
-                    {
-                        for (d, x) in dst.iter_mut().zip(src) {
-                            *d = x * r;
-                        }
-                    }
-                    peak_abs_rows(&self.g_t, stride, m, ws, nch, peaks);
-                } else if nch > 0 {
-                    for ((qj, gj), r) in self
-                        .q_t
-                        .chunks_exact_mut(stride)
-                        .zip(self.g_t.chunks_exact(stride))
-                        .zip(&self.r)
-                    {
-                        for (q, g) in qj.iter_mut().zip(gj) {
-                            *q = g * r;
-                        }
-                    }
-                    peak_abs_rows(&self.q_t, stride, m, &self.w_step[..nch * m], nch, peaks);
-                }
-                // The row-major samples are filled on demand (`samples`).
-                self.q_stale = true;
-                for j in 0..m {
-                    self.tmp_q[j] = self.g_end[j] * self.r[j];
-                    self.tmp_v[j] = self.g_dot_end[j] * self.r[j];
-                }
-                self.bank.set_state(&self.tmp_q, &self.tmp_v);
+                self.peaks_from_rest(nch, peaks);
             } else {
-                if have_impulse {
-                    self.bank.apply_impulse(&self.r);
-                }
-                let force = if have_force { Some(&self.f[..]) } else { None };
-                self.bank.run(s, force, &mut self.q_table);
-                self.q_stale = false;
-                if nch > 0 {
-                    for (k, qk) in self.q_table[..s * m].chunks_exact(m).enumerate() {
-                        for (j, &q) in qk.iter().enumerate() {
-                            self.q_t[j * stride + k] = q;
-                        }
-                    }
-                    peak_abs_rows(&self.q_t, stride, m, &self.w_step[..nch * m], nch, peaks);
-                }
+                self.peaks_by_stepping(nch, have_impulse, have_force, peaks);
             }
             if carry {
                 self.asleep = false;
@@ -327,7 +313,87 @@ impl ModalResponse {
             ctx.info.asleep = carry;
         }
         self.peaks = peaks_buf;
+    }
 
+    /// The reset path of [`ModalResponse::peak_displacements`]: from rest, q(k) = g(kT) ∘ r,
+    /// so the peaks are one dense multiply-max; leaves the filters in their end-of-step state.
+    fn peaks_from_rest(&mut self, nch: usize, peaks: &mut [f64]) {
+        let (m, s, stride) = (self.m, self.samples, self.stride);
+        // Fold r into whichever operand is smaller: the S × m table or the m × nch channel
+        // weights. (The comparison uses nch rounded up to 8, as the earlier 8-channel-panel
+        // kernel did, so each workload keeps its rounding: results are bit-identical to that
+        // kernel.)
+        if nch > 0 && s > nch.div_ceil(8) * 8 {
+            if self.w_scaled.len() < nch * m {
+                self.w_scaled.resize(nch * m, 0.0);
+            }
+            let ws = &mut self.w_scaled[..nch * m];
+            for ((dst, src), r) in ws
+                .chunks_exact_mut(nch)
+                .zip(self.w_step.chunks_exact(nch))
+                .zip(&self.r)
+            {
+                for (d, x) in dst.iter_mut().zip(src) {
+                    *d = x * r;
+                }
+            }
+            peak_abs_rows(&self.g_t, stride, m, ws, nch, peaks);
+        } else if nch > 0 {
+            for ((qj, gj), r) in self
+                .q_t
+                .chunks_exact_mut(stride)
+                .zip(self.g_t.chunks_exact(stride))
+                .zip(&self.r)
+            {
+                for (q, g) in qj.iter_mut().zip(gj) {
+                    *q = g * r;
+                }
+            }
+            peak_abs_rows(&self.q_t, stride, m, &self.w_step[..nch * m], nch, peaks);
+        }
+        // The row-major samples are filled on demand (`samples`).
+        self.q_stale = true;
+        for j in 0..m {
+            self.tmp_q[j] = self.g_end[j] * self.r[j];
+            self.tmp_v[j] = self.g_dot_end[j] * self.r[j];
+        }
+        self.bank.set_state(&self.tmp_q, &self.tmp_v);
+    }
+
+    /// The stepping path of [`ModalResponse::peak_displacements`] (carry-over or forces): the
+    /// impulse applied to the filters, then S samples with the force held constant, the
+    /// samples transposed mode-major and the peaks taken.
+    fn peaks_by_stepping(
+        &mut self,
+        nch: usize,
+        have_impulse: bool,
+        have_force: bool,
+        peaks: &mut [f64],
+    ) {
+        let (m, s, stride) = (self.m, self.samples, self.stride);
+        if have_impulse {
+            self.bank.apply_impulse(&self.r);
+        }
+        let force = if have_force { Some(&self.f[..]) } else { None };
+        self.bank.run(s, force, &mut self.q_table);
+        self.q_stale = false;
+        if nch > 0 {
+            for (k, qk) in self.q_table[..s * m].chunks_exact(m).enumerate() {
+                for (j, &q) in qk.iter().enumerate() {
+                    self.q_t[j * stride + k] = q;
+                }
+            }
+            peak_abs_rows(&self.q_t, stride, m, &self.w_step[..nch * m], nch, peaks);
+        }
+    }
+
+    /// Eq. 12–13: one response per resting contact into `ctx.out`, `Δv = d/h` with d the
+    /// contact's channel peak (`PerNode`: the corners' peaks blended with its barycentric
+    /// weights); an unmapped contact gets an unmapped response.
+    fn velocity_changes(&self, ctx: &mut StepCtx<'_>, resting: &[RestingContact]) {
+        let contacts = ctx.contacts;
+        let slots = contacts.slots();
+        let per_node = ctx.params.variant == Variant::PerNode;
         let h = ctx.params.h;
         ctx.out.clear();
         for ((rc, &s), &c) in resting.iter().zip(slots).zip(&self.chan) {

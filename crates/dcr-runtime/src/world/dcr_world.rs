@@ -1,33 +1,22 @@
 //! [`DcrWorld`]: the elastic objects of a rigid-body world and their per-step responses.
 
+mod chains;
+mod classify;
+mod energy_bound;
+mod impulse_pass;
+mod lateral_kick;
+
 use std::collections::HashMap;
 
-use super::pose::{rotate, rotate_back};
+use self::classify::{ContactAge, Source};
+use self::impulse_pass::{Touched, Tracked};
 use super::{
     BaseSupport, BodyState, ContactReport, ElasticHandle, ElasticObjectDesc, EnergyInfo,
     ImpulseEvent, ObjectStepInfo, ObjectTotals, Pose, WorldError, WorldParams, WorldStepInfo,
 };
 use crate::mapping::BuildIdHasher;
-use crate::math::{add, cross, dot, norm, scale, sub};
-use crate::response::{effective_mass, DistantResponse, Impact, RestingContact};
-
-/// Age record of one contact id (classification).
-#[derive(Clone, Copy, Debug)]
-struct ContactAge {
-    first_step: u64,
-    last_step: u64,
-    /// Whether the contact has been an impact on the object on side 1 / side 2.
-    fired: [bool; 2],
-}
-
-/// Where a resting contact's response goes.
-#[derive(Clone, Copy, Debug)]
-struct Source {
-    /// Index of the receiving body in this step's `bodies`.
-    body: u32,
-    /// Application point on the receiving body (m, world).
-    point: [f64; 3],
-}
+use crate::math::dot;
+use crate::response::{DistantResponse, Impact, RestingContact};
 
 /// One elastic object.
 #[derive(Debug)]
@@ -58,37 +47,12 @@ struct Object {
     info: ObjectStepInfo,
 }
 
-/// Per-body velocity change from the impulses issued this step (world frame).
-#[derive(Clone, Copy, Debug, Default)]
-struct Tracked {
-    dlin: [f64; 3],
-    dang: [f64; 3],
-    /// Support velocity (m/s, world) already in `dlin`: given once per body and step, at its
-    /// centre of mass, with its first response.
-    support: [f64; 3],
-    /// Index into `touched` while the current object is processed, else `u32::MAX`.
-    touch: u32,
-}
-
 /// A slot of the handle table: its generation and the object's index in `objects`
 /// (`u32::MAX`: free).
 #[derive(Clone, Copy, Debug)]
 struct Slot {
     generation: u32,
     dense: u32,
-}
-
-/// A body pushed by the current object: its velocity change before the object and the
-/// object's summed impulse on it.
-#[derive(Clone, Copy, Debug, Default)]
-struct Touched {
-    body: u32,
-    dlin0: [f64; 3],
-    dang0: [f64; 3],
-    p_lin: [f64; 3],
-    p_ang: [f64; 3],
-    /// The body's (A, B) energy terms (`body_energy_terms`), once its impulses are summed.
-    energy: (f64, f64),
 }
 
 /// The elastic objects of a rigid-body world and their distant collision responses (paper
@@ -256,9 +220,6 @@ pub struct DcrWorld {
     next_purge: u64,
     info: WorldStepInfo,
 }
-
-/// Steps between purges of the age table.
-const PURGE_EVERY: u64 = 16;
 
 fn invalid(field: &'static str, detail: String) -> WorldError {
     WorldError::Params { field, detail }
@@ -782,6 +743,32 @@ impl DcrWorld {
     /// ([`DcrWorld::set_pose`]). Does not allocate after warm-up.
     pub fn step(&mut self, contacts: &[ContactReport], bodies: &[BodyState]) -> &[ImpulseEvent] {
         let step = self.step;
+        self.begin_step(bodies);
+        // §4.5: the step's contacts split into impacts and resting contacts per object.
+        self.classify(contacts, bodies);
+        // Static objects first, then dynamic ones: a chain only goes forward in this order.
+        for k in 0..self.order.len() {
+            let o = self.order[k] as usize;
+            if !self.is_due(o) {
+                continue;
+            }
+            let first_event = self.events.len();
+            // Eq. 9–16, then Eq. 17–18: the response to the object's impacts, a Δv per resting
+            // contact, issued as impulses on the resting bodies (one Gauss–Seidel pass).
+            self.respond(o, bodies);
+            // E_in ≤ η (D + R): the object's impulses scaled down when they inject more.
+            self.bound_energy(o, bodies, first_event);
+            // Impulses on dynamic elastic objects later in the order become their impacts.
+            self.hand_on_chains(o, first_event);
+        }
+        self.end_step(step);
+        &self.events
+    }
+
+    /// Resets the per-step state: counters, events, the bodies' index (rebuilt only when the
+    /// body list changes) and tracked velocity changes, each object's impacts and contacts.
+    fn begin_step(&mut self, bodies: &[BodyState]) {
+        let step = self.step;
         self.step += 1;
         self.quiet = false;
         self.info = WorldStepInfo {
@@ -801,13 +788,7 @@ impl DcrWorld {
             }
         }
         self.tracked.clear();
-        self.tracked.resize(
-            bodies.len(),
-            Tracked {
-                touch: u32::MAX,
-                ..Default::default()
-            },
-        );
+        self.tracked.resize(bodies.len(), Tracked::UNTOUCHED);
         for o in &mut self.objects {
             o.impacts.clear();
             o.resting.clear();
@@ -825,11 +806,11 @@ impl DcrWorld {
                 ..Default::default()
             };
         }
-        self.classify(contacts, bodies);
-        for k in 0..self.order.len() {
-            let o = self.order[k] as usize;
-            self.respond(o, bodies);
-        }
+    }
+
+    /// Adds the step's counters to the objects' totals and the world's energy sums, records
+    /// the events for classification and purges the age table.
+    fn end_step(&mut self, step: u64) {
         for o in &mut self.objects {
             let t = &mut o.totals;
             let i = &o.info;
@@ -848,318 +829,8 @@ impl DcrWorld {
             self.info.dissipated += e.dissipated;
         }
         self.info.events = self.events.len() as u32;
-        self.pushed.retain(|&(_, s)| s + 2 > step);
-        self.pushed
-            .extend(self.events.iter().map(|e| (e.contact, step)));
-        // Forget ids absent long enough to be new anyway (bounded table, no growth once warm).
-        if step >= self.next_purge {
-            self.next_purge = step + PURGE_EVERY;
-            let gap = self.params.classify.new_after_missing_steps;
-            self.ages.retain(|_, a| a.last_step + gap >= step);
-        }
-        &self.events
-    }
-
-    /// Splits the step's contact reports into impacts and resting contacts per object.
-    fn classify(&mut self, contacts: &[ContactReport], bodies: &[BodyState]) {
-        let step = self.step - 1;
-        let cp = self.params.classify;
-        // The last body looked up on each side: consecutive reports usually share their bodies
-        // (an engine reports a pair's points together).
-        let mut memo: [Option<(u64, Option<u32>)>; 2] = [None; 2];
-        for c in contacts {
-            let objs = [self.enabled_at(c.body1), self.enabled_at(c.body2)];
-            if objs == [None, None] || c.body1 == c.body2 {
-                continue;
-            }
-            self.info.contacts += 1;
-            let lambda = c.impulse;
-            let valid = lambda.is_finite() && lambda > 0.0;
-            let mut fired_before: Option<&mut [bool; 2]> = None;
-            let fresh_age = if cp.engine_newness {
-                c.is_new && step >= cp.settle_steps && !recently_pushed(&self.pushed, c.id, step)
-            } else {
-                let hop = !(lambda > 0.0) && recently_pushed(&self.pushed, c.id, step);
-                let fresh = ContactAge {
-                    first_step: step,
-                    last_step: step,
-                    fired: [false; 2],
-                };
-                let age = self.ages.entry(c.id).or_insert(fresh);
-                // Absent for a while, or touching with zero impulse: its age restarts — but not
-                // in the step after a response pushed it off (see `recently_pushed`).
-                if age.last_step + cp.new_after_missing_steps < step || (!(lambda > 0.0) && !hop) {
-                    *age = fresh;
-                }
-                age.last_step = step;
-                let f = step >= cp.settle_steps
-                    && age.first_step >= cp.settle_steps
-                    && step - age.first_step <= cp.fresh_steps;
-                fired_before = Some(&mut age.fired);
-                f
-            };
-            let mut bidx = [None; 2];
-            for (side, b) in [c.body1, c.body2].into_iter().enumerate() {
-                bidx[side] = match memo[side] {
-                    Some((id, i)) if id == b => i,
-                    _ => {
-                        let i = self.body_index.get(&b).copied();
-                        memo[side] = Some((b, i));
-                        i
-                    }
-                };
-            }
-            let mut fired = [false; 2];
-            for side in 0..2 {
-                let Some(o) = objs[side] else { continue };
-                let obj = &mut self.objects[o as usize];
-                let other = 1 - side;
-                let own_point = if side == 0 { c.point1 } else { c.point2 };
-                let other_point = if side == 0 { c.point2 } else { c.point1 };
-                let already = fired_before.as_ref().is_some_and(|f| f[side]);
-                if fresh_age && !already && valid && lambda >= obj.threshold {
-                    if let Some(f) = fired_before.as_mut() {
-                        f[side] = true;
-                    }
-                    fired[side] = true;
-                    // The impulse on this object: −λn on body1, +λn on body2.
-                    let d = if side == 0 {
-                        scale(c.normal, -1.0)
-                    } else {
-                        c.normal
-                    };
-                    obj.impacts.push(Impact {
-                        point: rotate_back(&obj.rot, sub(own_point, obj.pose.translation)),
-                        direction: rotate_back(&obj.rot, d),
-                        impulse: lambda,
-                    });
-                    obj.info.impacts += 1;
-                    self.info.impacts += 1;
-                } else if valid {
-                    if let Some(b) = bidx[other].filter(|&b| bodies[b as usize].is_dynamic()) {
-                        obj.resting.push(RestingContact {
-                            id: c.id,
-                            point: rotate_back(&obj.rot, sub(own_point, obj.pose.translation)),
-                        });
-                        obj.sources.push(Source {
-                            body: b,
-                            point: other_point,
-                        });
-                        obj.info.resting += 1;
-                        self.info.resting += 1;
-                    }
-                }
-            }
-            let nfired = fired.iter().filter(|&&f| f).count();
-            if nfired > 0 {
-                let lost = dissipated(c, bidx, bodies) / nfired as f64;
-                for side in 0..2 {
-                    if fired[side] {
-                        let o = objs[side].expect("fired side has an object") as usize;
-                        self.objects[o].info.energy.dissipated += lost;
-                    }
-                }
-            }
-        }
-    }
-
-    /// Runs object `o`'s response (if it has impacts), issues its impulses, bounds their
-    /// energy and hands chained impacts forward.
-    fn respond(&mut self, o: usize, bodies: &[BodyState]) {
-        let step = self.step - 1;
-        let obj = &mut self.objects[o];
-        if !obj.enabled || (obj.impacts.is_empty() && !obj.response.needs_step()) {
-            return;
-        }
-        if let Some(last) = obj.last_called {
-            obj.response.skip_steps(step - last - 1);
-        }
-        obj.last_called = Some(step);
-        obj.info.queried = true;
-        self.info.queries += 1;
-        let first_event = self.events.len();
-        let mut supports = 0;
-        let t0 = std::time::Instant::now();
-        let out = obj.response.step(&obj.impacts, &obj.resting);
-        obj.info.response_time_ns = t0.elapsed().as_nanos() as u64;
-        self.touched.clear();
-        for (resp, src) in out.iter().zip(&obj.sources) {
-            let lateral = resp.lateral_delta_v != [0.0; 3];
-            if !resp.mapped || !(resp.delta_v > 0.0 || lateral) {
-                continue;
-            }
-            let b = &bodies[src.body as usize];
-            let n = rotate(&obj.rot, resp.normal);
-            let r = sub(src.point, b.center_of_mass);
-            let t = &mut self.tracked[src.body as usize];
-            // Normal part: the Δv not yet produced at this point (one Gauss–Seidel pass).
-            let mut j = [0.0; 3];
-            let mut need = 0.0;
-            // The response's part of what earlier impulses gave the body here (their support
-            // is not a response).
-            let achieved = dot(sub(add(t.dlin, cross(t.dang, r)), t.support), n);
-            let want = obj.gain * resp.delta_v - achieved;
-            if want > 0.0 {
-                let m_eff = effective_mass(b.inv_mass, b.inv_inertia, r, n);
-                if m_eff > 0.0 {
-                    need = want;
-                    j = scale(n, m_eff * want);
-                }
-            }
-            // Tangential part (lateral kick), after the normal part, the same way.
-            if lateral {
-                let tw = rotate(&obj.rot, resp.lateral_delta_v);
-                let mag = norm(tw);
-                let dir = scale(tw, 1.0 / mag);
-                let jv = scale(j, b.inv_mass);
-                let jw = mat_vec(&b.inv_inertia, cross(r, j));
-                let achieved = dot(add(add(t.dlin, jv), cross(add(t.dang, jw), r)), dir);
-                let want = obj.gain * mag - achieved;
-                let m_eff = effective_mass(b.inv_mass, b.inv_inertia, r, dir);
-                if want > 0.0 && m_eff > 0.0 {
-                    j = add(j, scale(dir, m_eff * want));
-                }
-            }
-            if j == [0.0; 3] {
-                continue;
-            }
-            if t.touch == u32::MAX {
-                t.touch = self.touched.len() as u32;
-                self.touched.push(Touched {
-                    body: src.body,
-                    dlin0: t.dlin,
-                    dang0: t.dang,
-                    ..Default::default()
-                });
-            }
-            let tc = &mut self.touched[t.touch as usize];
-            let rj = cross(r, j);
-            tc.p_lin = add(tc.p_lin, j);
-            tc.p_ang = add(tc.p_ang, rj);
-            t.dlin = add(t.dlin, scale(j, b.inv_mass));
-            t.dang = add(t.dang, mat_vec(&b.inv_inertia, rj));
-            self.events.push(ImpulseEvent {
-                body: b.id,
-                point: src.point,
-                impulse: j,
-                normal: n,
-                delta_v: need,
-                object: obj.handle,
-                served_by: resp.served_by,
-                contact: resp.id,
-                chained: obj.depth > 0,
-            });
-            // Support compensation (WorldParams::gravity), once per body and step: the normal
-            // velocity gravity takes off during the next step, at the centre of mass — for a
-            // push that lifts the body off (Δv ≥ g_n h); a smaller one leaves it on its contact.
-            let g_n = -dot(self.params.gravity, n);
-            let gh = g_n * self.params.h;
-            if gh > 0.0 && need >= gh && t.support == [0.0; 3] && b.inv_mass > 0.0 {
-                let dv = scale(n, gh);
-                let js = scale(dv, 1.0 / b.inv_mass);
-                t.support = dv;
-                t.dlin = add(t.dlin, dv);
-                tc.p_lin = add(tc.p_lin, js);
-                self.events.push(ImpulseEvent {
-                    body: b.id,
-                    point: b.center_of_mass,
-                    impulse: js,
-                    normal: n,
-                    delta_v: 0.0,
-                    object: obj.handle,
-                    served_by: resp.served_by,
-                    contact: resp.id,
-                    chained: obj.depth > 0,
-                });
-                supports += 1;
-            }
-        }
-        obj.info.response = obj.response.last_step_info();
-        // Energy of this object's impulses, E(s) = s A + s² B, and the bound.
-        let (mut a, mut bq) = (0.0, 0.0);
-        for tc in &mut self.touched {
-            let b = &bodies[tc.body as usize];
-            tc.energy = body_energy_terms(b, tc);
-            a += tc.energy.0;
-            bq += tc.energy.1;
-        }
-        let requested = a + bq;
-        let budget = self
-            .params
-            .energy_eta
-            .map(|eta| eta * (obj.info.energy.dissipated + obj.info.energy.received));
-        let s = match budget {
-            Some(budget) if requested > budget => {
-                self.info.energy_limited += 1;
-                bound_scale(a, bq, budget)
-            }
-            _ => 1.0,
-        };
-        obj.info.energy.requested = requested;
-        obj.info.energy.scale = s;
-        obj.info.events = (self.events.len() - first_event - supports) as u32;
-        if s != 1.0 {
-            for e in &mut self.events[first_event..] {
-                e.impulse = scale(e.impulse, s);
-                e.delta_v *= s;
-            }
-        }
-        let mut injected = 0.0;
-        let depth = obj.depth;
-        for tc in &self.touched {
-            let b = &bodies[tc.body as usize];
-            let t = &mut self.tracked[tc.body as usize];
-            if s != 1.0 {
-                t.dlin = add(tc.dlin0, scale(sub(t.dlin, tc.dlin0), s));
-                t.dang = add(tc.dang0, scale(sub(t.dang, tc.dang0), s));
-            }
-            t.touch = u32::MAX;
-            let (ea, eb) = tc.energy;
-            let e_b = s * ea + s * s * eb;
-            injected += e_b;
-            if !self.any_dynamic {
-                continue;
-            }
-            // Energy given to a dynamic elastic object's body: its chain budget.
-            if let Some(target) = self.object_at(b.id) {
-                if self.forward(o, target as usize, depth) {
-                    self.objects[target as usize].info.energy.received += e_b.max(0.0);
-                }
-            }
-        }
-        self.objects[o].info.energy.injected = injected;
-        // Chains: impulses on dynamic elastic objects later in the order become impacts.
-        self.handed.clear();
-        for e in &self.events[first_event..] {
-            let Some(target) = self.object_at(e.body) else {
-                continue;
-            };
-            let mag = norm(e.impulse);
-            if !(mag > 0.0) {
-                continue;
-            }
-            if !self.forward(o, target as usize, depth) {
-                self.info.chains_dropped += 1;
-                continue;
-            }
-            let t = &self.objects[target as usize];
-            self.handed.push((
-                target,
-                Impact {
-                    point: rotate_back(&t.rot, sub(e.point, t.pose.translation)),
-                    direction: rotate_back(&t.rot, scale(e.impulse, 1.0 / mag)),
-                    impulse: mag,
-                },
-                depth + 1,
-            ));
-        }
-        for &(target, imp, d) in &self.handed {
-            let t = &mut self.objects[target as usize];
-            t.impacts.push(imp);
-            t.depth = t.depth.max(d);
-            t.info.chained_impacts += 1;
-            self.info.chained_impacts += 1;
-        }
+        self.remember_pushed(step);
+        self.purge_ages(step);
     }
 
     /// The object on engine body `body` (a scan of a few ids, else the hash table).
@@ -1182,138 +853,10 @@ impl DcrWorld {
             .filter(|&o| self.objects[o as usize].enabled)
     }
 
-    /// Whether an impulse from object `from` (at chain depth `depth`) on object `to`'s body
-    /// chains: `to` is dynamic, later in the order, and the chain is not at its limit.
-    fn forward(&self, from: usize, to: usize, depth: u32) -> bool {
-        self.objects[to].dynamic
-            && self.objects[to].enabled
-            && self.rank[to] > self.rank[from]
-            && depth < self.params.max_chain_depth
-    }
-}
-
-/// Whether contact `id` received a response event one or two steps before `step`. A body
-/// pushed off its resting contact after step N (the support compensation gives it the
-/// response's Δv at the end of N+1, so its contact carries no impulse at N+1) and caught again
-/// by the same contact at N+1 or N+2 has hopped by at most Δv·h: that contact is neither new
-/// nor an impact. A body that stays off longer lands as a new contact. A short scan: the
-/// events of two steps.
-#[inline]
-fn recently_pushed(pushed: &[(u64, u64)], id: u64, step: u64) -> bool {
-    !pushed.is_empty()
-        && pushed
-            .iter()
-            .any(|&(c, s)| c == id && s + 2 >= step && s < step)
 }
 
 /// `M v` for a row-major 3 × 3 matrix.
 #[inline]
 fn mat_vec(m: &[[f64; 3]; 3], v: [f64; 3]) -> [f64; 3] {
     [dot(m[0], v), dot(m[1], v), dot(m[2], v)]
-}
-
-/// Velocity of body `b` at world point `p` (m/s; zero for a body without state).
-#[inline]
-fn velocity_at(b: Option<&BodyState>, p: [f64; 3]) -> [f64; 3] {
-    match b {
-        Some(b) => add(b.linvel, cross(b.angvel, sub(p, b.center_of_mass))),
-        None => [0.0; 3],
-    }
-}
-
-/// Inverse effective mass `m⁻¹ + (r × n)ᵀ I⁻¹ (r × n)` (1/kg) of body `b` at `p` along `n`.
-#[inline]
-fn inverse_effective_mass(b: Option<&BodyState>, p: [f64; 3], n: [f64; 3]) -> f64 {
-    match b {
-        Some(b) => {
-            let rn = cross(sub(p, b.center_of_mass), n);
-            b.inv_mass + dot(rn, mat_vec(&b.inv_inertia, rn))
-        }
-        None => 0.0,
-    }
-}
-
-/// Energy an impact dissipated (J): `max(0, ½ k λ² − λ u⁺)` (see [`DcrWorld`], "Energy bound").
-fn dissipated(c: &ContactReport, bidx: [Option<u32>; 2], bodies: &[BodyState]) -> f64 {
-    let b1 = bidx[0].map(|i| &bodies[i as usize]);
-    let b2 = bidx[1].map(|i| &bodies[i as usize]);
-    let u_plus = dot(
-        sub(velocity_at(b2, c.point2), velocity_at(b1, c.point1)),
-        c.normal,
-    );
-    let k = inverse_effective_mass(b1, c.point1, c.normal)
-        + inverse_effective_mass(b2, c.point2, c.normal);
-    let lambda = c.impulse;
-    let lost = 0.5 * k * lambda * lambda - lambda * u_plus;
-    if lost.is_finite() {
-        lost.max(0.0)
-    } else {
-        0.0
-    }
-}
-
-/// (A, B) of a body's kinetic-energy change `A + B` from the summed impulse of `tc`: A = P·V
-/// with V the body's velocity before them (after the step plus earlier objects' impulses),
-/// B = ½ PᵀM⁻¹P.
-#[inline]
-fn body_energy_terms(b: &BodyState, tc: &Touched) -> (f64, f64) {
-    let v = add(b.linvel, tc.dlin0);
-    let w = add(b.angvel, tc.dang0);
-    let a = dot(tc.p_lin, v) + dot(tc.p_ang, w);
-    let bq = 0.5
-        * (b.inv_mass * dot(tc.p_lin, tc.p_lin) + dot(tc.p_ang, mat_vec(&b.inv_inertia, tc.p_ang)));
-    (a, bq)
-}
-
-/// The largest s ∈ [0, 1] with `s a + s² b ≤ budget`, given `a + b > budget ≥ 0` and b ≥ 0.
-fn bound_scale(a: f64, b: f64, budget: f64) -> f64 {
-    let budget = budget.max(0.0);
-    let s = if b > 0.0 {
-        let disc = (a * a + 4.0 * b * budget).sqrt();
-        if a >= 0.0 {
-            // 2·budget / (a + √…): no cancellation.
-            if a + disc > 0.0 {
-                2.0 * budget / (a + disc)
-            } else {
-                0.0
-            }
-        } else {
-            (disc - a) / (2.0 * b)
-        }
-    } else if a > 0.0 {
-        budget / a
-    } else {
-        1.0
-    };
-    s.clamp(0.0, 1.0)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::bound_scale;
-
-    /// The scale meets the budget exactly (to rounding) and is the largest such.
-    #[test]
-    fn bound_scale_is_the_largest_root() {
-        for &(a, b, budget) in &[
-            (2.0, 1.0, 1.0),
-            (0.0, 3.0, 0.5),
-            (-1.0, 2.0, 0.1),
-            (-1.0, 2.0, 0.0),
-            (4.0, 0.0, 1.0),
-            (1e-3, 1e3, 1e-6),
-        ] {
-            let s = bound_scale(a, b, budget);
-            let e = s * a + s * s * b;
-            assert!(
-                e <= budget * (1.0 + 1e-12) + 1e-300,
-                "{a} {b} {budget}: {e}"
-            );
-            let s2 = (s * (1.0 + 1e-9)).min(1.0) + 1e-12;
-            assert!(
-                s2 * a + s2 * s2 * b > budget,
-                "{a} {b} {budget}: not the largest"
-            );
-        }
-    }
 }

@@ -527,15 +527,48 @@ pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
         .map_err(|e| anyhow::anyhow!("scene {}: {e}", desc.name))?;
     let seconds = params.seconds.unwrap_or(desc.seconds);
     let mut built = build_world(desc, &params.root)?;
-
-    // The world and its elastic objects. Off runs measure only (impacts, what the responses
-    // would have been) and apply nothing.
+    // Off runs measure only (impacts, what the responses would have been) and apply nothing.
     let apply = if params.dcr {
         params.apply
     } else {
         ApplyMode::MeasureOnly
     };
-    let mut dcr = DcrRapier::new(
+    let mut dcr = new_adapter(desc, params, apply)?;
+    let objects = add_elastic_objects(desc, params, &mut built, &mut dcr)?;
+    let drivers = resolve_drivers(desc, &built)?;
+    let mut rec = RunRecord::new(desc, &built, steps);
+    let wall = Instant::now();
+    let mut last_progress = Instant::now();
+    for k in 0..steps {
+        apply_drivers(&drivers, &mut built, k as f64 * desc.h);
+        rec.step(&mut built, &mut dcr);
+        rec.count_world_step(&dcr, &objects, apply);
+        rec.collect_events(&dcr, &objects, &built, apply, k);
+        rec.record_poses(&built, (k + 1) as f64 * desc.h);
+        if params.progress && last_progress.elapsed().as_secs_f64() > 5.0 {
+            last_progress = Instant::now();
+            eprintln!(
+                "[dcr-scenes] {} ({}) step {}/{} ({:.1} s wall)",
+                desc.name,
+                if params.dcr { "on" } else { "off" },
+                k + 1,
+                steps,
+                wall.elapsed().as_secs_f64()
+            );
+        }
+    }
+    let (report, rapier_us, adapter_us) =
+        rec.into_report(desc, params, (seconds, steps, apply), &built, objects);
+    if let Some(dir) = &params.out_dir {
+        write_outputs(dir, &report, &rapier_us, &adapter_us)?;
+    }
+    Ok(report)
+}
+
+/// The rapier adapter of a run: the scene's step, the run's energy bound, apply mode,
+/// contact recycling and gate.
+fn new_adapter(desc: &SceneDesc, params: &RunParams, apply: ApplyMode) -> Result<DcrRapier> {
+    DcrRapier::new(
         WorldParams {
             h: desc.h,
             energy_eta: params.energy_eta,
@@ -547,9 +580,33 @@ pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
             gate: params.gate,
         },
     )
-    .map_err(|err| anyhow::anyhow!("scene {}: {err}", desc.name))?;
-    let mut infos = Vec::new();
-    let mut handles: Vec<ElasticHandle> = Vec::new();
+    .map_err(|err| anyhow::anyhow!("scene {}: {err}", desc.name))
+}
+
+/// One elastic object of a run: its handle and what the report says of it.
+struct RunObject {
+    handle: ElasticHandle,
+    /// The base's file name.
+    base: String,
+    gain: f64,
+    surface_vertices: usize,
+    surface_triangles: usize,
+    modes: usize,
+    method: String,
+    /// IIR sub-step T (s) and samples per step, for runs with the response on.
+    iir_t: Option<f64>,
+    samples_per_step: Option<usize>,
+}
+
+/// Bakes (if missing) and loads each elastic object's base and adds the object to the
+/// adapter, with the run's method, gain and lateral kick.
+fn add_elastic_objects(
+    desc: &SceneDesc,
+    params: &RunParams,
+    built: &mut BuiltWorld,
+    dcr: &mut DcrRapier,
+) -> Result<Vec<RunObject>> {
+    let mut objects = Vec::new();
     for (i, e) in desc.elastic.iter().enumerate() {
         let transfer = transfer_of(e, &params.method)?;
         let (path, _) = match transfer {
@@ -585,82 +642,118 @@ pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
             )
             .map_err(|err| anyhow::anyhow!("elastic object {}: {err}", e.name))?;
         let response = dcr.world().response(handle);
-        infos.push((
-            path.file_name()
+        objects.push(RunObject {
+            handle,
+            base: path
+                .file_name()
                 .map_or(String::new(), |f| f.to_string_lossy().into_owned()),
             gain,
-            base.num_surface_vertices(),
-            base.surface_triangles.len(),
-            base.num_modes(),
-            method_name,
-            params.dcr.then(|| response.substep()),
-            params.dcr.then(|| response.samples_per_step()),
-        ));
-        handles.push(handle);
+            surface_vertices: base.num_surface_vertices(),
+            surface_triangles: base.surface_triangles.len(),
+            modes: base.num_modes(),
+            method: method_name,
+            iir_t: params.dcr.then(|| response.substep()),
+            samples_per_step: params.dcr.then(|| response.samples_per_step()),
+        });
     }
-    let mut stats: Vec<ModelStats> = desc
-        .elastic
+    Ok(objects)
+}
+
+/// The scene's drivers with the index of the body each one moves.
+fn resolve_drivers(desc: &SceneDesc, built: &BuiltWorld) -> Result<Vec<(usize, DriverDesc)>> {
+    desc.drivers
         .iter()
-        .map(|e| ModelStats {
-            name: e.name.clone(),
-            ..Default::default()
+        .map(|d| {
+            let b = built
+                .body_index(&d.body)
+                .with_context(|| format!("driver: no body {}", d.body))?;
+            Ok((b, d.clone()))
         })
-        .collect();
-    // Receiving body id → index into `built.bodies` (events name bodies by rapier handle).
-    let body_index: BTreeMap<u64, usize> = built
-        .bodies
-        .iter()
-        .enumerate()
-        .map(|(i, b)| (dcr_rapier::f64::body_id(b.handle), i))
-        .collect();
+        .collect()
+}
 
-    // Drivers.
-    let mut drivers = Vec::new();
-    for d in &desc.drivers {
-        let b = built
-            .body_index(&d.body)
-            .with_context(|| format!("driver: no body {}", d.body))?;
-        drivers.push((b, d.clone()));
+/// What a run records step by step: timings, the world's counters per object, the events
+/// and what each body received, and the dynamic bodies' poses.
+struct RunRecord {
+    stats: Vec<ModelStats>,
+    /// Receiving body id → index into `built.bodies` (events name bodies by rapier handle).
+    body_index: BTreeMap<u64, usize>,
+    /// The recorded (dynamic) bodies, indices into `built.bodies`.
+    recorded: Vec<usize>,
+    traj: Trajectory,
+    rapier_us: Vec<f64>,
+    adapter_us: Vec<f64>,
+    step_times: Vec<StepTime>,
+    events: Vec<ResponseEvent>,
+    world_steps: usize,
+    replay_missed: usize,
+    received: BTreeMap<String, BodyReceived>,
+}
+
+impl RunRecord {
+    /// An empty record for `steps` steps of `desc`, with the poses at t = 0.
+    fn new(desc: &SceneDesc, built: &BuiltWorld, steps: usize) -> RunRecord {
+        let recorded: Vec<usize> = (0..built.bodies.len())
+            .filter(|&i| built.bodies[i].dynamic)
+            .collect();
+        let mut rec = RunRecord {
+            stats: desc
+                .elastic
+                .iter()
+                .map(|e| ModelStats {
+                    name: e.name.clone(),
+                    ..Default::default()
+                })
+                .collect(),
+            body_index: built
+                .bodies
+                .iter()
+                .enumerate()
+                .map(|(i, b)| (dcr_rapier::f64::body_id(b.handle), i))
+                .collect(),
+            traj: Trajectory {
+                names: recorded
+                    .iter()
+                    .map(|&i| built.bodies[i].name.clone())
+                    .collect(),
+                ..Default::default()
+            },
+            recorded,
+            rapier_us: Vec::with_capacity(steps),
+            adapter_us: Vec::with_capacity(steps),
+            step_times: Vec::with_capacity(steps),
+            events: Vec::new(),
+            world_steps: 0,
+            replay_missed: 0,
+            received: BTreeMap::new(),
+        };
+        rec.record_poses(built, 0.0);
+        rec
     }
 
-    // Recording.
-    let rec: Vec<usize> = (0..built.bodies.len())
-        .filter(|&i| built.bodies[i].dynamic)
-        .collect();
-    let mut traj = Trajectory {
-        names: rec.iter().map(|&i| built.bodies[i].name.clone()).collect(),
-        ..Default::default()
-    };
-    let record = |built: &BuiltWorld, traj: &mut Trajectory, t: f64| {
-        traj.time.push(t);
-        for &i in &rec {
+    /// Appends the recorded bodies' poses at time `t` (s) to the trajectory.
+    fn record_poses(&mut self, built: &BuiltWorld, t: f64) {
+        self.traj.time.push(t);
+        for &i in &self.recorded {
             let p = built.world.bodies[built.bodies[i].handle].position();
-            traj.positions
+            self.traj
+                .positions
                 .extend([p.translation.x, p.translation.y, p.translation.z]);
-            traj.rotations
+            self.traj
+                .rotations
                 .extend([p.rotation.x, p.rotation.y, p.rotation.z, p.rotation.w]);
         }
-    };
-    record(&built, &mut traj, 0.0);
+    }
 
-    let mut rapier_us = Vec::with_capacity(steps);
-    let mut adapter_us = Vec::with_capacity(steps);
-    let mut events = Vec::new();
-    let mut world_steps = 0;
-    let mut replay_missed = 0;
-    let mut received: BTreeMap<String, BodyReceived> = BTreeMap::new();
-    let mut step_times = Vec::with_capacity(steps);
-    let wall = Instant::now();
-    let mut last_progress = Instant::now();
-    for k in 0..steps {
-        let t = k as f64 * desc.h;
-        apply_drivers(&drivers, &mut built, t);
+    /// One step: the adapter's `before_step`, rapier's step and the adapter's `after_step`,
+    /// each timed (µs).
+    fn step(&mut self, built: &mut BuiltWorld, dcr: &mut DcrRapier) {
         let ta = Instant::now();
         dcr.before_step(&mut built.world.bodies);
         let before_us = ta.elapsed().as_secs_f64() * 1e6;
         let ts = Instant::now();
         built.world.step_with_events(dcr.hooks(), &());
-        rapier_us.push(ts.elapsed().as_secs_f64() * 1e6);
+        self.rapier_us.push(ts.elapsed().as_secs_f64() * 1e6);
         let ta = Instant::now();
         dcr.after_step(
             &mut built.world.bodies,
@@ -668,20 +761,25 @@ pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
             &built.world.narrow_phase,
         );
         let us = before_us + ta.elapsed().as_secs_f64() * 1e6;
-        adapter_us.push(us);
-        world_steps += usize::from(dcr.step_info().world_stepped);
-        replay_missed += dcr.step_info().replay_missed as usize;
-        step_times.push(StepTime {
-            rapier_us: *rapier_us.last().unwrap_or(&0.0),
+        self.adapter_us.push(us);
+        self.world_steps += usize::from(dcr.step_info().world_stepped);
+        self.replay_missed += dcr.step_info().replay_missed as usize;
+        self.step_times.push(StepTime {
+            rapier_us: *self.rapier_us.last().unwrap_or(&0.0),
             adapter_us: us,
             world_stepped: dcr.step_info().world_stepped,
             reports: dcr.step_info().reports,
         });
-        // The world's counters describe its last `step`: read them only when it stepped.
-        let stepped = dcr.step_info().world_stepped;
-        for (i, &h) in handles.iter().enumerate().filter(|_| stepped) {
-            let info = dcr.world().object_info(h);
-            let s = &mut stats[i];
+    }
+
+    /// Adds the world's per-object counters of the step to `stats`. The world's counters
+    /// describe its last `step`: read only when it stepped.
+    fn count_world_step(&mut self, dcr: &DcrRapier, objects: &[RunObject], apply: ApplyMode) {
+        if !dcr.step_info().world_stepped {
+            return;
+        }
+        for (s, o) in self.stats.iter_mut().zip(objects) {
+            let info = dcr.world().object_info(o.handle);
             s.impacts += info.impacts as usize;
             s.chained_impacts += info.chained_impacts as usize;
             s.responses_applied += info.events as usize;
@@ -710,15 +808,31 @@ pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
                 s.query_resting.push(info.resting as usize);
             }
         }
+    }
+
+    /// Accounts step `k`'s impulse events per object and per receiving body, and keeps them
+    /// (runs that apply them) for the exports.
+    fn collect_events(
+        &mut self,
+        dcr: &DcrRapier,
+        objects: &[RunObject],
+        built: &BuiltWorld,
+        apply: ApplyMode,
+        k: usize,
+    ) {
         for e in dcr.events() {
-            let i = handles
+            let i = objects
                 .iter()
-                .position(|&h| h == e.object)
+                .position(|o| o.handle == e.object)
                 .unwrap_or_default();
-            stats[i].max_delta_v = stats[i].max_delta_v.max(e.delta_v);
-            stats[i].events_by_table += usize::from(e.served_by == ServedBy::TransferTable);
-            if let Some(&body) = body_index.get(&e.body) {
-                let r = received.entry(built.bodies[body].name.clone()).or_default();
+            let s = &mut self.stats[i];
+            s.max_delta_v = s.max_delta_v.max(e.delta_v);
+            s.events_by_table += usize::from(e.served_by == ServedBy::TransferTable);
+            if let Some(&body) = self.body_index.get(&e.body) {
+                let r = self
+                    .received
+                    .entry(built.bodies[body].name.clone())
+                    .or_default();
                 r.events += 1;
                 r.max_delta_v = r.max_delta_v.max(e.delta_v);
                 let j = e.impulse;
@@ -730,8 +844,8 @@ pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
             if apply == ApplyMode::MeasureOnly {
                 continue;
             }
-            if let Some(&body) = body_index.get(&e.body) {
-                events.push(ResponseEvent {
+            if let Some(&body) = self.body_index.get(&e.body) {
+                self.events.push(ResponseEvent {
                     row: k + if apply == ApplyMode::InSolver { 2 } else { 1 },
                     model: i,
                     body,
@@ -744,94 +858,89 @@ pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
                 debug_assert!(false, "event for unknown body {:?}", body_handle(e.body));
             }
         }
-        record(&built, &mut traj, (k + 1) as f64 * desc.h);
-        if params.progress && last_progress.elapsed().as_secs_f64() > 5.0 {
-            last_progress = Instant::now();
-            eprintln!(
-                "[dcr-scenes] {} ({}) step {}/{} ({:.1} s wall)",
-                desc.name,
-                if params.dcr { "on" } else { "off" },
-                k + 1,
-                steps,
-                wall.elapsed().as_secs_f64()
-            );
-        }
     }
 
-    let models: Vec<ModelReport> = stats
-        .into_iter()
-        .zip(infos)
-        .map(
-            |(s, (base, gain, sv, st, modes, method, t, sps))| ModelReport {
+    /// The run's report (per-object summaries, outcomes, totals and shares), with the
+    /// per-step rapier and adapter times (µs) for `timings.npz`.
+    fn into_report(
+        self,
+        desc: &SceneDesc,
+        params: &RunParams,
+        (seconds, steps, apply): (f64, usize, ApplyMode),
+        built: &BuiltWorld,
+        objects: Vec<RunObject>,
+    ) -> (RunReport, Vec<f64>, Vec<f64>) {
+        let models: Vec<ModelReport> = self
+            .stats
+            .into_iter()
+            .zip(objects)
+            .map(|(s, o)| ModelReport {
                 model: s.name.clone(),
-                base,
-                gain,
-                surface_vertices: sv,
-                surface_triangles: st,
-                modes,
-                method,
-                iir_t: t,
-                samples_per_step: sps,
+                base: o.base,
+                gain: o.gain,
+                surface_vertices: o.surface_vertices,
+                surface_triangles: o.surface_triangles,
+                modes: o.modes,
+                method: o.method,
+                iir_t: o.iir_t,
+                samples_per_step: o.samples_per_step,
                 distant_contacts: s.query_resting.iter().copied().max().unwrap_or(0),
                 queries: s.query_us.len(),
                 query_us_median: percentile(&s.query_us, 50.0),
                 query_us_p99: percentile(&s.query_us, 99.0),
                 stats: s,
+            })
+            .collect();
+        let traj = self.traj;
+        let mut outcomes = BTreeMap::new();
+        for o in &desc.outcomes {
+            if let Some(v) = measure_outcome(o, &traj) {
+                outcomes.insert(o.name.clone(), (v, unit_of(&o.kind).to_string()));
+            }
+        }
+        let rapier_ms = self.rapier_us.iter().sum::<f64>() / 1e3;
+        let adapter_ms = self.adapter_us.iter().sum::<f64>() / 1e3;
+        let report = RunReport {
+            scene: desc.name.clone(),
+            dcr: params.dcr,
+            seconds,
+            steps,
+            h: desc.h,
+            bodies: traj.names.clone(),
+            trajectory_hash: traj.hash(),
+            outcomes,
+            injected_ke: models.iter().map(|m| m.stats.injected_ke).sum(),
+            dissipated: models.iter().map(|m| m.stats.dissipated).sum(),
+            models,
+            rapier_ms,
+            adapter_ms,
+            dcr_share_of_step: if rapier_ms > 0.0 {
+                adapter_ms / rapier_ms
+            } else {
+                0.0
             },
-        )
-        .collect();
-    let mut outcomes = BTreeMap::new();
-    for o in &desc.outcomes {
-        if let Some(v) = measure_outcome(o, &traj) {
-            outcomes.insert(o.name.clone(), (v, unit_of(&o.kind).to_string()));
-        }
+            energy_eta: params.energy_eta,
+            apply: match apply {
+                ApplyMode::AfterStep => "after_step",
+                ApplyMode::InSolver => "in_solver",
+                _ => "none",
+            }
+            .to_string(),
+            lateral_kick: params.lateral_kick,
+            contact_recycling: params.contact_recycling && apply != ApplyMode::InSolver,
+            gate: match params.gate {
+                StepGate::EveryStep => "every_step",
+                _ => "impact_steps",
+            }
+            .to_string(),
+            world_steps: self.world_steps,
+            received: self.received,
+            replay_missed: self.replay_missed,
+            trajectory: traj,
+            events: self.events,
+            bodies_all: built.bodies.iter().map(|b| b.name.clone()).collect(),
+            step_times: self.step_times,
+        };
+        (report, self.rapier_us, self.adapter_us)
     }
-    let rapier_ms = rapier_us.iter().sum::<f64>() / 1e3;
-    let adapter_ms = adapter_us.iter().sum::<f64>() / 1e3;
-    let report = RunReport {
-        scene: desc.name.clone(),
-        dcr: params.dcr,
-        seconds,
-        steps,
-        h: desc.h,
-        bodies: traj.names.clone(),
-        trajectory_hash: traj.hash(),
-        outcomes,
-        injected_ke: models.iter().map(|m| m.stats.injected_ke).sum(),
-        dissipated: models.iter().map(|m| m.stats.dissipated).sum(),
-        models,
-        rapier_ms,
-        adapter_ms,
-        dcr_share_of_step: if rapier_ms > 0.0 {
-            adapter_ms / rapier_ms
-        } else {
-            0.0
-        },
-        energy_eta: params.energy_eta,
-        apply: match apply {
-            ApplyMode::AfterStep => "after_step",
-            ApplyMode::InSolver => "in_solver",
-            _ => "none",
-        }
-        .to_string(),
-        lateral_kick: params.lateral_kick,
-        contact_recycling: params.contact_recycling && apply != ApplyMode::InSolver,
-        gate: match params.gate {
-            StepGate::EveryStep => "every_step",
-            _ => "impact_steps",
-        }
-        .to_string(),
-        world_steps,
-        received,
-        replay_missed,
-        trajectory: traj,
-        events,
-        bodies_all: built.bodies.iter().map(|b| b.name.clone()).collect(),
-        step_times,
-    };
-
-    if let Some(dir) = &params.out_dir {
-        write_outputs(dir, &report, &rapier_us, &adapter_us)?;
-    }
-    Ok(report)
 }

@@ -68,4 +68,12 @@ pub enum BakeError {
         /// What failed.
         error: Box<crate::transfer::TransferError>,
     },
+    /// The many-mode Lanczos bake for the transfer table's modes failed; nothing is written.
+    #[error("{file}: transfer table modes: {error}")]
+    TransferModes {
+        /// Mesh file.
+        file: String,
+        /// Why that bake failed.
+        error: Box<BakeError>,
+    },
 }

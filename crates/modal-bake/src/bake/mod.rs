@@ -3,14 +3,16 @@
 //!
 //! One file per part: `params` ([`BakeParams`], what determines a result), `error`
 //! ([`BakeError`]), `report` ([`BakeReport`], [`BakeStage`]), `hashing` ([`geometry_hash`]),
-//! `prepare` (orientation, connectivity, fixed-node selection), `surface`
-//! ([`extract_surface`]), `estimate` ([`SizeEstimate`], [`Budget`]: size before work),
+//! `prepare` (orientation, connectivity, fixed-node selection), `surface` (the
+//! surface a base stores, from [`extract_surface`]), `mode_set` (the transfer table's many-mode
+//! sets: [`mode_set_dense`], [`mode_set_lanczos`]), `estimate` ([`SizeEstimate`], [`Budget`]: size before work),
 //! `plausibility` ([`unit_hint`], [`plausibility_warnings`]: unit mistakes named), `pipeline` ([`bake_mesh`], [`bake_file`]) and `staleness`
 //! ([`base_status`], [`BaseStatus`]).
 
 mod error;
 mod estimate;
 mod hashing;
+mod mode_set;
 mod params;
 mod pipeline;
 mod plausibility;
@@ -26,6 +28,7 @@ pub use estimate::{
     format_bytes, format_count, format_seconds, Budget, SizeEstimate, SurfaceMeasures,
 };
 pub use hashing::{geometry_hash, round_16_digits};
+pub use mode_set::{mode_set_dense, mode_set_from_dense, mode_set_lanczos};
 pub use params::{BakeParams, FixedBelow, ModeRequest};
 pub use pipeline::{
     bake_file, bake_mesh, MAX_RESIDUAL, OUTPUT_VERSION, RIGID_REL_TOL, TOOL_VERSION,
@@ -36,4 +39,5 @@ pub use plausibility::{
 };
 pub use report::{BakeReport, BakeStage, TransferReport};
 pub use staleness::{base_status, is_mesh_up_to_date, is_up_to_date, mesh_base_status, BaseStatus};
-pub use surface::extract_surface;
+/// The boundary surface of a tetrahedral mesh (defined in [`crate::mesh`]).
+pub use crate::mesh::extract_surface;

@@ -400,7 +400,7 @@ fn bake_with_table(
         (None, "base")
     } else if report.free_dofs <= tr::DENSE_MAX_DOFS {
         progress(BakeStage::TransferModes);
-        let set = tr::mode_set_dense(&base, &mesh, params, tp.modes, file).map_err(terr)?;
+        let set = super::mode_set_dense(&base, &mesh, params, tp.modes, file).map_err(terr)?;
         (Some(set), "dense")
     } else {
         let TransferModes::Count(n) = tp.modes else {
@@ -411,7 +411,7 @@ fn bake_with_table(
             ))));
         };
         progress(BakeStage::TransferModes);
-        let set = tr::mode_set_lanczos(&mesh, params, n, file).map_err(terr)?;
+        let set = super::mode_set_lanczos(&mesh, params, n, file)?;
         (Some(set), "lanczos")
     };
     let modes_s = t.elapsed().as_secs_f64();

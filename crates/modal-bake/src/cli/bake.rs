@@ -286,26 +286,33 @@ pub fn annotate(base: &mut ModesFile, options: &BakeOptions, report: &BakeReport
     }
 }
 
-pub fn run(args: &BakeArgs) -> anyhow::Result<()> {
+/// The checks every `bake` runs first (output path, option ranges, budget, the default
+/// material's warning); returns the meshing options for the input.
+///
+/// # Errors
+/// An output that must not be written, an option out of range, a malformed budget.
+pub fn check_args(args: &BakeArgs) -> anyhow::Result<AssetOptions> {
     super::check_output(&args.out, "-o", &[&args.mesh])?;
     args.options.model.check_ranges()?;
     args.budget.budget()?;
     if let Some(w) = args.options.model.default_material_warning() {
         eprintln!("warning: {w}");
     }
-    let asset = asset_for(&args.asset, args.transfer.transfer_h.is_some(), &args.mesh);
-    if let Some(target) = args.target_error {
-        return super::target::run(args, &asset, target);
-    }
+    Ok(asset_for(&args.asset, args.transfer.transfer_h.is_some(), &args.mesh))
+}
+
+/// `bake` without `--target-error` (after [`check_args`]): reads or meshes the input, bakes
+/// it and writes the base.
+pub fn run(args: &BakeArgs, asset: &AssetOptions) -> anyhow::Result<()> {
     let params = BakeParams {
         transfer: args.transfer.params(),
         ..args.options.params()
     };
     if is_surface_asset(&args.mesh) {
         args.budget
-            .check_surface(&args.mesh, &asset, args.options.modes_for_estimate())?;
+            .check_surface(&args.mesh, asset, args.options.modes_for_estimate())?;
     }
-    let (mesh, read_s) = load_mesh_with_progress(&args.mesh, &asset)?;
+    let (mesh, read_s) = load_mesh_with_progress(&args.mesh, asset)?;
     bake_loaded(args, &params, mesh, read_s)
 }
 

@@ -1,7 +1,7 @@
 //! `modal-bake info`.
 
 use std::fmt::Write as _;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use clap::Args;
 use dcr_runtime::format::ModesFile;
@@ -113,60 +113,85 @@ fn warnings(base: &ModesFile) -> Vec<String> {
 pub fn run(args: &InfoArgs) -> anyhow::Result<()> {
     // FormatError messages name the file and the entry at fault.
     let base = ModesFile::read(&args.file)?;
+    let warnings = warnings(&base);
+    let text = if args.json {
+        let v = info_json(&args.file, &base, &warnings);
+        format!("{}\n", serde_json::to_string_pretty(&v)?)
+    } else {
+        info_text(&args.file, &base, &warnings)?
+    };
+    super::emit(&text);
+    Ok(())
+}
+
+/// `info --json`: every field of the base's summary, the mode table and the warnings.
+fn info_json(file: &Path, base: &ModesFile, warnings: &[String]) -> serde_json::Value {
     let freqs = base.frequencies_hz();
     let order = if base.quadratic.is_some() { 2 } else { 1 };
-    let warnings = warnings(&base);
-    if args.json {
-        let v = serde_json::json!({
-            "file": args.file.display().to_string(),
-            "format_version": base.meta.format_version,
-            "tool_version": base.meta.tool_version,
-            "source_hash": base.meta.source_hash,
-            "params_hash": base.meta.params_hash,
-            "modes": base.num_modes(),
-            "eigenvalues": base.eigenvalues,
-            "frequencies_hz": freqs,
-            "residuals": base.residuals,
-            "surface_vertices": base.num_surface_vertices(),
-            "surface_triangles": base.surface_triangles.len(),
-            "order": order,
-            "surface_mid_edge_nodes": base.quadratic.as_ref().map_or(0, |q| q.edges.len()),
-            "volume_nodes": base.meta.volume_nodes,
-            "volume_tets": base.meta.volume_tets,
-            "fixed_nodes": base.fixed_nodes.len(),
-            "rigid_modes_excluded": base.meta.rigid_modes_excluded,
-            "mass_kg": base.meta.mass_kg,
-            "material": {"name": material_name(&base), "youngs_pa": base.material.youngs, "poisson": base.material.poisson, "density_kg_m3": base.material.density},
-            "fixed_by": selectors(&base),
-            "warnings": warnings,
-            "rayleigh": base.rayleigh,
-            "precision": base.precision,
-            "bake_params": base.meta.bake_params,
-            "surface_order": base.surface_order.is_some(),
-            "transfer": base.transfer.as_ref().map(|t| serde_json::json!({
-                "h_s": t.h,
-                "rayleigh": t.rayleigh,
-                "modes": t.modes,
-                "samples": t.samples,
-                "region_vertices": t.len(),
-                "edge_midpoints": t.edges.len(),
-                "order": t.order,
-                "edges": t.edges.len(),
-                "faces": t.faces.len(),
-                "points": t.num_points(),
-                "packed_values": t.peaks.len(),
-                "max_peak_m_per_ns": t.peaks.iter().fold(0.0f32, |a, &b| a.max(b)),
-            })),
-            "accuracy": base.meta.accuracy,
-        });
-        super::emit(&format!("{}\n", serde_json::to_string_pretty(&v)?));
-        return Ok(());
-    }
+    serde_json::json!({
+        "file": file.display().to_string(),
+        "format_version": base.meta.format_version,
+        "tool_version": base.meta.tool_version,
+        "source_hash": base.meta.source_hash,
+        "params_hash": base.meta.params_hash,
+        "modes": base.num_modes(),
+        "eigenvalues": base.eigenvalues,
+        "frequencies_hz": freqs,
+        "residuals": base.residuals,
+        "surface_vertices": base.num_surface_vertices(),
+        "surface_triangles": base.surface_triangles.len(),
+        "order": order,
+        "surface_mid_edge_nodes": base.quadratic.as_ref().map_or(0, |q| q.edges.len()),
+        "volume_nodes": base.meta.volume_nodes,
+        "volume_tets": base.meta.volume_tets,
+        "fixed_nodes": base.fixed_nodes.len(),
+        "rigid_modes_excluded": base.meta.rigid_modes_excluded,
+        "mass_kg": base.meta.mass_kg,
+        "material": {"name": material_name(&base), "youngs_pa": base.material.youngs, "poisson": base.material.poisson, "density_kg_m3": base.material.density},
+        "fixed_by": selectors(&base),
+        "warnings": warnings,
+        "rayleigh": base.rayleigh,
+        "precision": base.precision,
+        "bake_params": base.meta.bake_params,
+        "surface_order": base.surface_order.is_some(),
+        "transfer": base.transfer.as_ref().map(|t| serde_json::json!({
+            "h_s": t.h,
+            "rayleigh": t.rayleigh,
+            "modes": t.modes,
+            "samples": t.samples,
+            "region_vertices": t.len(),
+            "edge_midpoints": t.edges.len(),
+            "order": t.order,
+            "edges": t.edges.len(),
+            "faces": t.faces.len(),
+            "points": t.num_points(),
+            "packed_values": t.peaks.len(),
+            "max_peak_m_per_ns": t.peaks.iter().fold(0.0f32, |a, &b| a.max(b)),
+        })),
+        "accuracy": base.meta.accuracy,
+    })
+}
+
+/// `info`: the base's summary as text, then the warnings and the mode table.
+fn info_text(file: &Path, base: &ModesFile, warnings: &[String]) -> Result<String, std::fmt::Error> {
     let mut out = String::new();
+    write_model(&mut out, file, base)?;
+    write_surface(&mut out, base)?;
+    write_tables(&mut out, base)?;
+    for w in warnings {
+        writeln!(out, "  warning: {w}")?;
+    }
+    write_modes(&mut out, base)?;
+    Ok(out)
+}
+
+/// The file, format, material, volume mesh and fixed nodes.
+fn write_model(out: &mut String, file: &Path, base: &ModesFile) -> std::fmt::Result {
+    let order = if base.quadratic.is_some() { 2 } else { 1 };
     writeln!(
         out,
         "{}  (format v{}, {})",
-        args.file.display(),
+        file.display(),
         base.meta.format_version,
         base.meta.tool_version
     )?;
@@ -202,6 +227,11 @@ pub fn run(args: &InfoArgs) -> anyhow::Result<()> {
             sel.join("; ")
         )?;
     }
+    Ok(())
+}
+
+/// The stored surface, damping, geometry hash and heat-geodesic order.
+fn write_surface(out: &mut String, base: &ModesFile) -> std::fmt::Result {
     match &base.quadratic {
         Some(q) => writeln!(
             out,
@@ -234,6 +264,11 @@ pub fn run(args: &InfoArgs) -> anyhow::Result<()> {
             "none (AMD at load)"
         }
     )?;
+    Ok(())
+}
+
+/// The transfer table and the accuracy record, if stored.
+fn write_tables(out: &mut String, base: &ModesFile) -> std::fmt::Result {
     match &base.transfer {
         Some(t) => writeln!(
             out,
@@ -272,9 +307,12 @@ pub fn run(args: &InfoArgs) -> anyhow::Result<()> {
             a.payload_bytes as f64 / 1024.0
         )?;
     }
-    for w in &warnings {
-        writeln!(out, "  warning: {w}")?;
-    }
+    Ok(())
+}
+
+/// The mode table: frequency, eigenvalue and residual of each mode.
+fn write_modes(out: &mut String, base: &ModesFile) -> std::fmt::Result {
+    let freqs = base.frequencies_hz();
     writeln!(out, "  {} modes:", base.num_modes())?;
     writeln!(out, "     #   freq (Hz)      λ (rad²/s²)    residual")?;
     for (j, (&l, f)) in base.eigenvalues.iter().zip(&freqs).enumerate() {
@@ -284,6 +322,5 @@ pub fn run(args: &InfoArgs) -> anyhow::Result<()> {
             base.residuals[j]
         )?;
     }
-    super::emit(&out);
     Ok(())
 }

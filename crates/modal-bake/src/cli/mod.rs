@@ -156,9 +156,18 @@ pub fn one_line(e: &anyhow::Error) -> String {
     modal_bake::args::error_line(e)
 }
 
+/// `bake`: a plain bake, or with `--target-error` the cheapest base meeting the target.
+fn run_bake(args: &bake::BakeArgs) -> anyhow::Result<()> {
+    let asset = bake::check_args(args)?;
+    match args.target_error {
+        Some(target) => target::run(args, &asset, target),
+        None => bake::run(args, &asset),
+    }
+}
+
 fn run_command(command: Command) -> ExitCode {
     let result = match command {
-        Command::Bake(a) => bake::run(&a).map(|()| ExitCode::SUCCESS),
+        Command::Bake(a) => run_bake(&a).map(|()| ExitCode::SUCCESS),
         Command::Mesh(a) => mesh::run(&a).map(|()| ExitCode::SUCCESS),
         Command::Info(a) => info::run(&a).map(|()| ExitCode::SUCCESS),
         Command::Probe(a) => probe::run(&a).map(|()| ExitCode::SUCCESS),

@@ -36,7 +36,7 @@ use faer::sparse::SparseColMat;
 use faer::{Mat, MatRef, Par, Spec};
 
 use super::kernels::{sym_eig_qr, sym_spmm};
-use super::lanczos::{normalize_signs, orthonormalize_ascending, RitzPairs};
+use super::ritz::{normalize_signs, orthonormalize_ascending, RitzPairs};
 use super::shift_invert::shifted;
 use super::{EigenError, EigenInfo, EigenParams, EigenProgress, EigenResult};
 

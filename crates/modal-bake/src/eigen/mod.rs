@@ -81,17 +81,18 @@ mod kernels;
 mod lanczos;
 mod ordering;
 mod panel_solve;
+mod ritz;
 mod shift_invert;
 
 use faer::sparse::SparseColMat;
-use faer::Mat;
+use faer::{Mat, Par};
 
 use crate::fem::Material;
 use crate::mesh::TetMesh;
 
 pub use kernels::SplitMix64;
 /// A pair counts as converged within this factor of its double-precision residual floor.
-pub use lanczos::FLOOR_FACTOR;
+pub use ritz::FLOOR_FACTOR;
 pub(crate) use shift_invert::{lin_comb, ShiftInvert};
 
 /// Parameters of [`solve_lowest`].
@@ -275,7 +276,97 @@ pub fn solve_lowest(
     params: &EigenParams,
     progress: &mut dyn FnMut(EigenProgress),
 ) -> Result<EigenResult, EigenError> {
-    lanczos::solve(k, m, params, progress)
+    let n = k.nrows();
+    check_input(k, m, params)?;
+    let sigma = params.shift;
+    let lam_lim = params.max_freq_hz.map(|f| (2.0 * std::f64::consts::PI * f).powi(2));
+    let par = match params.threads {
+        0 if n < AUTO_SEQ_BELOW => Par::Seq,
+        t => Par::rayon(t),
+    };
+    let info = EigenInfo {
+        shift: sigma,
+        ..Default::default()
+    };
+    if params.nev == 0 && lam_lim.is_none() {
+        return Ok(EigenResult {
+            eigenvalues: vec![],
+            vectors: Mat::zeros(n, 0),
+            residuals: vec![],
+            residual_floors: vec![],
+            info,
+        });
+    }
+    let b = params.block.min(n).max(1);
+    let ncv0 = lanczos::krylov_dim(params, params.nev.max(1), b, n);
+    let small = n <= DENSE_MAX_DOFS;
+    if n <= ncv0 + b + DENSE_MARGIN || (small && params.nev * DENSE_FRACTION_INV > n) {
+        return dense::solve(k, m, params, lam_lim, info, progress);
+    }
+    match lanczos::solve_lanczos(k, m, params, lam_lim, par, info.clone(), progress) {
+        // A small problem whose request Lanczos cannot meet (a frequency cap near or beyond
+        // the highest mode; the Krylov basis cannot outgrow the problem) is solved densely.
+        Err(EigenError::NotConverged { .. } | EigenError::InvalidInput(_)) if small => {
+            dense::solve(k, m, params, lam_lim, info, progress)
+        }
+        other => other,
+    }
+}
+
+/// Problems with at most this many dofs beyond the Krylov basis size are solved densely.
+const DENSE_MARGIN: usize = 16;
+
+/// Problems with at most this many free dofs are solved densely (`dense.rs`) when more than
+/// n / [`DENSE_FRACTION_INV`] pairs are wanted, or when Lanczos fails on them (a frequency cap
+/// near or beyond the highest mode). The dense path costs O(n³) whatever is wanted; measured
+/// with `examples/dense_timing` (clamped beams, every mode, on 2 cores at load 10):
+/// 750 dofs 0.7 s, 1512 dofs 5.2 s, 2646 dofs 38–46 s, 2940 dofs 80 s, against 2.6 s and
+/// 4 s for Lanczos's n/10 lowest at 2646 and 2940 dofs. 2000 keeps the dense bake within
+/// about 15 s there.
+pub(super) const DENSE_MAX_DOFS: usize = 2000;
+
+/// Count requests for more than n / this many pairs of a small problem go straight to the
+/// dense path (Lanczos failed on 250 of the 570 dofs of the free-free beam).
+pub(super) const DENSE_FRACTION_INV: usize = 4;
+
+/// With `threads == 0`, problems below this many dofs run sequentially: thread
+/// synchronisation costs more than it saves there (measured on 2 cores).
+pub(super) const AUTO_SEQ_BELOW: usize = 20_000;
+
+fn check_input(
+    k: &SparseColMat<usize, f64>,
+    m: &SparseColMat<usize, f64>,
+    params: &EigenParams,
+) -> Result<(), EigenError> {
+    let n = k.nrows();
+    let bad = |s: String| Err(EigenError::InvalidInput(s));
+    if k.ncols() != n || m.nrows() != n || m.ncols() != n {
+        return bad(format!(
+            "K is {}x{}, M is {}x{}; both must be square and equal",
+            k.nrows(),
+            k.ncols(),
+            m.nrows(),
+            m.ncols()
+        ));
+    }
+    if params.nev > n {
+        return bad(format!("nev = {} exceeds the problem size {n}", params.nev));
+    }
+    if params.block == 0 {
+        return bad("block size must be at least 1".into());
+    }
+    if !(params.tol > 0.0 && params.tol.is_finite()) {
+        return bad(format!("tolerance must be positive, got {}", params.tol));
+    }
+    if !params.shift.is_finite() {
+        return bad(format!("shift must be finite, got {}", params.shift));
+    }
+    if let Some(f) = params.max_freq_hz {
+        if !(f > 0.0 && f.is_finite()) {
+            return bad(format!("max frequency must be positive, got {f} Hz"));
+        }
+    }
+    Ok(())
 }
 
 /// Coefficient c of [`default_shift`]: σ = −c·(E/ρ)·t²/L⁴.

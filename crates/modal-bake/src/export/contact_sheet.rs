@@ -92,28 +92,7 @@ fn normalize(a: [f64; 3]) -> [f64; 3] {
 /// let png = render_contact_sheet(&base, &SheetParams::default()).unwrap().encode_png().unwrap();
 /// ```
 pub fn render_contact_sheet(base: &ModesFile, p: &SheetParams) -> Result<Pixmap, ExportError> {
-    let m = base.num_modes();
-    if p.modes == 0 || p.modes > m {
-        return Err(ExportError::Invalid(format!(
-            "cannot show {} modes from a base with {m}",
-            p.modes
-        )));
-    }
-    if p.columns == 0 || p.panel[0] < 64 || p.panel[1] < 64 + LABEL_H {
-        return Err(ExportError::Invalid(
-            "the sheet needs at least one column and panels of at least 64 × 86 pixels".into(),
-        ));
-    }
-    if !(p.scale > 0.0 && p.scale <= super::MAX_SCALE) {
-        return Err(ExportError::Invalid(format!(
-            "parameter `scale` (--scale) must be in (0, {}] (the largest displacement as a \
-             fraction of the bounding-box diagonal), got {}",
-            super::MAX_SCALE,
-            p.scale
-        )));
-    }
-    let cols = p.columns.min(p.modes);
-    let rows = p.modes.div_ceil(cols);
+    let (cols, rows) = sheet_grid(base, p)?;
     let (pw, ph) = (p.panel[0], p.panel[1]);
     let (w, h) = (
         (cols * pw).max(1080),
@@ -135,22 +114,87 @@ pub fn render_contact_sheet(base: &ModesFile, p: &SheetParams) -> Result<Pixmap,
         0.5 * (lo[1] + hi[1]),
         0.5 * (lo[2] + hi[2]),
     ];
-    let diag = diagonal(&surf.positions);
     let (az, el) = (p.azimuth_deg.to_radians(), p.elevation_deg.to_radians());
-    let eye0 = [el.cos() * az.sin(), el.sin(), el.cos() * az.cos()];
-    let tris = &surf.triangles;
+    let panel = PanelView {
+        surf: &surf,
+        centre,
+        diag: diagonal(&surf.positions),
+        eye0: [el.cos() * az.sin(), el.sin(), el.cos() * az.cos()],
+        size: [pw, ph - LABEL_H],
+        scale: p.scale,
+    };
     let freqs = base.frequencies_hz();
-    let ns = surf.len();
-
     for j in 0..p.modes {
         let (col, row) = (j % cols, j / cols);
+        let r = panel.render(j);
+        let (x0, y0) = (col * pw, SHEET_TITLE_H + row * ph + LABEL_H);
+        blit(&mut pix, &r, x0, y0);
+        let label = format!("mode {}  {} Hz", j + 1, format_hz(freqs[j]));
+        draw_text(
+            &mut pix,
+            &label,
+            (x0 + 8) as f32,
+            (SHEET_TITLE_H + row * ph + 3) as f32,
+            2.0,
+        );
+    }
+    draw_separators(&mut pix, [cols, rows], [pw, ph]);
+    draw_title(&mut pix, base, p);
+    draw_legend(&mut pix, p, SHEET_TITLE_H + rows * ph);
+    Ok(pix)
+}
+
+/// The sheet's (columns, rows) after checking the mode count, the panel size and the scale.
+fn sheet_grid(base: &ModesFile, p: &SheetParams) -> Result<(usize, usize), ExportError> {
+    let m = base.num_modes();
+    if p.modes == 0 || p.modes > m {
+        return Err(ExportError::Invalid(format!(
+            "cannot show {} modes from a base with {m}",
+            p.modes
+        )));
+    }
+    if p.columns == 0 || p.panel[0] < 64 || p.panel[1] < 64 + LABEL_H {
+        return Err(ExportError::Invalid(
+            "the sheet needs at least one column and panels of at least 64 × 86 pixels".into(),
+        ));
+    }
+    if !(p.scale > 0.0 && p.scale <= super::MAX_SCALE) {
+        return Err(ExportError::Invalid(format!(
+            "parameter `scale` (--scale) must be in (0, {}] (the largest displacement as a \
+             fraction of the bounding-box diagonal), got {}",
+            super::MAX_SCALE,
+            p.scale
+        )));
+    }
+    let cols = p.columns.min(p.modes);
+    Ok((cols, p.modes.div_ceil(cols)))
+}
+
+/// What every panel of a sheet shares: the surface, its centre (m) and diagonal (m), the
+/// default view direction, the picture's size in pixels (without the label) and the scale.
+struct PanelView<'a> {
+    surf: &'a ExportSurface,
+    centre: [f64; 3],
+    diag: f64,
+    eye0: [f64; 3],
+    size: [usize; 2],
+    scale: f64,
+}
+
+impl PanelView<'_> {
+    /// Mode `j`'s picture: the surface displaced by the mode (largest displacement
+    /// `scale · diag`), coloured by displacement magnitude, over its rest shape, seen from the
+    /// mode's view direction and fitted to the panel; rendered at [`SS`]× and downsampled.
+    fn render(&self, j: usize) -> Raster {
+        let (surf, centre) = (self.surf, self.centre);
+        let ns = surf.len();
         let peak = surf.mode_max_norm(j);
         let a = if peak > 0.0 {
-            p.scale * diag / peak
+            self.scale * self.diag / peak
         } else {
             0.0
         };
-        let eye = view_for_mode(&surf, j, eye0);
+        let eye = view_for_mode(surf, j, self.eye0);
         let right = normalize(if cross([0.0, 1.0, 0.0], eye) == [0.0; 3] {
             [1.0, 0.0, 0.0]
         } else {
@@ -184,13 +228,14 @@ pub fn render_contact_sheet(base: &ModesFile, p: &SheetParams) -> Result<Pixmap,
         }
         let (ext_x, ext_y) = (x1s - x0s, y1s - y0s);
         let (mid_x, mid_y) = (0.5 * (x0s + x1s), 0.5 * (y0s + y1s));
-        let ppm = 0.92 * (pw as f64 / ext_x).min((ph - LABEL_H) as f64 / ext_y);
+        let [pw, ph] = self.size;
+        let ppm = 0.92 * (pw as f64 / ext_x).min(ph as f64 / ext_y);
         let ppm = if ppm.is_finite() && ppm > 0.0 {
             ppm
         } else {
             1.0
         };
-        let (sw, sh) = (pw * SS, (ph - LABEL_H) * SS);
+        let (sw, sh) = (pw * SS, ph * SS);
         let s = ppm * SS as f64;
         let screen = |q: [f64; 3]| -> [f32; 3] {
             let d = sub(q, centre);
@@ -202,7 +247,7 @@ pub fn render_contact_sheet(base: &ModesFile, p: &SheetParams) -> Result<Pixmap,
         };
         let draw = |points: &[[f64; 3]], colour: &dyn Fn(usize) -> [f32; 3]| {
             let mut r = Raster::new(sw, sh, BG);
-            for t in tris {
+            for t in &surf.triangles {
                 let q = [
                     points[t[0] as usize],
                     points[t[1] as usize],
@@ -220,43 +265,41 @@ pub fn render_contact_sheet(base: &ModesFile, p: &SheetParams) -> Result<Pixmap,
         };
         let ghost = draw(&surf.positions, &|_| GHOST);
         let mut r = draw(&pos, &|v| col_v[v]);
-        // The rest shape shows where the displaced surface does not cover it, and its outline
-        // is drawn over the displaced surface (motion within the silhouette: stretching,
-        // twisting).
-        let covered: Vec<bool> = ghost.color.iter().map(|g| *g != BG).collect();
-        for (k, (c, g)) in r.color.iter_mut().zip(&ghost.color).enumerate() {
-            if *c == BG {
-                *c = *g;
-            } else if covered[k] {
-                let (x, y) = (k % sw, k / sw);
-                let edge = x == 0
-                    || y == 0
-                    || x + 1 == sw
-                    || y + 1 == sh
-                    || !covered[k - 1]
-                    || !covered[k + 1]
-                    || !covered[k - sw]
-                    || !covered[k + sw];
-                if edge {
-                    *c = c.map(|v| 0.35 * v + 0.65 * OUTLINE);
-                }
+        overlay_rest_shape(&mut r, &ghost, sw, sh);
+        r.downsample(SS)
+    }
+}
+
+/// The rest shape (`ghost`) shows where the displaced surface (`r`, `sw` × `sh`) does not
+/// cover it, and its outline is drawn over the displaced surface (motion within the
+/// silhouette: stretching, twisting).
+fn overlay_rest_shape(r: &mut Raster, ghost: &Raster, sw: usize, sh: usize) {
+    let covered: Vec<bool> = ghost.color.iter().map(|g| *g != BG).collect();
+    for (k, (c, g)) in r.color.iter_mut().zip(&ghost.color).enumerate() {
+        if *c == BG {
+            *c = *g;
+        } else if covered[k] {
+            let (x, y) = (k % sw, k / sw);
+            let edge = x == 0
+                || y == 0
+                || x + 1 == sw
+                || y + 1 == sh
+                || !covered[k - 1]
+                || !covered[k + 1]
+                || !covered[k - sw]
+                || !covered[k + sw];
+            if edge {
+                *c = c.map(|v| 0.35 * v + 0.65 * OUTLINE);
             }
         }
-        let r = r.downsample(SS);
-        let (x0, y0) = (col * pw, SHEET_TITLE_H + row * ph + LABEL_H);
-        blit(&mut pix, &r, x0, y0);
-        let label = format!("mode {}  {} Hz", j + 1, format_hz(freqs[j]));
-        draw_text(
-            &mut pix,
-            &label,
-            (x0 + 8) as f32,
-            (SHEET_TITLE_H + row * ph + 3) as f32,
-            2.0,
-        );
     }
-    // Thin panel separators.
+}
+
+/// Thin separators between the `[cols, rows]` panels of `[pw, ph]` pixels.
+fn draw_separators(pix: &mut Pixmap, [cols, rows]: [usize; 2], [pw, ph]: [usize; 2]) {
     let mut paint = Paint::default();
     paint.set_color_rgba8(200, 200, 200, 255);
+    let w = pix.width() as f32;
     let panels_h = (rows * ph) as f32;
     for c in 1..cols {
         if let Some(rect) = Rect::from_xywh((c * pw) as f32, SHEET_TITLE_H as f32, 1.0, panels_h) {
@@ -265,13 +308,10 @@ pub fn render_contact_sheet(base: &ModesFile, p: &SheetParams) -> Result<Pixmap,
     }
     for rr in 0..=rows {
         let y = (SHEET_TITLE_H + rr * ph) as f32;
-        if let Some(rect) = Rect::from_xywh(0.0, y, w as f32, 1.0) {
+        if let Some(rect) = Rect::from_xywh(0.0, y, w, 1.0) {
             pix.fill_rect(rect, &paint, Transform::identity(), None);
         }
     }
-    draw_title(&mut pix, base, p);
-    draw_legend(&mut pix, p, SHEET_TITLE_H + rows * ph);
-    Ok(pix)
 }
 
 /// Frequency for a label: one decimal from 1 Hz, three significant digits below.

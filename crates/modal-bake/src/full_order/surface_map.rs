@@ -1,11 +1,11 @@
 //! [`SurfaceMap`]: brute-force closest point on the extracted boundary surface, with the same
-//! conventions as `dcr_runtime::ModalModel` (triangle indices of [`crate::bake::extract_surface`],
+//! conventions as `dcr_runtime::ModalModel` (triangle indices of [`crate::mesh::extract_surface`],
 //! barycentric weights in triangle order, area-weighted vertex normals interpolated with the
 //! weights and normalised).
 
 use dcr_runtime::model::{area_weighted_normals, surface_point_on, SurfacePoint};
 
-use crate::bake::extract_surface;
+use crate::mesh::extract_surface;
 use crate::mesh::TetMesh;
 use crate::vec3::{add, dot, norm2, scale, sub};
 

@@ -136,7 +136,7 @@ fn one_side(points: &[[f64; 3]], target: &TriMesh) -> (f64, [f64; 3]) {
 /// assert!(d.mesh_to_asset_m > 1.0); // the box's bottom is far from the asset
 /// ```
 pub fn surface_distance(asset: &SurfaceMesh, mesh: &TetMesh) -> SurfaceDistance {
-    let (_, boundary) = crate::bake::extract_surface(mesh);
+    let (_, boundary) = super::extract_surface(mesh);
     let bbox = asset.bounding_box();
     let diag = (0..3)
         .map(|k| (bbox[1][k] - bbox[0][k]).powi(2))

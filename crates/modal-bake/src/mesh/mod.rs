@@ -22,6 +22,7 @@
 //! their line, byte offset or element ids. Every error is a [`MeshError`] naming the file.
 
 mod asset;
+mod boundary;
 mod cursor;
 mod distance;
 pub mod ftetwild;
@@ -40,6 +41,7 @@ pub mod work;
 use std::path::Path;
 
 pub use asset::mesh_asset;
+pub use boundary::extract_surface;
 pub use distance::{surface_distance, SurfaceDistance};
 pub use mesh_error::{Location, MeshError, MeshErrorKind};
 pub use mesher::{

@@ -30,12 +30,14 @@ use dcr_runtime::filter::{samples_per_step, Sampling};
 use dcr_runtime::format::{AccuracyRecord, ModesFile};
 use dcr_runtime::{Method, ModalModel};
 
-use crate::bake::{bake_mesh, BakeError, BakeParams, BakeReport, BakeStage, ModeRequest};
+use crate::bake::{
+    bake_mesh, mode_set_from_dense, mode_set_lanczos, BakeError, BakeParams, BakeReport,
+    BakeStage, ModeRequest,
+};
 use crate::full_order::{FullOrderSystem, ModalAll, SystemParams};
 use crate::mesh::TetMesh;
 use crate::transfer::{
-    build_transfer_table, mode_set_from_dense, mode_set_lanczos, select_region, TableOrder,
-    TransferError, TransferModes, TransferParams, AUTO_LANCZOS_MODES, DENSE_MAX_DOFS, UP_MIN_COS,
+    build_transfer_table, select_region, TableOrder, TransferError, TransferModes, TransferParams, AUTO_LANCZOS_MODES, DENSE_MAX_DOFS, UP_MIN_COS,
 };
 
 /// Modal candidates (modes), cheapest first.
@@ -156,7 +158,7 @@ pub fn bake_to_target(
     };
     let set = match &ma {
         Some(m) => mode_set_from_dense(&base20, &sys, m, m.eigenvalues.len()),
-        None => mode_set_lanczos(&mesh, &base_params, AUTO_LANCZOS_MODES, file).map_err(terr)?,
+        None => mode_set_lanczos(&mesh, &base_params, AUTO_LANCZOS_MODES, file)?,
     };
     let pp = PairsParams {
         h: transfer.h,

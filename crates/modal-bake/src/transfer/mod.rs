@@ -12,15 +12,14 @@
 //! `dcr_runtime::Method::Transfer`.
 //!
 //! The mode set is any base-shaped [`ModesFile`](dcr_runtime::format::ModesFile) holding many
-//! modes (surface rows of U): from the dense all-mode eigensolve ([`mode_set_dense`], small
-//! meshes) or a Lanczos bake with many modes ([`mode_set_lanczos`]).
+//! modes (surface rows of U): from the dense all-mode eigensolve
+//! ([`mode_set_dense`](crate::bake::mode_set_dense), small meshes) or a Lanczos bake with many
+//! modes ([`mode_set_lanczos`](crate::bake::mode_set_lanczos)).
 
-mod mode_set;
 mod region;
 mod table_builder;
 mod transfer_params;
 
-pub use mode_set::{mode_set_dense, mode_set_from_dense, mode_set_lanczos};
 pub use region::{select_region, RegionBox};
 pub use table_builder::{build_transfer_table, CLUSTER_BYTES};
 pub use transfer_params::{

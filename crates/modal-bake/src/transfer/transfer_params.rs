@@ -1,7 +1,6 @@
 //! [`TransferParams`]: what a peak-transfer table tabulates, and the errors and progress of a
 //! build.
 
-use crate::bake::BakeError;
 use crate::full_order::FullOrderError;
 
 /// Default oversampling of the table's peak search: T = π/(2 ω_max) for its highest mode (the
@@ -181,7 +180,4 @@ pub enum TransferError {
     /// The dense eigensolve for the table's modes failed.
     #[error("transfer table modes: {0}")]
     FullOrder(#[from] FullOrderError),
-    /// The Lanczos bake for the table's modes failed.
-    #[error("transfer table modes: {0}")]
-    Bake(Box<BakeError>),
 }

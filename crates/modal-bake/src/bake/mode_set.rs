@@ -1,11 +1,12 @@
-//! The many-mode sets a transfer table is built from: the dense all-mode eigensolve (small
-//! meshes) or a Lanczos bake with many modes, as base-shaped [`ModesFile`]s.
+//! The many-mode sets a transfer table ([`crate::transfer`]) is built from: the dense all-mode
+//! eigensolve (small meshes) or a Lanczos bake with many modes, as base-shaped
+//! [`ModesFile`]s. They live with the bake because the second one is a bake.
 
 use dcr_runtime::format::ModesFile;
 
-use super::{TransferError, TransferModes, DENSE_MAX_DOFS};
-use crate::bake::{bake_mesh, BakeParams, ModeRequest};
+use super::{bake_mesh, BakeError, BakeParams, ModeRequest};
 use crate::full_order::{FullOrderSystem, ModalAll, SystemParams};
+use crate::transfer::{TransferError, TransferModes, DENSE_MAX_DOFS};
 use crate::mesh::TetMesh;
 
 /// A base-shaped mode set (surface rows of U) of the lowest `modes` dense eigenpairs, in the
@@ -64,13 +65,13 @@ pub fn mode_set_from_dense(
 /// A mode set of the lowest `n` modes from a Lanczos bake of `mesh` with `params`.
 ///
 /// # Errors
-/// [`TransferError::Bake`] when that bake fails (e.g. the eigensolver does not converge).
+/// [`BakeError::TransferModes`] when that bake fails (e.g. the eigensolver does not converge).
 pub fn mode_set_lanczos(
     mesh: &TetMesh,
     params: &BakeParams,
     n: usize,
     file: &str,
-) -> Result<ModesFile, TransferError> {
+) -> Result<ModesFile, BakeError> {
     let p = BakeParams {
         modes: ModeRequest::Count(n),
         transfer: None,
@@ -78,5 +79,8 @@ pub fn mode_set_lanczos(
     };
     bake_mesh(mesh.clone(), &p, file, &mut |_| {})
         .map(|(b, _)| b)
-        .map_err(|e| TransferError::Bake(Box::new(e)))
+        .map_err(|e| BakeError::TransferModes {
+            file: file.to_string(),
+            error: Box::new(e),
+        })
 }

@@ -1,5 +1,7 @@
 //! A point mapped onto the model's surface, and the surface conventions every mapper shares:
-//! area-weighted vertex normals and the point at barycentric weights of a triangle.
+//! area-weighted vertex normals and the point at barycentric weights of a triangle. Below both
+//! [`crate::model`] (which re-exports these items) and [`crate::attenuation`] (whose geodesics
+//! start from a [`SurfacePoint`]), so neither depends on the other for them.
 
 use crate::math::{add, cross, norm, normalize, scale, sub};
 
