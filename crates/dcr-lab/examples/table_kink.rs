@@ -23,9 +23,9 @@ use dcr_lab::accuracy::{
     all_objects, base20, load_mesh, pairs_params, system_params, Base20, H, IMPACTS,
 };
 use dcr_runtime::{Method, ModalModel, RestingContact};
+use modal_bake::bake::mode_set_from_dense;
 use modal_bake::full_order::{FullOrderSystem, ModalAll};
 use modal_bake::target_error::ReferencePairs;
-use modal_bake::bake::mode_set_from_dense;
 use modal_bake::transfer::{build_transfer_table, TransferModes, TransferParams, DENSE_MAX_DOFS};
 
 fn main() -> anyhow::Result<()> {

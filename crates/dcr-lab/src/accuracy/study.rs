@@ -9,15 +9,16 @@ use std::time::Instant;
 use dcr_runtime::format::ModesFile;
 use dcr_runtime::{DistantResponse, Impact, Method, ModalModel, RestingContact, ServedBy};
 use modal_bake::bake::{bake_mesh, BakeError, BakeParams, ModeRequest};
+use modal_bake::bake::{mode_set_from_dense, mode_set_lanczos};
 use modal_bake::full_order::{
     converged_peaks, ConvergedPeaks, FullOrderSystem, ModalAll, PeakSolver, PeakWindow,
     RefineParams, SystemParams,
 };
 use modal_bake::mesh::TetMesh;
 use modal_bake::target_error::{PairsParams, ReferencePairs};
-use modal_bake::bake::{mode_set_from_dense, mode_set_lanczos};
 use modal_bake::transfer::{
-    build_transfer_table, select_region, TableOrder, TransferModes, TransferParams, AUTO_LANCZOS_MODES, DENSE_MAX_DOFS, UP_MIN_COS,
+    build_transfer_table, select_region, TableOrder, TransferModes, TransferParams,
+    AUTO_LANCZOS_MODES, DENSE_MAX_DOFS, UP_MIN_COS,
 };
 
 use super::objects::ObjectSpec;

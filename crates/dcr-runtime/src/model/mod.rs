@@ -8,11 +8,11 @@
 mod load_error;
 mod modal_model;
 
-pub use load_error::LoadError;
-pub use modal_model::ModalModel;
 pub use crate::surface_point::{
     area_weighted_normals, quadratic_triangle_weights, surface_point_on, SurfacePoint,
 };
+pub use load_error::LoadError;
+pub use modal_model::ModalModel;
 
 #[cfg(test)]
 mod tests;

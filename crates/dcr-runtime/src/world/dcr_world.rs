@@ -852,7 +852,6 @@ impl DcrWorld {
         self.object_at(body)
             .filter(|&o| self.objects[o as usize].enabled)
     }
-
 }
 
 /// `M v` for a row-major 3 × 3 matrix.

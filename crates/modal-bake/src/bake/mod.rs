@@ -23,6 +23,8 @@ mod surface;
 
 pub use dcr_runtime::format::{MaterialSi, ModesFile, ModesPrecision};
 
+/// The boundary surface of a tetrahedral mesh (defined in [`crate::mesh`]).
+pub use crate::mesh::extract_surface;
 pub use error::BakeError;
 pub use estimate::{
     format_bytes, format_count, format_seconds, Budget, SizeEstimate, SurfaceMeasures,
@@ -39,5 +41,3 @@ pub use plausibility::{
 };
 pub use report::{BakeReport, BakeStage, TransferReport};
 pub use staleness::{base_status, is_mesh_up_to_date, is_up_to_date, mesh_base_status, BaseStatus};
-/// The boundary surface of a tetrahedral mesh (defined in [`crate::mesh`]).
-pub use crate::mesh::extract_surface;

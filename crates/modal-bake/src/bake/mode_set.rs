@@ -6,8 +6,8 @@ use dcr_runtime::format::ModesFile;
 
 use super::{bake_mesh, BakeError, BakeParams, ModeRequest};
 use crate::full_order::{FullOrderSystem, ModalAll, SystemParams};
-use crate::transfer::{TransferError, TransferModes, DENSE_MAX_DOFS};
 use crate::mesh::TetMesh;
+use crate::transfer::{TransferError, TransferModes, DENSE_MAX_DOFS};
 
 /// A base-shaped mode set (surface rows of U) of the lowest `modes` dense eigenpairs, in the
 /// layout of `template` (a base baked from the same mesh and options: same surface order).

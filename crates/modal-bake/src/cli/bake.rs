@@ -298,7 +298,11 @@ pub fn check_args(args: &BakeArgs) -> anyhow::Result<AssetOptions> {
     if let Some(w) = args.options.model.default_material_warning() {
         eprintln!("warning: {w}");
     }
-    Ok(asset_for(&args.asset, args.transfer.transfer_h.is_some(), &args.mesh))
+    Ok(asset_for(
+        &args.asset,
+        args.transfer.transfer_h.is_some(),
+        &args.mesh,
+    ))
 }
 
 /// `bake` without `--target-error` (after [`check_args`]): reads or meshes the input, bakes

@@ -173,7 +173,11 @@ fn info_json(file: &Path, base: &ModesFile, warnings: &[String]) -> serde_json::
 }
 
 /// `info`: the base's summary as text, then the warnings and the mode table.
-fn info_text(file: &Path, base: &ModesFile, warnings: &[String]) -> Result<String, std::fmt::Error> {
+fn info_text(
+    file: &Path,
+    base: &ModesFile,
+    warnings: &[String],
+) -> Result<String, std::fmt::Error> {
     let mut out = String::new();
     write_model(&mut out, file, base)?;
     write_surface(&mut out, base)?;

@@ -279,7 +279,9 @@ pub fn solve_lowest(
     let n = k.nrows();
     check_input(k, m, params)?;
     let sigma = params.shift;
-    let lam_lim = params.max_freq_hz.map(|f| (2.0 * std::f64::consts::PI * f).powi(2));
+    let lam_lim = params
+        .max_freq_hz
+        .map(|f| (2.0 * std::f64::consts::PI * f).powi(2));
     let par = match params.threads {
         0 if n < AUTO_SEQ_BELOW => Par::Seq,
         t => Par::rayon(t),

@@ -31,13 +31,14 @@ use dcr_runtime::format::{AccuracyRecord, ModesFile};
 use dcr_runtime::{Method, ModalModel};
 
 use crate::bake::{
-    bake_mesh, mode_set_from_dense, mode_set_lanczos, BakeError, BakeParams, BakeReport,
-    BakeStage, ModeRequest,
+    bake_mesh, mode_set_from_dense, mode_set_lanczos, BakeError, BakeParams, BakeReport, BakeStage,
+    ModeRequest,
 };
 use crate::full_order::{FullOrderSystem, ModalAll, SystemParams};
 use crate::mesh::TetMesh;
 use crate::transfer::{
-    build_transfer_table, select_region, TableOrder, TransferError, TransferModes, TransferParams, AUTO_LANCZOS_MODES, DENSE_MAX_DOFS, UP_MIN_COS,
+    build_transfer_table, select_region, TableOrder, TransferError, TransferModes, TransferParams,
+    AUTO_LANCZOS_MODES, DENSE_MAX_DOFS, UP_MIN_COS,
 };
 
 /// Modal candidates (modes), cheapest first.

@@ -136,7 +136,6 @@ impl DcrWorld {
         }
     }
 
-
     /// Forgets the ids absent long enough to be new anyway, every [`PURGE_EVERY`] steps (a
     /// bounded table that stops growing once warm).
     pub(super) fn purge_ages(&mut self, step: u64) {

@@ -39,7 +39,11 @@ pub(super) struct Expansion<'a> {
 impl Expansion<'_> {
     /// Start block: a random block mapped into the range of T (z ← A⁻¹Mz), deflated twice
     /// against the locked vectors, M-orthonormalised and stored as the basis's first block.
-    pub(super) fn start(&mut self, basis: &mut KrylovBasis, info: &mut EigenInfo) -> Result<(), EigenError> {
+    pub(super) fn start(
+        &mut self,
+        basis: &mut KrylovBasis,
+        info: &mut EigenInfo,
+    ) -> Result<(), EigenError> {
         let (n, b) = (self.z.nrows(), self.z.ncols());
         let (locked, mlocked) = self.deflation;
         for j in 0..b {

@@ -58,7 +58,13 @@ impl KrylovBasis {
 
     /// Thick restart: keeps the best p Ritz vectors of the `kk`-column basis plus its newest
     /// block, H becoming diag(θ) with the newest block's coupling row. Returns p.
-    pub(super) fn thick_restart(&mut self, ritz: &RitzEstimates, kk: usize, wanted: usize, b: usize) -> usize {
+    pub(super) fn thick_restart(
+        &mut self,
+        ritz: &RitzEstimates,
+        kk: usize,
+        wanted: usize,
+        b: usize,
+    ) -> usize {
         let (n, ncv, cap) = (self.v.nrows(), self.ncv, self.cap);
         let p = (wanted + (kk - wanted) / 2)
             .min(ncv - b)
