@@ -19,11 +19,10 @@ use dcr_lab::accuracy::{
     H,
 };
 use dcr_runtime::{Method, ModalModel};
+use modal_bake::bake::mode_set_from_dense;
 use modal_bake::full_order::{FullOrderSystem, ModalAll, PeakSolver};
 use modal_bake::target_error::ReferencePairs;
-use modal_bake::transfer::{
-    build_transfer_table, mode_set_from_dense, TransferModes, TransferParams,
-};
+use modal_bake::transfer::{build_transfer_table, TransferModes, TransferParams};
 
 fn main() -> anyhow::Result<()> {
     let name = std::env::args().nth(1).unwrap_or_else(|| "cliff".into());

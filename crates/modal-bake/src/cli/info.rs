@@ -147,8 +147,8 @@ fn info_json(file: &Path, base: &ModesFile, warnings: &[String]) -> serde_json::
         "fixed_nodes": base.fixed_nodes.len(),
         "rigid_modes_excluded": base.meta.rigid_modes_excluded,
         "mass_kg": base.meta.mass_kg,
-        "material": {"name": material_name(&base), "youngs_pa": base.material.youngs, "poisson": base.material.poisson, "density_kg_m3": base.material.density},
-        "fixed_by": selectors(&base),
+        "material": {"name": material_name(base), "youngs_pa": base.material.youngs, "poisson": base.material.poisson, "density_kg_m3": base.material.density},
+        "fixed_by": selectors(base),
         "warnings": warnings,
         "rayleigh": base.rayleigh,
         "precision": base.precision,
@@ -202,7 +202,7 @@ fn write_model(out: &mut String, file: &Path, base: &ModesFile) -> std::fmt::Res
     writeln!(
         out,
         "  material: {}: E {:.4e} Pa, ν {}, ρ {} kg/m³; mass {:.6} kg",
-        material_name(&base),
+        material_name(base),
         base.material.youngs,
         base.material.poisson,
         base.material.density,
@@ -222,7 +222,7 @@ fn write_model(out: &mut String, file: &Path, base: &ModesFile) -> std::fmt::Res
             base.meta.rigid_modes_excluded
         )?;
     } else {
-        let sel = selectors(&base);
+        let sel = selectors(base);
         writeln!(
             out,
             "  fixed: {} nodes{}{}",
