@@ -149,7 +149,10 @@ fn despawning_the_table_mid_run_removes_its_object() {
     assert_eq!(ctx.entity_of(handle), None);
     let status = app.world().resource::<DcrStatus>();
     assert_eq!(status.refused_steps, 0, "{status:?}");
-    assert!(status.steps >= steps_before + u64::from(100 - first) - 1, "{status:?}");
+    assert!(
+        status.steps >= steps_before + u64::from(100 - first) - 1,
+        "{status:?}"
+    );
     let logged = LOGGED.lock().unwrap();
     let new: Vec<&String> = logged[logged_before..]
         .iter()
