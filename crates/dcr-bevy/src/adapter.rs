@@ -48,6 +48,12 @@ impl DcrContext {
         self.dcr.step_info()
     }
 
+    /// The world's step h (s): the plugin's at build, then bevy_rapier's `dt` (the plugin
+    /// follows a change of `TimestepMode::Fixed { dt, substeps: 1 }`).
+    pub fn h(&self) -> f64 {
+        self.dcr.world().params().h
+    }
+
     /// The elastic entity of `handle`, if it is one of this context's objects.
     pub fn entity_of(&self, handle: ElasticHandle) -> Option<Entity> {
         self.objects
@@ -69,6 +75,68 @@ impl DcrContext {
         let handle = self.dcr.add_object(bodies, colliders, body, desc)?;
         self.objects.push((handle, entity));
         Ok(handle)
+    }
+
+    /// Removes the elastic objects whose entity no longer satisfies `keep` (despawned, or its
+    /// [`crate::DcrElastic`] removed): their handles become stale and their bodies' contacts
+    /// are no longer read. Returns how many were removed. No allocation.
+    pub(crate) fn remove_objects_unless(&mut self, mut keep: impl FnMut(Entity) -> bool) -> usize {
+        let mut removed = 0;
+        let mut k = 0;
+        while k < self.objects.len() {
+            let (handle, entity) = self.objects[k];
+            if keep(entity) {
+                k += 1;
+                continue;
+            }
+            if let Err(e) = self.dcr.remove_object(handle) {
+                // Only a handle this context never held could fail; it is dropped all the same.
+                log::error!("dcr-bevy: removing the elastic object of entity {entity}: {e}");
+            }
+            self.objects.remove(k);
+            removed += 1;
+        }
+        removed
+    }
+
+    /// Applies an elastic object's run-time settings from the next step on: enabled or
+    /// disabled, gain (dimensionless, ≥ 0), impact threshold (N·s, ≥ 0).
+    ///
+    /// # Errors
+    /// A stale handle, or a gain or threshold out of range (the message names it); the
+    /// settings before the bad one are applied.
+    pub(crate) fn apply_settings(
+        &mut self,
+        handle: ElasticHandle,
+        enabled: bool,
+        gain: f64,
+        threshold: f64,
+    ) -> Result<(), AdapterError> {
+        if !self.dcr.world().contains(handle) {
+            // The adapter's stale-handle error (the world's getters below panic on one).
+            return self.dcr.set_object_gain(handle, gain);
+        }
+        if self.dcr.world().is_enabled(handle) != enabled {
+            self.dcr.set_object_enabled(handle, enabled)?;
+        }
+        if self.dcr.world().gain(handle) != gain {
+            self.dcr.set_object_gain(handle, gain)?;
+        }
+        if self.dcr.world().impact_threshold(handle) != threshold {
+            self.dcr.set_object_threshold(handle, threshold)?;
+        }
+        Ok(())
+    }
+
+    /// The per-step rails: the world's step follows rapier's `dt` (s) — responses re-derived
+    /// for a new dt, with a warning once per change — and its gravity (m/s², world) follows
+    /// bevy_rapier's, for the support of impulses applied after the step. Returns whether the
+    /// world's h now equals `dt` (false when a response cannot serve it: a transfer table
+    /// under `TablePolicy::Refuse`, logged as an error by the adapter).
+    pub(crate) fn sync(&mut self, dt: f64, gravity: Vec3) -> bool {
+        self.dcr.sync_timestep(dt);
+        self.dcr.set_gravity(gravity);
+        crate::systems::same_step(dt, self.dcr.world().params().h)
     }
 
     /// Before rapier's step (does something only under the in-solver application mode, which

@@ -14,8 +14,15 @@ use crate::ModesAsset;
 /// base was baked from should be, and give it the collision shapes in the mesh's frame. The
 /// plugin adds the object once the base has loaded and bevy_rapier has created the body
 /// (the object's pose is then the body's pose; a dynamic body's pose is read every step), and
-/// inserts [`DcrObject`] (or [`DcrElasticFailed`]). Changing the component afterwards has no
-/// effect. Kinematic bodies are refused by the world's rules (they never respond).
+/// inserts [`DcrObject`] (or [`DcrElasticFailed`]). Kinematic bodies are refused by the
+/// world's rules (they never respond).
+///
+/// At run time, from the next physics step on: changing `enabled`, `gain` or
+/// `response.impact_threshold` changes the object (a disabled object ignores its contacts and
+/// issues no response; enabled again, its filters restart at rest); removing the component or
+/// despawning the entity removes the object from the world (its [`DcrObject`] handle goes
+/// stale; inserting a `DcrElastic` again adds a new object). The other fields (`base`, the rest
+/// of `response`) are read once, when the object is added.
 ///
 /// ```
 /// # use bevy::prelude::*;
@@ -38,21 +45,25 @@ pub struct DcrElastic {
     /// Scale of the velocity changes the responses ask for (dimensionless, ≥ 0). Default 1 (the
     /// paper's response).
     pub gain: f64,
+    /// Whether the object responds (default true); false keeps it in the world, silent.
+    pub enabled: bool,
 }
 
 impl DcrElastic {
-    /// An elastic object with base `base`, the default response parameters and gain 1.
+    /// An enabled elastic object with base `base`, the default response parameters and gain 1.
     pub fn new(base: Handle<ModesAsset>) -> DcrElastic {
         DcrElastic {
             base,
             response: ResponseParams::default(),
             gain: 1.0,
+            enabled: true,
         }
     }
 }
 
 /// Inserted by the plugin on a [`DcrElastic`] entity once its object is in the world: its
-/// handle in [`crate::DcrContext::world`] (counters: `world().object_info(handle)`).
+/// handle in [`crate::DcrContext::world`] (counters: `world().object_info(handle)`). Removed
+/// by the plugin with the object when the entity's [`DcrElastic`] is removed.
 #[derive(Component, Clone, Copy, Debug, PartialEq, Eq)]
 pub struct DcrObject(pub ElasticHandle);
 

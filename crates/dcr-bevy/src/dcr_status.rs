@@ -7,16 +7,18 @@ use bevy::prelude::Resource;
 #[derive(Clone, Debug, PartialEq)]
 #[non_exhaustive]
 pub enum DcrRefusal {
-    /// bevy_rapier's `TimestepMode` is not `Fixed { dt: h, substeps: 1 }`: a variable or
-    /// interpolated step, or substeps, would step rapier by something else than the world's
-    /// `h` (s) per call.
+    /// bevy_rapier's `TimestepMode` is not `Fixed { dt, substeps: 1 }`: a variable or
+    /// interpolated step, or substeps, would step rapier by something else than one fixed
+    /// step per fixed update.
     TimestepMode {
         /// The mode found (its `Debug` text).
         found: String,
         /// The world's step (s).
         h: f64,
     },
-    /// rapier's `integration_parameters.dt` after the step (s) is not the world's `h` (s).
+    /// rapier stepped by `dt` (s) and the world cannot follow: a response cannot be
+    /// re-derived for it (a transfer table baked for the world's `h` under
+    /// `TablePolicy::Refuse`), so the world keeps `h` (s).
     StepLength {
         /// rapier's dt (s).
         dt: f64,
@@ -45,7 +47,8 @@ impl std::fmt::Display for DcrRefusal {
             ),
             DcrRefusal::StepLength { dt, h } => write!(
                 f,
-                "rapier stepped by dt = {dt} s but the world's h is {h} s: set \
+                "rapier stepped by dt = {dt} s but the world's responses cannot be re-derived \
+                 for it (a transfer table baked for h = {h} s): set \
                  `TimestepMode::Fixed {{ dt: {h}, substeps: 1 }}`"
             ),
             DcrRefusal::NotStepped => write!(
@@ -65,7 +68,8 @@ impl std::fmt::Display for DcrRefusal {
 /// What the plugin did with the fixed updates so far.
 #[derive(Resource, Clone, Debug, Default, PartialEq)]
 pub struct DcrStatus {
-    /// Fixed updates on which the response ran after rapier's step.
+    /// Fixed updates on which the response ran after rapier's step (the adapter's counters:
+    /// [`crate::DcrContext::step_info`]).
     pub steps: u64,
     /// Fixed updates on which the plugin refused to run the response (see `last_refusal`).
     pub refused_steps: u64,

@@ -46,11 +46,16 @@ pub enum DcrPluginError {
 /// Requirements, which the plugin sets or checks:
 /// - bevy_rapier runs in `FixedUpdate`
 ///   (`RapierPhysicsPlugin::<NoUserData>::default().in_fixed_schedule()`), one rapier step of
-///   the world's `h` (s) per fixed update: at build the plugin inserts
+///   fixed length per fixed update: at build the plugin inserts
 ///   `TimestepMode::Fixed { dt: h, substeps: 1 }` and `Time::<Fixed>::from_seconds(h)`. A fixed
 ///   update on which rapier was not stepped between [`DcrSet::BeforeStep`] and
-///   [`DcrSet::AfterStep`], or stepped by another length, is refused: no response, an error
-///   logged once, counted in [`DcrStatus::refused_steps`] with the reason.
+///   [`DcrSet::AfterStep`], or stepped with substeps or a variable step, is refused: no
+///   response, an error logged once, counted in [`DcrStatus::refused_steps`] with the reason.
+/// - The world follows bevy_rapier: every step its h becomes rapier's `dt` (another
+///   `TimestepMode::Fixed { dt, substeps: 1 }` re-derives the responses for it, with a warning
+///   once per change; a base whose transfer table cannot serve it is refused, as the world's
+///   table policy says) and its gravity `RapierConfiguration::gravity` (the support of
+///   impulses applied after the step).
 /// - bevy's `AssetPlugin` (added at `finish` if missing) for the [`ModesAsset`] loader.
 ///
 /// The impulses are applied in rapier's body set after the step and before bevy_rapier's
@@ -95,7 +100,8 @@ impl DcrPlugin {
         })
     }
 
-    /// The world's step (s): bevy_rapier's fixed `dt` and the fixed-update period.
+    /// The world's step at build (s): bevy_rapier's fixed `dt` and the fixed-update period the
+    /// plugin inserts.
     pub fn h(&self) -> f64 {
         self.h
     }
@@ -109,10 +115,7 @@ impl Plugin for DcrPlugin {
             return;
         };
         app.insert_resource(context)
-            .insert_resource(StepGuard {
-                h: self.h,
-                before: None,
-            })
+            .init_resource::<StepGuard>()
             .init_resource::<DcrStatus>()
             .insert_resource(TimestepMode::Fixed {
                 dt: self.h as f32,

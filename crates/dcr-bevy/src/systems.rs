@@ -1,12 +1,14 @@
 //! The plugin's two systems, on either side of bevy_rapier's step in `FixedUpdate`.
 //!
 //! [`dcr_before_step`] (in [`crate::DcrSet::BeforeStep`], after bevy_rapier's
-//! `PhysicsSet::SyncBackend`) adds the elastic objects whose base has loaded and whose body
-//! exists, and remembers the change tick. [`dcr_after_step`] (in [`crate::DcrSet::AfterStep`],
-//! after `PhysicsSet::StepSimulation` and **before** `PhysicsSet::Writeback`) checks that rapier
-//! was stepped once by the world's `h`, reads the contacts, steps the world and applies its
-//! impulses in rapier's body set, so that the writeback copies them into the `Velocity`
-//! components. An impulse applied after the writeback would be lost for a body with a
+//! `PhysicsSet::SyncBackend`) removes the objects whose entity was despawned or lost its
+//! [`DcrElastic`], applies changed run-time settings (enabled, gain, impact threshold), adds
+//! the elastic objects whose base has loaded and whose body exists, and remembers the change
+//! tick. [`dcr_after_step`] (in [`crate::DcrSet::AfterStep`], after
+//! `PhysicsSet::StepSimulation` and **before** `PhysicsSet::Writeback`) checks that rapier was
+//! stepped once by a fixed step, makes the world's h and gravity bevy_rapier's, reads the
+//! contacts, steps the world and applies its impulses in rapier's body set, so that the
+//! writeback copies them into the `Velocity` components. An impulse applied after the writeback would be lost for a body with a
 //! `Velocity` component: the next `SyncBackend` sees the component changed (by the writeback)
 //! and sets the body's velocity back to it.
 
@@ -18,18 +20,16 @@ use bevy_rapier3d::prelude::{
     DefaultRapierContext, RapierConfiguration, RapierContextColliders, RapierContextSimulation,
     RapierRigidBodyHandle, RapierRigidBodySet, RigidBody, TimestepMode,
 };
-use dcr_rapier::ElasticObjectDesc;
+use dcr_rapier::{ElasticHandle, ElasticObjectDesc};
 
 use crate::{
     DcrContext, DcrElastic, DcrElasticFailed, DcrObject, DcrRefusal, DcrResponse, DcrStatus,
     ModesAsset,
 };
 
-/// The change tick of the last [`dcr_before_step`] run, and the world's step.
-#[derive(Resource, Debug)]
+/// The change tick of the last [`dcr_before_step`] run.
+#[derive(Resource, Debug, Default)]
 pub(crate) struct StepGuard {
-    /// The world's step (s).
-    pub h: f64,
     /// `this_run` of the last [`dcr_before_step`].
     pub before: Option<Tick>,
 }
@@ -37,11 +37,14 @@ pub(crate) struct StepGuard {
 /// Relative tolerance of the step-length checks (f32 rounding of `h`).
 const DT_TOLERANCE: f64 = 1e-6;
 
-fn same_step(dt: f64, h: f64) -> bool {
+/// Whether two step lengths (s) are the same step, to f32 precision.
+pub(crate) fn same_step(dt: f64, h: f64) -> bool {
     (dt - h).abs() <= DT_TOLERANCE * h
 }
 
-/// Adds the elastic objects that are ready, then runs the adapter's before-step half.
+/// Removes the objects of despawned entities and of entities whose [`DcrElastic`] was removed,
+/// applies changed run-time settings, adds the elastic objects that are ready, then runs the
+/// adapter's before-step half.
 #[allow(clippy::type_complexity)]
 // A Bevy system takes each resource and query it reads as its own parameter.
 #[allow(clippy::too_many_arguments)]
@@ -52,6 +55,15 @@ pub(crate) fn dcr_before_step(
     ticks: SystemChangeTick,
     assets: Res<Assets<ModesAsset>>,
     server: Res<AssetServer>,
+    elastic: Query<(), With<DcrElastic>>,
+    orphans: Query<
+        Entity,
+        (
+            Or<(With<DcrObject>, With<DcrElasticFailed>)>,
+            Without<DcrElastic>,
+        ),
+    >,
+    changed: Query<(Entity, &DcrElastic, &DcrObject), Changed<DcrElastic>>,
     pending: Query<
         (
             Entity,
@@ -67,6 +79,16 @@ pub(crate) fn dcr_before_step(
     >,
 ) {
     guard.before = Some(ticks.this_run());
+    // Despawned, or DcrElastic removed: the object leaves the world (its handle goes stale).
+    dcr.remove_objects_unless(|entity| elastic.contains(entity));
+    for entity in &orphans {
+        commands
+            .entity(entity)
+            .remove::<(DcrObject, DcrElasticFailed)>();
+    }
+    for (entity, el, object) in &changed {
+        apply_settings(&mut dcr, entity, el, object.0);
+    }
     let Ok((mut bodies, mut colliders)) = context.single_mut() else {
         return;
     };
@@ -101,6 +123,7 @@ pub(crate) fn dcr_before_step(
             desc,
         ) {
             Ok(handle) => {
+                apply_settings(&mut dcr, entity, elastic, handle);
                 commands.entity(entity).insert(DcrObject(handle));
             }
             Err(e) => fail(&mut commands, e.to_string()),
@@ -109,7 +132,25 @@ pub(crate) fn dcr_before_step(
     dcr.before_step(&mut bodies.bodies);
 }
 
-/// Checks the step, reads rapier's contacts, steps the world, applies its impulses before
+/// Makes the object's run-time settings those of its component; an error (a value out of
+/// range) is logged, naming the entity.
+fn apply_settings(
+    dcr: &mut DcrContext,
+    entity: Entity,
+    elastic: &DcrElastic,
+    handle: ElasticHandle,
+) {
+    if let Err(e) = dcr.apply_settings(
+        handle,
+        elastic.enabled,
+        elastic.gain,
+        elastic.response.impact_threshold,
+    ) {
+        log::error!("dcr-bevy: elastic entity {entity}: its DcrElastic settings: {e}");
+    }
+}
+
+/// Checks the step, makes the world's h and gravity bevy_rapier's, reads rapier's contacts, steps the world, applies its impulses before
 /// bevy_rapier's writeback and writes one [`DcrResponse`] message per impulse.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn dcr_after_step(
@@ -132,7 +173,6 @@ pub(crate) fn dcr_after_step(
     mut buffer: Local<Vec<DcrResponse>>,
     mut warned_fixed: Local<bool>,
 ) {
-    let h = guard.h;
     let refusal = 'check: {
         let Ok((sim, _, _, config)) = context.single_mut() else {
             break 'check Some(DcrRefusal::NoContext);
@@ -141,14 +181,11 @@ pub(crate) fn dcr_after_step(
             status.paused_steps += 1;
             return;
         }
-        match *mode {
-            TimestepMode::Fixed { dt, substeps: 1 } if same_step(f64::from(dt), h) => {}
-            other => {
-                break 'check Some(DcrRefusal::TimestepMode {
-                    found: format!("{other:?}"),
-                    h,
-                })
-            }
+        if !matches!(*mode, TimestepMode::Fixed { substeps: 1, .. }) {
+            break 'check Some(DcrRefusal::TimestepMode {
+                found: format!("{:?}", *mode),
+                h: dcr.h(),
+            });
         }
         let stepped = guard
             .before
@@ -156,12 +193,15 @@ pub(crate) fn dcr_after_step(
         if !stepped {
             break 'check Some(DcrRefusal::NotStepped);
         }
+        // The rails: h follows rapier's dt (responses re-derived, a warning once per change),
+        // gravity follows bevy_rapier's.
         let dt = f64::from(sim.integration_parameters.dt);
-        if !same_step(dt, h) {
-            break 'check Some(DcrRefusal::StepLength { dt, h });
+        if !dcr.sync(dt, config.gravity) {
+            break 'check Some(DcrRefusal::StepLength { dt, h: dcr.h() });
         }
         None
     };
+    let h = dcr.h();
     if let Some(reason) = refusal {
         if status.last_refusal.as_ref() != Some(&reason) {
             log::error!("dcr-bevy: response refused: {reason}");

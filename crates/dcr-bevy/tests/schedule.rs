@@ -2,6 +2,8 @@
 //!
 //! - a bevy_rapier that does not step in `FixedUpdate`, a variable timestep, or substeps are
 //!   refused (no response, the reason in `DcrStatus`);
+//! - another fixed step is followed: the world's h becomes rapier's dt; the world's gravity
+//!   is bevy_rapier's, also after it changes;
 //! - the in-solver application mode is refused at construction;
 //! - on plain bevy_rapier: an impulse given to a body with a `Velocity` component after the
 //!   writeback is lost at the next step, the same impulse given between the step and the
@@ -12,7 +14,7 @@ use bevy::time::TimeUpdateStrategy;
 use bevy_rapier3d::prelude::*;
 use dcr_bevy::dcr_rapier::f32::{AdapterParams, ApplyMode};
 use dcr_bevy::dcr_rapier::WorldParams;
-use dcr_bevy::{DcrPlugin, DcrPluginError, DcrRefusal, DcrStatus};
+use dcr_bevy::{DcrContext, DcrPlugin, DcrPluginError, DcrRefusal, DcrStatus};
 
 const H: f64 = 0.01;
 
@@ -83,10 +85,6 @@ fn a_variable_timestep_or_substeps_are_refused() {
             dt: H as f32,
             substeps: 2,
         },
-        TimestepMode::Fixed {
-            dt: 1.0 / 60.0,
-            substeps: 1,
-        },
     ] {
         let mut app = app(RapierPhysicsPlugin::default().in_fixed_schedule());
         app.insert_resource(mode);
@@ -98,6 +96,36 @@ fn a_variable_timestep_or_substeps_are_refused() {
             "{mode:?}: {s:?}"
         );
     }
+}
+
+#[test]
+fn the_world_follows_rapiers_fixed_step_and_gravity() {
+    let mut app = app(RapierPhysicsPlugin::default().in_fixed_schedule());
+    let s = status_after(&mut app, 3);
+    assert_eq!(s.refused_steps, 0, "{s:?}");
+    let dcr = app.world().resource::<DcrContext>();
+    assert_eq!(dcr.h(), H);
+    // bevy_rapier's default gravity, for the support of impulses applied after the step.
+    assert_eq!(
+        dcr.world().params().gravity,
+        [0.0, f64::from(-9.81f32), 0.0]
+    );
+
+    // Another fixed step and another gravity: followed from the next step on.
+    let dt = 1.0f32 / 60.0;
+    app.insert_resource(TimestepMode::Fixed { dt, substeps: 1 });
+    let world = app.world_mut();
+    let mut configs = world.query::<&mut RapierConfiguration>();
+    configs
+        .single_mut(world)
+        .expect("one rapier context")
+        .gravity = Vec3::new(0.0, 0.0, -3.5);
+    let s = status_after(&mut app, 3);
+    assert_eq!(s.refused_steps, 0, "{s:?}");
+    assert!(s.steps >= 5, "{s:?}");
+    let dcr = app.world().resource::<DcrContext>();
+    assert_eq!(dcr.h(), f64::from(dt));
+    assert_eq!(dcr.world().params().gravity, [0.0, 0.0, -3.5]);
 }
 
 #[test]

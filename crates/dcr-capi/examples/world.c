@@ -1,14 +1,15 @@
 /*
  * world: drives the dcr world API for a few rigid-body steps, as an engine integration would.
  *
- *   world BASE.modes [STEPS]
+ *   world BASE.modes [STEPS [UP]]
  *
  * One static elastic object (engine body 1) built from BASE, placed in the world rotated by
- * 90 degrees about +y and moved by (2, 0, 0) m, so object and world frames differ. A 1 kg box
- * (body 7) rests on the object's top face (+z in the object frame) near a corner, and a 0.5 kg
- * ball (body 9) hits the middle of that face with 2 N*s at step 5 (STEPS, default 10). After
- * every step the example prints what it reported and what the world returned, one record per
- * line (%.17g):
+ * 90 degrees about +y and moved by (2, 0, 0) m, so object and world frames differ. UP is the
+ * base's up axis in its own frame (the frame of the mesh it was baked from): x, y, z, -x, -y
+ * or -z, default z; the scenes' table is y-up. A 1 kg box (body 7) rests on the object's top
+ * face (the side of its bounding box along UP) near a corner, and a 0.5 kg ball (body 9) hits
+ * the middle of that face with 2 N*s at step 5 (STEPS, default 10). After every step the
+ * example prints what it reported and what the world returned, one record per line (%.17g):
  *
  *   pose   QX QY QZ QW TX TY TZ                      (once: the object's pose)
  *   body   ID INV_MASS I00..I22 CX CY CZ VX VY VZ WX WY WZ
@@ -16,9 +17,13 @@
  *   contact ID BODY1 BODY2 P1X P1Y P1Z P2X P2Y P2Z NX NY NZ IMPULSE IS_NEW
  *   event  BODY PX PY PZ JX JY JZ NX NY NZ DELTA_V OBJECT SERVED_BY CONTACT CHAINED
  *
- * and, at the end, the world's counters. An engine would apply each event with its
- * apply-impulse-at-point (rapier: RigidBody::apply_impulse_at_point(impulse, point, true)).
- * Exit status: 0 on success, 1 on an error (message on stderr), 2 on a usage error.
+ * and, at the end, the world's counters on stderr. Contacts farther than the response's
+ * max_map_distance from the base's surface get no response: when the object's running totals
+ * (dcr_world_object_totals) count any, a warning on stderr says so and names UP (a base whose
+ * up axis is not UP puts the box beside the object, not on it). An engine would apply each
+ * event with its apply-impulse-at-point (rapier: RigidBody::apply_impulse_at_point(impulse,
+ * point, true)). Exit status: 0 on success, 1 on an error (message on stderr), 2 on a usage
+ * error.
  */
 #include <math.h>
 #include <stdio.h>
@@ -85,13 +90,36 @@ static void print_event(const DcrImpulseEvent *e) {
            (unsigned long long)e->contact, e->chained ? 1 : 0);
 }
 
+/* The up axis `arg` (x, y, z, optionally signed) as an axis index and a sign; 0 if invalid. */
+static int parse_up(const char *arg, int *axis, double *sign) {
+    *sign = 1.0;
+    if (arg[0] == '-' || arg[0] == '+') {
+        *sign = arg[0] == '-' ? -1.0 : 1.0;
+        ++arg;
+    }
+    if ((arg[0] != 'x' && arg[0] != 'y' && arg[0] != 'z') || arg[1] != '\0') {
+        return 0;
+    }
+    *axis = arg[0] - 'x';
+    return 1;
+}
+
 int main(int argc, char **argv) {
-    if (argc < 2 || argc > 3) {
-        fprintf(stderr, "usage: %s BASE.modes [STEPS]\n", argv[0]);
+    if (argc < 2 || argc > 4) {
+        fprintf(stderr, "usage: %s BASE.modes [STEPS [UP]]   (UP: x, y, z, -x, -y, -z; default z)\n",
+                argv[0]);
+        return 2;
+    }
+    int up_axis = 2;
+    double up_sign = 1.0;
+    const char *up_name = argc == 4 ? argv[3] : "z";
+    if (!parse_up(up_name, &up_axis, &up_sign)) {
+        fprintf(stderr, "world: UP `%s` must be one of x, y, z, -x, -y, -z (the base's up axis)\n",
+                up_name);
         return 2;
     }
     long steps = 10;
-    if (argc == 3) {
+    if (argc >= 3) {
         char *end = NULL;
         steps = strtol(argv[2], &end, 10);
         if (end == argv[2] || *end != '\0' || steps < 1 || steps > 100000) {
@@ -147,11 +175,16 @@ int main(int argc, char **argv) {
            desc.pose.rotation[1], desc.pose.rotation[2], desc.pose.rotation[3],
            desc.pose.translation[0], desc.pose.translation[1], desc.pose.translation[2]);
 
-    /* Points on the object's top face (object frame), then in the world frame. */
+    /* Points on the object's top face (object frame), then in the world frame: the bounding
+       box's side along UP, 80 % and 50 % across the other two axes. */
     const double *lo = info.bounding_box_min, *hi = info.bounding_box_max;
-    double rest_obj[3] = {lo[0] + 0.8 * (hi[0] - lo[0]), lo[1] + 0.8 * (hi[1] - lo[1]), hi[2]};
-    double hit_obj[3] = {0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), hi[2]};
-    double up_obj[3] = {0.0, 0.0, 1.0};
+    double rest_obj[3], hit_obj[3], up_obj[3] = {0.0, 0.0, 0.0};
+    for (int k = 0; k < 3; ++k) {
+        rest_obj[k] = lo[k] + 0.8 * (hi[k] - lo[k]);
+        hit_obj[k] = 0.5 * (lo[k] + hi[k]);
+    }
+    rest_obj[up_axis] = hit_obj[up_axis] = up_sign > 0.0 ? hi[up_axis] : lo[up_axis];
+    up_obj[up_axis] = up_sign;
     double rest_w[3], hit_w[3], up_w[3];
     const double zero[3] = {0.0, 0.0, 0.0};
     DcrPose identity_rot = desc.pose;
@@ -206,8 +239,22 @@ int main(int argc, char **argv) {
 
     DcrObjectStepInfo oi;
     DcrWorldStepInfo wi;
+    DcrObjectTotals totals;
     dcr_world_object_info(world, handle, &oi);
     dcr_world_step_info(world, &wi);
+    dcr_world_object_totals(world, handle, &totals);
+    if (totals.contacts_unmapped > 0 || totals.impacts_unmapped > 0) {
+        /* NaN: automatic, 5 % of the base's bounding-box diagonal. */
+        double max_map = isnan(desc.response.max_map_distance)
+                             ? 0.05 * info.bounding_box_diagonal_m
+                             : desc.response.max_map_distance;
+        fprintf(stderr,
+                "world: warning: %llu resting contacts and %llu impacts were not mapped onto the "
+                "base (farther than max_map_distance = %g m from its surface) and got no "
+                "response: is the base's up axis `%s`? Pass it as UP (x, y, z, -x, -y, -z)\n",
+                (unsigned long long)totals.contacts_unmapped,
+                (unsigned long long)totals.impacts_unmapped, max_map, up_name);
+    }
     fprintf(stderr,
             "world: %ld steps; last step: %u contacts, %u impacts, %u resting, %u events; "
             "object %u injected %.3g J in all, its impacts dissipated %.3g J\n",

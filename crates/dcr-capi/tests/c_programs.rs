@@ -454,3 +454,146 @@ fn header_compiles_as_strict_c99() {
         );
     }
 }
+
+/// `tests/c/lifecycle.c` under AddressSanitizer, linked both ways: an elastic object disabled,
+/// enabled (filters at rest) with gain 2 (exactly twice the first push), its threshold raised
+/// above a hit and lowered again, removed (every call with its handle refused as stale, its
+/// body's contacts harmless), and replaced on the same body (same slot, next generation, the
+/// first push again); no leak, no invalid access.
+#[test]
+fn lifecycle_c_is_clean_under_asan() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = bake_cube(dir.path());
+    for link in [Link::Static, Link::Shared] {
+        let bin = dir.path().join(format!("lifecycle-{link:?}"));
+        build_c(&[test_src("lifecycle.c")], &bin, link, true);
+        let o = run(&bin, &[base.to_str().unwrap()], true);
+        assert_clean(&o, "lifecycle");
+        assert!(
+            o.status.success() && o.stdout == b"ok\n",
+            "{link:?}: {}\n{}",
+            String::from_utf8_lossy(&o.stdout),
+            String::from_utf8_lossy(&o.stderr)
+        );
+    }
+}
+
+/// `examples/world.c` on the scenes' table (y-up): told the wrong up axis (`z`, its default)
+/// it reports contacts that miss the table, gets no event and warns on stderr that the
+/// contacts were not mapped, naming the axis; told `y` it pushes the box at the impact step
+/// and prints no warning.
+#[test]
+fn world_c_warns_when_its_contacts_are_not_mapped() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = dir.path().join("table.modes");
+    run_ok(
+        Command::new(modal_bake())
+            .arg("bake")
+            .arg(common::workspace().join("data/scenes/table.msh"))
+            .arg("-o")
+            .arg(&base)
+            .args(["--fixed", "feet", "--modes", "8"]),
+    );
+    let bin = dir.path().join("world-asan");
+    build_c(&[example("world.c")], &bin, Link::Static, true);
+    let b = base.to_str().unwrap();
+    let events = |o: &Output| {
+        String::from_utf8_lossy(&o.stdout)
+            .lines()
+            .filter(|l| l.starts_with("event "))
+            .count()
+    };
+
+    let wrong = run(&bin, &[b, "10"], true);
+    assert_clean(&wrong, "world, wrong up axis");
+    let err = String::from_utf8_lossy(&wrong.stderr);
+    assert!(wrong.status.success(), "{err}");
+    assert_eq!(events(&wrong), 0, "no response off the surface");
+    assert!(
+        err.contains("warning") && err.contains("not mapped") && err.contains("`z`"),
+        "no unmapped-contact warning naming the axis: {err}"
+    );
+
+    let right = run(&bin, &[b, "10", "y"], true);
+    assert_clean(&right, "world, up y");
+    let err = String::from_utf8_lossy(&right.stderr);
+    assert!(right.status.success(), "{err}");
+    assert_eq!(events(&right), 1, "the box is pushed once: {err}");
+    assert!(!err.contains("warning"), "{err}");
+
+    let bad = run(&bin, &[b, "10", "up"], true);
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("UP `up`"));
+}
+
+/// The fenced ```c blocks of `docs/engine-integration.md` and `crates/dcr-capi/README.md`,
+/// each a translation unit on its own: every block compiles as C99 with `-Wall -Wextra -Werror
+/// -pedantic` against `include/dcr.h`; a block with a `main` is linked (static library, under
+/// AddressSanitizer) and run with a base as its only argument, and must exit 0 without a
+/// sanitizer report. Both documents hold at least one block, and at least one is complete.
+#[test]
+fn c_snippets_of_the_docs_compile_and_the_complete_ones_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = bake_cube(dir.path());
+    let mut complete = 0;
+    for doc in ["docs/engine-integration.md", "crates/dcr-capi/README.md"] {
+        let text = std::fs::read_to_string(common::workspace().join(doc)).unwrap();
+        let blocks = c_blocks(&text);
+        assert!(!blocks.is_empty(), "{doc}: no ```c block");
+        for (i, (line, src)) in blocks.iter().enumerate() {
+            let stem = format!(
+                "{}_{i}",
+                doc.replace(['/', '.', '-'], "_").trim_end_matches("_md")
+            );
+            let file = dir.path().join(format!("{stem}.c"));
+            std::fs::write(&file, src).unwrap();
+            let what = format!("{doc}:{line}");
+            if src.contains("int main(") {
+                complete += 1;
+                let bin = dir.path().join(&stem);
+                build_c(std::slice::from_ref(&file), &bin, Link::Static, true);
+                let o = run(&bin, &[base.to_str().unwrap()], true);
+                assert_clean(&o, &what);
+                assert!(
+                    o.status.success(),
+                    "{what}: exit {}\n{}",
+                    o.status,
+                    String::from_utf8_lossy(&o.stderr)
+                );
+            } else {
+                run_ok(
+                    Command::new(common::cc())
+                        .args(["-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic", "-c"])
+                        .arg("-I")
+                        .arg(crate_dir().join("include"))
+                        .arg(&file)
+                        .arg("-o")
+                        .arg(dir.path().join(format!("{stem}.o"))),
+                );
+            }
+        }
+    }
+    assert!(complete >= 1, "no complete C program in the docs");
+}
+
+/// The ```c fenced blocks of a Markdown text: (line of the fence, source).
+fn c_blocks(text: &str) -> Vec<(usize, String)> {
+    let mut blocks = Vec::new();
+    let mut current: Option<(usize, String)> = None;
+    for (n, line) in text.lines().enumerate() {
+        match &mut current {
+            None if line.trim_start() == "```c" => current = Some((n + 1, String::new())),
+            Some((start, src)) if line.trim_start() == "```" => {
+                blocks.push((*start, std::mem::take(src)));
+                current = None;
+            }
+            Some((_, src)) => {
+                src.push_str(line);
+                src.push('\n');
+            }
+            None => {}
+        }
+    }
+    assert!(current.is_none(), "an unclosed ```c block");
+    blocks
+}

@@ -121,7 +121,7 @@ fn render(value: &Value) -> String {
         }
         let _ = writeln!(md);
     }
-    let _ = writeln!(md, "\nThe bound at smaller η and the first outcome each scene loses are in `docs/scenes.md` (\"Energy bound\").\n");
+    let _ = writeln!(md, "\nThe bound at smaller η and the first outcome each scene loses are in `docs/benchmarks.md` (\"Energy bound sweep\").\n");
     md
 }
 
