@@ -352,7 +352,13 @@ fn clap_message(e: &clap::Error) -> (Option<String>, String) {
         .take_while(|l| !l.starts_with("Usage:") && !l.starts_with("For more information"))
         .filter(|l| !l.is_empty())
         .collect();
-    let msg = lines.join("; ");
+    let mut msg = String::new();
+    for l in lines {
+        if !msg.is_empty() {
+            msg.push_str(if msg.ends_with(':') { " " } else { "; " });
+        }
+        msg.push_str(l);
+    }
     let msg = msg.strip_prefix("error: ").unwrap_or(&msg).to_string();
     (key, msg)
 }
@@ -399,10 +405,8 @@ pub fn read_manifest(
             entries.len()
         );
     }
-    let dir = path
-        .parent()
-        .filter(|d| !d.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
+    // Entry paths are relative to the manifest's folder (`Path::join` keeps absolute ones).
+    let dir = path.parent().unwrap_or(Path::new(""));
     let allowed = allowed_options();
     let mut cmd = EntryCli::command();
     let mut out = Vec::with_capacity(entries.len());
