@@ -223,7 +223,8 @@ class Campaign:
         whole_file = re.search(r"separate closed shells|holds no triangles|not a regular file", err)
         if need_location and (name not in err or not (LOCATED.search(err) or whole_file)):
             return self.record("unlocated", dict(what, stderr=err[-300:]))
-        if err.count("error:") > 1 or "{ " in err and " }" in err:
+        # (`error:` as a word: an option named `--target-error:` is not a second error.)
+        if len(re.findall(r"(?<![\w-])error:", err)) > 1 or "{ " in err and " }" in err:
             # A cause printed twice, or Rust `Debug` text in the message.
             return self.record("unclear", dict(what, stderr=err[-300:]))
         return self.record("refused", what)

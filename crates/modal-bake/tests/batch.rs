@@ -440,3 +440,98 @@ fn the_shard_index_is_read_from_the_variable_named() {
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert!(stderr.contains("shard 1/2 ($JOB_COMPLETION_INDEX)"), "{stderr}");
 }
+
+/// Mutates `text` once (seeded): a byte flipped, the text truncated, a byte deleted, a slice
+/// repeated, or a JSON/TOML token inserted.
+fn mutate(text: &[u8], rng: &mut dcr_runtime::testing::SplitMix64) -> Vec<u8> {
+    let mut b = text.to_vec();
+    let at = |rng: &mut dcr_runtime::testing::SplitMix64, n: usize| {
+        (rng.next_u64() % n.max(1) as u64) as usize
+    };
+    match rng.next_u64() % 5 {
+        0 => {
+            let i = at(rng, b.len());
+            b[i] ^= (rng.next_u64() % 255 + 1) as u8;
+        }
+        1 => b.truncate(at(rng, b.len())),
+        2 => {
+            b.remove(at(rng, b.len()));
+        }
+        3 => {
+            let i = at(rng, b.len());
+            let j = (i + at(rng, 40)).min(b.len());
+            let slice = b[i..j].to_vec();
+            let k = at(rng, b.len());
+            b.splice(k..k, slice);
+        }
+        _ => {
+            let tokens: [&[u8]; 12] = [
+                b"{", b"}", b"[", b"]", b",", b"\"", b":", b"-", b"1e999", b"null", b"=", b"\n[[entries]]\n",
+            ];
+            let t = tokens[at(rng, tokens.len())];
+            let k = at(rng, b.len());
+            b.splice(k..k, t.iter().copied());
+        }
+    }
+    b
+}
+
+// Seeded mutation fuzzing of the manifest reader (JSON and TOML) through the binary: every
+// mutated manifest is read whole or refused (exit 1) with one error line naming the file and a
+// location (an entry and field, a line, a byte offset, a key), never a panic; `--dry-run`
+// writes nothing. `DCR_FUZZ_ITERS` (default 150 per form) runs longer.
+#[test]
+fn mutated_manifests_are_read_or_refused_with_a_location_never_a_panic() {
+    let iters: usize = std::env::var("DCR_FUZZ_ITERS")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(150);
+    let root = tempfile::tempdir().unwrap();
+    let dir = root.path();
+    let list = &entries()[..3];
+    let json_text = serde_json::to_vec_pretty(&serde_json::json!({"version": 1, "entries": list})).unwrap();
+    let mut toml_text = String::from("version = 1\n");
+    for e in list {
+        let t: toml::Table = serde_json::from_value(e.clone()).unwrap();
+        toml_text.push_str("\n[[entries]]\n");
+        toml_text.push_str(&toml::to_string(&t).unwrap().replace("[options]", "[entries.options]"));
+    }
+    let located = regex_lite(&[
+        "entries[", "line ", "offset ", "`version`", "version:", "entries is empty",
+        "entries must be", "the manifest", "key `", "no `entries`",
+    ]);
+    let mut rng = dcr_runtime::testing::SplitMix64(
+        std::env::var("DCR_FUZZ_SEED").ok().and_then(|v| v.parse().ok()).unwrap_or(27),
+    );
+    let (mut read, mut refused) = (0, 0);
+    for (name, text) in [("m.json", json_text), ("m.toml", toml_text.into_bytes())] {
+        let path = dir.join(name);
+        for _ in 0..iters {
+            let mutated = mutate(&text, &mut rng);
+            std::fs::write(&path, &mutated).unwrap();
+            let o = batch(&path, &["--dry-run"]);
+            let stderr = String::from_utf8_lossy(&o.stderr);
+            let shown = String::from_utf8_lossy(&mutated);
+            match o.status.code() {
+                Some(0) => read += 1,
+                Some(1) => {
+                    refused += 1;
+                    let errors: Vec<&str> = stderr.lines().filter(|l| l.starts_with("error:")).collect();
+                    assert_eq!(errors.len(), 1, "{shown}\n{stderr}");
+                    assert!(errors[0].contains(name), "no file named: {}\n{shown}", errors[0]);
+                    assert!(located(errors[0]), "no location: {}\n{shown}", errors[0]);
+                }
+                _ => panic!("{:?}: {stderr}\n{shown}", o.status),
+            }
+            assert!(!stderr.contains("panicked"), "{stderr}");
+        }
+    }
+    let names: Vec<_> = std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().file_name()).collect();
+    assert_eq!(names.len(), 2, "--dry-run wrote {names:?}");
+    assert!(read > 0 && refused > 0, "read {read}, refused {refused}");
+}
+
+/// Whether a message holds any of `needles`.
+fn regex_lite(needles: &'static [&'static str]) -> impl Fn(&str) -> bool {
+    move |s| needles.iter().any(|n| s.contains(n))
+}

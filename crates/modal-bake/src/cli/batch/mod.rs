@@ -66,6 +66,10 @@ pub struct BatchArgs {
     /// Print the JSON report on stdout instead of the summary.
     #[arg(long)]
     pub json: bool,
+    /// Check the manifest and list the shard's entries (index, mesh, output) without checking
+    /// or baking any base and without writing anything.
+    #[arg(long)]
+    pub dry_run: bool,
     #[command(flatten)]
     pub budget: BudgetOptions,
 }
@@ -108,6 +112,43 @@ pub fn run(args: &BatchArgs) -> anyhow::Result<ExitCode> {
     };
     let entries = manifest::read_manifest(&args.manifest, &args.budget, args.report.as_deref())?;
     let mine: Vec<&Entry> = entries.iter().filter(|e| shard.contains(e.index)).collect();
+    if args.dry_run {
+        let list: Vec<_> = mine
+            .iter()
+            .map(|e| {
+                serde_json::json!({
+                    "index": e.index,
+                    "mesh": e.args.mesh.display().to_string(),
+                    "out": e.args.out.display().to_string(),
+                })
+            })
+            .collect();
+        if args.json {
+            let v = serde_json::json!({
+                "manifest": args.manifest.display().to_string(),
+                "shard": {"index": shard.index, "count": shard.count, "source": shard.source},
+                "entries": list,
+            });
+            outln!("{}", serde_json::to_string_pretty(&v)?);
+        } else {
+            outln!(
+                "{}: valid; shard {shard} ({}): {} of {} entries",
+                args.manifest.display(),
+                shard.source,
+                mine.len(),
+                entries.len()
+            );
+            for e in &mine {
+                outln!(
+                    "entries[{}] {} -> {}",
+                    e.index,
+                    e.args.mesh.display(),
+                    e.args.out.display()
+                );
+            }
+        }
+        return Ok(ExitCode::SUCCESS);
+    }
     let start = Instant::now();
     line(
         start,
