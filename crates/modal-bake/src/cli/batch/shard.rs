@@ -243,5 +243,19 @@ mod tests {
             assert!(spec.resolve().unwrap_err().contains(name), "{bad}");
         }
         std::env::remove_var(name);
+
+        // A Slurm array not numbered 0 … N−1 is refused (some entries would run nowhere).
+        let slurm = parse("env:SLURM_ARRAY_TASK_ID/4").unwrap();
+        std::env::set_var("SLURM_ARRAY_TASK_ID", "2");
+        std::env::set_var("SLURM_ARRAY_TASK_MIN", "1");
+        assert!(slurm.resolve().unwrap_err().contains("starts at 1"));
+        std::env::set_var("SLURM_ARRAY_TASK_MIN", "0");
+        std::env::set_var("SLURM_ARRAY_TASK_COUNT", "3");
+        assert!(slurm.resolve().unwrap_err().contains("3 tasks"));
+        std::env::set_var("SLURM_ARRAY_TASK_COUNT", "4");
+        assert_eq!(slurm.resolve().unwrap().index, 2);
+        for v in ["SLURM_ARRAY_TASK_ID", "SLURM_ARRAY_TASK_MIN", "SLURM_ARRAY_TASK_COUNT"] {
+            std::env::remove_var(v);
+        }
     }
 }
