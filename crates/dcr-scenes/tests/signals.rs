@@ -67,7 +67,10 @@ fn check_left(dir: &Path, what: &str) {
             .unwrap_or_else(|e| panic!("{what}: {n} is not a whole base: {e}"));
     }
     let out = names(&dir.join("out"));
-    assert!(out.is_empty(), "{what}: outputs of an interrupted run: {out:?}");
+    assert!(
+        out.is_empty(),
+        "{what}: outputs of an interrupted run: {out:?}"
+    );
 }
 
 #[test]

@@ -130,9 +130,16 @@ fn the_union_of_the_shards_equals_the_unsharded_run_byte_for_byte() {
         }
     }
     seen.sort_unstable();
-    assert_eq!(seen, (0..8).collect::<Vec<_>>(), "each entry in exactly one shard");
+    assert_eq!(
+        seen,
+        (0..8).collect::<Vec<_>>(),
+        "each entry in exactly one shard"
+    );
     let union = files(&root.path().join("sharded"));
-    assert!(union == reference, "the shards' bases differ from the unsharded run's");
+    assert!(
+        union == reference,
+        "the shards' bases differ from the unsharded run's"
+    );
 
     // The batch bakes as `bake` does.
     let single = root.path().join("single.modes");
@@ -158,7 +165,11 @@ fn the_union_of_the_shards_equals_the_unsharded_run_byte_for_byte() {
     for e in entries() {
         text.push_str("\n[[entries]]\n");
         let t: toml::Table = serde_json::from_value(e).unwrap();
-        text.push_str(&toml::to_string(&t).unwrap().replace("[options]", "[entries.options]"));
+        text.push_str(
+            &toml::to_string(&t)
+                .unwrap()
+                .replace("[options]", "[entries.options]"),
+        );
     }
     let toml_manifest = toml_dir.join("manifest.toml");
     std::fs::write(&toml_manifest, &text).unwrap();
@@ -177,15 +188,22 @@ fn stale_bases_are_rebaked_with_their_reason_and_a_failed_entry_does_not_stop_th
     // Other parameters for entry 1, a corrupt base for entry 2, a failing entry 3.
     list[1]["options"]["modes"] = 5.into();
     std::fs::write(dir.join("bases/cyl.modes"), b"not a base").unwrap();
-    list.push(serde_json::json!({"mesh": data("meshes/beam.msh"), "out": "bases/bad.modes",
-                                 "options": {"fixed": ["no_such_group"]}}));
+    list.push(
+        serde_json::json!({"mesh": data("meshes/beam.msh"), "out": "bases/bad.modes",
+                                 "options": {"fixed": ["no_such_group"]}}),
+    );
     let manifest = write_manifest(&dir, &list);
     let report_path = dir.join("reports/run.json");
     let o = batch(
         &manifest,
         &["--report", report_path.to_str().unwrap(), "--jobs", "2"],
     );
-    assert_eq!(o.status.code(), Some(1), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(
+        o.status.code(),
+        Some(1),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
     let report: serde_json::Value =
         serde_json::from_slice(&std::fs::read(&report_path).unwrap()).unwrap();
     let a = actions(&report);
@@ -238,7 +256,10 @@ fn two_runs_on_one_folder_at_once_lose_nothing() {
         "temporaries left: {:?}",
         left.keys()
     );
-    assert!(left == reference, "the shared folder differs from one run's");
+    assert!(
+        left == reference,
+        "the shared folder differs from one run's"
+    );
 }
 
 #[test]
@@ -274,7 +295,10 @@ fn a_run_killed_mid_bake_resumes_skipping_what_it_finished() {
         "killed after {finished:?}"
     );
     for f in &finished {
-        assert!(files(&dir)[f] == reference[f], "{f}: a finished base is whole");
+        assert!(
+            files(&dir)[f] == reference[f],
+            "{f}: a finished base is whole"
+        );
     }
 
     let report = ok(&batch(&manifest, &["--json"]));
@@ -285,8 +309,15 @@ fn a_run_killed_mid_bake_resumes_skipping_what_it_finished() {
         assert_eq!(e["action"], expected, "{e}");
     }
     let after = files(&dir);
-    assert!(after.keys().all(|k| !k.contains(".tmp-")), "{:?}", after.keys());
-    assert!(after == reference, "the resumed run differs from an uninterrupted one");
+    assert!(
+        after.keys().all(|k| !k.contains(".tmp-")),
+        "{:?}",
+        after.keys()
+    );
+    assert!(
+        after == reference,
+        "the resumed run differs from an uninterrupted one"
+    );
 }
 
 /// Runs a batch over `manifest` in `dir`, expecting a refusal before any work: exit 1, one
@@ -317,47 +348,153 @@ fn hostile_manifests_are_refused_before_any_work_naming_file_entry_and_field() {
     let mesh = data("meshes/cube_v41.msh").display().to_string();
     let good = |out: &str| json!({"mesh": mesh, "out": out});
     let fifo = dir.join("fifo");
-    assert!(Command::new("mkfifo").arg(&fifo).status().unwrap().success());
+    assert!(Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .unwrap()
+        .success());
     std::fs::create_dir(dir.join("folder.modes")).unwrap();
     let fifo_s = fifo.display().to_string();
     let cases: Vec<(serde_json::Value, Vec<&str>)> = vec![
-        (json!({"entries": [good("a.modes"), {"mesh": mesh}]}), vec!["entries[1]", "`out`"]),
-        (json!({"entries": [{"out": "a.modes"}]}), vec!["entries[0]", "`mesh`"]),
-        (json!({"entries": [{"mesh": mesh, "out": "a.modes", "outt": 1}]}), vec!["entries[0]", "unknown key `outt`"]),
-        (json!({"entries": [good("a.modes")], "jobs": 4}), vec!["unknown key `jobs`"]),
-        (json!({"version": 2, "entries": [good("a.modes")]}), vec!["version"]),
+        (
+            json!({"entries": [good("a.modes"), {"mesh": mesh}]}),
+            vec!["entries[1]", "`out`"],
+        ),
+        (
+            json!({"entries": [{"out": "a.modes"}]}),
+            vec!["entries[0]", "`mesh`"],
+        ),
+        (
+            json!({"entries": [{"mesh": mesh, "out": "a.modes", "outt": 1}]}),
+            vec!["entries[0]", "unknown key `outt`"],
+        ),
+        (
+            json!({"entries": [good("a.modes")], "jobs": 4}),
+            vec!["unknown key `jobs`"],
+        ),
+        (
+            json!({"version": 2, "entries": [good("a.modes")]}),
+            vec!["version"],
+        ),
         (json!({"entries": []}), vec!["entries is empty"]),
-        (json!({"entries": {"mesh": mesh}}), vec!["entries must be an array"]),
+        (
+            json!({"entries": {"mesh": mesh}}),
+            vec!["entries must be an array"],
+        ),
         (json!([good("a.modes")]), vec!["must be a table"]),
-        (json!({"entries": [{"mesh": 5, "out": "a.modes"}]}), vec!["entries[0].mesh must be a string"]),
-        (json!({"entries": [{"mesh": mesh, "out": ""}]}), vec!["entries[0].out is empty"]),
-        (json!({"entries": [{"mesh": mesh, "out": "a.modes", "options": {"modez": 3}}]}), vec!["entries[0].options.modez", "unknown bake option"]),
-        (json!({"entries": [{"mesh": mesh, "out": "a.modes", "options": {"fixed_box": [0,0,0,1,1,1]}}]}), vec!["entries[0].options.fixed_box", "did you mean `fixed-box`"]),
-        (json!({"entries": [{"mesh": mesh, "out": "a.modes", "options": {"max-memory": 100}}]}), vec!["entries[0].options.max-memory", "command line"]),
-        (json!({"entries": [{"mesh": mesh, "out": "a.modes", "options": {"out": "b.modes"}}]}), vec!["entries[0].options.out"]),
-        (json!({"entries": [{"mesh": mesh, "out": "a.modes", "options": {"target-error": 5}}]}), vec!["entries[0].options.target-error"]),
-        (json!({"entries": [{"mesh": mesh, "out": "a.modes", "options": {"modes": null}}]}), vec!["entries[0].options.modes", "null"]),
-        (json!({"entries": [{"mesh": mesh, "out": "a.modes", "options": {"modes": {"n": 3}}}]}), vec!["entries[0].options.modes"]),
-        (json!({"entries": [{"mesh": mesh, "out": "a.modes", "options": "--modes 3"}]}), vec!["entries[0].options must be a table"]),
-        (json!({"entries": [{"mesh": mesh, "out": "a.modes", "options": {"modes": -1}}]}), vec!["entries[0].options.modes"]),
-        (json!({"entries": [{"mesh": mesh, "out": "a.modes", "options": {"modes": 10.5}}]}), vec!["entries[0].options.modes", "10.5"]),
-        (json!({"entries": [{"mesh": mesh, "out": "a.modes", "options": {"modes": 1e12}}]}), vec!["entries[0].options", "modes"]),
-        (json!({"entries": [{"mesh": mesh, "out": "a.modes", "options": {"youngs": -5}}]}), vec!["entries[0].options", "--youngs"]),
-        (json!({"entries": [{"mesh": mesh, "out": "a.modes", "options": {"material": "cheese"}}]}), vec!["entries[0].options.material", "cheese"]),
-        (json!({"entries": [{"mesh": mesh, "out": "a.modes", "options": {"modes": 3, "max-freq": 100}}]}), vec!["entries[0].options"]),
-        (json!({"entries": [{"mesh": mesh, "out": "a.modes", "options": {"size": 0.1}}]}), vec!["entries[0].options", "surface assets"]),
-        (json!({"entries": [{"mesh": mesh, "out": "a.modes", "options": {"rayleigh": [1, 2, 3]}}]}), vec!["entries[0].options.rayleigh"]),
+        (
+            json!({"entries": [{"mesh": 5, "out": "a.modes"}]}),
+            vec!["entries[0].mesh must be a string"],
+        ),
+        (
+            json!({"entries": [{"mesh": mesh, "out": ""}]}),
+            vec!["entries[0].out is empty"],
+        ),
+        (
+            json!({"entries": [{"mesh": mesh, "out": "a.modes", "options": {"modez": 3}}]}),
+            vec!["entries[0].options.modez", "unknown bake option"],
+        ),
+        (
+            json!({"entries": [{"mesh": mesh, "out": "a.modes", "options": {"fixed_box": [0,0,0,1,1,1]}}]}),
+            vec!["entries[0].options.fixed_box", "did you mean `fixed-box`"],
+        ),
+        (
+            json!({"entries": [{"mesh": mesh, "out": "a.modes", "options": {"max-memory": 100}}]}),
+            vec!["entries[0].options.max-memory", "command line"],
+        ),
+        (
+            json!({"entries": [{"mesh": mesh, "out": "a.modes", "options": {"out": "b.modes"}}]}),
+            vec!["entries[0].options.out"],
+        ),
+        (
+            json!({"entries": [{"mesh": mesh, "out": "a.modes", "options": {"target-error": 5}}]}),
+            vec!["entries[0].options.target-error"],
+        ),
+        (
+            json!({"entries": [{"mesh": mesh, "out": "a.modes", "options": {"modes": null}}]}),
+            vec!["entries[0].options.modes", "null"],
+        ),
+        (
+            json!({"entries": [{"mesh": mesh, "out": "a.modes", "options": {"modes": {"n": 3}}}]}),
+            vec!["entries[0].options.modes"],
+        ),
+        (
+            json!({"entries": [{"mesh": mesh, "out": "a.modes", "options": "--modes 3"}]}),
+            vec!["entries[0].options must be a table"],
+        ),
+        (
+            json!({"entries": [{"mesh": mesh, "out": "a.modes", "options": {"modes": -1}}]}),
+            vec!["entries[0].options.modes"],
+        ),
+        (
+            json!({"entries": [{"mesh": mesh, "out": "a.modes", "options": {"modes": 10.5}}]}),
+            vec!["entries[0].options.modes", "10.5"],
+        ),
+        (
+            json!({"entries": [{"mesh": mesh, "out": "a.modes", "options": {"modes": 1e12}}]}),
+            vec!["entries[0].options", "modes"],
+        ),
+        (
+            json!({"entries": [{"mesh": mesh, "out": "a.modes", "options": {"youngs": -5}}]}),
+            vec!["entries[0].options", "--youngs"],
+        ),
+        (
+            json!({"entries": [{"mesh": mesh, "out": "a.modes", "options": {"material": "cheese"}}]}),
+            vec!["entries[0].options.material", "cheese"],
+        ),
+        (
+            json!({"entries": [{"mesh": mesh, "out": "a.modes", "options": {"modes": 3, "max-freq": 100}}]}),
+            vec!["entries[0].options"],
+        ),
+        (
+            json!({"entries": [{"mesh": mesh, "out": "a.modes", "options": {"size": 0.1}}]}),
+            vec!["entries[0].options", "surface assets"],
+        ),
+        (
+            json!({"entries": [{"mesh": mesh, "out": "a.modes", "options": {"rayleigh": [1, 2, 3]}}]}),
+            vec!["entries[0].options.rayleigh"],
+        ),
         // Paths that are inputs, devices, FIFOs, folders; duplicate outputs.
-        (json!({"entries": [good("a.modes"), {"mesh": mesh, "out": mesh}]}), vec!["entries[1].out", "the mesh of entries[0]"]),
-        (json!({"entries": [good("manifest.json")]}), vec!["entries[0].out", "the manifest"]),
-        (json!({"entries": [good("/dev/null")]}), vec!["entries[0].out", "character device"]),
-        (json!({"entries": [good(&fifo_s)]}), vec!["entries[0].out", "FIFO"]),
-        (json!({"entries": [good("folder.modes")]}), vec!["entries[0].out", "directory"]),
-        (json!({"entries": [good("a.modes"), good("b.modes"), good("./sub/../a.modes")]}), vec!["entries[2].out", "entries[0].out", "same file"]),
-        (json!({"entries": [{"mesh": "/dev/zero", "out": "a.modes"}]}), vec!["entries[0].mesh", "character device"]),
-        (json!({"entries": [{"mesh": fifo_s, "out": "a.modes"}]}), vec!["entries[0].mesh", "FIFO"]),
-        (json!({"entries": [{"mesh": "missing.msh", "out": "a.modes"}]}), vec!["entries[0].mesh", "missing.msh"]),
-        (json!({"entries": [{"mesh": ".", "out": "a.modes"}]}), vec!["entries[0].mesh", "directory"]),
+        (
+            json!({"entries": [good("a.modes"), {"mesh": mesh, "out": mesh}]}),
+            vec!["entries[1].out", "the mesh of entries[0]"],
+        ),
+        (
+            json!({"entries": [good("manifest.json")]}),
+            vec!["entries[0].out", "the manifest"],
+        ),
+        (
+            json!({"entries": [good("/dev/null")]}),
+            vec!["entries[0].out", "character device"],
+        ),
+        (
+            json!({"entries": [good(&fifo_s)]}),
+            vec!["entries[0].out", "FIFO"],
+        ),
+        (
+            json!({"entries": [good("folder.modes")]}),
+            vec!["entries[0].out", "directory"],
+        ),
+        (
+            json!({"entries": [good("a.modes"), good("b.modes"), good("./sub/../a.modes")]}),
+            vec!["entries[2].out", "entries[0].out", "same file"],
+        ),
+        (
+            json!({"entries": [{"mesh": "/dev/zero", "out": "a.modes"}]}),
+            vec!["entries[0].mesh", "character device"],
+        ),
+        (
+            json!({"entries": [{"mesh": fifo_s, "out": "a.modes"}]}),
+            vec!["entries[0].mesh", "FIFO"],
+        ),
+        (
+            json!({"entries": [{"mesh": "missing.msh", "out": "a.modes"}]}),
+            vec!["entries[0].mesh", "missing.msh"],
+        ),
+        (
+            json!({"entries": [{"mesh": ".", "out": "a.modes"}]}),
+            vec!["entries[0].mesh", "directory"],
+        ),
     ];
     for (i, (manifest, needles)) in cases.iter().enumerate() {
         let path = dir.join("manifest.json");
@@ -372,7 +509,8 @@ fn hostile_manifests_are_refused_before_any_work_naming_file_entry_and_field() {
     let path = dir.join("manifest.json");
     let texts: Vec<(Vec<u8>, &str)> = vec![
         (
-            format!(r#"{{"entries": [{{"mesh": "{mesh}", "out": "a.modes", "out": "b.modes"}}]}}"#).into_bytes(),
+            format!(r#"{{"entries": [{{"mesh": "{mesh}", "out": "a.modes", "out": "b.modes"}}]}}"#)
+                .into_bytes(),
             "appears twice",
         ),
         (b"{\"entries\": [".to_vec(), "not valid JSON"),
@@ -385,14 +523,25 @@ fn hostile_manifests_are_refused_before_any_work_naming_file_entry_and_field() {
     }
     let toml_path = dir.join("m.toml");
     std::fs::write(&toml_path, "[[entries]]\nmesh = 3\n").unwrap();
-    refused(dir, &toml_path, &[], &["m.toml", "entries[0].mesh must be a string"]);
+    refused(
+        dir,
+        &toml_path,
+        &[],
+        &["m.toml", "entries[0].mesh must be a string"],
+    );
     std::fs::write(&toml_path, "[[entries]\n").unwrap();
     refused(dir, &toml_path, &[], &["m.toml", "not valid TOML"]);
     std::fs::remove_file(&toml_path).unwrap();
 
     // Absurd counts: entries past the limit, a file past the size limit.
-    let many: Vec<_> = (0..100_001).map(|i| json!({"mesh": "x", "out": format!("{i}")})).collect();
-    std::fs::write(&path, serde_json::to_string(&json!({"entries": many})).unwrap()).unwrap();
+    let many: Vec<_> = (0..100_001)
+        .map(|i| json!({"mesh": "x", "out": format!("{i}")}))
+        .collect();
+    std::fs::write(
+        &path,
+        serde_json::to_string(&json!({"entries": many})).unwrap(),
+    )
+    .unwrap();
     refused(dir, &path, &[], &["manifest.json", "100001 entries"]);
     let big = std::fs::File::create(&path).unwrap();
     big.set_len(17 << 20).unwrap();
@@ -401,12 +550,26 @@ fn hostile_manifests_are_refused_before_any_work_naming_file_entry_and_field() {
 
     // The manifest itself as a device or FIFO (never opened), bad --shard and --jobs.
     let valid = dir.join("valid.json");
-    std::fs::write(&valid, serde_json::to_string(&json!({"entries": [good("a.modes")]})).unwrap()).unwrap();
-    refused(dir, Path::new("/dev/zero"), &[], &["/dev/zero", "character device"]);
+    std::fs::write(
+        &valid,
+        serde_json::to_string(&json!({"entries": [good("a.modes")]})).unwrap(),
+    )
+    .unwrap();
+    refused(
+        dir,
+        Path::new("/dev/zero"),
+        &[],
+        &["/dev/zero", "character device"],
+    );
     refused(dir, &fifo, &[], &["fifo", "FIFO"]);
     refused(dir, &valid, &["--jobs", "0"], &["--jobs"]);
     refused(dir, &valid, &["--jobs", "100000"], &["--jobs"]);
-    refused(dir, &valid, &["--report", valid.to_str().unwrap()], &["--report", "the manifest"]);
+    refused(
+        dir,
+        &valid,
+        &["--report", valid.to_str().unwrap()],
+        &["--report", "the manifest"],
+    );
     refused(dir, &valid, &["--report", &mesh], &["--report"]);
     let o = batch(&valid, &["--shard", "3/3"]);
     assert_eq!(o.status.code(), Some(2), "clap refuses the value");
@@ -438,7 +601,10 @@ fn the_shard_index_is_read_from_the_variable_named() {
     assert_eq!(r["shard"]["source"], "$JOB_COMPLETION_INDEX");
     assert_eq!(actions(&r).keys().copied().collect::<Vec<_>>(), vec![1]);
     let stderr = String::from_utf8_lossy(&o.stderr);
-    assert!(stderr.contains("shard 1/2 ($JOB_COMPLETION_INDEX)"), "{stderr}");
+    assert!(
+        stderr.contains("shard 1/2 ($JOB_COMPLETION_INDEX)"),
+        "{stderr}"
+    );
 }
 
 /// Mutates `text` once (seeded): a byte flipped, the text truncated, a byte deleted, a slice
@@ -466,7 +632,18 @@ fn mutate(text: &[u8], rng: &mut dcr_runtime::testing::SplitMix64) -> Vec<u8> {
         }
         _ => {
             let tokens: [&[u8]; 12] = [
-                b"{", b"}", b"[", b"]", b",", b"\"", b":", b"-", b"1e999", b"null", b"=", b"\n[[entries]]\n",
+                b"{",
+                b"}",
+                b"[",
+                b"]",
+                b",",
+                b"\"",
+                b":",
+                b"-",
+                b"1e999",
+                b"null",
+                b"=",
+                b"\n[[entries]]\n",
             ];
             let t = tokens[at(rng, tokens.len())];
             let k = at(rng, b.len());
@@ -489,19 +666,35 @@ fn mutated_manifests_are_read_or_refused_with_a_location_never_a_panic() {
     let root = tempfile::tempdir().unwrap();
     let dir = root.path();
     let list = &entries()[..3];
-    let json_text = serde_json::to_vec_pretty(&serde_json::json!({"version": 1, "entries": list})).unwrap();
+    let json_text =
+        serde_json::to_vec_pretty(&serde_json::json!({"version": 1, "entries": list})).unwrap();
     let mut toml_text = String::from("version = 1\n");
     for e in list {
         let t: toml::Table = serde_json::from_value(e.clone()).unwrap();
         toml_text.push_str("\n[[entries]]\n");
-        toml_text.push_str(&toml::to_string(&t).unwrap().replace("[options]", "[entries.options]"));
+        toml_text.push_str(
+            &toml::to_string(&t)
+                .unwrap()
+                .replace("[options]", "[entries.options]"),
+        );
     }
     let located = regex_lite(&[
-        "entries[", "line ", "offset ", "`version`", "version:", "entries is empty",
-        "entries must be", "the manifest", "key `", "no `entries`",
+        "entries[",
+        "line ",
+        "offset ",
+        "`version`",
+        "version:",
+        "entries is empty",
+        "entries must be",
+        "the manifest",
+        "key `",
+        "no `entries`",
     ]);
     let mut rng = dcr_runtime::testing::SplitMix64(
-        std::env::var("DCR_FUZZ_SEED").ok().and_then(|v| v.parse().ok()).unwrap_or(27),
+        std::env::var("DCR_FUZZ_SEED")
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(27),
     );
     let (mut read, mut refused) = (0, 0);
     for (name, text) in [("m.json", json_text), ("m.toml", toml_text.into_bytes())] {
@@ -516,9 +709,14 @@ fn mutated_manifests_are_read_or_refused_with_a_location_never_a_panic() {
                 Some(0) => read += 1,
                 Some(1) => {
                     refused += 1;
-                    let errors: Vec<&str> = stderr.lines().filter(|l| l.starts_with("error:")).collect();
+                    let errors: Vec<&str> =
+                        stderr.lines().filter(|l| l.starts_with("error:")).collect();
                     assert_eq!(errors.len(), 1, "{shown}\n{stderr}");
-                    assert!(errors[0].contains(name), "no file named: {}\n{shown}", errors[0]);
+                    assert!(
+                        errors[0].contains(name),
+                        "no file named: {}\n{shown}",
+                        errors[0]
+                    );
                     assert!(located(errors[0]), "no location: {}\n{shown}", errors[0]);
                 }
                 _ => panic!("{:?}: {stderr}\n{shown}", o.status),
@@ -526,7 +724,10 @@ fn mutated_manifests_are_read_or_refused_with_a_location_never_a_panic() {
             assert!(!stderr.contains("panicked"), "{stderr}");
         }
     }
-    let names: Vec<_> = std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().file_name()).collect();
+    let names: Vec<_> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
     assert_eq!(names.len(), 2, "--dry-run wrote {names:?}");
     assert!(read > 0 && refused > 0, "read {read}, refused {refused}");
 }
@@ -534,4 +735,69 @@ fn mutated_manifests_are_read_or_refused_with_a_location_never_a_panic() {
 /// Whether a message holds any of `needles`.
 fn regex_lite(needles: &'static [&'static str]) -> impl Fn(&str) -> bool {
     move |s| needles.iter().any(|n| s.contains(n))
+}
+
+// A surface asset is checked as `check` checks it (meshed again the same way and compared):
+// baked once, then up to date; another element order makes it stale. Needs gmsh (skipped
+// without it unless `DCR_REQUIRE_GMSH=1`).
+#[test]
+fn a_surface_asset_entry_is_meshed_checked_and_skipped_when_fresh() {
+    if modal_bake::mesh::gmsh::gmsh_version(None).is_err() {
+        assert_ne!(
+            std::env::var("DCR_REQUIRE_GMSH").as_deref(),
+            Ok("1"),
+            "DCR_REQUIRE_GMSH=1 but gmsh does not run"
+        );
+        eprintln!("SKIPPED: gmsh does not run");
+        return;
+    }
+    let root = tempfile::tempdir().unwrap();
+    let dir = root.path();
+    // A 0.1 m cube, outward faces.
+    let v = [
+        [0, 0, 0],
+        [1, 0, 0],
+        [1, 1, 0],
+        [0, 1, 0],
+        [0, 0, 1],
+        [1, 0, 1],
+        [1, 1, 1],
+        [0, 1, 1],
+    ];
+    let q = [
+        [1, 4, 3, 2],
+        [5, 6, 7, 8],
+        [1, 2, 6, 5],
+        [3, 4, 8, 7],
+        [2, 3, 7, 6],
+        [1, 5, 8, 4],
+    ];
+    let mut obj = String::from("o cube\n");
+    for p in v {
+        obj += &format!(
+            "v {} {} {}\n",
+            0.1 * p[0] as f64,
+            0.1 * p[1] as f64,
+            0.1 * p[2] as f64
+        );
+    }
+    for f in q {
+        obj += &format!("f {} {} {} {}\n", f[0], f[1], f[2], f[3]);
+    }
+    std::fs::write(dir.join("cube.obj"), obj).unwrap();
+    let entry = |order: u8| {
+        serde_json::json!({"mesh": "cube.obj", "out": "bases/cube.modes",
+                           "options": {"order": order, "size": 0.04, "modes": 4, "material": "pine"}})
+    };
+    let manifest = write_manifest(dir, &[entry(1)]);
+    let first = ok(&batch(&manifest, &["--json"]));
+    assert_eq!(actions(&first)[&0], ("baked".into(), "missing".into()));
+    let again = ok(&batch(&manifest, &["--json"]));
+    assert_eq!(actions(&again)[&0], ("skipped".into(), "up_to_date".into()));
+    let manifest = write_manifest(dir, &[entry(2)]);
+    let finer = ok(&batch(&manifest, &["--json"]));
+    assert_eq!(
+        actions(&finer)[&0],
+        ("baked".into(), "geometry_changed".into())
+    );
 }

@@ -147,11 +147,7 @@ impl<'de> Deserialize<'de> for Value {
 }
 
 /// Takes the fields of a table, refusing keys not in `known`.
-fn fields(
-    value: Value,
-    at: &str,
-    known: &[&str],
-) -> anyhow::Result<Vec<(String, Value)>> {
+fn fields(value: Value, at: &str, known: &[&str]) -> anyhow::Result<Vec<(String, Value)>> {
     let Value::Map(items) = value else {
         bail!("{at} must be a table ({{...}}), not {}", value.kind());
     };
@@ -189,7 +185,11 @@ fn read_text(path: &Path) -> anyhow::Result<String> {
         .read_to_end(&mut bytes)
         .with_context(|| format!("manifest {}", path.display()))?;
     if bytes.len() as u64 > MAX_MANIFEST_BYTES {
-        bail!("manifest {}: grew past {} MiB while being read", path.display(), MAX_MANIFEST_BYTES >> 20);
+        bail!(
+            "manifest {}: grew past {} MiB while being read",
+            path.display(),
+            MAX_MANIFEST_BYTES >> 20
+        );
     }
     String::from_utf8(bytes).map_err(|e| {
         anyhow!(
@@ -240,8 +240,12 @@ struct EntryCli {
 fn forbidden(key: &str) -> Option<&'static str> {
     Some(match key {
         "out" | "o" => "give the output as the entry's `out` field",
-        "json" | "timings" => "the batch reports each entry in its own JSON report (--json, --report)",
-        "target-error" => "not supported in a batch; bake such a base with `modal-bake bake --target-error`",
+        "json" | "timings" => {
+            "the batch reports each entry in its own JSON report (--json, --report)"
+        }
+        "target-error" => {
+            "not supported in a batch; bake such a base with `modal-bake bake --target-error`"
+        }
         "max-memory" | "max-time" | "force" => {
             "the budget is the batch's: give it on the `modal-bake batch` command line"
         }
@@ -282,7 +286,10 @@ fn number_list(items: &[Value]) -> Option<String> {
 /// The command-line arguments of an entry's `options` table.
 fn option_args(options: Value, at: &str, allowed: &[String]) -> anyhow::Result<Vec<String>> {
     let Value::Map(items) = options else {
-        bail!("{at} must be a table of bake options, not {}", options.kind());
+        bail!(
+            "{at} must be a table of bake options, not {}",
+            options.kind()
+        );
     };
     let mut argv = Vec::new();
     for (key, value) in items {
@@ -377,7 +384,11 @@ pub fn read_manifest(
     let file = path.display().to_string();
     let text = read_text(path)?;
     let top = parse_text(path, &text)?;
-    let mut items = fields(top, &format!("{file}: the manifest"), &["version", "entries"])?;
+    let mut items = fields(
+        top,
+        &format!("{file}: the manifest"),
+        &["version", "entries"],
+    )?;
     match take(&mut items, "version") {
         None => {}
         Some(Value::Number(v)) if v == MANIFEST_VERSION.to_string() => {}
@@ -391,10 +402,13 @@ pub fn read_manifest(
     }
     let entries = match take(&mut items, "entries") {
         Some(Value::Array(e)) => e,
-        Some(other) => bail!("{file}: entries must be an array of tables, not {}", other.kind()),
-        None => bail!(
-            "{file}: no `entries` (an array of {{\"mesh\", \"out\", \"options\"}} tables)"
+        Some(other) => bail!(
+            "{file}: entries must be an array of tables, not {}",
+            other.kind()
         ),
+        None => {
+            bail!("{file}: no `entries` (an array of {{\"mesh\", \"out\", \"options\"}} tables)")
+        }
     };
     if entries.is_empty() {
         bail!("{file}: entries is empty; list at least one base to bake");
@@ -447,14 +461,16 @@ fn read_entry(
     cmd: &mut clap::Command,
 ) -> anyhow::Result<BakeArgs> {
     let mut items = fields(value, at, &["mesh", "out", "options"])?;
-    let path_field = |items: &mut Vec<(String, Value)>, key: &str, what: &str| {
-        match take(items, key) {
+    let path_field =
+        |items: &mut Vec<(String, Value)>, key: &str, what: &str| match take(items, key) {
             Some(Value::String(s)) if !s.is_empty() => Ok(dir.join(s)),
             Some(Value::String(_)) => bail!("{at}.{key} is empty; give the path of {what}"),
-            Some(other) => bail!("{at}.{key} must be a string (the path of {what}), not {}", other.kind()),
+            Some(other) => bail!(
+                "{at}.{key} must be a string (the path of {what}), not {}",
+                other.kind()
+            ),
             None => bail!("{at}: no `{key}` (the path of {what})"),
-        }
-    };
+        };
     let mesh: PathBuf = path_field(&mut items, "mesh", "the mesh or surface asset")?;
     let out: PathBuf = path_field(&mut items, "out", "the .modes base to write")?;
     let options = take(&mut items, "options").unwrap_or(Value::Map(Vec::new()));

@@ -159,7 +159,11 @@ pub fn run(args: &BatchArgs) -> anyhow::Result<ExitCode> {
             mine.len(),
             entries.len(),
             args.jobs.min(mine.len().max(1)),
-            if args.jobs.min(mine.len().max(1)) == 1 { "" } else { "s" }
+            if args.jobs.min(mine.len().max(1)) == 1 {
+                ""
+            } else {
+                "s"
+            }
         ),
     );
     let records = run_entries(&mine, args.jobs, start);
@@ -279,7 +283,11 @@ fn run_entry(entry: &Entry, tag: &str, start: Instant) -> EntryRecord {
     let t = Instant::now();
     line(
         start,
-        &format!("{tag} {} → {}: checking", args.mesh.display(), args.out.display()),
+        &format!(
+            "{tag} {} → {}: checking",
+            args.mesh.display(),
+            args.out.display()
+        ),
     );
     let mut status_seen = None;
     let result = (|| -> anyhow::Result<(BaseStatus, bool)> {
@@ -325,7 +333,11 @@ fn run_entry(entry: &Entry, tag: &str, start: Instant) -> EntryRecord {
     let seconds = t.elapsed().as_secs_f64();
     match result {
         Ok((status, baked)) => {
-            let mut r = record_of(entry, if baked { "baked" } else { "skipped" }, Some(status.reason()));
+            let mut r = record_of(
+                entry,
+                if baked { "baked" } else { "skipped" },
+                Some(status.reason()),
+            );
             if let BaseStatus::Unreadable(d) = &status {
                 r.detail = Some(d.clone());
             }
@@ -334,18 +346,29 @@ fn run_entry(entry: &Entry, tag: &str, start: Instant) -> EntryRecord {
                 &format!(
                     "{tag} {}: {} in {seconds:.1} s",
                     args.out.display(),
-                    if baked { "baked" } else { "up to date, skipped" }
+                    if baked {
+                        "baked"
+                    } else {
+                        "up to date, skipped"
+                    }
                 ),
             );
             r
         }
         Err(e) => {
-            let mut r = record_of(entry, "failed", status_seen.as_ref().map(BaseStatus::reason));
+            let mut r = record_of(
+                entry,
+                "failed",
+                status_seen.as_ref().map(BaseStatus::reason),
+            );
             if let Some(BaseStatus::Unreadable(d)) = &status_seen {
                 r.detail = Some(d.clone());
             }
             let msg = super::one_line(&e);
-            line(start, &format!("{tag} {}: FAILED: {msg}", args.out.display()));
+            line(
+                start,
+                &format!("{tag} {}: FAILED: {msg}", args.out.display()),
+            );
             r.error = Some(msg);
             r
         }

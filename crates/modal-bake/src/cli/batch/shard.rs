@@ -82,10 +82,8 @@ pub fn parse(s: &str) -> Result<ShardSpec, String> {
     }
     let index = match i.trim().strip_prefix("env:") {
         Some(name) => {
-            let valid = !name.is_empty()
-                && name
-                    .chars()
-                    .all(|c| c.is_ascii_alphanumeric() || c == '_');
+            let valid =
+                !name.is_empty() && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
             if !valid {
                 return Err(format!(
                     "`{s}`: `{name}` is not an environment variable name (letters, digits, _)"
@@ -165,7 +163,11 @@ impl ShardSpec {
 /// `SLURM_ARRAY_TASK_MIN` (when set) must be 0 and `SLURM_ARRAY_TASK_COUNT` (when set) N, or
 /// some entries would silently belong to no task.
 fn check_slurm_array(count: u64) -> Result<(), String> {
-    let var = |n: &str| std::env::var(n).ok().and_then(|v| v.trim().parse::<u64>().ok());
+    let var = |n: &str| {
+        std::env::var(n)
+            .ok()
+            .and_then(|v| v.trim().parse::<u64>().ok())
+    };
     if let Some(min) = var("SLURM_ARRAY_TASK_MIN").filter(|&m| m != 0) {
         return Err(format!(
             "--shard env:SLURM_ARRAY_TASK_ID/{count}: the job array starts at {min} (SLURM_ARRAY_TASK_MIN); \
@@ -221,7 +223,17 @@ mod tests {
             parse("env:JOB_COMPLETION_INDEX/8").unwrap().index,
             ShardIndex::Env("JOB_COMPLETION_INDEX".into())
         );
-        for bad in ["5/5", "1/0", "-1/4", "a/4", "3", "0/1e9", "env:/4", "env:A B/4", "0/2000000"] {
+        for bad in [
+            "5/5",
+            "1/0",
+            "-1/4",
+            "a/4",
+            "3",
+            "0/1e9",
+            "env:/4",
+            "env:A B/4",
+            "0/2000000",
+        ] {
             let e = parse(bad).unwrap_err();
             assert!(e.contains(bad), "{bad}: {e}");
         }
@@ -254,7 +266,11 @@ mod tests {
         assert!(slurm.resolve().unwrap_err().contains("3 tasks"));
         std::env::set_var("SLURM_ARRAY_TASK_COUNT", "4");
         assert_eq!(slurm.resolve().unwrap().index, 2);
-        for v in ["SLURM_ARRAY_TASK_ID", "SLURM_ARRAY_TASK_MIN", "SLURM_ARRAY_TASK_COUNT"] {
+        for v in [
+            "SLURM_ARRAY_TASK_ID",
+            "SLURM_ARRAY_TASK_MIN",
+            "SLURM_ARRAY_TASK_COUNT",
+        ] {
             std::env::remove_var(v);
         }
     }
