@@ -297,7 +297,7 @@ fn option_args(options: Value, at: &str, allowed: &[String]) -> anyhow::Result<V
         if let Some(why) = forbidden(&key) {
             bail!("{field}: not an option of a batch entry: {why}");
         }
-        if !allowed.iter().any(|a| *a == key) {
+        if !allowed.contains(&key) {
             let near = allowed
                 .iter()
                 .find(|a| a.replace('-', "_") == key.replace('-', "_").to_lowercase())

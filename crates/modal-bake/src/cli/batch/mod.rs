@@ -113,57 +113,19 @@ pub fn run(args: &BatchArgs) -> anyhow::Result<ExitCode> {
     let entries = manifest::read_manifest(&args.manifest, &args.budget, args.report.as_deref())?;
     let mine: Vec<&Entry> = entries.iter().filter(|e| shard.contains(e.index)).collect();
     if args.dry_run {
-        let list: Vec<_> = mine
-            .iter()
-            .map(|e| {
-                serde_json::json!({
-                    "index": e.index,
-                    "mesh": e.args.mesh.display().to_string(),
-                    "out": e.args.out.display().to_string(),
-                })
-            })
-            .collect();
-        if args.json {
-            let v = serde_json::json!({
-                "manifest": args.manifest.display().to_string(),
-                "shard": {"index": shard.index, "count": shard.count, "source": shard.source},
-                "entries": list,
-            });
-            outln!("{}", serde_json::to_string_pretty(&v)?);
-        } else {
-            outln!(
-                "{}: valid; shard {shard} ({}): {} of {} entries",
-                args.manifest.display(),
-                shard.source,
-                mine.len(),
-                entries.len()
-            );
-            for e in &mine {
-                outln!(
-                    "entries[{}] {} -> {}",
-                    e.index,
-                    e.args.mesh.display(),
-                    e.args.out.display()
-                );
-            }
-        }
-        return Ok(ExitCode::SUCCESS);
+        return dry_run(args, &shard, &mine, entries.len());
     }
     let start = Instant::now();
+    let jobs = args.jobs.min(mine.len().max(1));
     line(
         start,
         &format!(
-            "{}: shard {shard} ({}): {} of {} entries, {} job{}",
+            "{}: shard {shard} ({}): {} of {} entries, {jobs} job{}",
             args.manifest.display(),
             shard.source,
             mine.len(),
             entries.len(),
-            args.jobs.min(mine.len().max(1)),
-            if args.jobs.min(mine.len().max(1)) == 1 {
-                ""
-            } else {
-                "s"
-            }
+            if jobs == 1 { "" } else { "s" }
         ),
     );
     let records = run_entries(&mine, args.jobs, start);
@@ -212,6 +174,49 @@ pub fn run(args: &BatchArgs) -> anyhow::Result<ExitCode> {
     } else {
         ExitCode::FAILURE
     })
+}
+
+/// `--dry-run`: the shard's entries (index, mesh, output) on stdout, nothing checked or written.
+fn dry_run(
+    args: &BatchArgs,
+    shard: &Shard,
+    mine: &[&Entry],
+    total: usize,
+) -> anyhow::Result<ExitCode> {
+    if args.json {
+        let list: Vec<_> = mine
+            .iter()
+            .map(|e| {
+                serde_json::json!({
+                    "index": e.index,
+                    "mesh": e.args.mesh.display().to_string(),
+                    "out": e.args.out.display().to_string(),
+                })
+            })
+            .collect();
+        let v = serde_json::json!({
+            "manifest": args.manifest.display().to_string(),
+            "shard": {"index": shard.index, "count": shard.count, "source": shard.source},
+            "entries": list,
+        });
+        outln!("{}", serde_json::to_string_pretty(&v)?);
+    } else {
+        outln!(
+            "{}: valid; shard {shard} ({}): {} of {total} entries",
+            args.manifest.display(),
+            shard.source,
+            mine.len()
+        );
+        for e in mine {
+            outln!(
+                "entries[{}] {} -> {}",
+                e.index,
+                e.args.mesh.display(),
+                e.args.out.display()
+            );
+        }
+    }
+    Ok(ExitCode::SUCCESS)
 }
 
 /// Runs the entries on `jobs` threads, each taking the next entry in order; the records in
