@@ -801,3 +801,56 @@ fn a_surface_asset_entry_is_meshed_checked_and_skipped_when_fresh() {
         ("baked".into(), "geometry_changed".into())
     );
 }
+
+// SIGTERM and SIGINT to a batch baking two entries at once: the process ends by the signal,
+// every finished base is whole and no temporary is left.
+#[test]
+fn a_signal_mid_batch_ends_it_leaving_whole_bases_and_no_temporary() {
+    use std::os::unix::process::ExitStatusExt;
+    for (signal, number) in [("-TERM", 15), ("-INT", 2)] {
+        let root = tempfile::tempdir().unwrap();
+        let dir = root.path().join("farm");
+        let manifest = write_manifest(&dir, &entries());
+        let mut child = bin()
+            .arg("batch")
+            .arg(&manifest)
+            .args(["--jobs", "2"])
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        let mut lines = BufReader::new(child.stderr.take().unwrap()).lines();
+        assert!(
+            lines.any(|l| l.is_ok_and(|l| l.contains(": baked in"))),
+            "{signal}: no entry finished"
+        );
+        let sent = Command::new("kill")
+            .args([signal, &child.id().to_string()])
+            .status()
+            .unwrap();
+        assert!(sent.success());
+        let status = child.wait().unwrap();
+        let left = files(&dir);
+        if status.signal().is_none() {
+            // The batch finished before the signal landed: all eight bases are there.
+            assert!(
+                status.success() && left.len() == 8,
+                "{signal}: {status:?} {:?}",
+                left.keys()
+            );
+            continue;
+        }
+        assert_eq!(status.signal(), Some(number), "{signal}");
+        assert!(
+            left.keys().all(|k| !k.contains(".tmp-")),
+            "{signal}: {:?}",
+            left.keys()
+        );
+        for (name, bytes) in &left {
+            let path = dir.join(name);
+            assert!(!bytes.is_empty());
+            dcr_runtime::format::ModesFile::read(&path)
+                .unwrap_or_else(|e| panic!("{signal}: {name} is not a whole base: {e}"));
+        }
+    }
+}
