@@ -12,6 +12,11 @@ Surfaces (`--surfaces`, all by default):
   scenes   mutated scene files (every field given hostile values) and hostile outputs through
            `dcr-scenes run`
   lab      abusive `dcr-lab truth` / `fit-attenuation` options and `accuracy` with bad roots
+  batch    mutated `modal-bake batch` manifests (JSON and TOML: missing, unknown and repeated
+           keys, wrong types, absurd counts and values, outputs that are inputs, devices,
+           FIFOs, folders or another entry's output, meshes that are devices or FIFOs, bad
+           --shard / --jobs / --report), valid manifests run twice at once on one folder,
+           and runs SIGKILLed mid-bake and resumed
 Each run is under a memory cap (`ulimit -v 4000000`, 4 GB of address space) and a timeout,
 and is classified:
 
@@ -218,7 +223,8 @@ class Campaign:
         whole_file = re.search(r"separate closed shells|holds no triangles|not a regular file", err)
         if need_location and (name not in err or not (LOCATED.search(err) or whole_file)):
             return self.record("unlocated", dict(what, stderr=err[-300:]))
-        if err.count("error:") > 1 or "{ " in err and " }" in err:
+        # (`error:` as a word: an option named `--target-error:` is not a second error.)
+        if len(re.findall(r"(?<![\w-])error:", err)) > 1 or "{ " in err and " }" in err:
             # A cause printed twice, or Rust `Debug` text in the message.
             return self.record("unclear", dict(what, stderr=err[-300:]))
         return self.record("refused", what)
@@ -596,13 +602,239 @@ def lab_surface(c, rng, runs, work):
         shutil.rmtree(case)
 
 
+def toml_of(v):
+    """A manifest tree as TOML (the subset manifests use), or None when it has no TOML form."""
+    def val(x):
+        if isinstance(x, bool):
+            return "true" if x else "false"
+        if isinstance(x, (int, float)):
+            return repr(x) if x == x and abs(x) != float("inf") else None
+        if isinstance(x, str):
+            return json.dumps(x)
+        if isinstance(x, list):
+            items = [val(i) for i in x]
+            return None if None in items else "[" + ", ".join(items) + "]"
+        return None
+    if not isinstance(v, dict):
+        return None
+    out = []
+    for k, x in v.items():
+        if k == "entries" and isinstance(x, list) and all(isinstance(e, dict) for e in x):
+            continue
+        t = val(x)
+        if t is None:
+            return None
+        out.append("%s = %s" % (json.dumps(k), t))
+    for e in v.get("entries", []) if isinstance(v.get("entries"), list) else []:
+        if not isinstance(e, dict):
+            return None
+        out.append("\n[[entries]]")
+        opts = None
+        for k, x in e.items():
+            if k == "options" and isinstance(x, dict):
+                opts = x
+                continue
+            t = val(x)
+            if t is None:
+                return None
+            out.append("%s = %s" % (json.dumps(k), t))
+        if opts is not None:
+            out.append("[entries.options]")
+            for k, x in opts.items():
+                t = val(x)
+                if t is None:
+                    return None
+                out.append("%s = %s" % (json.dumps(k), t))
+    return "\n".join(out) + "\n"
+
+
+# Manifest mutations: (name, function of (manifest, rng) -> (manifest or bytes, extra args)).
+BATCH_FIELD = [
+    ("missing mesh", lambda e: e.pop("mesh")),
+    ("missing out", lambda e: e.pop("out")),
+    ("unknown key", lambda e: e.__setitem__("outt", "x.modes")),
+    ("mesh not a string", lambda e: e.__setitem__("mesh", 5)),
+    ("out empty", lambda e: e.__setitem__("out", "")),
+    ("options not a table", lambda e: e.__setitem__("options", "--modes 4")),
+]
+BATCH_OPTIONS = [
+    {"modez": 4}, {"fixed_box": [0, 0, 0, 1, 1, 1]}, {"max-memory": 1000}, {"out": "y.modes"},
+    {"target-error": 5}, {"modes": None}, {"modes": {"n": 3}}, {"modes": -1}, {"modes": 10.5},
+    {"modes": 1e12}, {"modes": 0}, {"youngs": -5}, {"youngs": 1e308}, {"poisson": 0.5},
+    {"density": 1e-300}, {"material": "cheese"}, {"modes": 3, "max-freq": 100},
+    {"size": 0.1}, {"rayleigh": [1, 2, 3]}, {"rayleigh": [-1, 0]}, {"max-freq": -5},
+    {"fixed-below": "w=3"}, {"fixed-box": [1, 1, 1, 0, 0, 0]}, {"transfer-h": -1},
+    {"transfer-modes": 3}, {"units": "furlong"}, {"modes": "1e999"}, {"lumped": "yes"},
+]
+BATCH_PATHS = {  # out paths (relative to the case folder) that must be refused
+    "out is the mesh": ("out", "mesh.msh"), "out respells the mesh": ("out", "./sub/../mesh.msh"),
+    "out links the mesh": ("out", "link.msh"), "out is the manifest": ("out", "@manifest"),
+    "out is a device": ("out", "/dev/null"), "out is a FIFO": ("out", "fifo"),
+    "out is a folder": ("out", "sub"), "out under a file": ("out", "mesh.msh/x.modes"),
+    "mesh is a device": ("mesh", "/dev/zero"), "mesh is a FIFO": ("mesh", "fifo"),
+    "mesh links a device": ("mesh", "zero"), "mesh is a folder": ("mesh", "sub"),
+    "mesh missing": ("mesh", "missing.msh"),
+}
+BATCH_ARGS = [["--shard", "3/3"], ["--shard", "0/0"], ["--shard", "-1/2"], ["--shard", "x"],
+              ["--shard", "env:DCR_CAMPAIGN_UNSET/2"], ["--jobs", "0"], ["--jobs", "1000000"],
+              ["--report", "@manifest"], ["--report", "mesh.msh"], ["--report", "fifo"],
+              ["--report", "/dev/null"], ["--report", "sub"], ["--max-memory", "-1"],
+              ["--max-time", "nan"]]
+
+
+def batch_surface(c, rng, runs, work):
+    """Mutated `modal-bake batch` manifests and options; valid ones run twice at once on one
+    folder, or SIGKILLed mid-bake and resumed."""
+    c.surface = "batch"
+    src = os.path.join(ROOT, "data", "meshes", "cube_v41.msh")
+    located = re.compile(r"entries\[\d+\]|--[a-z][a-z-]*|\bline \d+|\boffset \d+|\bentries\b|"
+                         r"\bversion\b|\bkey `|MiB|\bmanifest\b")
+    for i in range(runs):
+        case = os.path.join(work, "b%d" % i)
+        os.makedirs(os.path.join(case, "sub"))
+        shutil.copy(src, os.path.join(case, "mesh.msh"))
+        os.symlink(os.path.join(case, "mesh.msh"), os.path.join(case, "link.msh"))
+        os.symlink("/dev/zero", os.path.join(case, "zero"))
+        os.mkfifo(os.path.join(case, "fifo"))
+        man = {"version": 1, "entries": [
+            {"mesh": "mesh.msh", "out": "bases/a.modes", "options": {"modes": 4}},
+            {"mesh": "mesh.msh", "out": "bases/b.modes", "options": {"modes": 3, "fixed": ["bottom"]}},
+            {"mesh": "mesh.msh", "out": "bases/c.modes", "options": {"modes": 2, "material": "steel"}}]}
+        extra, must, raw = [], True, None
+        r = rng.random()
+        if r < 0.2:
+            name, f = rng.choice(BATCH_FIELD)
+            f(rng.choice(man["entries"]))
+            kind = name
+        elif r < 0.45:
+            o = rng.choice(BATCH_OPTIONS)
+            rng.choice(man["entries"])["options"] = dict(o)
+            kind = "options " + json.dumps(o)
+        elif r < 0.65:
+            kind = rng.choice(sorted(BATCH_PATHS))
+            field, value = BATCH_PATHS[kind]
+            rng.choice(man["entries"])[field] = value
+        elif r < 0.72:
+            kind = rng.choice(["duplicate out", "respelled duplicate out", "version 2",
+                               "empty entries", "entries not an array", "top unknown key",
+                               "absurd entry count", "top array"])
+            if kind == "duplicate out":
+                man["entries"][2]["out"] = man["entries"][0]["out"]
+            elif kind == "respelled duplicate out":
+                man["entries"][2]["out"] = "./sub/../" + man["entries"][0]["out"]
+            elif kind == "version 2":
+                man["version"] = 2
+            elif kind == "empty entries":
+                man["entries"] = []
+            elif kind == "entries not an array":
+                man["entries"] = man["entries"][0]
+            elif kind == "top unknown key":
+                man["jobs"] = 4
+            elif kind == "absurd entry count":
+                man["entries"] = [{"mesh": "mesh.msh", "out": "x%d.modes" % k}
+                                  for k in range(100001)]
+            else:
+                man = man["entries"]
+        elif r < 0.8:
+            kind = rng.choice(["flip", "truncate", "duplicate key", "not utf-8", "huge file"])
+            text = json.dumps(man).encode()
+            if kind == "flip":
+                b = bytearray(text)
+                for _ in range(rng.randint(1, 3)):
+                    j = rng.randrange(len(b))
+                    b[j] ^= rng.randint(1, 255)
+                raw = bytes(b)
+                must = False  # a flip may leave valid JSON (a path or a value changed)
+            elif kind == "truncate":
+                raw = text[:rng.randrange(len(text))]
+            elif kind == "duplicate key":
+                raw = text.replace(b'"out": "bases/a.modes"',
+                                   b'"out": "bases/a.modes", "out": "bases/z.modes"')
+            elif kind == "not utf-8":
+                raw = b"\xff\xfe" + text
+            else:
+                raw = text + b" " * (17 << 20)
+        elif r < 0.9:
+            extra = list(rng.choice(BATCH_ARGS))
+            kind = " ".join(extra)
+        else:
+            kind = rng.choice(["fine", "fine twice at once", "fine killed and resumed"])
+            must = False
+        toml_form = raw is None and rng.random() < 0.3 and toml_of(man) is not None
+        mpath = os.path.join(case, "m.toml" if toml_form else "m.json")
+        for e in man.get("entries", []) if isinstance(man, dict) and \
+                isinstance(man.get("entries"), list) else []:
+            if isinstance(e, dict) and e.get("out") == "@manifest":
+                e["out"] = os.path.basename(mpath)
+        extra = [mpath if a == "@manifest" else a for a in extra]
+        if raw is not None:
+            open(mpath, "wb").write(raw)
+        elif toml_form:
+            open(mpath, "w").write(toml_of(man))
+            kind += " (TOML)"
+        else:
+            open(mpath, "w").write(json.dumps(man))
+        watched = [os.path.join(case, f) for f in ("mesh.msh", "link.msh", "zero", "fifo", "sub",
+                                                   os.path.basename(mpath))]
+        before = snapshot(watched)
+        args = ["batch", mpath, "--json"] + extra
+        what = {"mutation": kind, "cmd": " ".join(args[:1] + args[2:])}
+        if kind.startswith("fine twice"):
+            procs = [subprocess.Popen(["bash", "-c", "ulimit -v 4000000; exec '%s' %s" % (
+                BIN, " ".join("'%s'" % a for a in args))], cwd=case, stdout=subprocess.PIPE,
+                stderr=subprocess.PIPE) for _ in range(2)]
+            outs = [p.communicate(timeout=TIMEOUT) for p in procs]
+            codes = [p.returncode for p in procs]
+            code, se = max(codes, key=lambda x: abs(x)), "".join(o[1].decode() for o in outs)
+        elif kind.startswith("fine killed"):
+            p = subprocess.Popen([BIN] + args, cwd=case, stdout=subprocess.DEVNULL,
+                                 stderr=subprocess.PIPE)
+            for line_ in p.stderr:
+                if b": baked in" in line_:
+                    break
+            p.kill()
+            p.wait()
+            code, so, se = run(args, case)
+            if code == 0:
+                rep = json.loads(so)
+                if not any(e["action"] == "skipped" for e in rep["entries"]) and \
+                        rep["totals"]["entries"] > 1:
+                    c.record("misread", dict(what, why="nothing was skipped on resume"))
+        else:
+            code, so, se = run(args, case)
+        after = snapshot(watched)
+        tmps = [os.path.join(d, f) for d, _, fs in os.walk(case) for f in fs if ".tmp-" in f]
+        bases = os.path.join(case, "bases")
+        if before != after or os.path.isfile("/dev/null"):
+            c.record("clobber", what)
+        elif tmps:
+            c.record("leftover", dict(what, files=tmps))
+        elif code != 0 and os.path.isdir(bases) and os.listdir(bases) and \
+                not kind.startswith("fine"):
+            c.record("leftover", dict(what, files=os.listdir(bases)))
+        else:
+            if code == 0 and kind.startswith("fine"):
+                # Every base written is whole and a second run finds them up to date.
+                c2, so2, se2 = run(["batch", mpath, "--json"], case)
+                if c2 != 0 or any(e["action"] != "skipped" for e in json.loads(so2)["entries"]):
+                    c.record("misread", dict(what, why="a second run rebaked", stderr=se2[-300:]))
+                    shutil.rmtree(case)
+                    continue
+            c.classify(code, se, "", None, set(), what, must_refuse=must, need_location=False)
+            if code not in (0, 101, "timeout") and isinstance(code, int) and 0 < code < 128:
+                named = os.path.basename(mpath) in se or re.search(r"--[a-z]", se)
+                if not (named and located.search(se)):
+                    c.record("unlocated", dict(what, stderr=se[-300:]))
+        shutil.rmtree(case)
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--runs", type=int, default=300, help="mutated inputs per kind")
     ap.add_argument("--seed", type=int, default=1)
-    ap.add_argument("--surfaces", default="volume,export,surface,scenes,lab",
+    ap.add_argument("--surfaces", default="volume,export,surface,scenes,lab,batch",
                     help="comma-separated: volume (with modes and options), export, surface, "
-                         "scenes, lab")
+                         "scenes, lab, batch")
     ap.add_argument("--json", help="write the totals and the bad cases here")
     a = ap.parse_args()
     if not os.path.exists(BIN):
@@ -625,6 +857,8 @@ def main():
         scenes_surface(c, rng, a.runs, work)
     if "lab" in surfaces:
         lab_surface(c, rng, a.runs, work)
+    if "batch" in surfaces:
+        batch_surface(c, rng, a.runs, work)
     shutil.rmtree(work)
     runs = sum(sum(t.values()) for t in c.totals.values())
     print("hostile campaign: %d runs" % runs)

@@ -12,9 +12,10 @@
 //! The files themselves are then written through [`super::AtomicFile`], which checks the type
 //! of the destination again at the rename.
 
+use std::collections::HashMap;
 use std::path::{Component, Path, PathBuf};
 
-use super::regular_file::{describe_file_type, same_file};
+use super::regular_file::describe_file_type;
 
 /// Why an output path is refused ([`OutputPlan::output`]).
 #[derive(Debug, thiserror::Error)]
@@ -105,8 +106,14 @@ pub enum OutputError {
 #[derive(Clone, Debug, Default)]
 pub struct OutputPlan {
     inputs: Vec<(String, PathBuf)>,
+    /// The first input of each existing file, by identity (a plan may hold a manifest's
+    /// tens of thousands of paths: each check is a lookup, not a scan).
+    input_ids: HashMap<FileId, usize>,
     /// (option, path as given, normalised path).
     outputs: Vec<(String, PathBuf, PathBuf)>,
+    /// The output of each normalised path and of each existing file's identity.
+    output_norms: HashMap<PathBuf, usize>,
+    output_ids: HashMap<FileId, usize>,
     /// Folders outputs go into: (option, path as given, normalised path).
     folders: Vec<(String, PathBuf, PathBuf)>,
 }
@@ -120,6 +127,9 @@ impl OutputPlan {
     /// Declares an input the outputs must not overwrite; `what` says what it is in messages
     /// (`the input`, `the base`, `the scene file`). Declare the inputs before the outputs.
     pub fn input(&mut self, what: &str, path: &Path) -> &mut OutputPlan {
+        if let Some(id) = file_id(path) {
+            self.input_ids.entry(id).or_insert(self.inputs.len());
+        }
         self.inputs.push((what.to_string(), path.to_path_buf()));
         self
     }
@@ -130,17 +140,25 @@ impl OutputPlan {
     /// [`OutputError`]: the output is an input, exists as a non-regular file, names no file,
     /// sits under a non-folder, or is the path of an output declared before.
     pub fn output(&mut self, option: &str, path: &Path) -> Result<(), OutputError> {
-        check_output_path(option, path, &self.inputs)?;
+        let id = file_id(path);
+        let input = id
+            .as_ref()
+            .and_then(|id| self.input_ids.get(id))
+            .map(|&i| &self.inputs[i]);
+        check_output_path(option, path, input)?;
         let norm = normalise(path);
-        for (other_option, other, other_norm) in &self.outputs {
-            if *other_norm == norm || same_file(other, path) {
-                return Err(OutputError::SamePath {
-                    option: option.to_string(),
-                    path: path.to_path_buf(),
-                    other_option: other_option.clone(),
-                    other: other.clone(),
-                });
-            }
+        let earlier = self
+            .output_norms
+            .get(&norm)
+            .or_else(|| id.as_ref().and_then(|id| self.output_ids.get(id)));
+        if let Some(&i) = earlier {
+            let (other_option, other, _) = &self.outputs[i];
+            return Err(OutputError::SamePath {
+                option: option.to_string(),
+                path: path.to_path_buf(),
+                other_option: other_option.clone(),
+                other: other.clone(),
+            });
         }
         for (other_option, other, other_norm) in &self.folders {
             if *other_norm == norm {
@@ -151,6 +169,10 @@ impl OutputPlan {
                     other: other.clone(),
                 });
             }
+        }
+        self.output_norms.insert(norm.clone(), self.outputs.len());
+        if let Some(id) = id {
+            self.output_ids.insert(id, self.outputs.len());
         }
         self.outputs
             .push((option.to_string(), path.to_path_buf(), norm));
@@ -201,12 +223,36 @@ impl OutputPlan {
     }
 }
 
-/// Checks one output path against `inputs` (what, path): not an input, not an existing
-/// non-regular file, names a file, its nearest existing ancestor a folder.
+/// The identity of an existing file (device and inode on Unix, the canonical path elsewhere;
+/// links followed): two paths of one file have one identity, as `same_file` decides.
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+enum FileId {
+    #[cfg(unix)]
+    Inode(u64, u64),
+    #[cfg(not(unix))]
+    Path(PathBuf),
+}
+
+fn file_id(path: &Path) -> Option<FileId> {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        let m = std::fs::metadata(path).ok()?;
+        Some(FileId::Inode(m.dev(), m.ino()))
+    }
+    #[cfg(not(unix))]
+    {
+        path.canonicalize().ok().map(FileId::Path)
+    }
+}
+
+/// Checks one output path: not `input` (what, path: the input it is the same file as, if
+/// any), not an existing non-regular file, names a file, its nearest existing ancestor a
+/// folder.
 fn check_output_path(
     option: &str,
     path: &Path,
-    inputs: &[(String, PathBuf)],
+    input: Option<&(String, PathBuf)>,
 ) -> Result<(), OutputError> {
     let names_file = !path.as_os_str().is_empty()
         && !path.as_os_str().to_string_lossy().ends_with('/')
@@ -218,15 +264,13 @@ fn check_output_path(
             example: "out/result.ext".into(),
         });
     }
-    for (what, input) in inputs {
-        if same_file(path, input) {
-            return Err(OutputError::IsInput {
-                option: option.to_string(),
-                path: path.to_path_buf(),
-                what: what.clone(),
-                input: input.clone(),
-            });
-        }
+    if let Some((what, input)) = input {
+        return Err(OutputError::IsInput {
+            option: option.to_string(),
+            path: path.to_path_buf(),
+            what: what.clone(),
+            input: input.clone(),
+        });
     }
     if let Ok(meta) = std::fs::metadata(path) {
         if !meta.is_file() {

@@ -97,7 +97,12 @@ impl BakeParams {
         }
     }
 
-    pub(super) fn check(&self) -> Result<Material, BakeError> {
+    /// Checks the parameters (material ranges, mode request, damping, fixed-node selectors)
+    /// before any mesh work; returns the material.
+    ///
+    /// # Errors
+    /// [`BakeError::Params`] or a material error naming the parameter.
+    pub fn check(&self) -> Result<Material, BakeError> {
         let mat = Material::new(
             self.material.youngs,
             self.material.poisson,

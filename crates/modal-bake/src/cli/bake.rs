@@ -332,15 +332,19 @@ pub fn bake_chosen_mesh(args: &BakeArgs, mesh: modal_bake::mesh::TetMesh) -> any
     bake_loaded(args, &params, mesh, 0.0)
 }
 
-/// The bake of a mesh in memory (read in `read_s` seconds): the checks before the
-/// factorization, the bake, the record of the material and selectors, the atomic write and
-/// the report.
-fn bake_loaded(
+/// The checks before the factorization, the bake of a mesh in memory (read in `read_s`
+/// seconds), the record of the material and selectors and the atomic write of `args.out`;
+/// `on_stage` sees each stage. Shared by `bake` and `batch`.
+///
+/// # Errors
+/// The estimate over the budget, or a failed bake or write (nothing is written).
+pub fn bake_and_write(
     args: &BakeArgs,
     params: &BakeParams,
     mesh: modal_bake::mesh::TetMesh,
     read_s: f64,
-) -> anyhow::Result<()> {
+    on_stage: &mut dyn FnMut(BakeStage),
+) -> anyhow::Result<BakeReport> {
     let surface = is_surface_asset(&args.mesh);
     let file = args.mesh.display().to_string();
     before_factorization(
@@ -351,23 +355,36 @@ fn bake_loaded(
         args.asset.units,
         surface,
     )?;
-    let mut progress = Progress::new("bake");
-    let report = bake::bake_mesh(mesh, params, &file, &mut |s| progress.update(s))
+    bake::bake_mesh(mesh, params, &file, &mut |s| on_stage(s))
         .map_err(anyhow::Error::new)
         .and_then(|(mut base, mut report)| {
             report.read_s = read_s;
             report.material_name = args.options.model.material_choice().describe();
             annotate(&mut base, &args.options, &report);
-            progress.update(BakeStage::Write);
+            on_stage(BakeStage::Write);
             let t = std::time::Instant::now();
             super::create_parent(&args.out)?;
             base.write_atomic(&args.out)?;
             report.write_s = t.elapsed().as_secs_f64();
             Ok(report)
-        });
+        })
+        .with_context(|| format!("baking {} failed; nothing was written", args.mesh.display()))
+}
+
+/// The bake of a mesh in memory (read in `read_s` seconds): the checks before the
+/// factorization, the bake, the record of the material and selectors, the atomic write and
+/// the report.
+fn bake_loaded(
+    args: &BakeArgs,
+    params: &BakeParams,
+    mesh: modal_bake::mesh::TetMesh,
+    read_s: f64,
+) -> anyhow::Result<()> {
+    let file = args.mesh.display().to_string();
+    let mut progress = Progress::new("bake");
+    let report = bake_and_write(args, params, mesh, read_s, &mut |s| progress.update(s));
     progress.finish();
-    let report = report
-        .with_context(|| format!("baking {} failed; nothing was written", args.mesh.display()))?;
+    let report = report?;
     if let Some(w) = bake::plausibility_warnings(
         None,
         f64::NAN,

@@ -9,6 +9,7 @@ macro_rules! outln {
 }
 
 mod bake;
+mod batch;
 mod budget;
 mod check;
 mod export;
@@ -42,6 +43,10 @@ enum Command {
     /// .stl / .ply meshed with gmsh or fTetWild) into OUT.modes.
     #[command(allow_negative_numbers = true)]
     Bake(bake::BakeArgs),
+    /// Bake the bases a manifest (JSON or TOML) lists, skipping those up to date; one shard
+    /// of it (--shard I/N) on a farm, --jobs J at once. See docs/farm.md.
+    #[command(allow_negative_numbers = true)]
+    Batch(batch::BatchArgs),
     /// Tetrahedralize a surface asset (OBJ, STL, PLY) into a .msh mesh: inspected, then gmsh
     /// or fTetWild (--mesher auto).
     Mesh(mesh::MeshArgs),
@@ -176,6 +181,7 @@ fn run_command(command: Command) -> ExitCode {
         Command::Truth(a) => lab_alias::run("truth", &a),
         Command::FitAttenuation(a) => lab_alias::run("fit-attenuation", &a),
         Command::Check(a) => return check::run(&a),
+        Command::Batch(a) => batch::run(&a),
     };
     match result {
         Ok(code) => code,
