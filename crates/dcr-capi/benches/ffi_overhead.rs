@@ -20,7 +20,8 @@ use std::time::Instant;
 
 use dcr_capi::*;
 use dcr_runtime::testing::{box_surface, geometric_omegas, synthetic_base, SplitMix64};
-use dcr_runtime::{DistantResponse, Impact, Method, ModalModel, ResponseParams, Sampling};
+use dcr_runtime::{DistantResponse, Method, ModalModel, ResponseParams};
+use dcr_runtime::response::{Impact, Sampling};
 
 const H: f64 = 0.01;
 const SAMPLES: usize = 21;
@@ -82,8 +83,8 @@ fn main() {
         }
         p
     };
-    let resting: Vec<dcr_runtime::RestingContact> = (0..CONTACTS)
-        .map(|i| dcr_runtime::RestingContact {
+    let resting: Vec<dcr_runtime::response::RestingContact> = (0..CONTACTS)
+        .map(|i| dcr_runtime::response::RestingContact {
             id: i as u64,
             point: point(&mut rng),
         })

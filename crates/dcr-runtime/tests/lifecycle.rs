@@ -13,10 +13,9 @@ use std::sync::Arc;
 
 use dcr_runtime::format::{ModesFile, TransferTable};
 use dcr_runtime::testing::plate_base;
-use dcr_runtime::{
-    BaseSupport, BodyState, ContactReport, DcrWorld, ElasticHandle, ElasticObjectDesc,
-    ImpulseEvent, Method, ModalModel, ResponseParams, TablePolicy, WorldError, WorldParams,
-};
+use dcr_runtime::{BodyState, ContactReport, DcrWorld, ElasticHandle, ElasticObjectDesc, ImpulseEvent, Method, ModalModel, ResponseParams, WorldError, WorldParams};
+use dcr_runtime::response::TablePolicy;
+use dcr_runtime::world::BaseSupport;
 
 fn model_of(base: ModesFile) -> Arc<ModalModel> {
     Arc::new(ModalModel::from_base(base).unwrap())

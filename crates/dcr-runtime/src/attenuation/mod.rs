@@ -13,6 +13,9 @@ pub use attenuation_params::{AmplitudeKind, AttenuationLaw, AttenuationParams, D
 pub(crate) use distance_cache::DistanceCache;
 pub use geodesic_table::GeodesicTable;
 pub use heat_geodesic::{GeodesicError, HeatGeodesic, HeatWorkspace};
+#[cfg(feature = "bench-internals")]
+#[doc(hidden)]
+pub use heat_geodesic::LltProbe;
 
 #[cfg(test)]
 mod tests;

@@ -373,8 +373,9 @@ impl Layout {
     }
 
     /// `x ← A⁻¹ x` for A = L Lᵀ, x in storage order (`l`, `inv_diag` = 1/L_kk: the whole
-    /// factor's): every step of a query's solve in one serial call, for tests.
-    #[cfg(test)]
+    /// factor's): every step of a query's solve in one serial call, for tests and the
+    /// `sparse_llt` benchmark.
+    #[cfg(any(test, feature = "bench-internals"))]
     pub(super) fn solve(&self, l: &[f64], inv_diag: &[f64], x: &mut [f64]) {
         let (halves, xt) = self.split_mut(x);
         if let (Some(parts), Some([x0, x1])) = (&self.halves, halves) {
