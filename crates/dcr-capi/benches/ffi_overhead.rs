@@ -19,9 +19,9 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use dcr_capi::*;
+use dcr_runtime::response::{Impact, Sampling};
 use dcr_runtime::testing::{box_surface, geometric_omegas, synthetic_base, SplitMix64};
 use dcr_runtime::{DistantResponse, Method, ModalModel, ResponseParams};
-use dcr_runtime::response::{Impact, Sampling};
 
 const H: f64 = 0.01;
 const SAMPLES: usize = 21;

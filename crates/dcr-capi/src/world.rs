@@ -4,8 +4,11 @@
 use std::mem::{align_of, offset_of, size_of};
 use std::sync::Arc;
 
-use dcr_runtime::{BodyState, ContactReport, DcrWorld as RtWorld, ElasticHandle, ElasticObjectDesc, ImpulseEvent, ObjectStepInfo, WorldStepInfo};
 use dcr_runtime::world::{BaseSupport, ObjectTotals};
+use dcr_runtime::{
+    BodyState, ContactReport, DcrWorld as RtWorld, ElasticHandle, ElasticObjectDesc, ImpulseEvent,
+    ObjectStepInfo, WorldStepInfo,
+};
 
 use crate::guard::guard;
 use crate::ptr::{

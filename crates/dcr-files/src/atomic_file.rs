@@ -424,5 +424,4 @@ mod tests {
         // Only the FIFO, the folder, the link and nothing else: no temporary left behind.
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 3);
     }
-
 }

@@ -22,8 +22,8 @@ use dcr_lab::accuracy::truth_cache::cached_converged_peaks;
 use dcr_lab::accuracy::{
     all_objects, base20, load_mesh, pairs_params, system_params, Base20, H, IMPACTS,
 };
-use dcr_runtime::{Method, ModalModel};
 use dcr_runtime::response::RestingContact;
+use dcr_runtime::{Method, ModalModel};
 use modal_bake::full_order::{FullOrderSystem, ModalAll};
 use modal_bake::target_error::ReferencePairs;
 use modal_bake::transfer::{

@@ -267,7 +267,16 @@ fn static_correction_recovers_static_deflection() {
     let r = ma.project(&f);
     let (h, dt) = (0.1, 1e-5);
     let steps = (h / dt) as usize;
-    let all = ma.response_peaks(&r, &w, p.system.rayleigh, dt, steps, None, ModalInput::Step, false);
+    let all = ma.response_peaks(
+        &r,
+        &w,
+        p.system.rayleigh,
+        dt,
+        steps,
+        None,
+        ModalInput::Step,
+        false,
+    );
     let m20 = ma.response_peaks(
         &r,
         &w,

@@ -11,9 +11,12 @@ use std::sync::Arc;
 
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
 use dcr_runtime::attenuation::HeatGeodesic;
+use dcr_runtime::response::{
+    AmplitudeKind, AttenuationLaw, AttenuationParams, DistanceKind, Impact, RestingContact,
+    Sampling,
+};
 use dcr_runtime::testing::{box_surface, geometric_omegas, synthetic_base, SplitMix64};
 use dcr_runtime::{DistantResponse, Method, ModalModel, ResponseParams};
-use dcr_runtime::response::{AmplitudeKind, AttenuationLaw, AttenuationParams, DistanceKind, Impact, RestingContact, Sampling};
 
 /// (name, samples per step, distant contacts, surface vertices, paper ms).
 const ROWS: [(&str, usize, usize, usize, f64); 7] = [
@@ -399,7 +402,14 @@ fn kernel(c: &mut Criterion) {
         for _ in 0..300 {
             let t0 = std::time::Instant::now();
             for _ in 0..200 {
-                dcr_runtime::response::peak_abs_projection(black_box(&q), s, m, black_box(&w), nch, &mut a);
+                dcr_runtime::response::peak_abs_projection(
+                    black_box(&q),
+                    s,
+                    m,
+                    black_box(&w),
+                    nch,
+                    &mut a,
+                );
             }
             best_new = best_new.min(t0.elapsed().as_secs_f64() / 200.0);
             let t0 = std::time::Instant::now();
@@ -416,7 +426,14 @@ fn kernel(c: &mut Criterion) {
     }
     c.bench_function("kernel/dinner/new", |bch| {
         bch.iter(|| {
-            dcr_runtime::response::peak_abs_projection(black_box(&q), s, m, black_box(&w), nch, &mut a);
+            dcr_runtime::response::peak_abs_projection(
+                black_box(&q),
+                s,
+                m,
+                black_box(&w),
+                nch,
+                &mut a,
+            );
             black_box(a[3])
         })
     });
@@ -490,8 +507,26 @@ fn kernel_rows(c: &mut Criterion) {
             continue;
         }
         let (t_rows, t_panels) = interleaved_best(
-            || dcr_runtime::response::peak_abs_rows(black_box(&v), stride, m, black_box(&b), nc, &mut pr),
-            || dcr_runtime::response::peak_abs_projection(black_box(&q), s, m, black_box(&w), nch, &mut pp),
+            || {
+                dcr_runtime::response::peak_abs_rows(
+                    black_box(&v),
+                    stride,
+                    m,
+                    black_box(&b),
+                    nc,
+                    &mut pr,
+                )
+            },
+            || {
+                dcr_runtime::response::peak_abs_projection(
+                    black_box(&q),
+                    s,
+                    m,
+                    black_box(&w),
+                    nch,
+                    &mut pp,
+                )
+            },
         );
         println!(
             "kernel/{name} {s}x{nc} interleaved best-of-300: rows {:.3} µs, panels {:.3} µs",

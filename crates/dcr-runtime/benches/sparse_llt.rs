@@ -126,7 +126,11 @@ fn main() {
             "{name}: {n} vertices, factor entries {nnz} (faer auto: {} {nnz_auto}); \
              factor both own {:.3} / faer simplicial {:.3} / faer auto {:.3} ms; \
              heat solve {:.4} / {:.4} / {:.4} ms; poisson solve {:.4} / {:.4} / {:.4} ms",
-            if supernodal { "supernodal" } else { "simplicial" },
+            if supernodal {
+                "supernodal"
+            } else {
+                "simplicial"
+            },
             ms(0, 0),
             ms(1, 0),
             ms(2, 0),

@@ -16,9 +16,15 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Arc;
 
 use dcr_runtime::attenuation::HeatGeodesic;
+use dcr_runtime::response::{
+    AmplitudeKind, AttenuationLaw, AttenuationParams, DistanceKind, ForceInput, Impact,
+    RestingContact, Variant,
+};
 use dcr_runtime::testing::{box_surface, geometric_omegas, synthetic_base, SplitMix64};
-use dcr_runtime::{BodyState, ContactReport, DcrWorld, DistantResponse, ElasticObjectDesc, Method, ModalModel, Pose, ResponseParams, WorldParams};
-use dcr_runtime::response::{AmplitudeKind, AttenuationLaw, AttenuationParams, DistanceKind, ForceInput, Impact, RestingContact, Variant};
+use dcr_runtime::{
+    BodyState, ContactReport, DcrWorld, DistantResponse, ElasticObjectDesc, Method, ModalModel,
+    Pose, ResponseParams, WorldParams,
+};
 
 struct Counting;
 

@@ -382,9 +382,14 @@ fn every_output_refuses_a_linked_device_and_the_scene_survives() {
             .file_type()
             .is_symlink());
     };
-    for (i, name) in ["trajectory.npz", "timings.npz", "summary.json", "outcomes.svg"]
-        .iter()
-        .enumerate()
+    for (i, name) in [
+        "trajectory.npz",
+        "timings.npz",
+        "summary.json",
+        "outcomes.svg",
+    ]
+    .iter()
+    .enumerate()
     {
         let out = d.join(format!("out{i}"));
         let l = link(&out, name);

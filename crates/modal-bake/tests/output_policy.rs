@@ -215,8 +215,11 @@ fn every_output_refuses_a_linked_device_and_a_fifo_and_the_input_survives() {
     let base = beam_base(d);
     let before = std::fs::read(&base).unwrap();
     let asset = d.join("a.obj");
-    std::fs::write(&asset, "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n")
-        .unwrap();
+    std::fs::write(
+        &asset,
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n",
+    )
+    .unwrap();
     let mesh = repo_root().join("data/meshes/beam.msh");
     let null = d.join("null.out");
     std::os::unix::fs::symlink("/dev/null", &null).unwrap();

@@ -7,8 +7,8 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use dcr_runtime::format::ModesFile;
-use dcr_runtime::{DistantResponse, Method, ModalModel};
 use dcr_runtime::response::{Impact, RestingContact, ServedBy};
+use dcr_runtime::{DistantResponse, Method, ModalModel};
 use modal_bake::bake::{bake_mesh, BakeError, BakeParams, ModeRequest};
 use modal_bake::full_order::{
     converged_peaks, ConvergedPeaks, FullOrderSystem, ModalAll, PeakSolver, PeakWindow,

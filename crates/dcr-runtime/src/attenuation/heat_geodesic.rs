@@ -689,7 +689,8 @@ impl LltProbe {
         use faer::Par;
         let s = usize::from(supernodal);
         let sym = &self.symbolic[s];
-        let mut buf = MemBuffer::new(sym.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default()));
+        let mut buf =
+            MemBuffer::new(sym.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default()));
         for k in 0..2 {
             let mut values = vec![0.0; sym.len_val()];
             sym.factorize_numeric_llt::<f64>(

@@ -12,10 +12,10 @@ mod sparse_llt;
 pub use attenuation_params::{AmplitudeKind, AttenuationLaw, AttenuationParams, DistanceKind};
 pub(crate) use distance_cache::DistanceCache;
 pub use geodesic_table::GeodesicTable;
-pub use heat_geodesic::{GeodesicError, HeatGeodesic, HeatWorkspace};
 #[cfg(feature = "bench-internals")]
 #[doc(hidden)]
 pub use heat_geodesic::LltProbe;
+pub use heat_geodesic::{GeodesicError, HeatGeodesic, HeatWorkspace};
 
 #[cfg(test)]
 mod tests;

@@ -56,7 +56,7 @@ impl MethodResponse {
 /// ```
 /// use std::sync::Arc;
 /// use dcr_runtime::{testing, DistantResponse, ModalModel, ResponseParams};
-use dcr_runtime::response::{Impact, RestingContact};
+/// use dcr_runtime::response::{Impact, RestingContact};
 ///
 /// // A synthetic 1 m × 0.6 m plate base (8 modes); real bases come from `ModalModel::load`.
 /// let model = Arc::new(ModalModel::from_base(testing::plate_base())?);

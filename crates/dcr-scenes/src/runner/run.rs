@@ -8,8 +8,11 @@ use anyhow::{bail, Context, Result};
 use dcr_rapier::f64::{body_handle, AdapterParams, ApplyMode, DcrRapier, StepGate};
 use dcr_rapier::{ElasticHandle, ElasticObjectDesc, WorldParams};
 use dcr_runtime::format::ModesFile;
+use dcr_runtime::response::{
+    AmplitudeKind, AttenuationLaw, AttenuationParams, DistanceKind, ServedBy, TableFallback,
+    TablePolicy,
+};
 use dcr_runtime::{Method, ModalModel, ResponseParams};
-use dcr_runtime::response::{AmplitudeKind, AttenuationLaw, AttenuationParams, DistanceKind, ServedBy, TableFallback, TablePolicy};
 use ndarray::{Array1, Array2};
 use ndarray_npy::NpzWriter;
 use rapier3d_f64::math::Vector;

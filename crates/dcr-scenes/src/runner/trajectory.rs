@@ -63,8 +63,7 @@ impl Trajectory {
     /// I/O errors, or a destination the writer refuses (a device, FIFO or folder).
     pub fn write_npz(&self, path: &Path) -> Result<()> {
         let bytes = self.to_npz()?;
-        dcr_files::write_atomic(path, &bytes)
-            .with_context(|| format!("writing {}", path.display()))
+        dcr_files::write_atomic(path, &bytes).with_context(|| format!("writing {}", path.display()))
     }
 
     /// The NPZ file [`Trajectory::write_npz`] writes, in memory.

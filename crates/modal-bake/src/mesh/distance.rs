@@ -81,7 +81,10 @@ fn count_samples(vertices: &[[f64; 3]], triangles: &[[usize; 3]], h: f64) -> f64
         .iter()
         .map(|t| {
             let [a, b, c] = t.map(|v| vertices[v]);
-            let n = dcr_runtime::math::cross(dcr_runtime::math::sub(b, a), dcr_runtime::math::sub(c, a));
+            let n = dcr_runtime::math::cross(
+                dcr_runtime::math::sub(b, a),
+                dcr_runtime::math::sub(c, a),
+            );
             0.5 * dcr_runtime::math::norm2(n).sqrt()
         })
         .sum();

@@ -4,8 +4,8 @@
 use std::sync::Arc;
 
 use dcr_runtime::format::ModesFile;
-use dcr_runtime::{DistantResponse, Method, ModalModel, ResponseParams};
 use dcr_runtime::response::{Impact, RestingContact};
+use dcr_runtime::{DistantResponse, Method, ModalModel, ResponseParams};
 
 use crate::eigen::SplitMix64;
 use crate::full_order::{
