@@ -108,7 +108,14 @@ fn main() {
                         .iter()
                         .zip(&rhs)
                         .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
-                    assert!(diff <= 1e-9 * scale, "{}: solves differ", path.display());
+                    // The Poisson operator is regularised by ε = 1e-8/t only (closed
+                    // surfaces): its solves agree to its conditioning, not to rounding.
+                    let tol = [1e-10, 1e-5][which];
+                    assert!(
+                        diff <= tol * scale,
+                        "{}: solves differ ({which}: {diff:e} of {scale:e})",
+                        path.display()
+                    );
                 }
             }
             if round == 0 {
