@@ -586,7 +586,7 @@ impl HeatGeodesic {
 
 /// The heat method's two operators factored three ways on one surface and elimination order,
 /// for the `sparse_llt` benchmark (feature `bench-internals`): the hand-written left-looking
-/// factor ([`Pattern::factor_pair`]) with its solves, faer's simplicial numeric factor on the
+/// factor (`sparse_llt::Pattern::factor_pair`) with its solves, faer's simplicial numeric factor on the
 /// same symbolic analysis, and faer's own choice (supernodal when its flop-ratio threshold
 /// says so) under the same order. Not part of the runtime's API.
 #[cfg(feature = "bench-internals")]
