@@ -19,8 +19,9 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use dcr_capi::*;
+use dcr_runtime::response::{Impact, Sampling};
 use dcr_runtime::testing::{box_surface, geometric_omegas, synthetic_base, SplitMix64};
-use dcr_runtime::{DistantResponse, Impact, Method, ModalModel, ResponseParams, Sampling};
+use dcr_runtime::{DistantResponse, Method, ModalModel, ResponseParams};
 
 const H: f64 = 0.01;
 const SAMPLES: usize = 21;
@@ -82,8 +83,8 @@ fn main() {
         }
         p
     };
-    let resting: Vec<dcr_runtime::RestingContact> = (0..CONTACTS)
-        .map(|i| dcr_runtime::RestingContact {
+    let resting: Vec<dcr_runtime::response::RestingContact> = (0..CONTACTS)
+        .map(|i| dcr_runtime::response::RestingContact {
             id: i as u64,
             point: point(&mut rng),
         })

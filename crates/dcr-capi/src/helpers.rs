@@ -1,6 +1,6 @@
 //! Eq. 17–18 helpers for callers of the per-object query: effective mass and response impulse.
 
-use dcr_runtime::{effective_mass, response_impulse};
+use dcr_runtime::response::{effective_mass, response_impulse};
 
 use crate::guard::guard;
 use crate::ptr::{arg_slice, read_vec3, write_out};

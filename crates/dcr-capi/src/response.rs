@@ -4,10 +4,10 @@
 use std::mem::{align_of, offset_of, size_of};
 use std::sync::Arc;
 
-use dcr_runtime::{
-    ContactResponse, DistantResponse, Impact, RestingContact, ServedBy, StepInfo, TableFallback,
-    TableStatus,
+use dcr_runtime::response::{
+    ContactResponse, Impact, RestingContact, ServedBy, StepInfo, TableFallback, TableStatus,
 };
+use dcr_runtime::DistantResponse;
 
 use crate::guard::guard;
 use crate::model::DcrModel;

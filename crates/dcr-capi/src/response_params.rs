@@ -3,10 +3,10 @@
 //! Enumerations that the caller writes are plain `uint32_t` codes (`DCR_METHOD_*`, …), so that
 //! an unknown value is an error the library reports, never undefined behaviour.
 
-use dcr_runtime::{
-    AmplitudeKind, AttenuationLaw, AttenuationParams, DistanceKind, Method, ResponseParams,
-    Sampling, TablePolicy, Variant,
+use dcr_runtime::response::{
+    AmplitudeKind, AttenuationLaw, AttenuationParams, DistanceKind, Sampling, TablePolicy, Variant,
 };
+use dcr_runtime::{Method, ResponseParams};
 
 use crate::guard::guard;
 use crate::ptr::{arg_slice, check_struct_size, write_out};

@@ -4,9 +4,10 @@
 use std::mem::{align_of, offset_of, size_of};
 use std::sync::Arc;
 
+use dcr_runtime::world::{BaseSupport, ObjectTotals};
 use dcr_runtime::{
-    BaseSupport, BodyState, ContactReport, DcrWorld as RtWorld, ElasticHandle, ElasticObjectDesc,
-    ImpulseEvent, ObjectStepInfo, ObjectTotals, WorldStepInfo,
+    BodyState, ContactReport, DcrWorld as RtWorld, ElasticHandle, ElasticObjectDesc, ImpulseEvent,
+    ObjectStepInfo, WorldStepInfo,
 };
 
 use crate::guard::guard;
@@ -1013,7 +1014,7 @@ pub unsafe extern "C" fn dcr_world_object_of_body(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use dcr_runtime::ServedBy;
+    use dcr_runtime::response::ServedBy;
 
     /// Lending the runtime's event and reading it as a `DcrImpulseEvent` gives the values the
     /// field conversion gives.

@@ -1,7 +1,8 @@
 //! [`DcrWorldParams`], [`DcrClassifyParams`], [`DcrElasticObjectDesc`] and [`DcrPose`]: the
 //! set-up data of a world, with their documented defaults.
 
-use dcr_runtime::{ClassifyParams, Pose, WorldParams};
+use dcr_runtime::world::ClassifyParams;
+use dcr_runtime::{Pose, WorldParams};
 
 use crate::guard::guard;
 use crate::model::DcrModel;

@@ -358,12 +358,12 @@ fn world_c_events_equal_the_rust_world() {
     }
 }
 
-fn served(s: dcr_runtime::ServedBy) -> u8 {
+fn served(s: dcr_runtime::response::ServedBy) -> u8 {
     match s {
-        dcr_runtime::ServedBy::Modal => dcr_capi::DCR_SERVED_BY_MODAL,
-        dcr_runtime::ServedBy::Attenuation => dcr_capi::DCR_SERVED_BY_ATTENUATION,
-        dcr_runtime::ServedBy::TransferTable => dcr_capi::DCR_SERVED_BY_TRANSFER_TABLE,
-        dcr_runtime::ServedBy::Unmapped => dcr_capi::DCR_SERVED_BY_UNMAPPED,
+        dcr_runtime::response::ServedBy::Modal => dcr_capi::DCR_SERVED_BY_MODAL,
+        dcr_runtime::response::ServedBy::Attenuation => dcr_capi::DCR_SERVED_BY_ATTENUATION,
+        dcr_runtime::response::ServedBy::TransferTable => dcr_capi::DCR_SERVED_BY_TRANSFER_TABLE,
+        dcr_runtime::response::ServedBy::Unmapped => dcr_capi::DCR_SERVED_BY_UNMAPPED,
     }
 }
 

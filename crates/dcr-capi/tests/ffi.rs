@@ -9,11 +9,9 @@ use std::path::Path;
 use std::sync::Arc;
 
 use dcr_capi::*;
+use dcr_runtime::response::{AttenuationParams, DistanceKind, Impact, RestingContact, ServedBy};
 use dcr_runtime::testing::{plate_base, SplitMix64};
-use dcr_runtime::{
-    AttenuationParams, DistanceKind, DistantResponse, Impact, Method, ModalModel, ResponseParams,
-    RestingContact, ServedBy,
-};
+use dcr_runtime::{DistantResponse, Method, ModalModel, ResponseParams};
 
 /// Loads `base` written to `dir` through the C API.
 fn c_model(dir: &Path) -> *mut DcrModel {

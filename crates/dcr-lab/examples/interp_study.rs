@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use dcr_runtime::filter::{damping_ratio, ModeFilter};
-use dcr_runtime::testing::SplitMix64;
+use dcr_runtime::rng::SplitMix64;
 use faer::linalg::matmul::matmul;
 use faer::{Accum, Mat, Par};
 use modal_bake::full_order::{FullOrderSystem, MaterialSi, ModalAll, SystemParams};

@@ -22,7 +22,8 @@ use dcr_lab::accuracy::truth_cache::cached_converged_peaks;
 use dcr_lab::accuracy::{
     all_objects, base20, load_mesh, pairs_params, system_params, Base20, H, IMPACTS,
 };
-use dcr_runtime::{Method, ModalModel, RestingContact};
+use dcr_runtime::response::RestingContact;
+use dcr_runtime::{Method, ModalModel};
 use modal_bake::bake::mode_set_from_dense;
 use modal_bake::full_order::{FullOrderSystem, ModalAll};
 use modal_bake::target_error::ReferencePairs;
@@ -139,7 +140,7 @@ fn main() -> anyhow::Result<()> {
         (x, y)
     });
     walk("the impact", imp.point, &mut |p| {
-        let moved = dcr_runtime::Impact { point: p, ..imp };
+        let moved = dcr_runtime::response::Impact { point: p, ..imp };
         let x = de.step(std::slice::from_ref(&moved), &rc)[0].peak_displacement;
         let y = dt.step(std::slice::from_ref(&moved), &rc)[0].peak_displacement;
         (x, y)

@@ -9,8 +9,8 @@ use dcr_lab::attenuation_fit::{
     fit_attenuation_mesh, fit_eq14, fit_eq14_fixed_r0, fit_simplified, sample_attenuation,
     AttenuationFitParams, FitTruth, SurfaceResponse,
 };
-use dcr_lab::truth::{run_truth, CrossCheck, TruthImpact, TruthMethod, TruthParams};
-use dcr_runtime::testing::SplitMix64;
+use dcr_lab::truth::{run_truth, CrossCheck, SystemParams, TruthImpact, TruthMethod, TruthParams};
+use dcr_runtime::rng::SplitMix64;
 use modal_bake::full_order::{FullOrderSystem, ModalAll, RefineParams};
 use modal_bake::mesh::TetMesh;
 
@@ -60,7 +60,7 @@ fn recovers_known_parameters_from_noisy_samples() {
     assert!((f.r0 / r0 - 1.0).abs() < 0.15, "{f:?}");
     assert!((f.rms_log - 0.1).abs() < 0.01, "{f:?}");
     // The fitted law is what the runtime evaluates.
-    let law = dcr_runtime::AttenuationLaw::Full {
+    let law = dcr_runtime::response::AttenuationLaw::Full {
         alpha: f.alpha,
         beta: f.beta,
         r0: f.r0,
@@ -114,16 +114,19 @@ fn measured_samples_match_run_truth_at_the_same_points() {
     // The fast sampler (modal rows + two-term recursion) equals the truth module's modal-all
     // sum for the same impact, contact, window and sample period.
     let tp = TruthParams {
-        fixed: vec!["zmin".into()],
+        system: SystemParams {
+            fixed: vec!["zmin".into()],
+            ..Default::default()
+        },
         h: 2e-3,
         method: TruthMethod::ModalAll,
         ..Default::default()
     };
-    let sys = FullOrderSystem::new(slab(), &tp.system(), "slab").unwrap();
+    let sys = FullOrderSystem::new(slab(), &tp.system, "slab").unwrap();
     let ma = ModalAll::new(&sys, 6000).unwrap();
     let resp = SurfaceResponse::from_modal_all(&sys, &ma, None);
     let (samples, kind, dt, _) =
-        sample_attenuation(&resp, tp.rayleigh, tp.h, None, 4, 3, &mut |_| {}).unwrap();
+        sample_attenuation(&resp, tp.system.rayleigh, tp.h, None, 4, 3, &mut |_| {}).unwrap();
     assert_eq!(kind, "geodesic");
     for smp in &samples {
         // One run at exactly the sampler's period (no refinement), to compare like with like.

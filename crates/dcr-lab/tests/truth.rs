@@ -6,7 +6,7 @@
 
 use std::sync::Arc;
 
-use dcr_lab::truth::{run_truth, TruthImpact, TruthMethod, TruthParams};
+use dcr_lab::truth::{run_truth, SystemParams, TruthImpact, TruthMethod, TruthParams};
 use dcr_runtime::filter::{damping_ratio, ModeFilter};
 use dcr_runtime::ModalModel;
 use modal_bake::bake::{bake_mesh, BakeParams, MaterialSi, ModeRequest};
@@ -35,7 +35,10 @@ fn impact() -> TruthImpact {
 
 fn params(fixed: bool, method: TruthMethod) -> TruthParams {
     TruthParams {
-        fixed: if fixed { vec!["xmin".into()] } else { vec![] },
+        system: SystemParams {
+            fixed: if fixed { vec!["xmin".into()] } else { vec![] },
+            ..Default::default()
+        },
         h: 0.005,
         dt: 1e-6,
         method,
@@ -118,7 +121,7 @@ fn newmark_matches_modal_all_free_free() {
 #[test]
 fn newmark_matches_modal_all_overdamped() {
     let mut p = params(true, TruthMethod::Newmark);
-    p.rayleigh = [200.0, 1e-4];
+    p.system.rayleigh = [200.0, 1e-4];
     let nm = run_truth(cantilever(), &p, &impact(), &CONTACTS, "c", &mut |_| {}).unwrap();
     p.method = TruthMethod::ModalAll;
     let ma = run_truth(cantilever(), &p, &impact(), &CONTACTS, "c", &mut |_| {}).unwrap();
@@ -152,7 +155,7 @@ fn modal_all_truncated_equals_baked_base() {
                 density: 770.0,
             },
             modes: ModeRequest::Count(20),
-            fixed: p.fixed.clone(),
+            fixed: p.system.fixed.clone(),
             ..Default::default()
         };
         let (base, _) = bake_mesh(cantilever(), &bp, "c", &mut |_| {}).unwrap();
@@ -171,7 +174,7 @@ fn modal_all_truncated_equals_baked_base() {
             let filters: Vec<ModeFilter> = model
                 .omega()
                 .iter()
-                .map(|&om| ModeFilter::new(om, damping_ratio(om, p.rayleigh), dt))
+                .map(|&om| ModeFilter::new(om, damping_ratio(om, p.system.rayleigh), dt))
                 .collect();
             let mut peak = 0.0f64;
             for k in 1..=steps {
@@ -223,7 +226,7 @@ fn truth_is_linear_in_the_impulse() {
 fn truth_extreme_materials_agree() {
     for (e, rho, h, dt) in [(1e13, 1.0, 2e-6, 1e-9), (1e3, 2e4, 20.0, 2e-3)] {
         let mut p = params(true, TruthMethod::Newmark);
-        p.material = MaterialSi {
+        p.system.material = MaterialSi {
             youngs: e,
             poisson: 0.3,
             density: rho,
@@ -252,8 +255,8 @@ fn truth_extreme_materials_agree() {
 fn static_correction_recovers_static_deflection() {
     use modal_bake::full_order::{FullOrderSystem, ModalAll, ModalInput};
     let mut p = params(true, TruthMethod::ModalAll);
-    p.rayleigh = [2000.0, 0.0];
-    let sys = FullOrderSystem::new(cantilever(), &p.system(), "c").unwrap();
+    p.system.rayleigh = [2000.0, 0.0];
+    let sys = FullOrderSystem::new(cantilever(), &p.system, "c").unwrap();
     let ma = ModalAll::new(&sys, 6000).unwrap();
     let isp = sys.surface.project(impact().point).unwrap();
     let f = sys.load_vector(&isp, isp.normal.map(|x| -x), 100.0);
@@ -264,11 +267,20 @@ fn static_correction_recovers_static_deflection() {
     let r = ma.project(&f);
     let (h, dt) = (0.1, 1e-5);
     let steps = (h / dt) as usize;
-    let all = ma.response_peaks(&r, &w, p.rayleigh, dt, steps, None, ModalInput::Step, false);
+    let all = ma.response_peaks(
+        &r,
+        &w,
+        p.system.rayleigh,
+        dt,
+        steps,
+        None,
+        ModalInput::Step,
+        false,
+    );
     let m20 = ma.response_peaks(
         &r,
         &w,
-        p.rayleigh,
+        p.system.rayleigh,
         dt,
         steps,
         Some(20),
@@ -278,7 +290,7 @@ fn static_correction_recovers_static_deflection() {
     let c20 = ma.response_peaks(
         &r,
         &w,
-        p.rayleigh,
+        p.system.rayleigh,
         dt,
         steps,
         Some(20),
@@ -411,7 +423,7 @@ fn newmark_runs_several_impulses_as_one() {
     use modal_bake::full_order::{newmark_peaks, newmark_peaks_multi, FullOrderSystem};
     for fixed in [false, true] {
         let p = params(fixed, TruthMethod::Newmark);
-        let sys = FullOrderSystem::new(cantilever(), &p.system(), "c").unwrap();
+        let sys = FullOrderSystem::new(cantilever(), &p.system, "c").unwrap();
         let rows: Vec<Vec<f64>> = CONTACTS
             .iter()
             .map(|c| sys.contact_row(&sys.surface.project(*c).unwrap()))

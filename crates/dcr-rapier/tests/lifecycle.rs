@@ -15,8 +15,9 @@
 use std::sync::Arc;
 
 use dcr_rapier::dcr_runtime::format::TransferTable;
+use dcr_rapier::dcr_runtime::response::TablePolicy;
 use dcr_rapier::dcr_runtime::testing::plate_base;
-use dcr_rapier::dcr_runtime::{Method, TablePolicy};
+use dcr_rapier::dcr_runtime::Method;
 use dcr_rapier::{ElasticObjectDesc, ModalModel, ResponseParams, WorldParams};
 
 fn model() -> Arc<ModalModel> {

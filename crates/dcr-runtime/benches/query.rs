@@ -11,11 +11,12 @@ use std::sync::Arc;
 
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
 use dcr_runtime::attenuation::HeatGeodesic;
-use dcr_runtime::testing::{box_surface, geometric_omegas, synthetic_base, SplitMix64};
-use dcr_runtime::{
-    AmplitudeKind, AttenuationLaw, AttenuationParams, DistanceKind, DistantResponse, Impact,
-    Method, ModalModel, ResponseParams, RestingContact, Sampling,
+use dcr_runtime::response::{
+    AmplitudeKind, AttenuationLaw, AttenuationParams, DistanceKind, Impact, RestingContact,
+    Sampling,
 };
+use dcr_runtime::testing::{box_surface, geometric_omegas, synthetic_base, SplitMix64};
+use dcr_runtime::{DistantResponse, Method, ModalModel, ResponseParams};
 
 /// (name, samples per step, distant contacts, surface vertices, paper ms).
 const ROWS: [(&str, usize, usize, usize, f64); 7] = [
@@ -391,7 +392,7 @@ fn kernel(c: &mut Criterion) {
     let q: Vec<f64> = (0..s * m).map(|_| rng.next_f64() - 0.5).collect();
     let w: Vec<f64> = (0..m * nch).map(|_| rng.next_f64() - 0.5).collect();
     let (mut a, mut b) = (vec![0.0; nch], vec![0.0; nch]);
-    dcr_runtime::peak_abs_projection(&q, s, m, &w, nch, &mut a);
+    dcr_runtime::response::peak_abs_projection(&q, s, m, &w, nch, &mut a);
     old_kernel::peak_abs_projection(&q, m, &w, &mut b);
     assert_eq!(a, b, "new kernel must match the old one bit for bit");
     // Interleaved A/B robust to a noisy, shared machine: the best (minimum) per-call time of
@@ -401,7 +402,14 @@ fn kernel(c: &mut Criterion) {
         for _ in 0..300 {
             let t0 = std::time::Instant::now();
             for _ in 0..200 {
-                dcr_runtime::peak_abs_projection(black_box(&q), s, m, black_box(&w), nch, &mut a);
+                dcr_runtime::response::peak_abs_projection(
+                    black_box(&q),
+                    s,
+                    m,
+                    black_box(&w),
+                    nch,
+                    &mut a,
+                );
             }
             best_new = best_new.min(t0.elapsed().as_secs_f64() / 200.0);
             let t0 = std::time::Instant::now();
@@ -418,7 +426,14 @@ fn kernel(c: &mut Criterion) {
     }
     c.bench_function("kernel/dinner/new", |bch| {
         bch.iter(|| {
-            dcr_runtime::peak_abs_projection(black_box(&q), s, m, black_box(&w), nch, &mut a);
+            dcr_runtime::response::peak_abs_projection(
+                black_box(&q),
+                s,
+                m,
+                black_box(&w),
+                nch,
+                &mut a,
+            );
             black_box(a[3])
         })
     });
@@ -481,8 +496,8 @@ fn kernel_rows(c: &mut Criterion) {
             }
         }
         let (mut pr, mut pp) = (vec![0.0; nc], vec![0.0; nch]);
-        dcr_runtime::peak_abs_rows(&v, stride, m, &b, nc, &mut pr);
-        dcr_runtime::peak_abs_projection(&q, s, m, &w, nch, &mut pp);
+        dcr_runtime::response::peak_abs_rows(&v, stride, m, &b, nc, &mut pr);
+        dcr_runtime::response::peak_abs_projection(&q, s, m, &w, nch, &mut pp);
         assert_eq!(
             pr[..],
             pp[..nc],
@@ -492,8 +507,26 @@ fn kernel_rows(c: &mut Criterion) {
             continue;
         }
         let (t_rows, t_panels) = interleaved_best(
-            || dcr_runtime::peak_abs_rows(black_box(&v), stride, m, black_box(&b), nc, &mut pr),
-            || dcr_runtime::peak_abs_projection(black_box(&q), s, m, black_box(&w), nch, &mut pp),
+            || {
+                dcr_runtime::response::peak_abs_rows(
+                    black_box(&v),
+                    stride,
+                    m,
+                    black_box(&b),
+                    nc,
+                    &mut pr,
+                )
+            },
+            || {
+                dcr_runtime::response::peak_abs_projection(
+                    black_box(&q),
+                    s,
+                    m,
+                    black_box(&w),
+                    nch,
+                    &mut pp,
+                )
+            },
         );
         println!(
             "kernel/{name} {s}x{nc} interleaved best-of-300: rows {:.3} µs, panels {:.3} µs",
@@ -504,7 +537,7 @@ fn kernel_rows(c: &mut Criterion) {
             // (criterion's own filter skips these when not selected)
             c.bench_function(&format!("kernel/{name}/rows"), |bch| {
                 bch.iter(|| {
-                    dcr_runtime::peak_abs_rows(
+                    dcr_runtime::response::peak_abs_rows(
                         black_box(&v),
                         stride,
                         m,
@@ -517,7 +550,7 @@ fn kernel_rows(c: &mut Criterion) {
             });
             c.bench_function(&format!("kernel/{name}/panels"), |bch| {
                 bch.iter(|| {
-                    dcr_runtime::peak_abs_projection(
+                    dcr_runtime::response::peak_abs_projection(
                         black_box(&q),
                         s,
                         m,

@@ -77,16 +77,18 @@
 //! world frame; [`DistantResponse`] and the types under it work in the base's object frame.
 //! Engine-boundary types are plain data (`[f64; 3]`, `u64` ids, slices).
 //!
-//! Features: `testing` (synthetic bases such as `testing::plate_base`, for tests and
-//! doctests, also of other crates), `bench-internals` (the peak kernels, for benchmarks). The
-//! crate is pure Rust: fill-reducing orderings that need METIS are planned by the baker and
-//! stored in the base (`surface_order`).
+//! Features (none by default): `write` (`format::ModesFile::write_atomic`, the `.modes` encoder,
+//! through the tools' writer crate `dcr-files`; engines that only read bases leave it off),
+//! `testing` (synthetic bases such as `testing::plate_base`, for tests and doctests, also of
+//! other crates), `bench-internals` (the peak kernels, for benchmarks). [`math`] is the
+//! workspace's small `[f64; 3]` kit. The crate is pure Rust: fill-reducing orderings that need
+//! METIS are planned by the baker and stored in the base (`surface_order`).
 
 pub mod attenuation;
 pub mod filter;
 pub mod format;
 pub(crate) mod mapping;
-mod math;
+pub mod math;
 pub mod model;
 pub mod response;
 pub mod rng;
@@ -95,18 +97,20 @@ mod surface_point;
 pub mod testing;
 pub mod world;
 
-pub use attenuation::{AmplitudeKind, AttenuationLaw, AttenuationParams, DistanceKind};
-pub use filter::Sampling;
+// The integrator's surface: a base, the world and its per-step data, and the per-object
+// response underneath. The response layer's knobs (methods, variants, table policy, attenuation
+// and sampling settings, per-step diagnostics) live under `response`, the world's other types
+// (classification settings, energy reports, totals) under `world`.
 pub use model::{LoadError, ModalModel};
-pub use response::{
-    effective_mass, response_impulse, ContactResponse, DistantResponse, ForceInput, Impact, Method,
-    ParamsError, ResponseParams, RestingContact, ServedBy, StepInfo, TableFallback, TablePolicy,
-    TableStatus, Variant,
-};
-#[cfg(feature = "bench-internals")]
-pub use response::{peak_abs_projection, peak_abs_rows};
+pub use response::{DistantResponse, Method, ResponseParams};
 pub use world::{
-    BaseSupport, BodyState, ClassifyParams, ContactReport, DcrWorld, ElasticHandle,
-    ElasticObjectDesc, EnergyInfo, ImpulseEvent, ObjectStepInfo, ObjectTotals, Pose, WorldError,
-    WorldParams, WorldStepInfo,
+    BodyState, ContactReport, DcrWorld, ElasticHandle, ElasticObjectDesc, ImpulseEvent,
+    ObjectStepInfo, Pose, WorldError, WorldParams, WorldStepInfo,
 };
+
+// Not part of the root surface: targets of intra-doc links in `world/dcr_world.rs`, which names
+// them from the crate root (their homes are `world` and `response`).
+#[doc(hidden)]
+pub use response::{effective_mass, ContactResponse, StepInfo, TablePolicy};
+#[doc(hidden)]
+pub use world::ClassifyParams;

@@ -9,10 +9,8 @@
 use std::sync::Arc;
 
 use dcr_runtime::filter::{damping_ratio, samples_per_step, ModeFilter};
-use dcr_runtime::{
-    testing, DistantResponse, Impact, ModalModel, ParamsError, ResponseParams, RestingContact,
-    Sampling,
-};
+use dcr_runtime::response::{Impact, ParamsError, RestingContact, Sampling};
+use dcr_runtime::{testing, DistantResponse, ModalModel, ResponseParams};
 
 const HIT: [f64; 3] = [0.5, 0.3, 0.0];
 const DOWN: [f64; 3] = [0.0, 0.0, -1.0];

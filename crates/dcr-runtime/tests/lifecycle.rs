@@ -12,10 +12,12 @@
 use std::sync::Arc;
 
 use dcr_runtime::format::{ModesFile, TransferTable};
+use dcr_runtime::response::TablePolicy;
 use dcr_runtime::testing::plate_base;
+use dcr_runtime::world::BaseSupport;
 use dcr_runtime::{
-    BaseSupport, BodyState, ContactReport, DcrWorld, ElasticHandle, ElasticObjectDesc,
-    ImpulseEvent, Method, ModalModel, ResponseParams, TablePolicy, WorldError, WorldParams,
+    BodyState, ContactReport, DcrWorld, ElasticHandle, ElasticObjectDesc, ImpulseEvent, Method,
+    ModalModel, ResponseParams, WorldError, WorldParams,
 };
 
 fn model_of(base: ModesFile) -> Arc<ModalModel> {

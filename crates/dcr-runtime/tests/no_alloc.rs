@@ -16,11 +16,14 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Arc;
 
 use dcr_runtime::attenuation::HeatGeodesic;
+use dcr_runtime::response::{
+    AmplitudeKind, AttenuationLaw, AttenuationParams, DistanceKind, ForceInput, Impact,
+    RestingContact, Variant,
+};
 use dcr_runtime::testing::{box_surface, geometric_omegas, synthetic_base, SplitMix64};
 use dcr_runtime::{
-    AmplitudeKind, AttenuationLaw, AttenuationParams, BodyState, ContactReport, DcrWorld,
-    DistanceKind, DistantResponse, ElasticObjectDesc, ForceInput, Impact, Method, ModalModel, Pose,
-    ResponseParams, RestingContact, Variant, WorldParams,
+    BodyState, ContactReport, DcrWorld, DistantResponse, ElasticObjectDesc, Method, ModalModel,
+    Pose, ResponseParams, WorldParams,
 };
 
 struct Counting;

@@ -12,11 +12,9 @@
 use std::sync::Arc;
 
 use dcr_runtime::format::{ModesFile, TransferTable};
+use dcr_runtime::response::{ForceInput, Impact, RestingContact, ServedBy};
 use dcr_runtime::testing::{plate_base, SplitMix64};
-use dcr_runtime::{
-    DistantResponse, ForceInput, Impact, Method, ModalModel, ResponseParams, RestingContact,
-    ServedBy,
-};
+use dcr_runtime::{DistantResponse, Method, ModalModel, ResponseParams};
 
 const H: f64 = 0.01;
 

@@ -13,11 +13,13 @@
 use std::sync::Arc;
 
 use dcr_runtime::format::{ModesFile, TransferTable};
+use dcr_runtime::response::{
+    Impact, ParamsError, RestingContact, ServedBy, TableFallback, TablePolicy, TableStatus,
+};
 use dcr_runtime::testing::{plate_base, SplitMix64};
 use dcr_runtime::{
-    BodyState, ContactReport, DcrWorld, DistantResponse, ElasticHandle, ElasticObjectDesc, Impact,
-    Method, ModalModel, ParamsError, Pose, ResponseParams, RestingContact, ServedBy, TableFallback,
-    TablePolicy, TableStatus, WorldError, WorldParams,
+    BodyState, ContactReport, DcrWorld, DistantResponse, ElasticHandle, ElasticObjectDesc, Method,
+    ModalModel, Pose, ResponseParams, WorldError, WorldParams,
 };
 
 const PLATE: u64 = 1;

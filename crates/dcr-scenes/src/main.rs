@@ -5,8 +5,8 @@ use std::process::ExitCode;
 
 use anyhow::{bail, Context, Result};
 use clap::{Parser, Subcommand, ValueEnum};
+use dcr_files::OutputPlan;
 use dcr_rapier::f64::{ApplyMode, StepGate};
-use dcr_runtime::format::OutputPlan;
 use dcr_scenes::export::{side_label, write_outcomes_svg, write_scene_glb, Side};
 use dcr_scenes::runner::{
     base_path, run_scene, stress_bench, table1, transfer_base_path, MethodChoice, RunParams,

@@ -351,3 +351,77 @@ fn non_regular_scene_files_are_refused_before_opening() {
         assert!(String::from_utf8_lossy(&o.stderr).contains("not a regular file"));
     }
 }
+
+// Every file `dcr-scenes` writes — the run's `--out` files (trajectory, timings, summary,
+// outcomes plot), the bases it bakes into `--bases`, and `table1 --gltf DIR`'s per-scene GLB —
+// refuses a device reached through a symbolic link (`FILE` → `/dev/null`) before anything
+// runs: the command fails naming the option, and the link, the device and the scene survive.
+#[test]
+fn every_output_refuses_a_linked_device_and_the_scene_survives() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let p = write(d, &scene("roof"));
+    let before = std::fs::read(&p).unwrap();
+    let link = |dir: &Path, name: &str| {
+        std::fs::create_dir_all(dir).unwrap();
+        let l = dir.join(name);
+        std::os::unix::fs::symlink("/dev/null", &l).unwrap();
+        l
+    };
+    let refused = |args: &[&str], option: &str, l: &Path| {
+        let o = run(args);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success(), "{args:?} succeeded");
+        assert!(
+            err.contains(option) && err.contains("a character device"),
+            "{args:?}: {err}"
+        );
+        assert_eq!(err.trim().lines().count(), 1, "{err}");
+        assert!(std::fs::symlink_metadata(l)
+            .unwrap()
+            .file_type()
+            .is_symlink());
+    };
+    for (i, name) in [
+        "trajectory.npz",
+        "timings.npz",
+        "summary.json",
+        "outcomes.svg",
+    ]
+    .iter()
+    .enumerate()
+    {
+        let out = d.join(format!("out{i}"));
+        let l = link(&out, name);
+        let bases = d.join(format!("bases{i}"));
+        refused(
+            &["run", s(&p), "--out", s(&out), "--bases", s(&bases)],
+            "--out",
+            &l,
+        );
+        assert!(!bases.exists(), "a base was baked");
+    }
+    for (i, name) in ["roof.modes", "roof.transfer.modes"].iter().enumerate() {
+        let bases = d.join(format!("linked_bases{i}"));
+        let l = link(&bases, name);
+        let out = d.join(format!("linked_out{i}"));
+        refused(
+            &["run", s(&p), "--out", s(&out), "--bases", s(&bases)],
+            "--bases",
+            &l,
+        );
+        assert!(!out.exists(), "the run wrote");
+    }
+    let gltf = d.join("gltf");
+    let l = link(&gltf, "roof.glb");
+    refused(
+        &["table1", "--scenes", "roof", "--gltf", s(&gltf)],
+        "--gltf",
+        &l,
+    );
+    assert_eq!(std::fs::read(&p).unwrap(), before, "the scene changed");
+    assert!(std::fs::metadata("/dev/null")
+        .unwrap()
+        .file_type()
+        .is_char_device());
+}

@@ -19,4 +19,3 @@ pub mod ordering;
 pub mod signals;
 pub mod target_error;
 pub mod transfer;
-mod vec3;

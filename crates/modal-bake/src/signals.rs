@@ -1,5 +1,5 @@
 //! Signal handling for the command-line tool: on SIGINT, SIGTERM or SIGHUP the temporaries
-//! being written ([`dcr_runtime::format::AtomicFile`]) are removed, the mesher child processes
+//! being written ([`dcr_files::AtomicFile`]) are removed, the mesher child processes
 //! are ended and their work folders removed ([`crate::mesh::work::abort_meshing`]), then the process ends as
 //! the signal's default action would (a shell sees it killed by that signal). Without this the
 //! default action would end the process at once and leave a partial `.NAME.tmp-…` beside the
@@ -19,7 +19,7 @@ pub fn remove_temporaries_on_signals() -> std::io::Result<()> {
         .name("signals".into())
         .spawn(move || {
             if let Some(sig) = signals.forever().next() {
-                dcr_runtime::format::remove_pending_temporaries();
+                dcr_files::remove_pending_temporaries();
                 crate::mesh::work::abort_meshing();
                 // Restore the default action and raise the signal again.
                 let _ = signal_hook::low_level::emulate_default_handler(sig);

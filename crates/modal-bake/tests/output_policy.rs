@@ -203,3 +203,63 @@ fn check_names_the_material_option_as_bake_does() {
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(err.contains("--poisson 0.7"), "{err}");
 }
+
+// Every file `modal-bake` writes — each exporter (`--vtu`, `--gltf` also with `--onto`,
+// `--png`), `mesh -o`, `bake -o` and `geodesic --npy` — refuses a device reached through a
+// symbolic link (`out.x` → `/dev/null`) and a FIFO: the command fails naming the option, and
+// the link, the device, the FIFO and the input survive unchanged.
+#[test]
+fn every_output_refuses_a_linked_device_and_a_fifo_and_the_input_survives() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let base = beam_base(d);
+    let before = std::fs::read(&base).unwrap();
+    let asset = d.join("a.obj");
+    std::fs::write(
+        &asset,
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n",
+    )
+    .unwrap();
+    let mesh = repo_root().join("data/meshes/beam.msh");
+    let null = d.join("null.out");
+    std::os::unix::fs::symlink("/dev/null", &null).unwrap();
+    let fifo = d.join("fifo.out");
+    mkfifo(&fifo);
+    for (target, what) in [(&null, "a character device"), (&fifo, "a FIFO")] {
+        let t = s(target);
+        let commands: Vec<(Vec<&str>, &str)> = vec![
+            (vec!["export", s(&base), "--vtu", t], "--vtu"),
+            (vec!["export", s(&base), "--gltf", t], "--gltf"),
+            (
+                vec!["export", s(&base), "--gltf", t, "--onto", s(&asset)],
+                "--gltf",
+            ),
+            (vec!["export", s(&base), "--png", t], "--png"),
+            (vec!["mesh", s(&asset), "-o", t], "-o"),
+            (vec!["bake", s(&mesh), "-o", t, "--fixed", "clamp"], "-o"),
+            (
+                vec!["geodesic", s(&base), "--from-vertex", "0", "--npy", t],
+                "--npy",
+            ),
+        ];
+        for (args, option) in commands {
+            refused(&args, &[option, what]);
+        }
+    }
+    assert_eq!(std::fs::read(&base).unwrap(), before, "the base changed");
+    assert!(std::fs::symlink_metadata(&null)
+        .unwrap()
+        .file_type()
+        .is_symlink());
+    assert!(std::fs::metadata("/dev/null")
+        .unwrap()
+        .file_type()
+        .is_char_device());
+    assert!(std::fs::metadata(&fifo).unwrap().file_type().is_fifo());
+    let mut left: Vec<String> = std::fs::read_dir(d)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    left.sort();
+    assert_eq!(left, ["a.obj", "beam.modes", "fifo.out", "null.out"]);
+}

@@ -21,7 +21,7 @@ fn child_writer() {
     };
     modal_bake::signals::remove_temporaries_on_signals().unwrap();
     let dest = Path::new(&dir).join("out.modes");
-    let mut f = dcr_runtime::format::AtomicFile::create(&dest).unwrap();
+    let mut f = dcr_files::AtomicFile::create(&dest).unwrap();
     f.write_all(&[7u8; 1 << 20]).unwrap();
     f.flush().unwrap();
     println!("ready");
@@ -80,7 +80,7 @@ fn sigkill_leftovers_are_removed_by_the_next_write() {
     assert_eq!(status.signal(), Some(9));
     assert_eq!(left.len(), 1, "{left:?}");
     assert!(left[0].starts_with(".out.modes.tmp-"), "{left:?}");
-    dcr_runtime::format::write_atomic(&dir.path().join("out.modes"), b"next").unwrap();
+    dcr_files::write_atomic(&dir.path().join("out.modes"), b"next").unwrap();
     let names: Vec<_> = std::fs::read_dir(dir.path())
         .unwrap()
         .map(|e| e.unwrap().file_name())

@@ -8,7 +8,7 @@ use super::study::{maxv, median, ObjectStudy, BASE_MODES};
 use super::{GOAL_MEDIAN_PCT, GOAL_WORST_PCT};
 
 /// Writes `summary.svg` (log scale, 0.01 … 100 %+), creating its folder, through the one
-/// writer ([`dcr_runtime::format::write_atomic`]).
+/// writer ([`dcr_files::write_atomic`]).
 ///
 /// # Errors
 /// The file cannot be written.
@@ -100,6 +100,6 @@ pub fn summary(path: &Path, studies: &[ObjectStudy]) -> anyhow::Result<()> {
         std::fs::create_dir_all(dir)
             .map_err(|e| anyhow::anyhow!("creating {}: {e}", dir.display()))?;
     }
-    dcr_runtime::format::write_atomic(path, svg.as_bytes())?;
+    dcr_files::write_atomic(path, svg.as_bytes())?;
     Ok(())
 }

@@ -7,7 +7,8 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use dcr_runtime::format::ModesFile;
-use dcr_runtime::{DistantResponse, Impact, Method, ModalModel, RestingContact, ServedBy};
+use dcr_runtime::response::{Impact, RestingContact, ServedBy};
+use dcr_runtime::{DistantResponse, Method, ModalModel};
 use modal_bake::bake::{bake_mesh, BakeError, BakeParams, ModeRequest};
 use modal_bake::bake::{mode_set_from_dense, mode_set_lanczos};
 use modal_bake::full_order::{
@@ -512,8 +513,8 @@ fn attenuation_row(
     name: &str,
 ) -> (MethodRow, f64) {
     let att = |c: f64| {
-        Method::Attenuation(dcr_runtime::AttenuationParams {
-            law: dcr_runtime::AttenuationLaw::Simplified { c, beta: 1.0 },
+        Method::Attenuation(dcr_runtime::response::AttenuationParams {
+            law: dcr_runtime::response::AttenuationLaw::Simplified { c, beta: 1.0 },
             ..Default::default()
         })
     };

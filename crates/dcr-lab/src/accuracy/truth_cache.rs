@@ -194,5 +194,5 @@ pub fn cached_converged_peaks(
 fn store(dir: &Path, path: &Path, e: &Entry) -> std::io::Result<()> {
     std::fs::create_dir_all(dir)?;
     let bytes = serde_json::to_vec(e).map_err(std::io::Error::other)?;
-    dcr_runtime::format::write_atomic(path, &bytes).map_err(std::io::Error::other)
+    dcr_files::write_atomic(path, &bytes).map_err(std::io::Error::other)
 }

@@ -45,7 +45,7 @@ mod surface_response;
 use std::time::Instant;
 
 use dcr_runtime::attenuation::HeatGeodesic;
-use dcr_runtime::testing::SplitMix64;
+use dcr_runtime::rng::SplitMix64;
 use modal_bake::bake::{bake_mesh, BakeError, BakeParams, MaterialSi, ModeRequest};
 use modal_bake::full_order::{FullOrderError, FullOrderSystem, ModalAll, SystemParams};
 use modal_bake::mesh::TetMesh;

@@ -85,7 +85,7 @@ pub fn run(args: &AccuracyArgs) -> anyhow::Result<()> {
     }
     let svg = args.out.join("accuracy");
     let path = args.out.join("accuracy.md");
-    let mut plan = dcr_runtime::format::OutputPlan::new();
+    let mut plan = dcr_files::OutputPlan::new();
     plan.output_folder("--out", &args.out)?;
     plan.output_folder("--out", &svg)?;
     plan.output("--out", &path)?;
@@ -99,7 +99,7 @@ pub fn run(args: &AccuracyArgs) -> anyhow::Result<()> {
         no_energy: args.no_energy,
     };
     let md = dcr_lab::accuracy::generate(&args.root, &args.out, &opts)?;
-    dcr_runtime::format::write_atomic(&path, md.as_bytes())
+    dcr_files::write_atomic(&path, md.as_bytes())
         .with_context(|| format!("writing {}", path.display()))?;
     eprintln!(
         "wrote {} and {}",

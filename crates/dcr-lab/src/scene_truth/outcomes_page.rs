@@ -6,7 +6,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use anyhow::{Context, Result};
-use dcr_runtime::format::write_atomic;
+use dcr_files::write_atomic;
 use dcr_scenes::runner::{run_scene, MethodChoice, RunParams, Trajectory};
 use dcr_scenes::scene::{name_matches, SceneDesc};
 use plotters::prelude::*;

@@ -2,6 +2,7 @@
 //! Rayleigh damping carried over to `rapier3d_f64::dynamics::SoftBodyBuilder`.
 
 use anyhow::{bail, Context, Result};
+use dcr_runtime::math::{cross, dot, sub};
 use modal_bake::mesh::TetMesh;
 use rapier3d_f64::math::{Pose, Vector};
 use rapier3d_f64::prelude::*;
@@ -75,23 +76,12 @@ pub struct TetSoftBody {
     pub beta_range: [f64; 3],
 }
 
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
 /// The inverse of the 3×3 matrix with columns `c` (None when singular), as rows.
 fn inverse_cols(c: [[f64; 3]; 3]) -> Option<[[f64; 3]; 3]> {
     let [a, b, d] = c;
     // Rows of the inverse are the cross products of the other two columns over the determinant.
-    let cross = |u: [f64; 3], v: [f64; 3]| {
-        [
-            u[1] * v[2] - u[2] * v[1],
-            u[2] * v[0] - u[0] * v[2],
-            u[0] * v[1] - u[1] * v[0],
-        ]
-    };
     let r0 = cross(b, d);
-    let det = a[0] * r0[0] + a[1] * r0[1] + a[2] * r0[2];
+    let det = dot(a, r0);
     if det.abs() < f64::MIN_POSITIVE {
         return None;
     }

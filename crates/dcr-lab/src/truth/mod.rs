@@ -32,9 +32,10 @@ use std::path::Path;
 use std::time::Instant;
 
 pub use modal_bake::full_order::MaterialSi;
+pub use modal_bake::full_order::SystemParams;
 use modal_bake::full_order::{
     converged_peaks, FullOrderError, FullOrderSystem, ModalAll, PeakSolver, PeakWindow,
-    RefineParams, RefineProgress, SystemParams,
+    RefineParams, RefineProgress,
 };
 use modal_bake::mesh::{MeshError, TetMesh};
 
@@ -55,14 +56,9 @@ pub enum TruthMethod {
 /// Parameters of a truth run (SI units).
 #[derive(Clone, Debug, PartialEq)]
 pub struct TruthParams {
-    /// Isotropic material (E in Pa, ν, ρ in kg/m³). Default: 1.1 GPa, 0.3, 770 (as `bake`).
-    pub material: MaterialSi,
-    /// Names of physical groups whose nodes are fixed (empty: free-free).
-    pub fixed: Vec<String>,
-    /// Rayleigh damping [α0 (1/s), α1 (s)]. Default (10, 1e-7), as `bake`.
-    pub rayleigh: [f64; 2],
-    /// Lumped (diagonal) mass instead of consistent mass.
-    pub lumped: bool,
+    /// The object's full-order system: material, fixed groups, Rayleigh damping, lumped mass
+    /// (defaults as `bake`: 1.1 GPa, 0.3, 770 kg/m³, free-free, (10, 1e-7), consistent mass).
+    pub system: SystemParams,
     /// Window h (s) over which the peak is taken. Default 0.01.
     pub h: f64,
     /// First sample/step size Δt (s); the first step used is h/⌈h/Δt⌉, then halved until the
@@ -145,14 +141,7 @@ pub struct TruthCrossCheck {
 impl Default for TruthParams {
     fn default() -> Self {
         TruthParams {
-            material: MaterialSi {
-                youngs: 1.1e9,
-                poisson: 0.3,
-                density: 770.0,
-            },
-            fixed: Vec::new(),
-            rayleigh: [10.0, 1e-7],
-            lumped: false,
+            system: SystemParams::default(),
             h: 0.01,
             dt: 1e-5,
             method: TruthMethod::Newmark,
@@ -260,16 +249,6 @@ pub enum TruthError {
 }
 
 impl TruthParams {
-    /// The full-order system these parameters describe.
-    pub fn system(&self) -> SystemParams {
-        SystemParams {
-            material: self.material,
-            fixed: self.fixed.clone(),
-            rayleigh: self.rayleigh,
-            lumped: self.lumped,
-        }
-    }
-
     /// (samples S, step h/S).
     ///
     /// # Errors
@@ -379,7 +358,7 @@ fn distances(
 /// use modal_bake::mesh::TetMesh;
 /// let mesh = TetMesh::structured_box([4, 1, 1], [1.0, 0.2, 0.2]);
 /// let params = TruthParams {
-///     fixed: vec!["xmin".into()],
+///     system: SystemParams { fixed: vec!["xmin".into()], ..Default::default() },
 ///     h: 2e-3,
 ///     dt: 1e-5,
 ///     method: TruthMethod::ModalAll,
@@ -399,7 +378,7 @@ pub fn run_truth(
 ) -> Result<TruthResult, TruthError> {
     let (_, dt0) = params.sampling()?;
     let t = Instant::now();
-    let sys = FullOrderSystem::new(mesh, &params.system(), file)?;
+    let sys = FullOrderSystem::new(mesh, &params.system, file)?;
     let (isp, dir, csp) = map_points(&sys, impact, contacts)?;
     let f = sys.load_vector(&isp, dir, impact.impulse);
     let rows: Vec<Vec<f64>> = csp.iter().map(|c| sys.contact_row(c)).collect();

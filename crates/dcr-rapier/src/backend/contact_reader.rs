@@ -48,11 +48,9 @@ pub(super) struct ReportSource {
 /// same from step to step (rapier's contact graph), so a pair is found by comparing its key with
 /// the entry under a cursor (compared by collider handles, so the pair key is hashed only on a
 /// miss); a hash index by key catches the pairs that moved. Masks are 64-bit words because a
-/// variable shift of a 128-bit mask compiles to a dozen instructions and branches. Measured with
-/// callgrind on the stress scene cut to 300 boxes (300 pairs of four points, 300 steps): the
-/// whole light pass costs about 260 instructions per pair, from 350 with one 128-bit mask,
-/// rapier's `contact_pairs_with` and the key hashed every step (a hash set of loaded points cost
-/// more still).
+/// variable shift of a 128-bit mask compiles to a dozen instructions and branches; the cursor
+/// and the words replace rapier's `contact_pairs_with` and a key hashed every step (the
+/// instruction counts are in docs/benchmarks.md, "Design measurements").
 #[derive(Debug, Default)]
 pub(super) struct LoadMemory {
     entries: Vec<PairLoad>,

@@ -2,6 +2,8 @@
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
+use dcr_runtime::math::{add, dot, norm, scale, sub};
+use dcr_runtime::response::inverse_effective_mass;
 use dcr_runtime::{
     BodyState, ContactReport, DcrWorld, ElasticHandle, ElasticObjectDesc, ImpulseEvent, Pose,
     WorldError, WorldParams,
@@ -853,7 +855,9 @@ impl DcrRapier {
                     // plus the kick's Δv = |j_t| / m_eff,t along j_t.
                     let p = vector(e.point);
                     let t = scale(jt, 1.0 / norm(jt));
-                    let k = inv_eff_mass(&body_state(e.body, rb), e.point, t);
+                    let b = body_state(e.body, rb);
+                    let r = sub(e.point, b.center_of_mass);
+                    let k = inverse_effective_mass(b.inv_mass, b.inv_inertia, r, t);
                     let mut rel = arr(rb.velocity_at_point(p));
                     if let Some(eb) = bodies.get(body_handle(elastic_body)) {
                         rel = sub(rel, arr(eb.velocity_at_point(p)));
@@ -918,36 +922,4 @@ fn pose_of(p: &super::rapier::math::Pose) -> Pose {
         [to_f64(q.x), to_f64(q.y), to_f64(q.z), to_f64(q.w)],
         arr(p.translation),
     )
-}
-
-/// `1 / m_eff` of `body` at world point `p` along unit `t`: `m⁻¹ + (r × t)ᵀ I⁻¹ (r × t)`.
-fn inv_eff_mass(body: &BodyState, p: [f64; 3], t: [f64; 3]) -> f64 {
-    let r = sub(p, body.center_of_mass);
-    let rt = cross(r, t);
-    let i = &body.inv_inertia;
-    let irt = [dot(i[0], rt), dot(i[1], rt), dot(i[2], rt)];
-    body.inv_mass + dot(rt, irt)
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-fn add(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
-fn scale(a: [f64; 3], s: f64) -> [f64; 3] {
-    [a[0] * s, a[1] * s, a[2] * s]
-}
-fn norm(a: [f64; 3]) -> f64 {
-    dot(a, a).sqrt()
-}
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
 }

@@ -91,10 +91,9 @@ pub struct HeatWorkspace {
 
 impl HeatWorkspace {
     /// Lets queries run the two halves of the factor's elimination tree on two threads
-    /// (`rayon::join` in the caller's rayon pool, else rayon's global pool): on a 5k-vertex
-    /// surface a query takes down to 0.6× the serial time when a second core is free (less
-    /// gain where the two threads share a physical core or wait to be woken). The
-    /// distances are bit-identical either way. Serial by default. Called from a thread outside
+    /// (`rayon::join` in the caller's rayon pool, else rayon's global pool): faster when a
+    /// second core is free (less gain where the two threads share a physical core or wait to
+    /// be woken; docs/benchmarks.md). The distances are bit-identical either way. Serial by default. Called from a thread outside
     /// any rayon pool, rayon's job injection may allocate now and then; called from inside a
     /// pool (or serial) a query does not allocate. No effect where the elimination order does
     /// not split into two balanced halves (AMD orders: bases without a stored
@@ -187,8 +186,6 @@ impl HeatGeodesic {
     ) -> Result<Self, GeodesicError> {
         let asm = Assembly::new(vertices, triangles)?;
         let n = vertices.len();
-        let t = asm.mean_edge * asm.mean_edge;
-        let eps = 1e-8 / t;
         let symbolic = Self::symbolic(&asm, order)?;
         let SymbolicCholeskyRaw::Simplicial(simp) = symbolic.raw() else {
             unreachable!("simplicial factorisation forced")
@@ -198,20 +195,7 @@ impl HeatGeodesic {
             Some(p) => (p.arrays().0.to_vec(), p.arrays().1.to_vec()),
             None => ((0..n as u32).collect(), (0..n as u32).collect()),
         };
-        // Both operators' lower triangles, permuted, scattered into the factor's pattern.
-        let mut vals = vec![[0.0f64; 2]; pattern.row_idx.len()];
-        for c in 0..n {
-            for q in asm.col_ptr[c] as usize..asm.col_ptr[c + 1] as usize {
-                let (r, lv) = (asm.row_idx[q] as usize, asm.val[q]);
-                let (pr, pc) = (iperm[r], iperm[c]);
-                let m = if r == c { asm.mass[c] } else { 0.0 };
-                vals[pattern.position(pr.max(pc), pr.min(pc))] = [t * lv + m, lv + eps * m];
-            }
-        }
-        let mut w = vec![[0.0f64; 2]; n];
-        pattern.factor_pair(&mut vals, &mut w).map_err(|j| {
-            GeodesicError::Factorization(format!("pivot of vertex {} is not positive", perm[j]))
-        })?;
+        let vals = factor_operators(&asm, &pattern, &perm, &iperm)?;
         let layout = Layout::new(&pattern);
         let spos = iperm
             .iter()
@@ -598,6 +582,192 @@ impl HeatGeodesic {
             values
         })
     }
+}
+
+/// The heat method's two operators factored three ways on one surface and elimination order,
+/// for the `sparse_llt` benchmark (feature `bench-internals`): the hand-written left-looking
+/// factor (`sparse_llt::Pattern::factor_pair`) with its solves, faer's simplicial numeric factor on the
+/// same symbolic analysis, and faer's own choice (supernodal when its flop-ratio threshold
+/// says so) under the same order. Not part of the runtime's API.
+#[cfg(feature = "bench-internals")]
+#[doc(hidden)]
+pub struct LltProbe {
+    asm: Assembly,
+    perm: Vec<u32>,
+    iperm: Vec<u32>,
+    /// [simplicial (the runtime's), faer's default threshold].
+    symbolic: [SymbolicCholesky<u32>; 2],
+    /// (M + tL), (L + εM), lower triangles, original vertex order.
+    mats: [faer::sparse::SparseColMat<u32, f64>; 2],
+    own: Option<(Layout, [Factor; 2])>,
+    /// faer's factors per symbolic: `[heat, poisson]` values.
+    faer: [[Vec<f64>; 2]; 2],
+}
+
+#[cfg(feature = "bench-internals")]
+impl LltProbe {
+    /// Assembles the operators and runs both symbolic analyses under `order` (`None`: AMD).
+    ///
+    /// # Errors
+    /// As [`HeatGeodesic::with_ordering`].
+    pub fn new(
+        vertices: &[[f64; 3]],
+        triangles: &[[u32; 3]],
+        order: Option<&[u32]>,
+    ) -> Result<Self, GeodesicError> {
+        use faer::sparse::{SparseColMat, SymbolicSparseColMat};
+        let asm = Assembly::new(vertices, triangles)?;
+        let n = vertices.len();
+        let simplicial = HeatGeodesic::symbolic(&asm, order)?;
+        let (perm, iperm) = match simplicial.perm() {
+            Some(p) => (p.arrays().0.to_vec(), p.arrays().1.to_vec()),
+            None => ((0..n as u32).collect(), (0..n as u32).collect()),
+        };
+        let lap = SymbolicSparseColMatRef::new_checked(n, n, &asm.col_ptr, None, &asm.row_idx);
+        let auto = factorize_symbolic_cholesky(
+            lap,
+            Side::Lower,
+            SymmetricOrdering::Custom(PermRef::new_checked(&perm, &iperm, n)),
+            CholeskySymbolicParams::default(),
+        )
+        .map_err(|e| GeodesicError::Factorization(format!("{e:?}")))?;
+        let t = asm.mean_edge * asm.mean_edge;
+        let mats = [(t, 1.0), (1.0, 1e-8 / t)].map(|(a, b)| {
+            let mut val: Vec<f64> = asm.val.iter().map(|v| a * v).collect();
+            for c in 0..n {
+                val[asm.col_ptr[c] as usize] += b * asm.mass[c];
+            }
+            let pat = SymbolicSparseColMat::new_checked(
+                n,
+                n,
+                asm.col_ptr.clone(),
+                None,
+                asm.row_idx.clone(),
+            );
+            SparseColMat::new(pat, val)
+        });
+        Ok(LltProbe {
+            asm,
+            perm,
+            iperm,
+            symbolic: [simplicial, auto],
+            mats,
+            own: None,
+            faer: Default::default(),
+        })
+    }
+
+    /// Vertices, stored factor entries (the runtime's simplicial pattern), whether faer's
+    /// default analysis chose a supernodal factor, and its stored entries.
+    pub fn info(&self) -> (usize, usize, bool, usize) {
+        let sn = matches!(self.symbolic[1].raw(), SymbolicCholeskyRaw::Supernodal(_));
+        (
+            self.perm.len(),
+            self.symbolic[0].len_val(),
+            sn,
+            self.symbolic[1].len_val(),
+        )
+    }
+
+    /// The runtime's numeric set-up of both factors: pattern, left-looking factor, layout.
+    pub fn factor_own(&mut self) {
+        let SymbolicCholeskyRaw::Simplicial(simp) = self.symbolic[0].raw() else {
+            unreachable!("simplicial factorisation forced")
+        };
+        let pattern = Pattern::new(simp.col_ptr().to_vec(), simp.row_idx().to_vec());
+        let vals = factor_operators(&self.asm, &pattern, &self.perm, &self.iperm)
+            .expect("positive definite operators");
+        let layout = Layout::new(&pattern);
+        let factors = [0, 1].map(|k| Factor::new(&pattern, vals.iter().map(|v| v[k]).collect()));
+        self.own = Some((layout, factors));
+    }
+
+    /// faer's numeric factors of both operators: on the runtime's simplicial analysis
+    /// (`supernodal` false) or on faer's default one (true).
+    pub fn factor_faer(&mut self, supernodal: bool) {
+        use faer::dyn_stack::{MemBuffer, MemStack};
+        use faer::Par;
+        let s = usize::from(supernodal);
+        let sym = &self.symbolic[s];
+        let mut buf =
+            MemBuffer::new(sym.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default()));
+        for k in 0..2 {
+            let mut values = vec![0.0; sym.len_val()];
+            sym.factorize_numeric_llt::<f64>(
+                &mut values,
+                self.mats[k].as_ref(),
+                Side::Lower,
+                Default::default(),
+                Par::Seq,
+                MemStack::new(&mut buf),
+                Default::default(),
+            )
+            .expect("positive definite operators");
+            self.faer[s][k] = values;
+        }
+    }
+
+    /// `rhs ← A⁻¹ rhs` (original vertex order) with the runtime's factor and serial solves
+    /// (`which` 0 = heat, 1 = Poisson); `x` is scratch. Call [`LltProbe::factor_own`] first.
+    pub fn solve_own(&self, which: usize, rhs: &mut [f64], x: &mut Vec<f64>) {
+        let (layout, factors) = self.own.as_ref().expect("factor_own first");
+        let f = &factors[which];
+        x.clear();
+        x.resize(layout.len(), 0.0);
+        for (v, &r) in rhs.iter().enumerate() {
+            x[layout.position(self.iperm[v] as usize)] = r;
+        }
+        layout.solve(&f.vals, &f.inv_diag, x);
+        for (v, r) in rhs.iter_mut().enumerate() {
+            *r = x[layout.position(self.iperm[v] as usize)];
+        }
+    }
+
+    /// `rhs ← A⁻¹ rhs` with faer's factor and `solve_in_place_with_conj` (serial). Call
+    /// [`LltProbe::factor_faer`] with the same `supernodal` first.
+    pub fn solve_faer(&self, supernodal: bool, which: usize, rhs: &mut [f64]) {
+        use faer::dyn_stack::{MemBuffer, MemStack};
+        use faer::sparse::linalg::cholesky::LltRef;
+        use faer::Par;
+        let s = usize::from(supernodal);
+        let sym = &self.symbolic[s];
+        let mut buf = MemBuffer::new(sym.solve_in_place_scratch::<f64>(1, Par::Seq));
+        LltRef::<u32, f64>::new(sym, &self.faer[s][which]).solve_in_place_with_conj(
+            faer::Conj::No,
+            faer::MatMut::from_column_major_slice_mut(rhs, self.perm.len(), 1),
+            Par::Seq,
+            MemStack::new(&mut buf),
+        );
+    }
+}
+
+/// The numeric factors of (M + tL) and (L + εM) (t = mean edge², ε = 1e-8/t) on `pattern`,
+/// as `[heat, poisson]` pairs in pattern order: both operators' lower triangles, permuted by
+/// `iperm` (vertex → factor row), scattered into the pattern, then factored in one sweep
+/// ([`Pattern::factor_pair`]).
+fn factor_operators(
+    asm: &Assembly,
+    pattern: &Pattern,
+    perm: &[u32],
+    iperm: &[u32],
+) -> Result<Vec<[f64; 2]>, GeodesicError> {
+    let n = asm.mass.len();
+    let t = asm.mean_edge * asm.mean_edge;
+    let eps = 1e-8 / t;
+    let mut vals = vec![[0.0f64; 2]; pattern.row_idx.len()];
+    for c in 0..n {
+        for q in asm.col_ptr[c] as usize..asm.col_ptr[c + 1] as usize {
+            let (r, lv) = (asm.row_idx[q] as usize, asm.val[q]);
+            let (pr, pc) = (iperm[r], iperm[c]);
+            let m = if r == c { asm.mass[c] } else { 0.0 };
+            vals[pattern.position(pr.max(pc), pr.min(pc))] = [t * lv + m, lv + eps * m];
+        }
+    }
+    let mut w = vec![[0.0f64; 2]; n];
+    pattern.factor_pair(&mut vals, &mut w).map_err(|j| {
+        GeodesicError::Factorization(format!("pivot of vertex {} is not positive", perm[j]))
+    })?;
+    Ok(vals)
 }
 
 /// The power of two nearest 1e140 × (smallest lumped vertex mass, m²): the heat solution of a

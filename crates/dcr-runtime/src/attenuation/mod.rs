@@ -12,6 +12,9 @@ mod sparse_llt;
 pub use attenuation_params::{AmplitudeKind, AttenuationLaw, AttenuationParams, DistanceKind};
 pub(crate) use distance_cache::DistanceCache;
 pub use geodesic_table::GeodesicTable;
+#[cfg(feature = "bench-internals")]
+#[doc(hidden)]
+pub use heat_geodesic::LltProbe;
 pub use heat_geodesic::{GeodesicError, HeatGeodesic, HeatWorkspace};
 
 #[cfg(test)]

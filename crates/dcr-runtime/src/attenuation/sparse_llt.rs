@@ -3,13 +3,18 @@
 //! [`Layout`] (the elimination tree's two halves and the chain above them, when the order
 //! splits) so the halves can be solved on two threads.
 //!
-//! Hand-written rather than faer's `factorize_numeric_llt` / `LltRef::solve_in_place_with_conj`
-//! because faer's simplicial numeric factor (up-looking, one elimination-tree reach per row,
-//! `usize` indices) misses the heat-geodesic set-up and query budgets on ~5k-vertex surfaces
-//! (≈ 8 ms per operator and ≈ 0.3 ms per solve; docs/benchmarks.md, "Design measurements"). Here the pattern is
-//! known up front, so the factor is left-looking over a precomputed row pattern (each update a
-//! plain suffix of an earlier column), both operators share every index load (values stored as
-//! `[heat, poisson]` pairs), and all indices are `u32`.
+//! Why hand-written rather than faer's sparse Cholesky (`factorize_numeric_llt`,
+//! `LltRef::solve_in_place_with_conj`), the well-kept alternative: measured on the geodesic
+//! systems of the committed and scene bases (`cargo bench --workspace --bench sparse_llt`,
+//! figures in docs/benchmarks.md, "The heat method's sparse Cholesky"), setting up both
+//! operators here costs well under faer's numeric factorisation of them — on faer's simplicial
+//! analysis and under faer's own choice, which stays simplicial on these surfaces — because the
+//! pattern is known up front: the factor is left-looking over a precomputed row pattern (each
+//! update a plain suffix of an earlier column), both operators share every index load (values
+//! stored as `[heat, poisson]` pairs), and all indices are `u32`. The set-up is paid per
+//! object at load. A full serial solve is not faster than faer's on the larger surfaces; a
+//! query does not run one, though: it sweeps the two halves of [`Layout`] on two threads and,
+//! for a point source, only the source's ancestors forward, which faer's solve does not offer.
 
 use crate::math::fmadd;
 
@@ -373,8 +378,9 @@ impl Layout {
     }
 
     /// `x ← A⁻¹ x` for A = L Lᵀ, x in storage order (`l`, `inv_diag` = 1/L_kk: the whole
-    /// factor's): every step of a query's solve in one serial call, for tests.
-    #[cfg(test)]
+    /// factor's): every step of a query's solve in one serial call, for tests and the
+    /// `sparse_llt` benchmark.
+    #[cfg(any(test, feature = "bench-internals"))]
     pub(super) fn solve(&self, l: &[f64], inv_diag: &[f64], x: &mut [f64]) {
         let (halves, xt) = self.split_mut(x);
         if let (Some(parts), Some([x0, x1])) = (&self.halves, halves) {

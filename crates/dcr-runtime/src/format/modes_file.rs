@@ -39,18 +39,23 @@
 //! reader opens; second-order bases are version 2, which version-1 readers refuse rather than
 //! interpolate them linearly.
 //!
-//! Files are written deterministically (fixed zip timestamps, fixed entry order, stored) and
-//! atomically (temporary file in the target directory, then rename).
+//! Files are written (cargo feature `write`, which engines leave off) deterministically (fixed
+//! zip timestamps, fixed entry order, stored) and atomically through the tools' one writer
+//! (`dcr_files::write_atomic`: a unique temporary beside the destination, then a rename).
 //!
 //! Reading distrusts every size in the file: only regular files are opened; each entry's
 //! declared size is checked against the archive's length, each `.npy` header length against
 //! the entry's bytes and each shape against the data present before anything is allocated;
 //! the content is then validated ([`ModesFile::validate`], one table of rules per kind of value).
 
-use std::io::{Cursor, Read, Seek};
+#[cfg(feature = "write")]
+use std::io::Cursor;
+use std::io::{Read, Seek};
 use std::path::{Path, PathBuf};
 
-use super::npy::{decode, parse_header_text, write_entry, NpyElement};
+#[cfg(feature = "write")]
+use super::npy::write_entry;
+use super::npy::{decode, parse_header_text, NpyElement};
 use serde::{Deserialize, Serialize};
 
 use super::quadratic_surface::{QuadraticSurface, QUADRATIC_ENTRIES, QUADRATIC_FORMAT_VERSION};
@@ -242,7 +247,7 @@ pub enum FormatError {
         /// What it is instead ("a directory", "a FIFO", ...).
         what: &'static str,
     },
-    /// A write would replace something that is not a regular file.
+    /// A write (cargo feature `write`) would replace something that is not a regular file.
     #[error("{path}: is {what}; refusing to replace it with a file (give the path of a file)")]
     Clobber {
         /// Path concerned.
@@ -266,6 +271,21 @@ pub enum FormatError {
         /// What is wrong.
         detail: String,
     },
+}
+
+#[cfg(feature = "write")]
+impl From<dcr_files::WriteError> for FormatError {
+    fn from(e: dcr_files::WriteError) -> FormatError {
+        match e {
+            dcr_files::WriteError::Clobber { path, what } => FormatError::Clobber { path, what },
+            dcr_files::WriteError::Io { path, source } => FormatError::Io { path, source },
+            // `WriteError` is non-exhaustive: a future kind keeps its message.
+            other => FormatError::Io {
+                path: PathBuf::new(),
+                source: std::io::Error::other(other.to_string()),
+            },
+        }
+    }
 }
 
 impl ModesFile {
@@ -456,26 +476,29 @@ impl ModesFile {
         Ok(())
     }
 
-    /// Writes the base to `path` atomically and deterministically (same content → same bytes).
+    /// Writes the base to `path` atomically and deterministically (same content → same bytes);
+    /// cargo feature `write`.
     ///
     /// The data is written to a temporary file beside `path`, synced, then renamed over it
-    /// ([`super::AtomicFile`]: unique temporary names, stale temporaries of dead writers
+    /// (`dcr_files::AtomicFile`: unique temporary names, stale temporaries of dead writers
     /// removed); on any error the temporary file is removed and `path` is left untouched.
     ///
     /// # Errors
     /// [`FormatError::Invalid`] if the content fails [`ModesFile::validate`];
     /// [`FormatError::Clobber`] if `path` is a directory, device, FIFO or socket; I/O errors.
+    #[cfg(feature = "write")]
     pub fn write_atomic(&self, path: &Path) -> Result<(), FormatError> {
         self.validate(path)?;
         let bytes = self.to_bytes().map_err(|detail| FormatError::Archive {
             path: path.to_path_buf(),
             detail,
         })?;
-        super::atomic_file::write_atomic(path, &bytes)
+        dcr_files::write_atomic(path, &bytes).map_err(FormatError::from)
     }
 
     /// Serialises the archive to bytes (deterministic: stored entries, fixed timestamps, the
     /// entries in a fixed order).
+    #[cfg(feature = "write")]
     pub(crate) fn to_bytes(&self) -> Result<Vec<u8>, String> {
         let m = self.num_modes();
         let ns = self.num_surface_vertices();

@@ -10,9 +10,10 @@
 //! the only build scripts in its tree that run a C compiler (none remain). The headers a base
 //! holds use three keys, a type string, a
 //! boolean and a tuple of integers, which the small non-recursive parser below reads exactly;
-//! anything else (structured dtypes, nested values) is refused as unsupported. The writer emits
-//! the bytes `ndarray-npy` and NumPy write, so bases stay bit-identical.
+//! anything else (structured dtypes, nested values) is refused as unsupported. The writer (cargo
+//! feature `write`) emits the bytes `ndarray-npy` and NumPy write, so bases stay bit-identical.
 
+#[cfg(feature = "write")]
 use std::io::{Seek, Write};
 
 /// Magic string at the start of every `.npy` file.
@@ -21,6 +22,7 @@ const MAGIC: &[u8] = b"\x93NUMPY";
 /// An element type of a `.modes` entry: its NumPy type descriptors and little-endian bytes.
 pub(crate) trait NpyElement: Copy + Sized {
     /// Descriptor written (`'<f8'`).
+    #[cfg(feature = "write")]
     const DESCR: &'static str;
     /// Size in bytes.
     const SIZE: usize;
@@ -29,18 +31,21 @@ pub(crate) trait NpyElement: Copy + Sized {
     /// The element from its `SIZE` bytes, little-endian.
     fn from_le(bytes: &[u8]) -> Self;
     /// Appends the element's little-endian bytes.
+    #[cfg(feature = "write")]
     fn put_le(self, out: &mut Vec<u8>);
 }
 
 macro_rules! npy_element {
     ($t:ty, $descr:expr, [$($read:expr),*]) => {
         impl NpyElement for $t {
+            #[cfg(feature = "write")]
             const DESCR: &'static str = $descr;
             const SIZE: usize = std::mem::size_of::<$t>();
             const READ: &'static [(&'static str, bool)] = &[$($read),*];
             fn from_le(bytes: &[u8]) -> Self {
                 <$t>::from_le_bytes(bytes.try_into().expect("SIZE bytes"))
             }
+            #[cfg(feature = "write")]
             fn put_le(self, out: &mut Vec<u8>) {
                 out.extend_from_slice(&self.to_le_bytes());
             }
@@ -66,6 +71,7 @@ pub(crate) struct NpyHeader {
 
 /// The header bytes NumPy and `ndarray-npy` write for `descr` and `shape` (format 1.0, or 2.0
 /// when the text does not fit a 16-bit length).
+#[cfg(feature = "write")]
 pub(crate) fn header_bytes(descr: &str, shape: &[usize]) -> Vec<u8> {
     let dims = match shape {
         [] => "()".to_string(),
@@ -99,6 +105,7 @@ pub(crate) fn header_bytes(descr: &str, shape: &[usize]) -> Vec<u8> {
 }
 
 /// Writes `data` (C order, `shape`) as the archive entry `NAME.npy`.
+#[cfg(feature = "write")]
 pub(crate) fn write_entry<W: Write + Seek, A: NpyElement>(
     zip: &mut zip::ZipWriter<W>,
     name: &str,
@@ -289,6 +296,7 @@ mod tests {
     use super::*;
 
     /// The writer's header is NumPy's: 64-byte aligned, newline last, and it parses back.
+    #[cfg(feature = "write")]
     #[test]
     fn header_round_trips_and_is_aligned() {
         for shape in [vec![], vec![10], vec![188, 3], vec![188, 3, 10]] {

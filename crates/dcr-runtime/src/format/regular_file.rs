@@ -1,17 +1,17 @@
-//! Opening files for reading and checking paths for writing, safely against what a path can
-//! name besides a regular file (a directory, a device, a FIFO, a socket).
+//! Opening files for reading, safely against what a path can name besides a regular file (a
+//! directory, a device, a FIFO, a socket).
 //!
 //! Readers open regular files only: a FIFO blocks until a writer appears and a device such as
 //! `/dev/zero` never ends, so neither is opened at all (the type is looked up first, and checked
-//! again on the opened handle in case the path changed in between). Writers refuse to replace
-//! anything but a regular file (renaming over a device node would replace the node) and to
-//! write over one of their own inputs.
+//! again on the opened handle in case the path changed in between). The writing side (refusing
+//! to replace anything but a regular file, or an input) is the tools' `dcr-files` crate, which
+//! engines do not compile; its `describe_file_type` uses the same words as the one here.
 
 use std::fs::{File, FileType, Metadata};
 use std::path::Path;
 
 /// What kind of file system object `t` is, in words for messages ("a directory", "a FIFO", ...).
-pub fn describe_file_type(t: FileType) -> &'static str {
+pub(crate) fn describe_file_type(t: FileType) -> &'static str {
     #[cfg(unix)]
     {
         use std::os::unix::fs::FileTypeExt;
@@ -75,24 +75,4 @@ pub fn open_regular_file(path: &Path) -> Result<(File, u64), OpenError> {
     let meta = file.metadata().map_err(OpenError::Io)?;
     regular(&meta)?;
     Ok((file, meta.len()))
-}
-
-/// Whether `a` and `b` name the same existing file (same device and inode on Unix, same
-/// canonical path elsewhere). `false` when either does not exist.
-pub fn same_file(a: &Path, b: &Path) -> bool {
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::MetadataExt;
-        match (std::fs::metadata(a), std::fs::metadata(b)) {
-            (Ok(x), Ok(y)) => x.dev() == y.dev() && x.ino() == y.ino(),
-            _ => false,
-        }
-    }
-    #[cfg(not(unix))]
-    {
-        match (a.canonicalize(), b.canonicalize()) {
-            (Ok(x), Ok(y)) => x == y,
-            _ => false,
-        }
-    }
 }

@@ -537,69 +537,6 @@ fn only_regular_files_are_read() {
     }
 }
 
-// Regression: temporaries were named `.NAME.tmp-PID` — two writers with one pid on hosts sharing
-// a file system collided, and a temporary left by a killed writer stayed for ever. Names carry
-// host, pid and random bits; a new write removes the temporaries of writers that are gone.
-#[test]
-fn temporaries_are_unique_and_stale_ones_are_removed() {
-    let dir = tempfile::tempdir().unwrap();
-    let dest = dir.path().join("x.modes");
-    let a = AtomicFile::create(&dest).unwrap();
-    let b = AtomicFile::create(&dest).unwrap();
-    assert_ne!(a.temporary_path(), b.temporary_path());
-    let name = a
-        .temporary_path()
-        .file_name()
-        .unwrap()
-        .to_str()
-        .unwrap()
-        .to_string();
-    let host = atomic_file::this_host_tag();
-    let me = std::process::id();
-    assert!(
-        name.starts_with(&format!(".x.modes.tmp-{host}-{me}-")),
-        "{name}"
-    );
-    // Writers in progress are never stale; dropping one removes its temporary.
-    assert_eq!(atomic_file::stale_removed(dir.path(), "x.modes"), 0);
-    drop(a);
-    drop(b);
-    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
-
-    // A process that has exited: its pid names a dead writer on this host.
-    let mut child = std::process::Command::new("true").spawn().unwrap();
-    let dead = child.id();
-    child.wait().unwrap();
-    let alive = std::os::unix::process::parent_id();
-    let touch = |n: &str| {
-        let p = dir.path().join(n);
-        std::fs::write(&p, b"partial").unwrap();
-        p
-    };
-    let stale = [
-        touch(&format!(".x.modes.tmp-{host}-{dead}-0123456789abcdef")),
-        touch(&format!(".x.modes.tmp-{dead}")),
-    ];
-    let live = touch(&format!(".x.modes.tmp-{host}-{alive}-0123456789abcdef"));
-    let foreign = touch(".x.modes.tmp-otherhost-1-0123456789abcdef");
-    let old_foreign = touch(".x.modes.tmp-otherhost-2-0123456789abcdef");
-    std::fs::File::options()
-        .write(true)
-        .open(&old_foreign)
-        .unwrap()
-        .set_modified(std::time::SystemTime::now() - 2 * STALE_AFTER)
-        .unwrap();
-    let other = touch(".y.modes.tmp-h-1-0");
-    tiny_base().write_atomic(&dest).unwrap();
-    for p in stale.iter().chain([&old_foreign]) {
-        assert!(!p.exists(), "{} should be removed", p.display());
-    }
-    for p in [&live, &foreign, &other] {
-        assert!(p.exists(), "{} should stay", p.display());
-    }
-    assert!(dest.exists());
-}
-
 // Regression: `-o` onto a character device replaced the device node with the base (as root,
 // exit 0). Writes replace regular files only.
 #[test]

@@ -55,7 +55,8 @@ impl MethodResponse {
 ///
 /// ```
 /// use std::sync::Arc;
-/// use dcr_runtime::{testing, DistantResponse, Impact, ModalModel, ResponseParams, RestingContact};
+/// use dcr_runtime::{testing, DistantResponse, ModalModel, ResponseParams};
+/// use dcr_runtime::response::{Impact, RestingContact};
 ///
 /// // A synthetic 1 m × 0.6 m plate base (8 modes); real bases come from `ModalModel::load`.
 /// let model = Arc::new(ModalModel::from_base(testing::plate_base())?);
@@ -66,8 +67,8 @@ impl MethodResponse {
 /// let out = resp.step(&impacts, &resting);
 /// assert!(out[0].mapped && out[0].delta_v > 0.0);
 /// // Eq. 17–18: the impulse for a 1 kg box (no rotation) along the contact normal.
-/// let m_eff = dcr_runtime::effective_mass(1.0, [[0.0; 3]; 3], [0.0; 3], out[0].normal);
-/// let j = dcr_runtime::response_impulse(m_eff, out[0].delta_v, out[0].normal);
+/// let m_eff = dcr_runtime::response::effective_mass(1.0, [[0.0; 3]; 3], [0.0; 3], out[0].normal);
+/// let j = dcr_runtime::response::response_impulse(m_eff, out[0].delta_v, out[0].normal);
 /// assert!(j[2] > 0.0);
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```

@@ -22,7 +22,7 @@ mod transfer_response;
 pub use contact_response::{ContactResponse, ServedBy};
 pub(crate) use contact_set::ContactSet;
 pub use distant_response::DistantResponse;
-pub use effective_mass::{effective_mass, response_impulse};
+pub use effective_mass::{effective_mass, inverse_effective_mass, response_impulse};
 pub use force_input::ForceInput;
 pub use impact::Impact;
 #[cfg(feature = "bench-internals")]
@@ -30,6 +30,11 @@ pub use peak_kernel::{peak_abs_projection, peak_abs_rows};
 pub use response_params::{Method, ParamsError, ResponseParams, TablePolicy, TableStatus, Variant};
 pub use resting_contact::RestingContact;
 pub use step_info::{StepInfo, TableFallback};
+
+// The knobs of the attenuation method and of filter sampling, beside the other response
+// settings (their home modules define them).
+pub use crate::attenuation::{AmplitudeKind, AttenuationLaw, AttenuationParams, DistanceKind};
+pub use crate::filter::Sampling;
 
 #[cfg(test)]
 mod tests;

@@ -25,17 +25,16 @@ pub enum Method {
     /// T[p][q])` with the P2 weights N over each triangle's vertices and edge midpoints (normal
     /// impulse component only; several impacts' peaks are summed, an upper bound). The modal
     /// method serves instead — reported in `ContactResponse::served_by`, counted with its
-    /// reason in [`crate::StepInfo`] — when the base has no table, its h or Rayleigh damping
+    /// reason in [`crate::response::StepInfo`] — when the base has no table, its h or Rayleigh damping
     /// differs (relative tolerance 1e-9) or `carry_over` is on (all decided at set-up, where
     /// [`TablePolicy::Refuse`] makes them errors instead), the step has forces, or an impact
     /// (whole step) or a contact (that contact) is outside the table's region. `sampling` and
     /// `variant` do not apply to table-served contacts (the table fixed its own sampling).
     ///
-    /// Why it is the default (docs/accuracy.md, `scripts/accuracy.sh`): wherever a table
-    /// exists it is both more accurate and cheaper than the 20-mode modal query — a 640-mode
-    /// table on the paper's table: median / max error 0.9 / 9.6 % vs 16.2 / 69.0 % at 0.73× the
-    /// query time — and a base without a table behaves exactly as [`Method::Modal`]. Tables are
-    /// opt-in at bake time (minutes and megabytes per region).
+    /// Why it is the default: wherever a table exists it is both more accurate and cheaper than
+    /// the modal query over the base's modes (measured in docs/accuracy.md, `scripts/accuracy.sh`,
+    /// and docs/benchmarks.md), and a base without a table behaves exactly as
+    /// [`Method::Modal`]. Tables are opt-in at bake time (minutes and megabytes per region).
     #[default]
     Transfer,
 }
@@ -73,7 +72,7 @@ pub struct ResponseParams {
     /// [`TablePolicy::FallBackToModal`].
     pub table_policy: TablePolicy,
     /// The lateral kick (paper §5.4): also report the peak tangential displacement at each
-    /// contact as a tangential velocity change ([`crate::ContactResponse::lateral_delta_v`]),
+    /// contact as a tangential velocity change ([`crate::response::ContactResponse::lateral_delta_v`]),
     /// which [`crate::DcrWorld`] adds to the impulse. Computed from the modal base (3 mode rows
     /// per vertex) whichever method serves the normal part. Default `false`.
     pub lateral_kick: bool,
@@ -86,14 +85,14 @@ pub struct ResponseParams {
 /// ([`crate::DistantResponse::table_status`]); whether it serves a step is known per step (an
 /// impact or resting contact outside the table's region, a force input). Per-step cases
 /// always fall back to the modal method, counted in
-/// [`crate::StepInfo::contacts_table_fallback`] with the reason in
-/// [`crate::StepInfo::table_fallback`].
+/// [`crate::response::StepInfo::contacts_table_fallback`] with the reason in
+/// [`crate::response::StepInfo::table_fallback`].
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum TablePolicy {
     /// A table that does not apply to the run is not used: the modal method serves, and every
     /// resting contact of every step counts in `contacts_table_fallback` (reason
-    /// [`crate::TableFallback::Unavailable`]). A base without any table is plain modal (not
-    /// counted; [`crate::TableStatus::NoTable`]). Default.
+    /// [`crate::response::TableFallback::Unavailable`]). A base without any table is plain modal (not
+    /// counted; [`crate::response::TableStatus::NoTable`]). Default.
     #[default]
     FallBackToModal,
     /// Set-up fails ([`ParamsError::TableRefused`], with the numbers) when the base has no

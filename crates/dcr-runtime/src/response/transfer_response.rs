@@ -33,8 +33,8 @@
 //! entirely in the region is served by the modal method (the whole modal
 //! step is then run and the in-region contacts are overwritten with the table's values).
 //! Whether the table applies to the run at all is decided at set-up
-//! ([`crate::TablePolicy`]); per-step fallbacks are counted with their reason
-//! ([`crate::StepInfo::table_fallback`]).
+//! ([`crate::response::TablePolicy`]); per-step fallbacks are counted with their reason
+//! ([`crate::response::StepInfo::table_fallback`]).
 
 use super::modal_response::{ModalResponse, UNMAPPED};
 use super::step_ctx::{mapped_response, unmapped_response, StepCtx};

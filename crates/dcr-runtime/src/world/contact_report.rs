@@ -16,7 +16,7 @@ pub struct ContactReport {
     /// Stable id of this contact point, the same while the engine tracks it from step to step
     /// (e.g. a hash of the collider pair, the sub-shapes and the manifold point index). An id
     /// that disappears from the reports and comes back later is a new contact
-    /// ([`crate::ClassifyParams::new_after_missing_steps`]).
+    /// ([`crate::world::ClassifyParams::new_after_missing_steps`]).
     pub id: u64,
     /// Engine id of the first body.
     pub body1: u64,
@@ -35,6 +35,6 @@ pub struct ContactReport {
     /// The engine's own newness: `true` when this point carried no impulse at the engine's
     /// previous step (it did not exist, or only predictively). Rapier: the solver contact's
     /// warm-start impulse is 0; Box2D: a begin-touch event. Read only under
-    /// [`crate::ClassifyParams::engine_newness`]; pass `false` otherwise.
+    /// [`crate::world::ClassifyParams::engine_newness`]; pass `false` otherwise.
     pub is_new: bool,
 }

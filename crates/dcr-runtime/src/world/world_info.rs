@@ -108,7 +108,7 @@ pub struct ObjectTotals {
     /// Impacts farther than `max_map_distance` from the surface (ignored).
     pub impacts_unmapped: u64,
     /// Resting contacts a transfer-table response served with the modal method instead
-    /// ([`crate::StepInfo::contacts_table_fallback`]).
+    /// ([`crate::response::StepInfo::contacts_table_fallback`]).
     pub contacts_table_fallback: u64,
     /// Steps the object spent disabled ([`crate::DcrWorld::set_enabled`]).
     pub disabled_steps: u64,

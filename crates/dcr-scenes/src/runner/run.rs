@@ -8,10 +8,11 @@ use anyhow::{bail, Context, Result};
 use dcr_rapier::f64::{body_handle, AdapterParams, ApplyMode, DcrRapier, StepGate};
 use dcr_rapier::{ElasticHandle, ElasticObjectDesc, WorldParams};
 use dcr_runtime::format::ModesFile;
-use dcr_runtime::{
-    AmplitudeKind, AttenuationLaw, AttenuationParams, DistanceKind, Method, ModalModel,
-    ResponseParams, ServedBy, TableFallback, TablePolicy,
+use dcr_runtime::response::{
+    AmplitudeKind, AttenuationLaw, AttenuationParams, DistanceKind, ServedBy, TableFallback,
+    TablePolicy,
 };
+use dcr_runtime::{Method, ModalModel, ResponseParams};
 use ndarray::{Array1, Array2};
 use ndarray_npy::NpzWriter;
 use rapier3d_f64::math::Vector;
@@ -508,7 +509,7 @@ fn write_outputs(
             .zip([&trajectory[..], &timings[..], json.as_bytes()])
     {
         let path = dir.join(name);
-        dcr_runtime::format::write_atomic(&path, bytes)
+        dcr_files::write_atomic(&path, bytes)
             .with_context(|| format!("writing {}", path.display()))?;
     }
     Ok(())

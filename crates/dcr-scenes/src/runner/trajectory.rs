@@ -57,14 +57,13 @@ impl Trajectory {
     }
 
     /// Writes `time` (n), `positions` (n × bodies × 3) and `rotations` (n × bodies × 4,
-    /// xyzw) to an NPZ file (through the one writer, [`dcr_runtime::format::write_atomic`]).
+    /// xyzw) to an NPZ file (through the one writer, [`dcr_files::write_atomic`]).
     ///
     /// # Errors
     /// I/O errors, or a destination the writer refuses (a device, FIFO or folder).
     pub fn write_npz(&self, path: &Path) -> Result<()> {
         let bytes = self.to_npz()?;
-        dcr_runtime::format::write_atomic(path, &bytes)
-            .with_context(|| format!("writing {}", path.display()))
+        dcr_files::write_atomic(path, &bytes).with_context(|| format!("writing {}", path.display()))
     }
 
     /// The NPZ file [`Trajectory::write_npz`] writes, in memory.

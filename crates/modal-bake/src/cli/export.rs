@@ -85,7 +85,7 @@ pub fn run(args: &ExportArgs) -> anyhow::Result<()> {
             "nothing to write: give at least one of --vtu OUT.vtu, --gltf OUT.glb, --png OUT.png"
         );
     }
-    let mut plan = dcr_runtime::format::OutputPlan::new();
+    let mut plan = dcr_files::OutputPlan::new();
     plan.input("the base", &args.file);
     if let Some(asset) = &args.onto {
         plan.input("--onto", asset);

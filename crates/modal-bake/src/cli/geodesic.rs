@@ -59,7 +59,7 @@ pub fn run(args: &GeodesicArgs) -> anyhow::Result<()> {
             .write_npy(&mut bytes)
             .context("encoding the distances as .npy")?;
         super::create_parent(path)?;
-        dcr_runtime::format::write_atomic(path, &bytes)?;
+        dcr_files::write_atomic(path, &bytes)?;
     }
     if args.json {
         outln!(

@@ -252,7 +252,7 @@ pub fn run(args: &MeshArgs) -> anyhow::Result<()> {
     args.budget
         .check_surface(&args.asset, &args.asset_options, 26)?;
     let out = mesh_asset(&args.asset, &args.asset_options)?;
-    dcr_runtime::format::write_atomic(&args.out, &out.msh)
+    dcr_files::write_atomic(&args.out, &out.msh)
         .with_context(|| format!("writing {}", args.out.display()))?;
     let m = &out.mesh;
     let r = &out.report;

@@ -64,11 +64,11 @@ enum Command {
     Export(export::ExportArgs),
     /// Heat-method geodesic distances (m) from one surface vertex of a base.
     Geodesic(geodesic::GeodesicArgs),
-    /// Alias of `dcr-lab truth` (full-order reference response): runs the `dcr-lab` binary.
+    /// Moved to `dcr-lab truth` (full-order reference response; same options).
     #[command(disable_help_flag = true)]
     Truth(lab_alias::LabArgs),
-    /// Alias of `dcr-lab fit-attenuation` (Eq. 14 fitted to the full-order response): runs the
-    /// `dcr-lab` binary.
+    /// Moved to `dcr-lab fit-attenuation` (Eq. 14 fitted to the full-order response; same
+    /// options).
     #[command(disable_help_flag = true)]
     FitAttenuation(lab_alias::LabArgs),
 }
@@ -111,7 +111,7 @@ fn stdout_failure() -> Option<&'static std::io::Error> {
 /// # Errors
 /// A one-line message naming `option` and the path.
 pub fn check_output(out: &Path, option: &str, inputs: &[&Path]) -> anyhow::Result<()> {
-    let mut plan = dcr_runtime::format::OutputPlan::new();
+    let mut plan = dcr_files::OutputPlan::new();
     for input in inputs {
         plan.input("the input", input);
     }

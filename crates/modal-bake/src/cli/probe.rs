@@ -11,10 +11,10 @@ use std::sync::Arc;
 
 use anyhow::{bail, Context};
 use dcr_runtime::model::SurfacePoint;
-use dcr_runtime::{
-    AttenuationParams, DistantResponse, Impact, Method, ModalModel, ResponseParams, RestingContact,
-    Sampling, ServedBy, Variant,
+use dcr_runtime::response::{
+    AttenuationParams, Impact, RestingContact, Sampling, ServedBy, Variant,
 };
+use dcr_runtime::{DistantResponse, Method, ModalModel, ResponseParams};
 
 /// Distant-response model selectable from the command line.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]

@@ -3,9 +3,8 @@
 //!
 //! Why not faer's own `solve_in_place` (which the crate uses for single vectors and wide
 //! blocks): for a few right-hand sides it runs, per supernode, a dense GEMM that packs the
-//! supernode's rows below and then scatters the product column by column, and ends up 2–3×
-//! above one pass over the factor's memory (6 right-hand sides at 13.5k dofs: faer 21–30 ms,
-//! this solve 17–18 ms on one thread; the figures in docs/benchmarks.md, "Design measurements").
+//! supernode's rows below and then scatters the product column by column, well above one pass
+//! over the factor's memory (the comparison is in docs/benchmarks.md, "Design measurements").
 //! Here each factor entry is loaded once per solve and multiplies a row of w values held in
 //! SIMD registers; the columns of a supernode are taken in passes of [`PASS`], so each indexed
 //! row of x is loaded and stored once per pass rather than once per factor column.
@@ -13,8 +12,7 @@
 //! Two threads: from 20 000 rows on, when the supernodal elimination tree splits into two
 //! groups of whole subtrees holding similar weights below a top of at most 25% of the factor
 //! ([`Split`]), the two groups are swept at the same time. That is the case for nested
-//! dissection orderings (the bake bench's stout 108k-dof beam: groups of 40.8 M and 40.1 M
-//! entries below a top of 2.8%), not for the AMD ordering of the slender 109k beam (a near
+//! dissection orderings of bulky meshes, not for the AMD ordering of a slender beam (a near
 //! chain: no split within 25%, swept on one thread).
 //!
 //! Determinism: every sum in a fixed order that depends on the factor only; each right-hand side (lane) sees the
@@ -29,8 +27,8 @@ use faer::sparse::linalg::cholesky::supernodal::{SupernodalLltRef, SymbolicSuper
 /// PASS solved rows of x in registers (2 AVX registers each at w = 8) next to two partial
 /// sums, and 8 rows already fill the 16 AVX2 registers (spills); and FEM supernodes hold
 /// whole 3-dof nodes, so their widths are multiples of 3 and a pass of 6 leaves either
-/// nothing or a pass of [`REM`], which also runs on fixed-size arrays (passes of 8: 6.9 M vs
-/// 10.6 M instructions per solve at 3.5k dofs; docs/benchmarks.md, "Design measurements").
+/// nothing or a pass of [`REM`], which also runs on fixed-size arrays (passes of 8 execute
+/// more instructions; docs/benchmarks.md, "Design measurements").
 const PASS: usize = 6;
 
 /// The pass width left over in supernodes of an odd number of 3-dof nodes (specialised like a

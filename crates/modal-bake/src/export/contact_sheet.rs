@@ -67,7 +67,7 @@ pub const SHEET_TITLE_H: usize = 44;
 /// Height of the legend band below the panels (pixels).
 pub const SHEET_LEGEND_H: usize = 56;
 
-use crate::vec3::{cross, dot, sub};
+use dcr_runtime::math::{cross, dot, sub};
 fn normalize(a: [f64; 3]) -> [f64; 3] {
     let n = dot(a, a).sqrt();
     if n > 0.0 {

@@ -71,7 +71,7 @@ pub enum ExportError {
     Invalid(String),
     /// The writer refused or failed (the message names the path).
     #[error(transparent)]
-    Write(dcr_runtime::format::FormatError),
+    Write(dcr_files::WriteError),
 }
 
 /// The selected modes' label, e.g. `mode_01_12.3Hz`: 1-based mode number (two digits at
@@ -237,14 +237,14 @@ pub(crate) fn diagonal(points: &[[f64; 3]]) -> f64 {
 }
 
 /// Writes `bytes` to `path` through the project's one writer
-/// ([`dcr_runtime::format::write_atomic`]): a unique temporary beside it, renamed over it when
+/// ([`dcr_files::write_atomic`]): a unique temporary beside it, renamed over it when
 /// complete; a device, FIFO, socket or folder at `path` is refused, and on failure (or
 /// SIGINT/SIGTERM in a tool that installed [`crate::signals::remove_temporaries_on_signals`])
 /// nothing is left behind and an existing `path` is untouched. Check the command's outputs
-/// against its inputs first ([`dcr_runtime::format::OutputPlan`]).
+/// against its inputs first ([`dcr_files::OutputPlan`]).
 ///
 /// # Errors
 /// [`ExportError::Write`], naming `path`.
 pub fn write_file_atomic(path: &Path, bytes: &[u8]) -> Result<(), ExportError> {
-    dcr_runtime::format::write_atomic(path, bytes).map_err(ExportError::Write)
+    dcr_files::write_atomic(path, bytes).map_err(ExportError::Write)
 }

@@ -7,7 +7,7 @@ use dcr_runtime::model::{area_weighted_normals, surface_point_on, SurfacePoint};
 
 use crate::mesh::extract_surface;
 use crate::mesh::TetMesh;
-use crate::vec3::{add, dot, norm2, scale, sub};
+use dcr_runtime::math::{add, dot, norm2, scale, sub};
 
 /// The boundary surface of a tetrahedral mesh, for mapping points onto it (object frame, m).
 #[derive(Clone, Debug)]

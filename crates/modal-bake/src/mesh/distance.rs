@@ -81,8 +81,11 @@ fn count_samples(vertices: &[[f64; 3]], triangles: &[[usize; 3]], h: f64) -> f64
         .iter()
         .map(|t| {
             let [a, b, c] = t.map(|v| vertices[v]);
-            let n = crate::vec3::cross(crate::vec3::sub(b, a), crate::vec3::sub(c, a));
-            0.5 * crate::vec3::norm2(n).sqrt()
+            let n = dcr_runtime::math::cross(
+                dcr_runtime::math::sub(b, a),
+                dcr_runtime::math::sub(c, a),
+            );
+            0.5 * dcr_runtime::math::norm2(n).sqrt()
         })
         .sum();
     vertices.len() as f64 + 2.0 * triangles.len() as f64 + 2.0 * area / (h * h)

@@ -389,7 +389,8 @@ fn kind_of(v: &Value) -> &'static str {
 /// Reads a meshio-style JSON mesh from memory; `file` names it in errors.
 ///
 /// Two readers, one result: the typed reader ([`fast::parse`]) deserializes straight into flat
-/// buffers (about 5× faster than building a `serde_json::Value` tree; docs/benchmarks.md, "Design measurements"), and
+/// buffers (faster than building a `serde_json::Value` tree; docs/benchmarks.md, "Design
+/// measurements"), and
 /// refuses — without a message — anything but a well-formed mesh; the document reader
 /// ([`parse_json_dom`]) then reads the input again to find and locate the error (or, for the
 /// rare valid layouts the typed reader does not take, e.g. duplicated keys, to read it). Errors

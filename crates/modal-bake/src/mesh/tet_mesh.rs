@@ -56,7 +56,7 @@ pub(crate) fn tet_faces([a, b, c, d]: [usize; 4]) -> [[usize; 3]; 4] {
     [[a, c, b], [a, b, d], [a, d, c], [b, c, d]]
 }
 
-pub(crate) use crate::vec3::{cross, dot, sub};
+pub(crate) use dcr_runtime::math::{cross, dot, sub};
 
 impl TetMesh {
     /// This mesh as meshio-style JSON that [`crate::mesh::read_mesh`] reads back: `points`

@@ -4,7 +4,8 @@
 use std::sync::Arc;
 
 use dcr_runtime::format::ModesFile;
-use dcr_runtime::{DistantResponse, Impact, Method, ModalModel, ResponseParams, RestingContact};
+use dcr_runtime::response::{Impact, RestingContact};
+use dcr_runtime::{DistantResponse, Method, ModalModel, ResponseParams};
 
 use crate::eigen::SplitMix64;
 use crate::full_order::{
@@ -279,7 +280,7 @@ impl ReferencePairs {
         &self,
         dr: &mut DistantResponse,
         gain: f64,
-    ) -> (Vec<(f64, bool)>, Vec<dcr_runtime::ServedBy>) {
+    ) -> (Vec<(f64, bool)>, Vec<dcr_runtime::response::ServedBy>) {
         let mut errors = Vec::new();
         let mut served = Vec::new();
         for (i, imp) in self.impacts.iter().enumerate() {

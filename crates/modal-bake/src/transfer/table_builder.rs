@@ -29,7 +29,8 @@ use std::collections::HashMap;
 
 use dcr_runtime::filter::{damping_ratio, samples_per_step, ModeFilter};
 use dcr_runtime::format::{ModesFile, TransferTable, MAX_TRANSFER_POINTS};
-use dcr_runtime::{ModalModel, Sampling};
+use dcr_runtime::response::Sampling;
+use dcr_runtime::ModalModel;
 use faer::linalg::matmul::matmul;
 use faer::{Accum, Mat, Par};
 use rayon::prelude::*;

@@ -28,7 +28,7 @@ use parry3d_f64::partitioning::{Bvh, BvhBuildStrategy, BvhWorkspace};
 use robust::{orient3d, Coord3D};
 
 use super::SurfaceMesh;
-use crate::vec3::{cross, sub};
+use dcr_runtime::math::{cross, sub};
 
 /// How many defects of each kind are kept with their positions.
 pub const MAX_EXAMPLES: usize = 8;
@@ -348,7 +348,7 @@ pub fn inspect_surface(surface: &SurfaceMesh) -> SurfaceInspection {
                 let (u, w) = (sub(b, a), sub(c, a));
                 (
                     cross(u, w),
-                    (crate::vec3::norm2(u) * crate::vec3::norm2(w)).sqrt(),
+                    (dcr_runtime::math::norm2(u) * dcr_runtime::math::norm2(w)).sqrt(),
                 )
             })
             .collect();
@@ -403,8 +403,8 @@ fn separated(
         }
         free += 1;
         let d = sub(x[v], p);
-        let s = crate::vec3::dot(n, d);
-        let margin = 1e-9 * scale * crate::vec3::norm2(d).sqrt();
+        let s = dcr_runtime::math::dot(n, d);
+        let margin = 1e-9 * scale * dcr_runtime::math::norm2(d).sqrt();
         if s > margin {
             pos += 1;
         } else if s < -margin {

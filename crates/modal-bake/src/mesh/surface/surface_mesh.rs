@@ -27,7 +27,7 @@ pub struct SurfaceInfo {
     pub flipped: bool,
 }
 
-use crate::vec3::{cross, sub};
+use dcr_runtime::math::{cross, sub};
 
 fn find(parent: &mut [usize], mut v: usize) -> usize {
     while parent[v] != v {

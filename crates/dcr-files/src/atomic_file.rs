@@ -11,7 +11,8 @@
 //! host, whose liveness cannot be seen, or a pid since reused).
 //!
 //! Signals: the temporaries being written are registered process-wide; a signal handler (the
-//! `modal-bake` binary installs one for SIGINT, SIGTERM and SIGHUP) calls
+//! tools install `modal_bake::signals::remove_temporaries_on_signals` for SIGINT, SIGTERM and
+//! SIGHUP) calls
 //! [`remove_pending_temporaries`] before the process ends. SIGKILL cannot be caught: its
 //! temporary is removed by the next write of the same destination.
 //!
@@ -25,8 +26,8 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Mutex;
 use std::time::Duration;
 
-use super::modes_file::FormatError;
-use super::regular_file::describe_file_type;
+use crate::file_type::describe_file_type;
+use crate::WriteError;
 
 /// Age after which a temporary is stale whoever wrote it (a write takes seconds, not hours).
 pub const STALE_AFTER: Duration = Duration::from_secs(3600);
@@ -164,7 +165,7 @@ fn remove_stale(dir: &Path, name: &str) -> usize {
 /// use std::io::Write;
 /// let dir = tempfile::tempdir().unwrap();
 /// let dest = dir.path().join("out.bin");
-/// let mut f = dcr_runtime::format::AtomicFile::create(&dest).unwrap();
+/// let mut f = dcr_files::AtomicFile::create(&dest).unwrap();
 /// f.write_all(b"complete").unwrap();
 /// f.commit().unwrap();
 /// assert_eq!(std::fs::read(&dest).unwrap(), b"complete");
@@ -181,11 +182,11 @@ impl AtomicFile {
     /// beside it (never an existing file).
     ///
     /// # Errors
-    /// [`FormatError::Clobber`] when `dest` exists and is not a regular file (a directory,
-    /// device, FIFO or socket: renaming over it would replace it); [`FormatError::Io`] when
+    /// [`WriteError::Clobber`] when `dest` exists and is not a regular file (a directory,
+    /// device, FIFO or socket: renaming over it would replace it); [`WriteError::Io`] when
     /// the temporary cannot be created (missing folder, permissions, ...).
-    pub fn create(dest: &Path) -> Result<AtomicFile, FormatError> {
-        let io = |source| FormatError::Io {
+    pub fn create(dest: &Path) -> Result<AtomicFile, WriteError> {
+        let io = |source| WriteError::Io {
             path: dest.to_path_buf(),
             source,
         };
@@ -233,8 +234,8 @@ impl AtomicFile {
     /// Syncs the temporary to disk and renames it over the destination.
     ///
     /// # Errors
-    /// [`FormatError::Io`]; the temporary is removed and the destination left untouched.
-    pub fn commit(mut self) -> Result<(), FormatError> {
+    /// [`WriteError::Io`]; the temporary is removed and the destination left untouched.
+    pub fn commit(mut self) -> Result<(), WriteError> {
         let result = (|| {
             let file = self
                 .file
@@ -254,7 +255,7 @@ impl AtomicFile {
                 }
                 Ok(())
             }
-            Err(source) => Err(FormatError::Io {
+            Err(source) => Err(WriteError::Io {
                 path: self.dest.clone(),
                 source,
             }),
@@ -291,9 +292,9 @@ impl Drop for AtomicFile {
 
 /// `dest` may be replaced by a file: it does not exist or is a regular file (a symbolic link
 /// to one is replaced by the file).
-fn check_replaceable(dest: &Path) -> Result<(), FormatError> {
+fn check_replaceable(dest: &Path) -> Result<(), WriteError> {
     match std::fs::metadata(dest) {
-        Ok(meta) if !meta.is_file() => Err(FormatError::Clobber {
+        Ok(meta) if !meta.is_file() => Err(WriteError::Clobber {
             path: dest.to_path_buf(),
             what: describe_file_type(meta.file_type()),
         }),
@@ -305,9 +306,9 @@ fn check_replaceable(dest: &Path) -> Result<(), FormatError> {
 ///
 /// # Errors
 /// As [`AtomicFile::create`] and [`AtomicFile::commit`].
-pub fn write_atomic(dest: &Path, bytes: &[u8]) -> Result<(), FormatError> {
+pub fn write_atomic(dest: &Path, bytes: &[u8]) -> Result<(), WriteError> {
     let mut f = AtomicFile::create(dest)?;
-    f.write_all(bytes).map_err(|source| FormatError::Io {
+    f.write_all(bytes).map_err(|source| WriteError::Io {
         path: dest.to_path_buf(),
         source,
     })?;
@@ -315,11 +316,112 @@ pub fn write_atomic(dest: &Path, bytes: &[u8]) -> Result<(), FormatError> {
 }
 
 #[cfg(test)]
-pub(crate) fn stale_removed(dir: &Path, name: &str) -> usize {
-    remove_stale(dir, name)
-}
+mod tests {
+    use super::*;
 
-#[cfg(test)]
-pub(crate) fn this_host_tag() -> String {
-    host_tag()
+    // Regression: temporaries were named `.NAME.tmp-PID` — two writers with one pid on hosts
+    // sharing a file system collided, and a temporary left by a killed writer stayed for ever.
+    // Names carry host, pid and random bits; a new write removes the temporaries of writers
+    // that are gone.
+    #[test]
+    fn temporaries_are_unique_and_stale_ones_are_removed() {
+        let dir = tempfile::tempdir().unwrap();
+        let dest = dir.path().join("x.modes");
+        let a = AtomicFile::create(&dest).unwrap();
+        let b = AtomicFile::create(&dest).unwrap();
+        assert_ne!(a.temporary_path(), b.temporary_path());
+        let name = a
+            .temporary_path()
+            .file_name()
+            .unwrap()
+            .to_str()
+            .unwrap()
+            .to_string();
+        let host = host_tag();
+        let me = std::process::id();
+        assert!(
+            name.starts_with(&format!(".x.modes.tmp-{host}-{me}-")),
+            "{name}"
+        );
+        // Writers in progress are never stale; dropping one removes its temporary.
+        assert_eq!(remove_stale(dir.path(), "x.modes"), 0);
+        drop(a);
+        drop(b);
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+
+        // A process that has exited: its pid names a dead writer on this host.
+        let mut child = std::process::Command::new("true").spawn().unwrap();
+        let dead = child.id();
+        child.wait().unwrap();
+        let alive = std::os::unix::process::parent_id();
+        let touch = |n: &str| {
+            let p = dir.path().join(n);
+            std::fs::write(&p, b"partial").unwrap();
+            p
+        };
+        let stale = [
+            touch(&format!(".x.modes.tmp-{host}-{dead}-0123456789abcdef")),
+            touch(&format!(".x.modes.tmp-{dead}")),
+        ];
+        let live = touch(&format!(".x.modes.tmp-{host}-{alive}-0123456789abcdef"));
+        let foreign = touch(".x.modes.tmp-otherhost-1-0123456789abcdef");
+        let old_foreign = touch(".x.modes.tmp-otherhost-2-0123456789abcdef");
+        std::fs::File::options()
+            .write(true)
+            .open(&old_foreign)
+            .unwrap()
+            .set_modified(std::time::SystemTime::now() - 2 * STALE_AFTER)
+            .unwrap();
+        let other = touch(".y.modes.tmp-h-1-0");
+        write_atomic(&dest, b"complete").unwrap();
+        for p in stale.iter().chain([&old_foreign]) {
+            assert!(!p.exists(), "{} should be removed", p.display());
+        }
+        for p in [&live, &foreign, &other] {
+            assert!(p.exists(), "{} should stay", p.display());
+        }
+        assert_eq!(std::fs::read(&dest).unwrap(), b"complete");
+    }
+
+    // Regression: `-o` onto a character device replaced the device node with the base (as
+    // root, exit 0). Writes replace regular files only; a symbolic link to `/dev/null` is
+    // refused as the device it names, and the link and the device survive.
+    #[test]
+    fn writes_never_replace_what_is_not_a_regular_file() {
+        use std::os::unix::fs::FileTypeExt;
+        let dir = tempfile::tempdir().unwrap();
+        let fifo = dir.path().join("pipe.modes");
+        assert!(std::process::Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .unwrap()
+            .success());
+        let sub = dir.path().join("sub.modes");
+        std::fs::create_dir(&sub).unwrap();
+        let null = dir.path().join("null.modes");
+        std::os::unix::fs::symlink("/dev/null", &null).unwrap();
+        for (path, what) in [
+            (&fifo, "a FIFO"),
+            (&sub, "a directory"),
+            (&null, "a character device"),
+        ] {
+            let err = write_atomic(path, b"bytes").unwrap_err();
+            assert!(
+                matches!(&err, WriteError::Clobber { what: w, .. } if *w == what),
+                "{err}"
+            );
+        }
+        assert!(std::fs::metadata(&fifo).unwrap().file_type().is_fifo());
+        assert!(sub.is_dir());
+        assert!(std::fs::symlink_metadata(&null)
+            .unwrap()
+            .file_type()
+            .is_symlink());
+        assert!(std::fs::metadata("/dev/null")
+            .unwrap()
+            .file_type()
+            .is_char_device());
+        // Only the FIFO, the folder, the link and nothing else: no temporary left behind.
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 3);
+    }
 }

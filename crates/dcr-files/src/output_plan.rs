@@ -9,13 +9,13 @@
 //!   is not a folder,
 //! - two outputs on one path (both options named), existing or not.
 //!
-//! The files themselves are then written through [`super::AtomicFile`], which checks the type
+//! The files themselves are then written through [`crate::AtomicFile`], which checks the type
 //! of the destination again at the rename.
 
 use std::collections::HashMap;
 use std::path::{Component, Path, PathBuf};
 
-use super::regular_file::describe_file_type;
+use crate::file_type::describe_file_type;
 
 /// Why an output path is refused ([`OutputPlan::output`]).
 #[derive(Debug, thiserror::Error)]
@@ -93,7 +93,7 @@ pub enum OutputError {
 /// written (see the module docs).
 ///
 /// ```
-/// use dcr_runtime::format::OutputPlan;
+/// use dcr_files::OutputPlan;
 /// let dir = tempfile::tempdir().unwrap();
 /// let base = dir.path().join("a.modes");
 /// std::fs::write(&base, b"base").unwrap();
