@@ -108,9 +108,3 @@ pub use world::{
     ObjectStepInfo, Pose, WorldError, WorldParams, WorldStepInfo,
 };
 
-// Not part of the root surface: targets of intra-doc links in `world/dcr_world.rs`, which names
-// them from the crate root (their homes are `world` and `response`).
-#[doc(hidden)]
-pub use response::{effective_mass, ContactResponse, StepInfo, TablePolicy};
-#[doc(hidden)]
-pub use world::ClassifyParams;

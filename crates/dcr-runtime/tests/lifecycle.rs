@@ -351,3 +351,47 @@ fn base_support_mismatches_are_reported() {
         BaseSupport::StaticBodyFreeBase
     );
 }
+
+/// A body resting on an object while it is disabled (with a load above the threshold) is not
+/// an impact when the object is enabled again, nor on an object added mid-run under it; a
+/// real hit after the settle window still is.
+#[test]
+fn bodies_resting_on_a_reenabled_or_added_object_are_not_impacts() {
+    let heavy = contact(70, 1, 7, [0.9, 0.5, 0.0], 0.0981);
+    let (mut w, h) = plate_world(ResponseParams::default());
+    w.set_impact_threshold(h, 0.05).unwrap();
+    for _ in 0..5 {
+        w.step(&[heavy], &[boxy(7)]);
+    }
+    assert_eq!(w.object_totals(h).impacts, 0, "the initial resting set");
+    w.set_enabled(h, false).unwrap();
+    for _ in 0..6 {
+        w.step(&[heavy], &[boxy(7)]);
+    }
+    w.set_enabled(h, true).unwrap();
+    for _ in 0..6 {
+        let ev = w.step(&[heavy], &[boxy(7)]);
+        assert!(ev.is_empty());
+        assert_eq!(w.object_info(h).impacts, 0, "re-enabled: resting, not new");
+    }
+    // An object added under a body that already rests on its body.
+    let mut w = DcrWorld::new(params()).unwrap();
+    for _ in 0..6 {
+        w.step(&[heavy], &[boxy(7)]);
+    }
+    let h = w
+        .add_object(ElasticObjectDesc::new(model_of(plate_base()), 1))
+        .unwrap();
+    w.set_impact_threshold(h, 0.05).unwrap();
+    for _ in 0..6 {
+        let ev = w.step(&[heavy], &[boxy(7)]);
+        assert!(ev.is_empty());
+        assert_eq!(w.object_info(h).impacts, 0, "added mid-run: resting, not new");
+    }
+    // A hit after the window is an impact and moves the resting box.
+    let mut ball = contact(90, 9, 1, [0.5, 0.3, 0.0], 2.0);
+    ball.normal = [0.0, 0.0, -1.0];
+    let ev = w.step(&[heavy, ball], &[boxy(7)]).to_vec();
+    assert_eq!(w.object_info(h).impacts, 1);
+    assert!(!ev.is_empty());
+}

@@ -15,7 +15,6 @@ use super::{
     ImpulseEvent, ObjectStepInfo, ObjectTotals, Pose, WorldError, WorldParams, WorldStepInfo,
 };
 use crate::mapping::BuildIdHasher;
-use crate::math::dot;
 use crate::response::{DistantResponse, Impact, RestingContact};
 
 /// One elastic object.
@@ -27,6 +26,9 @@ struct Object {
     enabled: bool,
     /// World step from which it is disabled (for [`ObjectTotals::disabled_steps`]).
     disabled_since: u64,
+    /// World step from which it takes part (added, or enabled again): the contacts it first
+    /// sees in the `settle_steps` steps from here are its resting set, not impacts.
+    active_since: u64,
     support: BaseSupport,
     totals: ObjectTotals,
     body: u64,
@@ -68,7 +70,7 @@ struct Slot {
 ///
 /// # Impacts and resting contacts
 /// Every contact report that touches an elastic object's body is classified, per object
-/// ([`crate::ClassifyParams`]); the rules suit engines that create contacts before they carry
+/// ([`crate::world::ClassifyParams`]); the rules suit engines that create contacts before they carry
 /// an impulse (predictive contacts):
 /// - a contact id's *age* counts world steps since it appeared or last had zero impulse; an id
 ///   absent for `new_after_missing_steps` steps or more is new again when it returns (a
@@ -78,7 +80,9 @@ struct Slot {
 ///   impact on that object since, whose impulse is > 0 and ≥ the object's
 ///   `impact_threshold` (N·s). A zero-impulse (predictive) contact is never an impact and
 ///   stays fresh, so it fires when its impulse arrives; the contacts that appeared in the
-///   first `settle_steps` steps (the initial resting set) do not fire until they lift off;
+///   first `settle_steps` steps (the initial resting set) do not fire until they lift off —
+///   counted per object from the step it was added or enabled again, so bodies already
+///   resting on an object added or re-enabled mid-run are not impacts;
 /// - a **resting contact** is any other contact whose other body is dynamic
 ///   ([`BodyState::is_dynamic`]) with impulse > 0: it may receive a response.
 ///
@@ -86,7 +90,7 @@ struct Slot {
 /// enough to count as new, so its size is bounded by the contacts alive in a few steps and it
 /// stops growing after warm-up. Engines that know which points are new themselves (and
 /// callers that report only some steps, passing the others with [`DcrWorld::advance`]) use
-/// [`crate::ClassifyParams::engine_newness`] instead: an impact is a report with
+/// [`crate::world::ClassifyParams::engine_newness`] instead: an impact is a report with
 /// [`ContactReport::is_new`] and impulse > 0 and ≥ the threshold, after the settle window, and
 /// no table is kept.
 ///
@@ -100,7 +104,7 @@ struct Slot {
 /// # Impulses (Eq. 17–18) and one Gauss–Seidel pass per body
 /// A resting contact's response asks for a normal velocity change `Δv` (m/s) at the contact;
 /// the world issues `j = m_eff (g Δv − a) n` with the gain g, the effective mass of the body at
-/// the point along n (Eq. 17, [`crate::effective_mass`]) and `a` the normal velocity change the
+/// the point along n (Eq. 17, [`crate::response::effective_mass`]) and `a` the normal velocity change the
 /// impulses already issued to that body this step, by any object, produce at that point (a body
 /// resting on two objects hit at once moves as the larger push asks, not their sum; tracked from the
 /// body's inverse mass and world inverse inertia, so the engine is not re-read); nothing when
@@ -109,7 +113,7 @@ struct Slot {
 ///
 /// # Lateral kick
 /// With [`crate::ResponseParams::lateral_kick`] on an object, its responses also carry the
-/// tangential velocity change of §5.4 ([`crate::ContactResponse::lateral_delta_v`], rotated to
+/// tangential velocity change of §5.4 ([`crate::response::ContactResponse::lateral_delta_v`], rotated to
 /// the world); after the normal part the world adds `m_eff,t (g |Δv_t| − a_t) t̂` along its
 /// direction t̂ by the same Gauss–Seidel rule, so the event's impulse gets a tangential part.
 ///
@@ -286,7 +290,7 @@ impl DcrWorld {
     /// [`WorldError::DuplicateBody`] if another object is on the same body,
     /// [`WorldError::Object`] for a negative or non-finite gain, [`WorldError::Response`] if
     /// the response cannot be set up ([`DistantResponse::new`]), e.g. a transfer table refused
-    /// under [`crate::TablePolicy::Refuse`].
+    /// under [`crate::response::TablePolicy::Refuse`].
     pub fn add_object(&mut self, desc: ElasticObjectDesc) -> Result<ElasticHandle, WorldError> {
         if let Some(&existing) = self.by_body.get(&desc.body) {
             return Err(WorldError::DuplicateBody {
@@ -348,6 +352,7 @@ impl DcrWorld {
             handle,
             enabled: true,
             disabled_since: 0,
+            active_since: self.step,
             support,
             totals: ObjectTotals::default(),
             body: desc.body,
@@ -453,7 +458,9 @@ impl DcrWorld {
     /// Enables or disables an object from the next step on. A disabled object is as if absent
     /// from the steps: its contacts are neither classified nor answered, impulses on its body
     /// do not chain into it, it issues no events, and its filters are returned to rest (a
-    /// re-enabled object starts quiet). Its handle, pose, parameters and totals are kept.
+    /// re-enabled object starts quiet). Its handle, pose, parameters and totals are kept. Under
+    /// the ages rule, the contacts a re-enabled object first sees in its first `settle_steps`
+    /// steps are its resting set (bodies that rested on it while it was off), not impacts.
     /// O(1), no allocation.
     ///
     /// # Errors
@@ -467,6 +474,7 @@ impl DcrWorld {
         }
         if enabled {
             obj.totals.disabled_steps += step - obj.disabled_since;
+            obj.active_since = step;
         } else {
             obj.disabled_since = step;
             obj.response.reset();
@@ -554,8 +562,8 @@ impl DcrWorld {
     /// Changes the rigid-body step h (s) of the world and every object: each response is
     /// rebuilt for the new h — the modal filters' exact impulse-invariant coefficients (Eq. 10)
     /// and samples per step re-derived, a transfer table (baked for one h) re-checked under
-    /// its [`crate::TablePolicy`] (refused, or served by the modal method and counted in
-    /// [`crate::StepInfo::contacts_table_fallback`]). Filters restart at rest and resting
+    /// its [`crate::response::TablePolicy`] (refused, or served by the modal method and counted in
+    /// [`crate::response::StepInfo::contacts_table_fallback`]). Filters restart at rest and resting
     /// contacts are mapped again on their next step. Costs a set-up per object (an
     /// attenuation response refactors its heat-method operators): call it when the engine's
     /// step changes, not every step. Nothing changes when `h` is the current one.
@@ -563,7 +571,7 @@ impl DcrWorld {
     /// # Errors
     /// [`WorldError::Params`] for a non-positive or non-finite h; [`WorldError::Response`]
     /// when an object's response cannot be set up for it (e.g. a table refused under
-    /// [`crate::TablePolicy::Refuse`]). The world is unchanged then.
+    /// [`crate::response::TablePolicy::Refuse`]). The world is unchanged then.
     pub fn set_h(&mut self, h: f64) -> Result<(), WorldError> {
         if !(h.is_finite() && h > 0.0) {
             return Err(invalid("h", format!("{h} s (must be finite and > 0)")));
@@ -672,7 +680,7 @@ impl DcrWorld {
         }
     }
 
-    /// What the last step did for one object (counters, the response's [`crate::StepInfo`],
+    /// What the last step did for one object (counters, the response's [`crate::response::StepInfo`],
     /// energy account).
     ///
     /// # Panics
@@ -720,7 +728,7 @@ impl DcrWorld {
     /// window, ages, cache eviction) stay in engine steps. O(1), no allocation; clears the
     /// event buffer; [`DcrWorld::step_info`] and [`DcrWorld::object_info`] then read as zeros
     /// (a quiet step did nothing), so summing them per step counts each event once. Callers that skip steps should classify with
-    /// [`crate::ClassifyParams::engine_newness`]: ages count a contact unseen for a while as new.
+    /// [`crate::world::ClassifyParams::engine_newness`]: ages count a contact unseen for a while as new.
     pub fn advance(&mut self, steps: u64) {
         self.step += steps;
         self.events.clear();
@@ -854,8 +862,3 @@ impl DcrWorld {
     }
 }
 
-/// `M v` for a row-major 3 × 3 matrix.
-#[inline]
-fn mat_vec(m: &[[f64; 3]; 3], v: [f64; 3]) -> [f64; 3] {
-    [dot(m[0], v), dot(m[1], v), dot(m[2], v)]
-}

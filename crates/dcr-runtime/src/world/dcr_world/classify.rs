@@ -49,6 +49,9 @@ impl DcrWorld {
             let lambda = c.impulse;
             let valid = lambda.is_finite() && lambda > 0.0;
             let mut fired_before: Option<&mut [bool; 2]> = None;
+            // The step the contact id was first seen (its age's start); `step` under the
+            // engine's newness rule, whose objects' settle windows are checked on `is_new`.
+            let mut first_seen = step;
             let fresh_age = if cp.engine_newness {
                 c.is_new && step >= cp.settle_steps && !recently_pushed(&self.pushed, c.id, step)
             } else {
@@ -68,6 +71,7 @@ impl DcrWorld {
                 let f = step >= cp.settle_steps
                     && age.first_step >= cp.settle_steps
                     && step - age.first_step <= cp.fresh_steps;
+                first_seen = age.first_step;
                 fired_before = Some(&mut age.fired);
                 f
             };
@@ -90,7 +94,11 @@ impl DcrWorld {
                 let own_point = if side == 0 { c.point1 } else { c.point2 };
                 let other_point = if side == 0 { c.point2 } else { c.point1 };
                 let already = fired_before.as_ref().is_some_and(|f| f[side]);
-                if fresh_age && !already && valid && lambda >= obj.threshold {
+                // Under ages, a contact first seen in the object's own settle window (added or
+                // enabled again mid-run) belongs to its resting set.
+                let settled = cp.engine_newness
+                    || first_seen >= obj.active_since.saturating_add(cp.settle_steps);
+                if fresh_age && settled && !already && valid && lambda >= obj.threshold {
                     if let Some(f) = fired_before.as_mut() {
                         f[side] = true;
                     }

@@ -5,9 +5,9 @@
 //! the estimate of D are in [`DcrWorld`]'s documentation, "Energy bound".
 
 use super::impulse_pass::Touched;
-use super::{mat_vec, DcrWorld};
-use crate::math::{add, cross, dot, scale, sub};
-use crate::response::effective_mass;
+use super::DcrWorld;
+use crate::math::{add, cross, dot, mat_vec, scale, sub};
+use crate::response;
 use crate::world::{BodyState, ContactReport};
 
 impl DcrWorld {
@@ -81,18 +81,13 @@ fn velocity_at(b: Option<&BodyState>, p: [f64; 3]) -> [f64; 3] {
     }
 }
 
-/// Inverse effective mass `m⁻¹ + (r × n)ᵀ I⁻¹ (r × n)` (1/kg) of body `b` at `p` along `n`:
-/// the reciprocal of Eq. 17's [`effective_mass`], 0 for an immovable body or one without state.
+/// Inverse effective mass `m⁻¹ + (r × n)ᵀ I⁻¹ (r × n)` (1/kg) of body `b` at `p` along `n`
+/// (Eq. 17's denominator, [`response::inverse_effective_mass`]), 0 for a body without state.
 #[inline]
-fn inverse_effective_mass(b: Option<&BodyState>, p: [f64; 3], n: [f64; 3]) -> f64 {
+fn body_inverse_effective_mass(b: Option<&BodyState>, p: [f64; 3], n: [f64; 3]) -> f64 {
     match b {
         Some(b) => {
-            let m_eff = effective_mass(b.inv_mass, b.inv_inertia, sub(p, b.center_of_mass), n);
-            if m_eff > 0.0 {
-                1.0 / m_eff
-            } else {
-                0.0
-            }
+            response::inverse_effective_mass(b.inv_mass, b.inv_inertia, sub(p, b.center_of_mass), n)
         }
         None => 0.0,
     }
@@ -106,8 +101,8 @@ pub(super) fn dissipated(c: &ContactReport, bidx: [Option<u32>; 2], bodies: &[Bo
         sub(velocity_at(b2, c.point2), velocity_at(b1, c.point1)),
         c.normal,
     );
-    let k = inverse_effective_mass(b1, c.point1, c.normal)
-        + inverse_effective_mass(b2, c.point2, c.normal);
+    let k = body_inverse_effective_mass(b1, c.point1, c.normal)
+        + body_inverse_effective_mass(b2, c.point2, c.normal);
     let lambda = c.impulse;
     let lost = 0.5 * k * lambda * lambda - lambda * u_plus;
     if lost.is_finite() {

@@ -5,8 +5,8 @@
 //! documentation, "Impulses (Eq. 17–18) and one Gauss–Seidel pass per body".
 
 use super::lateral_kick::add_lateral_impulse;
-use super::{mat_vec, DcrWorld};
-use crate::math::{add, cross, dot, scale, sub};
+use super::DcrWorld;
+use crate::math::{add, cross, dot, mat_vec, scale, sub};
 use crate::response::effective_mass;
 use crate::world::pose::rotate;
 use crate::world::{BodyState, ImpulseEvent};

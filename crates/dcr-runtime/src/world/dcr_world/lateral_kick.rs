@@ -2,8 +2,7 @@
 //! asks for at a resting contact, issued after the normal part by the same Gauss–Seidel rule.
 //! See [`DcrWorld`](super::DcrWorld)'s documentation, "Lateral kick".
 
-use super::mat_vec;
-use crate::math::{add, cross, dot, norm, scale};
+use crate::math::{add, cross, dot, mat_vec, norm, scale};
 use crate::response::effective_mass;
 use crate::world::BodyState;
 
