@@ -3,13 +3,14 @@
 //!
 //! One file per part: `params` ([`BakeParams`], what determines a result), `error`
 //! ([`BakeError`]), `report` ([`BakeReport`], [`BakeStage`]), `hashing` ([`geometry_hash`]),
-//! `prepare` (orientation, connectivity, fixed-node selection), `surface`
+//! `prepare` (orientation, connectivity, fixed-node selection), `fixed_near` ([`FixedNear`]: nodes near given points and triangles), `surface`
 //! ([`extract_surface`]), `estimate` ([`SizeEstimate`], [`Budget`]: size before work),
 //! `plausibility` ([`unit_hint`], [`plausibility_warnings`]: unit mistakes named), `pipeline` ([`bake_mesh`], [`bake_file`]) and `staleness`
 //! ([`base_status`], [`BaseStatus`]).
 
 mod error;
 mod estimate;
+mod fixed_near;
 mod hashing;
 mod params;
 mod pipeline;
@@ -25,6 +26,7 @@ pub use error::BakeError;
 pub use estimate::{
     format_bytes, format_count, format_seconds, Budget, SizeEstimate, SurfaceMeasures,
 };
+pub use fixed_near::{FixedNear, DEFAULT_DISTANCE_FRACTION};
 pub use hashing::{geometry_hash, round_16_digits};
 pub use params::{BakeParams, FixedBelow, ModeRequest};
 pub use pipeline::{
