@@ -246,12 +246,13 @@ def main():
         basis = monkey.data.shape_keys.reference_key
         rest = [mw @ b.co for b in basis.data]
         head = [v for v, p in enumerate(rest) if abs(p.x) < 0.3 * half]
-        moved_head, moved_ears = 0.0, 0.0
+        moved_head, moved_ears, still = 0.0, 0.0, len(ears)
         for kb in keys:
             d = [((mw @ k.co) - r).length for k, r in zip(kb.data, rest)]
             peak = max(d)
             moved_ears = max(moved_ears, max(d[v] for v in ears) / peak)
             moved_head = max(moved_head, max(d[v] for v in head) / peak)
+            still = min(still, sum(d[v] <= 1e-6 * peak for v in ears))
         # A box around both ears (the old way of fixing a group) spans the head between
         # them and fixes its inside too: far more nodes than the ears' own region.
         msh = os.path.splitext(monkey["modal_bake_modes"])[0] + ".msh"
@@ -266,9 +267,13 @@ def main():
 
         n_near, n_box = fixed_nodes("--fixed-near", region), fixed_nodes(f"--fixed-box={box}")
         print(f"  ears: {len(ears)} vertices in the group; {n_near} nodes fixed (a box around "
-              f"both ears: {n_box}); ear vertices move at most {moved_ears:.2e} of each "
-              f"key's peak, the head between them up to {moved_head:.2f}", flush=True)
-        assert moved_ears < 0.02, f"ear vertices move {moved_ears:.3f} of the peak"
+              f"both ears: {n_box}); {still} ear vertices still in every key, the others "
+              f"(where the ears meet the head) move at most {moved_ears:.2e} of each key's "
+              f"peak, the head between them up to {moved_head:.2f}", flush=True)
+        # An ear vertex takes the motion of the closest point of the base's surface: inside
+        # the ears it is fixed; at the ears' rim the closest triangle may have a free node.
+        assert still >= len(ears) // 2, f"only {still} of {len(ears)} ear vertices are still"
+        assert moved_ears < 0.1, f"ear vertices move {moved_ears:.3f} of the peak"
         assert moved_head > 0.1, f"the head moves only {moved_head} of the peak"
         assert 3 * n_near < n_box, f"{n_near} nodes near the ears, {n_box} in their box"
         for line in cli("info", monkey["modal_bake_modes"]).splitlines():

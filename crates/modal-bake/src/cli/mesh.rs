@@ -250,6 +250,14 @@ pub fn mesh_asset(asset: &Path, options: &AssetOptions) -> anyhow::Result<Meshed
     if let Some(f) = &r.fallback_from {
         eprintln!("  fallback: {f}");
     }
+    if let Some(t) = r.thin_parts_m.filter(|t| r.size_m > 2.0 * t) {
+        eprintln!(
+            "warning: {}: the thinnest parts (5 % of the surface) are {t:.3e} m thick and the size is {:.3e} m: walls thinner than half an element are too stiff in bending, so the lowest frequencies may come out high; check with --target-error PCT, or give --size {:.3e} (twice their thickness) if the budget allows",
+            asset.display(),
+            r.size_m,
+            2.0 * t
+        );
+    }
     let [lo, hi] = r.inspection.bbox;
     let extent = (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt();
     warn_extent(&asset.display().to_string(), extent, options.units, "");
@@ -315,8 +323,8 @@ pub fn run(args: &MeshArgs) -> anyhow::Result<()> {
             r.size_m,
             r.curvature_elements
                 .map(|n| format!(
-                    " (finer where the surface curves: {n} elements per turn, at most {:.4e} m at a radius of curvature of the size)",
-                    r.size_m * std::f64::consts::TAU / f64::from(n)
+                    " (finer where the surface curves: {n} elements per turn, at most {:.3}·R at a radius of curvature R)",
+                    std::f64::consts::TAU / f64::from(n)
                 ))
                 .unwrap_or_default(),
             r.envelope_m

@@ -127,6 +127,9 @@ pub struct MeshReport {
     pub version: String,
     /// Element size (m; fTetWild: the ideal edge length).
     pub size_m: f64,
+    /// Thickness of the asset's thinnest parts (m; [`super::sizing::thin_parts`]); `None`
+    /// when no inward ray hits the surface again.
+    pub thin_parts_m: Option<f64>,
     /// gmsh remeshing: elements per full turn of curvature (finer elements where the surface
     /// curves); `None` for a uniform size, `keep_surface` and fTetWild.
     pub curvature_elements: Option<u32>,
@@ -429,6 +432,7 @@ pub fn mesh_surface(
         ..mesh.mesh.clone()
     };
     report.distance = surface_distance(surface, &linear);
+    report.thin_parts_m = super::sizing::thin_parts(surface);
     Ok(MeshedAsset {
         mesh: mesh.mesh,
         msh: mesh.msh,
@@ -477,6 +481,7 @@ fn run_backend(
                 program: out.info.program,
                 version: out.info.version,
                 size_m: out.info.size_m,
+                thin_parts_m: None,
                 curvature_elements: curvature,
                 envelope_m: None,
                 reproducible: true,
@@ -535,6 +540,7 @@ fn run_backend(
                 program: info.program,
                 version: info.version,
                 size_m: info.size_m,
+                thin_parts_m: None,
                 curvature_elements: None,
                 envelope_m: Some(info.envelope_m),
                 reproducible: info.reproducible,
