@@ -4,8 +4,8 @@
 
 Needs the `bpy` module (python3 -m pip install bpy==4.5.7), a release modal-bake, gmsh and
 pytetwild (modal-bake's meshers). In a fresh Blender scene (private user folder), installs the
-add-on from blender/modal_bake as an extension, adds Blender's own Suzanne (0.2 m, its 507
-vertices as Blender makes them: the artist's mesh, open eyes included) and presses Bake with
+add-on from blender/modal_bake as an extension, adds Blender's own Suzanne (size 0.2: 0.27 m
+wide; its 507 vertices as Blender makes them: the artist's mesh, open eyes included) and presses Bake with
 the panel's defaults but the material (ABS, order 2, free-free, 6 modes; the open surface goes
 to fTetWild). It then renders, with Workbench at 1000 × 300 (turned 20° so motion towards the
 camera shows), the rest mesh beside four copies with the keys "Mode 1 … 4" at KEY_VALUE (at 1.0 a
