@@ -53,7 +53,8 @@ pub fn curvature_elements(size: f64, diag: f64) -> u32 {
 ///
 /// The local radius of curvature at a triangle is estimated from its edges below
 /// [`FEATURE_ANGLE`]: an edge whose adjacent triangles' normals differ by θ over the distance
-/// d between their centroids curves with radius d/θ. This sees the surface's curvature, not
+/// d across the edge between their centroids curves with radius d/θ (a slight overestimate
+/// of the curvature on slender triangles, 1.5/R on a cylinder of long strips). This sees the surface's curvature, not
 /// the curvature of its feature lines (gmsh refines those too), so it underestimates on a
 /// part with many small holes; the bake checks the real mesh against the budget again before
 /// the factorization.
@@ -97,7 +98,16 @@ pub fn equivalent_size(surface: &SurfaceMesh, size: f64, curvature: bool) -> f64
         if !(theta > 0.0 && theta <= FEATURE_ANGLE) {
             continue;
         }
-        let d = crate::vec3::norm2(crate::vec3::sub(centroid[a], centroid[b])).sqrt();
+        // Distance across the edge between the two centroids: each lies 2·area/(3·|e|)
+        // from the edge's line (the centroid distance itself also counts any offset along
+        // the edge, large on slender triangles).
+        let [p, q] = w[0].0;
+        let e = crate::vec3::norm2(crate::vec3::sub(v[p], v[q])).sqrt();
+        let d = if e > 0.0 {
+            2.0 * (area[a] + area[b]) / (3.0 * e)
+        } else {
+            0.0
+        };
         if d > 0.0 {
             let k = theta / d;
             curvature_of[a] = curvature_of[a].max(k);
