@@ -11,11 +11,13 @@
 //!    surface is refused with the defect, its position and the fix.
 //! 4. Auto only: when the chosen backend fails, the other runs (gmsh only for a surface that
 //!    bounds a solid), and the report says why.
-//! 3b. The size: `--size`, or 1/20 of the bounding-box diagonal; gmsh's remeshing makes
-//!    elements finer where the surface curves ([`super::sizing`]), in proportion to the size.
 //! 5. Second order from either backend by straight-sided mid-edge nodes (gmsh's own, or
 //!    [`TetMesh::to_quadratic`] for fTetWild's linear tetrahedra).
-//! 6. [`surface_distance`]: the Hausdorff distance between the asset and the mesh boundary.
+//! 6. [`surface_distance`]: the Hausdorff distance between the asset and the mesh boundary,
+//!    and the thickness of the asset's thinnest parts ([`super::sizing::thin_parts`]).
+//!
+//! The size is `--size`, or 1/20 of the bounding-box diagonal; gmsh's remeshing makes elements
+//! finer where the surface curves ([`super::sizing`]), in proportion to the size.
 
 use std::path::PathBuf;
 use std::time::Duration;
