@@ -73,13 +73,13 @@ class ModalBakeSettings(bpy.types.PropertyGroup):
         name="Fixed region",
         items=[("none", "None (free)", "Free-free: nothing held"),
                ("below", "Below a height", "Every node at or below the height (world Z) is fixed"),
-               ("group", "Vertex group", "Every node inside the group's world bounding box is "
-                                         "fixed")],
+               ("group", "Vertex group", "Every node on the region the group's vertices and "
+                                         "faces cover is fixed (--fixed-near)")],
         default="none")
     fixed_height: FloatProperty(name="Height", subtype="DISTANCE", default=0.0,
                                 description="World Z (scene units) at or below which nodes are fixed")
     fixed_group: StringProperty(name="Vertex group",
-                                description="Vertex group whose vertices' bounding box is fixed")
+                                description="Vertex group whose vertices and faces are fixed")
     mesher: EnumProperty(
         name="Mesher",
         items=[("auto", "Auto", "modal-bake's choice (not passed)"),
@@ -151,28 +151,27 @@ def bake_settings(context, obj):
     if s.fixed == "below":
         out["fixed_below_z"] = s.fixed_height * unit
     elif s.fixed == "group":
-        out["fixed_box"] = group_box(context, obj, s.fixed_group)
+        out["fixed_group"] = group_region(context, obj, s.fixed_group)
     return out
 
 
-def group_box(context, obj, name):
-    """World bounding box (m) of the vertices of vertex group `name`, grown by 0.5 % of the
-    object's diagonal so nodes on its faces are inside."""
+def group_region(context, obj, name):
+    """The vertex group `name` as world-space points (m) and the faces whose vertices are all
+    in it (0-based indices into the points): the region `--fixed-near` fixes."""
     vg = obj.vertex_groups.get(name)
     if vg is None:
         raise runner.BakeError(f"{obj.name}: no vertex group named '{name}' (Fixed region)")
     unit = context.scene.unit_settings.scale_length or 1.0
     mw = obj.matrix_world
-    pts = [unit * (mw @ v.co) for v in obj.data.vertices
-           if any(g.group == vg.index and g.weight > 0.0 for g in v.groups)]
-    if not pts:
+    members = [v.index for v in obj.data.vertices
+               if any(g.group == vg.index and g.weight > 0.0 for g in v.groups)]
+    if not members:
         raise runner.BakeError(f"{obj.name}: vertex group '{name}' holds no vertex")
-    allp = [unit * (mw @ v.co) for v in obj.data.vertices]
-    diag = math.dist([min(p[a] for p in allp) for a in range(3)],
-                     [max(p[a] for p in allp) for a in range(3)])
-    g = 0.005 * diag
-    return ([min(p[a] for p in pts) - g for a in range(3)]
-            + [max(p[a] for p in pts) + g for a in range(3)])
+    local = {v: i for i, v in enumerate(members)}
+    points = [tuple(unit * c for c in (mw @ obj.data.vertices[v].co)) for v in members]
+    faces = [[local[v] for v in p.vertices] for p in obj.data.polygons
+             if all(v in local for v in p.vertices)]
+    return points, faces
 
 
 def output_folder(obj):
@@ -200,6 +199,10 @@ def prepare(context, obj):
              (("obj", ".obj"), ("msh", ".msh"), ("modes", ".modes"), ("glb", "_modes.glb"))}
     runner.write_obj(paths["obj"], positions, faces)
     settings = bake_settings(context, obj)
+    if "fixed_group" in settings:
+        paths["fixed"] = os.path.join(folder, stem + "_fixed.obj")
+        runner.write_obj(paths["fixed"], *settings.pop("fixed_group"))
+        settings["fixed_near"] = paths["fixed"]
     steps = [
         ("mesh", runner.mesh_command(exe, paths["obj"], paths["msh"], settings)),
         ("bake", runner.bake_command(exe, paths["msh"], paths["modes"], settings)),
@@ -441,7 +444,8 @@ _draw_handle = None
 
 
 def _draw_fixed_region():
-    """Viewport overlay: the fixed-below plane (world Z) or the vertex group's box."""
+    """Viewport overlay: the fixed-below plane (world Z) or the vertex group's vertices and
+    faces."""
     import gpu
     from gpu_extras.batch import batch_for_shader
     obj = bpy.context.active_object
@@ -466,16 +470,17 @@ def _draw_fixed_region():
     else:
         try:
             unit = bpy.context.scene.unit_settings.scale_length or 1.0
-            b = [x / unit for x in group_box(bpy.context, obj, s.fixed_group)]
+            points, faces = group_region(bpy.context, obj, s.fixed_group)
         except runner.BakeError:
             return
-        x0, y0, z0, x1, y1, z1 = b
-        v = [(x, y, z) for x in (x0, x1) for y in (y0, y1) for z in (z0, z1)]
-        edges = [(0, 1), (2, 3), (4, 5), (6, 7), (0, 2), (1, 3), (4, 6), (5, 7),
-                 (0, 4), (1, 5), (2, 6), (3, 7)]
-        batch = batch_for_shader(shader, "LINES", {"pos": v}, indices=edges)
+        pts = [tuple(c / unit for c in p) for p in points]
+        tris = [(f[0], f[j], f[j + 1]) for f in faces for j in range(1, len(f) - 1)]
+        shader.uniform_float("color", (1.0, 0.35, 0.1, 0.5))
+        if tris:
+            batch_for_shader(shader, "TRIS", {"pos": pts}, indices=tris).draw(shader)
         shader.uniform_float("color", (1.0, 0.35, 0.1, 1.0))
-        batch.draw(shader)
+        gpu.state.point_size_set(6.0)
+        batch_for_shader(shader, "POINTS", {"pos": pts}).draw(shader)
     gpu.state.blend_set("NONE")
 
 

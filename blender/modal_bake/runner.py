@@ -94,7 +94,8 @@ def mesh_command(exe, obj, msh, settings):
 
 def bake_command(exe, msh, modes_path, settings):
     """`modal-bake bake` arguments: modes, material (preset name, or explicit E/ν/ρ), fixed
-    region (`fixed_below_z` in m, or `fixed_box` [x0,y0,z0,x1,y1,z1] in m), target error."""
+    region (`fixed_below_z` in m, `fixed_box` [x0,y0,z0,x1,y1,z1] in m, or `fixed_near`: an
+    OBJ of the region's points and faces in m), target error."""
     cmd = [exe, "bake", msh, "-o", modes_path, "--modes", str(settings["modes"])]
     mat = settings.get("material")
     if mat == "custom":
@@ -106,6 +107,8 @@ def bake_command(exe, msh, modes_path, settings):
         cmd += [f"--fixed-below=z={num(settings['fixed_below_z'])}"]
     if settings.get("fixed_box") is not None:
         cmd += ["--fixed-box=" + ",".join(num(x) for x in settings["fixed_box"])]
+    if settings.get("fixed_near") is not None:
+        cmd += ["--fixed-near", settings["fixed_near"]]
     if settings.get("target_error_pct"):
         cmd += ["--target-error", num(settings["target_error_pct"])]
     return cmd

@@ -13,6 +13,9 @@ user folder, enables it, points its preference at the modal-bake binary, and:
 - bakes Suzanne (open eyes: needs `modal-bake mesh --mesher`, skipped with the reason if the
   binary has no such option; fTetWild takes minutes on it, so the CLI comparison bakes the
   add-on's tetrahedral mesh rather than meshing the OBJ again);
+- bakes Suzanne fixed by a vertex group on its ears (`--fixed-near`, the group's vertices and
+  faces): the ears' vertices stay still, the head between them moves, and a box around both
+  ears (which spans the head) would fix over twice as many nodes;
 - checks that a missing binary is a clear error, not a crash.
 
 Prints one line per check and "N passed, N failed, N skipped"; exits 1 on a failure. Without
@@ -213,6 +216,71 @@ def main():
         bake_and_check(monkey, 4, [], from_msh=True)
 
     check("Suzanne: shape keys with the CLI's frequencies", suzanne)
+
+    def suzanne_ears():
+        helptext = cli("bake", "--help")
+        if "--fixed-near" not in helptext:
+            raise Skip("this modal-bake has no `bake --fixed-near`")
+        bpy.ops.mesh.primitive_monkey_add(size=0.3, location=(0.0, 0.0, 0.0))
+        monkey = bpy.context.active_object
+        monkey.name = "SuzanneEars"
+        mw = monkey.matrix_world
+        xs = [(mw @ v.co).x for v in monkey.data.vertices]
+        half = max(abs(x) for x in xs)
+        # The ears: the vertices beyond 2/3 of the half-width, on both sides.
+        ears = [v.index for v in monkey.data.vertices if abs((mw @ v.co).x) > 2 / 3 * half]
+        group = monkey.vertex_groups.new(name="Ears")
+        group.add(ears, 1.0, "REPLACE")
+        monkey.modal_bake.order = "2"
+        monkey.modal_bake.modes = 4
+        monkey.modal_bake.size = 0.04
+        monkey.modal_bake.fixed = "group"
+        monkey.modal_bake.fixed_group = "Ears"
+        monkey.modal_bake.output_dir = os.path.join(work, "suzanne_ears")
+        region = os.path.join(work, "suzanne_ears", "SuzanneEars_fixed.obj")
+        keys = bake_and_check(monkey, 4, ["--fixed-near", region], from_msh=True)
+        with open(region) as f:
+            lines = f.read().splitlines()
+        assert sum(l.startswith("v ") for l in lines) == len(ears), "region file vertices"
+        assert any(l.startswith("f ") for l in lines), "region file has the ears' faces"
+        basis = monkey.data.shape_keys.reference_key
+        rest = [mw @ b.co for b in basis.data]
+        head = [v for v, p in enumerate(rest) if abs(p.x) < 0.3 * half]
+        moved_head, moved_ears, still = 0.0, 0.0, len(ears)
+        for kb in keys:
+            d = [((mw @ k.co) - r).length for k, r in zip(kb.data, rest)]
+            peak = max(d)
+            moved_ears = max(moved_ears, max(d[v] for v in ears) / peak)
+            moved_head = max(moved_head, max(d[v] for v in head) / peak)
+            still = min(still, sum(d[v] <= 1e-6 * peak for v in ears))
+        # A box around both ears (the old way of fixing a group) spans the head between
+        # them and fixes its inside too: far more nodes than the ears' own region.
+        msh = os.path.splitext(monkey["modal_bake_modes"])[0] + ".msh"
+        lo = [min(rest[v][a] for v in ears) for a in range(3)]
+        hi = [max(rest[v][a] for v in ears) for a in range(3)]
+        box = ",".join(f"{x:.7g}" for x in lo + hi)
+
+        def fixed_nodes(*selector):
+            out = os.path.join(work, "ears_count.modes")
+            return json.loads(cli("bake", msh, "-o", out, "--modes", "1", "--json",
+                                  *selector))["fixed_nodes"]
+
+        n_near, n_box = fixed_nodes("--fixed-near", region), fixed_nodes(f"--fixed-box={box}")
+        print(f"  ears: {len(ears)} vertices in the group; {n_near} nodes fixed (a box around "
+              f"both ears: {n_box}); {still} ear vertices still in every key, the others "
+              f"(where the ears meet the head) move at most {moved_ears:.2e} of each key's "
+              f"peak, the head between them up to {moved_head:.2f}", flush=True)
+        # An ear vertex takes the motion of the closest point of the base's surface: inside
+        # the ears it is fixed; at the ears' rim the closest triangle may have a free node.
+        assert still >= len(ears) // 2, f"only {still} of {len(ears)} ear vertices are still"
+        assert moved_ears < 0.1, f"ear vertices move {moved_ears:.3f} of the peak"
+        assert moved_head > 0.1, f"the head moves only {moved_head} of the peak"
+        assert 2 * n_near < n_box, f"{n_near} nodes near the ears, {n_box} in their box"
+        for line in cli("info", monkey["modal_bake_modes"]).splitlines():
+            if "near" in line:
+                print(f"  info: {line.strip()}", flush=True)
+
+    check("Suzanne's ears as a vertex group: exactly those vertices fixed", suzanne_ears)
 
     def missing_binary():
         prefs.binary = os.path.join(work, "no-such-modal-bake")

@@ -3,14 +3,16 @@
 //!
 //! One file per part: `params` ([`BakeParams`], what determines a result), `error`
 //! ([`BakeError`]), `report` ([`BakeReport`], [`BakeStage`]), `hashing` ([`geometry_hash`]),
-//! `prepare` (orientation, connectivity, fixed-node selection), `surface` (the
-//! surface a base stores, from [`extract_surface`]), `mode_set` (the transfer table's many-mode
-//! sets: [`mode_set_dense`], [`mode_set_lanczos`]), `estimate` ([`SizeEstimate`], [`Budget`]: size before work),
+//! `prepare` (orientation, connectivity, fixed-node selection), `fixed_near` ([`FixedNear`]:
+//! nodes near given points and triangles), `surface` (the surface a base stores, from
+//! [`extract_surface`]), `mode_set` (the transfer table's many-mode sets: [`mode_set_dense`],
+//! [`mode_set_lanczos`]), `estimate` ([`SizeEstimate`], [`Budget`]: size before work),
 //! `plausibility` ([`unit_hint`], [`plausibility_warnings`]: unit mistakes named), `pipeline` ([`bake_mesh`], [`bake_file`]) and `staleness`
 //! ([`base_status`], [`BaseStatus`]).
 
 mod error;
 mod estimate;
+mod fixed_near;
 mod hashing;
 mod mode_set;
 mod params;
@@ -29,6 +31,7 @@ pub use error::BakeError;
 pub use estimate::{
     format_bytes, format_count, format_seconds, Budget, SizeEstimate, SurfaceMeasures,
 };
+pub use fixed_near::{FixedNear, DEFAULT_DISTANCE_FRACTION};
 pub use hashing::{geometry_hash, round_16_digits};
 pub use mode_set::{mode_set_dense, mode_set_from_dense, mode_set_lanczos};
 pub use params::{BakeParams, FixedBelow, ModeRequest};

@@ -34,6 +34,10 @@ pub struct BakeParams {
     /// bounds included; `--fixed-box`).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub fixed_boxes: Vec<[f64; 6]>,
+    /// Fix every node within a distance of given points and triangles (m, object frame;
+    /// `--fixed-near FILE`, e.g. a vertex group's vertices and faces).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub fixed_near: Vec<super::FixedNear>,
     /// Default Rayleigh damping stored in the base (α0 in 1/s, α1 in s). Default (10, 1e-7).
     pub rayleigh: [f64; 2],
     /// Lumped (diagonal) mass instead of consistent mass.
@@ -76,6 +80,7 @@ impl Default for BakeParams {
             fixed: Vec::new(),
             fixed_below: Vec::new(),
             fixed_boxes: Vec::new(),
+            fixed_near: Vec::new(),
             rayleigh: [10.0, 1e-7],
             lumped: false,
             precision: ModesPrecision::F64,
@@ -144,6 +149,21 @@ impl BakeParams {
             if !b.iter().all(|x| x.is_finite()) || (0..3).any(|k| b[k] > b[k + 3]) {
                 return Err(BakeError::Params(format!(
                     "parameter `fixed_boxes` = {b:?}: expected finite [x0, y0, z0, x1, y1, z1] (m) with each minimum ≤ its maximum"
+                )));
+            }
+        }
+        for f in &self.fixed_near {
+            let n = f.points.len();
+            if n == 0
+                || !f.points.iter().flatten().all(|x| x.is_finite())
+                || f.triangles.iter().flatten().any(|&i| i >= n)
+                || f.distance.is_some_and(|d| !(d.is_finite() && d > 0.0))
+            {
+                return Err(BakeError::Params(format!(
+                    "parameter `fixed_near` ({}): expected at least one point, finite coordinates (m), triangles indexing the points and a positive distance (m), got {n} points, {} triangles, distance {:?}",
+                    f.label,
+                    f.triangles.len(),
+                    f.distance
                 )));
             }
         }

@@ -1,5 +1,5 @@
 //! A mesh made ready for baking: tetrahedra oriented and checked, connectivity checked, the
-//! fixed-node set selected (groups, half-spaces, boxes) and the geometry hashed.
+//! fixed-node set selected (groups, half-spaces, boxes, nodes near given points) and the geometry hashed.
 
 use super::{geometry_hash, unit_hint, BakeError, BakeParams};
 use crate::mesh::{MeshError, TetMesh, DEFAULT_DEGENERATE_REL_TOL, DEFAULT_STRAIGHT_REL_TOL};
@@ -17,12 +17,13 @@ pub(super) struct Prepared {
 }
 
 /// The nodes (sorted) each fixed-node selector of `params` picks, with a description per
-/// selector (`group bottom`, `below y=0.01`, `box [..]`).
+/// selector (`group bottom`, `below y=0.01`, `box [..]`, `near FILE (..)`).
 ///
 /// # Errors
 /// An unknown group, or a selector that picks no node (it names the mesh's extent).
 fn select_fixed(
     mesh: &TetMesh,
+    mid_table: &[([usize; 2], usize)],
     params: &BakeParams,
     file: &str,
 ) -> Result<Vec<(String, Vec<usize>)>, BakeError> {
@@ -89,6 +90,28 @@ fn select_fixed(
             nodes,
         ));
     }
+    let diagonal = mesh.extent();
+    for near in &params.fixed_near {
+        let nodes = near.select(&mesh.nodes, mid_table, diagonal);
+        let what = format!(
+            "near {} ({} points, {} triangles, within {:.4e} m)",
+            if near.label.is_empty() {
+                "the given points"
+            } else {
+                &near.label
+            },
+            near.points.len(),
+            near.triangles.len(),
+            near.distance_for(diagonal)
+        );
+        if nodes.is_empty() {
+            return Err(BakeError::Params(format!(
+                "{file}: parameter `fixed_near` ({what}) fixes no node ({}); check that the points are in the mesh's frame and unit (m), or give a larger distance",
+                extent()
+            )));
+        }
+        out.push((what, nodes));
+    }
     Ok(out)
 }
 
@@ -123,7 +146,7 @@ pub(super) fn prepare(
             pieces,
         });
     }
-    let selected = select_fixed(&mesh, params, file)?;
+    let selected = select_fixed(&mesh, &mid_table, params, file)?;
     let fixed_by: Vec<(String, usize)> = selected
         .iter()
         .map(|(what, nodes)| (what.clone(), nodes.len()))

@@ -39,6 +39,15 @@ pub struct BakeOptions {
     /// repeatable; combines with --fixed and --fixed-below).
     #[arg(long, value_name = "X0,Y0,Z0,X1,Y1,Z1", value_parser = parse::aabb, allow_hyphen_values = true)]
     pub fixed_box: Vec<[f64; 6]>,
+    /// Fix every node within --fixed-near-distance of the points and faces in an OBJ file
+    /// (`v x y z` lines in m, object frame; optional `f` faces), e.g. a vertex group's
+    /// vertices and faces: exactly the region they cover (repeatable; combines with the other
+    /// selectors). The mid-edge node of an edge whose two ends are fixed is fixed too.
+    #[arg(long, value_name = "FILE.obj", value_parser = parse::fixed_near)]
+    pub fixed_near: Vec<modal_bake::bake::FixedNear>,
+    /// Distance (m) for --fixed-near [default: 1/200 of the mesh's bounding-box diagonal].
+    #[arg(long, value_name = "M", requires = "fixed_near")]
+    pub fixed_near_distance: Option<f64>,
 }
 
 impl BakeOptions {
@@ -52,6 +61,14 @@ impl BakeOptions {
             fixed: self.model.fixed.clone(),
             fixed_below: self.fixed_below.clone(),
             fixed_boxes: self.fixed_box.clone(),
+            fixed_near: self
+                .fixed_near
+                .iter()
+                .map(|f| modal_bake::bake::FixedNear {
+                    distance: self.fixed_near_distance.or(f.distance),
+                    ..f.clone()
+                })
+                .collect(),
             rayleigh: self.model.rayleigh,
             lumped: self.model.lumped,
             precision: if self.f32 {
@@ -113,7 +130,7 @@ pub fn load_mesh(
     }
     if asset.any_set() {
         anyhow::bail!(
-            "--mesher, --size, --order, --envelope, --gmsh, --ftetwild, --keep-surface and --mesher-timeout apply to surface assets (.obj, .stl, .ply), not to the volume mesh {}",
+            "--mesher, --size, --order, --envelope, --gmsh, --ftetwild, --keep-surface, --uniform-size and --mesher-timeout apply to surface assets (.obj, .stl, .ply), not to the volume mesh {}",
             path.display()
         );
     }

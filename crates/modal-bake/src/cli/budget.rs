@@ -79,8 +79,12 @@ impl BudgetOptions {
             .size
             .unwrap_or_else(|| modal_bake::mesh::gmsh::default_size(s.bounding_box()));
         let order = asset.order();
+        // gmsh's curvature-driven sizes put more elements on a curved surface than `size`
+        // alone: estimate at the equivalent uniform size.
+        let curvature = !asset.uniform_size && !asset.keep_surface;
         let est = |size: f64, order: u8| {
-            SizeEstimate::of_surface(&measures, size, asset.keep_surface, order, modes)
+            let h = modal_bake::mesh::sizing::equivalent_size(&s, size, curvature);
+            SizeEstimate::of_surface(&measures, h, asset.keep_surface, order, modes)
         };
         let fits = |e: &SizeEstimate| e.fits(&budget);
         let e = est(size, order);
@@ -94,6 +98,11 @@ impl BudgetOptions {
                 format!(
                     ", --keep-surface: its {:.4e} m triangles set the size",
                     measures.mean_edge()
+                )
+            } else if curvature {
+                format!(
+                    ", finer where curved: as many elements as a uniform {:.4e} m",
+                    modal_bake::mesh::sizing::equivalent_size(&s, size, true)
                 )
             } else {
                 String::new()
@@ -110,7 +119,14 @@ impl BudgetOptions {
                 mb::format_count(measures.triangles as f64),
                 measures.mean_edge(),
                 size,
-                SizeEstimate::of_surface(&measures, size, false, order, modes).describe()
+                SizeEstimate::of_surface(
+                    &measures,
+                    modal_bake::mesh::sizing::equivalent_size(&s, size, !asset.uniform_size),
+                    false,
+                    order,
+                    modes
+                )
+                .describe()
             ));
             how.push(
                 "decimate the asset in the modelling tool (Blender: Decimate modifier)".into(),

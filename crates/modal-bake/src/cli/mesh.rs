@@ -117,9 +117,16 @@ pub struct AssetOptions {
     #[arg(long, value_enum, default_value_t = MesherArg::Auto)]
     pub mesher: MesherArg,
     /// Surface assets: target tetrahedron size (m; fTetWild's ideal edge length) [default:
-    /// 1/20 of the bounding-box diagonal].
+    /// 1/20 of the bounding-box diagonal]. gmsh's remeshing makes elements finer where the
+    /// surface curves: at most 2π·R/N for a radius of curvature R, with N = 6 elements per
+    /// turn at the default size and N in proportion to 1/size (12 at half of it), so every
+    /// element scales with --size.
     #[arg(long, value_name = "M")]
     pub size: Option<f64>,
+    /// Surface assets, gmsh remeshing: one size everywhere (no finer elements where the
+    /// surface curves).
+    #[arg(long)]
+    pub uniform_size: bool,
     /// Surface assets: element order, 1 (4-node tetrahedra) or 2 (10-node, straight-sided;
     /// far more accurate per degree of freedom) [default: 2; 1 with --transfer-h, whose table
     /// needs 4-node tetrahedra].
@@ -171,6 +178,7 @@ impl AssetOptions {
             keep_surface: self.keep_surface,
             timeout: modal_bake::mesh::work::timeout_of(self.mesher_timeout)
                 .map_err(anyhow::Error::msg)?,
+            curvature: !self.uniform_size,
         })
     }
 
@@ -181,6 +189,7 @@ impl AssetOptions {
             || self.order.is_some()
             || self.gmsh.is_some()
             || self.keep_surface
+            || self.uniform_size
             || self.mesher != MesherArg::Auto
             || self.envelope.is_some()
             || self.ftetwild.is_some()
@@ -241,6 +250,14 @@ pub fn mesh_asset(asset: &Path, options: &AssetOptions) -> anyhow::Result<Meshed
     if let Some(f) = &r.fallback_from {
         eprintln!("  fallback: {f}");
     }
+    if let Some(t) = r.thin_parts_m.filter(|t| r.size_m > 2.0 * t) {
+        eprintln!(
+            "warning: {}: the thinnest parts (5 % of the surface) are {t:.3e} m thick and the size is {:.3e} m: walls thinner than half an element are too stiff in bending, so the lowest frequencies may come out high; check with --target-error PCT, or give --size {:.3e} (twice their thickness) if the budget allows",
+            asset.display(),
+            r.size_m,
+            2.0 * t
+        );
+    }
     let [lo, hi] = r.inspection.bbox;
     let extent = (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt();
     warn_extent(&asset.display().to_string(), extent, options.units, "");
@@ -298,12 +315,18 @@ pub fn run(args: &MeshArgs) -> anyhow::Result<()> {
         }
         outln!("  solid: {}", r.solid);
         outln!(
-            "  mesh: {} nodes, {} {}-node tetrahedra ({} dofs), size {:.4e} m{}{}",
+            "  mesh: {} nodes, {} {}-node tetrahedra ({} dofs), size {:.4e} m{}{}{}",
             m.nodes.len(),
             m.tets.len(),
             if m.is_quadratic() { 10 } else { 4 },
             m.dofs(),
             r.size_m,
+            r.curvature_elements
+                .map(|n| format!(
+                    " (finer where the surface curves: {n} elements per turn, at most {:.3}·R at a radius of curvature R)",
+                    std::f64::consts::TAU / f64::from(n)
+                ))
+                .unwrap_or_default(),
             r.envelope_m
                 .map(|e| format!(", envelope {e:.4e} m"))
                 .unwrap_or_default(),

@@ -21,3 +21,8 @@ pub fn axis_value(s: &str) -> Result<modal_bake::bake::FixedBelow, String> {
         )),
     }
 }
+
+/// Reads a `--fixed-near` file (an OBJ of points and optional faces, m).
+pub fn fixed_near(s: &str) -> Result<modal_bake::bake::FixedNear, String> {
+    modal_bake::bake::FixedNear::read(s.as_ref()).map_err(|e| e.to_string())
+}

@@ -5,8 +5,9 @@
 //! found on `PATH` or given explicitly. The surface is handed over as an MSH 2.2 file of
 //! triangles (exact decimal coordinates) with a `.geo` script that, by default, classifies it
 //! into patches (feature angle 40°), rebuilds a geometry and remeshes it at the requested size
-//! (gmsh tutorial t13), or keeps the asset's triangles as the boundary (`keep_surface`), then
-//! fills the volume (Frontal-Delaunay 2D, Delaunay 3D). Second order uses straight-sided
+//! (gmsh tutorial t13) — uniformly, or finer where the surface curves
+//! ([`GmshParams::curvature_elements`], gmsh's `Mesh.MeshSizeFromCurvature`) — or keeps the
+//! asset's triangles as the boundary (`keep_surface`), then fills the volume (Frontal-Delaunay 2D, Delaunay 3D). Second order uses straight-sided
 //! elements (`Mesh.SecondOrderLinear = 1`), which the P2 assembly requires.
 //!
 //! Determinism: one thread (`General.NumThreads = 1`), fixed algorithms and `Mesh.RandomSeed`;
@@ -45,6 +46,11 @@ pub struct GmshParams {
     /// Time limit of the gmsh run; gmsh is stopped and an error returned past it. Default
     /// [`DEFAULT_TIMEOUT_S`].
     pub timeout: Duration,
+    /// Curvature-driven sizes when remeshing: at most 2π/`curvature_elements` times the local
+    /// radius of curvature (gmsh's `Mesh.MeshSizeFromCurvature`, elements per full turn),
+    /// never above `size`; 0 (the default here) for a uniform `size`. Ignored with
+    /// `keep_surface`.
+    pub curvature_elements: u32,
 }
 
 impl Default for GmshParams {
@@ -55,6 +61,7 @@ impl Default for GmshParams {
             gmsh: None,
             keep_surface: false,
             timeout: Duration::from_secs_f64(DEFAULT_TIMEOUT_S),
+            curvature_elements: 0,
         }
     }
 }
@@ -126,10 +133,10 @@ pub enum GmshError {
     Mesh(#[from] MeshError),
 }
 
-/// Default element size (m): 1/20 of the bounding-box diagonal.
+/// Default element size (m): 1/20 of the bounding-box diagonal
+/// ([`super::sizing::default_size`]).
 pub fn default_size(bbox: [[f64; 3]; 2]) -> f64 {
-    let d: f64 = (0..3).map(|k| (bbox[1][k] - bbox[0][k]).powi(2)).sum();
-    d.sqrt() / 20.0
+    super::sizing::default_size(bbox)
 }
 
 /// A way to run gmsh.
@@ -265,12 +272,13 @@ fn surface_msh(surface: &SurfaceMesh) -> String {
 }
 
 /// The `.geo` script meshing `surface.msh` into `volume.msh`.
-fn geo_script(size: f64, order: u8, keep_surface: bool) -> String {
+fn geo_script(size: f64, order: u8, keep_surface: bool, curvature_elements: u32) -> String {
     let remesh = if keep_surface {
         ""
     } else {
         "ClassifySurfaces{40 * Pi / 180, 1, 1, Pi};\nCreateGeometry;\n"
     };
+    let curvature = if keep_surface { 0 } else { curvature_elements };
     format!(
         "General.NumThreads = 1;\n\
          General.Terminal = 1;\n\
@@ -278,7 +286,7 @@ fn geo_script(size: f64, order: u8, keep_surface: bool) -> String {
          Mesh.Algorithm = 6;\n\
          Mesh.Algorithm3D = 1;\n\
          Mesh.MeshSizeMax = {size:?};\n\
-         Mesh.MeshSizeFromCurvature = 0;\n\
+         Mesh.MeshSizeFromCurvature = {curvature};\n\
          Mesh.ElementOrder = {order};\n\
          Mesh.SecondOrderLinear = 1;\n\
          Mesh.MshFileVersion = 4.1;\n\
@@ -337,7 +345,12 @@ pub fn tetrahedralize_with_progress(
     std::fs::write(dir.path().join("surface.msh"), surface_msh(surface)).map_err(io)?;
     std::fs::write(
         dir.path().join("volume.geo"),
-        geo_script(size, params.order, params.keep_surface),
+        geo_script(
+            size,
+            params.order,
+            params.keep_surface,
+            params.curvature_elements,
+        ),
     )
     .map_err(io)?;
     let args = [

@@ -13,7 +13,11 @@
 //!    bounds a solid), and the report says why.
 //! 5. Second order from either backend by straight-sided mid-edge nodes (gmsh's own, or
 //!    [`TetMesh::to_quadratic`] for fTetWild's linear tetrahedra).
-//! 6. [`surface_distance`]: the Hausdorff distance between the asset and the mesh boundary.
+//! 6. [`surface_distance`]: the Hausdorff distance between the asset and the mesh boundary,
+//!    and the thickness of the asset's thinnest parts ([`super::sizing::thin_parts`]).
+//!
+//! The size is `--size`, or 1/20 of the bounding-box diagonal; gmsh's remeshing makes elements
+//! finer where the surface curves ([`super::sizing`]), in proportion to the size.
 
 use std::path::PathBuf;
 use std::time::Duration;
@@ -21,6 +25,7 @@ use std::time::Duration;
 use super::distance::{surface_distance, SurfaceDistance};
 use super::ftetwild::{self, FtetwildError, FtetwildParams};
 use super::gmsh::{self, GmshError, GmshParams};
+use super::sizing::diagonal;
 use super::surface::{inspect_surface, SurfaceError, SurfaceInspection, SurfaceMesh};
 use super::work::DEFAULT_TIMEOUT_S;
 use super::{msh41_bytes, read_msh_bytes, MeshError, TetMesh};
@@ -83,6 +88,10 @@ pub struct MeshParams {
     pub keep_surface: bool,
     /// Time limit of each mesher run. Default [`DEFAULT_TIMEOUT_S`].
     pub timeout: Duration,
+    /// gmsh remeshing: finer elements where the surface curves, N =
+    /// [`super::sizing::curvature_elements`] per full turn (6 at the default size, in
+    /// proportion to 1/size). Default true.
+    pub curvature: bool,
 }
 
 impl Default for MeshParams {
@@ -96,6 +105,7 @@ impl Default for MeshParams {
             ftetwild: None,
             keep_surface: false,
             timeout: Duration::from_secs_f64(DEFAULT_TIMEOUT_S),
+            curvature: true,
         }
     }
 }
@@ -119,6 +129,12 @@ pub struct MeshReport {
     pub version: String,
     /// Element size (m; fTetWild: the ideal edge length).
     pub size_m: f64,
+    /// Thickness of the asset's thinnest parts (m; [`super::sizing::thin_parts`]); `None`
+    /// when no inward ray hits the surface again.
+    pub thin_parts_m: Option<f64>,
+    /// gmsh remeshing: elements per full turn of curvature (finer elements where the surface
+    /// curves); `None` for a uniform size, `keep_surface` and fTetWild.
+    pub curvature_elements: Option<u32>,
     /// fTetWild's envelope (m); `None` for gmsh.
     pub envelope_m: Option<f64>,
     /// Whether the backend's output is reproducible (same input → same bytes).
@@ -223,13 +239,6 @@ pub enum AssetError {
     Mesh(#[from] MeshError),
 }
 
-fn diagonal(b: [[f64; 3]; 2]) -> f64 {
-    (0..3)
-        .map(|k| (b[1][k] - b[0][k]).powi(2))
-        .sum::<f64>()
-        .sqrt()
-}
-
 /// Refuses vertices outside the supported range and sizes implying too many elements.
 fn check_ranges(
     surface: &SurfaceMesh,
@@ -265,7 +274,7 @@ fn check_ranges(
             )))
         }
         Some(s) => s,
-        None => diag / 20.0,
+        None => super::sizing::default_size(inspection.bbox),
     };
     if let Some(e) = params.envelope {
         if !(e.is_finite() && e > 0.0 && e < diag) {
@@ -317,7 +326,7 @@ pub fn mesh_surface(
         )));
     }
     let inspection = inspect_surface(surface);
-    check_ranges(surface, &inspection, params, file)?;
+    let size = check_ranges(surface, &inspection, params, file)?;
     let solid = inspection.is_solid();
     let first = inspection
         .first_defect()
@@ -358,7 +367,21 @@ pub fn mesh_surface(
         MesherChoice::Ftetwild => (Backend::Ftetwild, "--mesher ftetwild".to_string()),
     };
     progress(&format!("meshing with {}: {reason}", backend.name()));
-    let first_try = run_backend(backend, surface, &inspection, params, file, progress);
+    let curvature = (params.curvature && !params.keep_surface)
+        .then(|| super::sizing::curvature_elements(size, diagonal(inspection.bbox)));
+    let params = &MeshParams {
+        size: Some(size),
+        ..params.clone()
+    };
+    let first_try = run_backend(
+        backend,
+        surface,
+        &inspection,
+        params,
+        curvature,
+        file,
+        progress,
+    );
     let (mesh, mut report) = match first_try {
         Ok(ok) => ok,
         Err(e) if params.mesher == MesherChoice::Auto => {
@@ -372,7 +395,15 @@ pub fn mesh_surface(
                 backend.name(),
                 other.name()
             ));
-            match run_backend(other, surface, &inspection, params, file, progress) {
+            match run_backend(
+                other,
+                surface,
+                &inspection,
+                params,
+                curvature,
+                file,
+                progress,
+            ) {
                 Ok((m, mut r)) => {
                     r.fallback_from = Some(format!("{} failed: {e}", backend.name()));
                     r.reason = format!(
@@ -403,6 +434,7 @@ pub fn mesh_surface(
         ..mesh.mesh.clone()
     };
     report.distance = surface_distance(surface, &linear);
+    report.thin_parts_m = super::sizing::thin_parts(surface);
     Ok(MeshedAsset {
         mesh: mesh.mesh,
         msh: mesh.msh,
@@ -420,6 +452,7 @@ fn run_backend(
     surface: &SurfaceMesh,
     inspection: &SurfaceInspection,
     params: &MeshParams,
+    curvature: Option<u32>,
     file: &str,
     progress: &dyn Fn(&str),
 ) -> Result<(Made, MeshReport), AssetError> {
@@ -434,6 +467,7 @@ fn run_backend(
                 gmsh: params.gmsh.clone(),
                 keep_surface: params.keep_surface,
                 timeout: params.timeout,
+                curvature_elements: curvature.unwrap_or(0),
             };
             let out = gmsh::tetrahedralize_with_progress(&s, &g, file, &tick)?;
             let volume = out.mesh.volume();
@@ -449,6 +483,8 @@ fn run_backend(
                 program: out.info.program,
                 version: out.info.version,
                 size_m: out.info.size_m,
+                thin_parts_m: None,
+                curvature_elements: curvature,
                 envelope_m: None,
                 reproducible: true,
                 seconds: out.info.seconds,
@@ -506,6 +542,8 @@ fn run_backend(
                 program: info.program,
                 version: info.version,
                 size_m: info.size_m,
+                thin_parts_m: None,
+                curvature_elements: None,
                 envelope_m: Some(info.envelope_m),
                 reproducible: info.reproducible,
                 seconds: info.seconds,

@@ -33,6 +33,7 @@ mod mesh_error;
 pub mod mesher;
 mod msh;
 mod msh_writer;
+pub mod sizing;
 pub mod surface;
 mod tet_mesh;
 mod validate;

@@ -1,7 +1,9 @@
 //! Choosing a surface asset's mesh for an accuracy target (`modal-bake bake ASSET
 //! --target-error PCT` without a transfer table): mesh at a starting element size, bake the
 //! lowest modes, mesh again at the size divided by [`REFINE`], and stop when no one of the
-//! lowest modes moved by more than the target between the last two meshes. A step whose mesh
+//! lowest modes moved by more than the target between the last two meshes. Every element
+//! scales with the size (gmsh's curvature-driven sizes too, [`crate::mesh::sizing`]), so each
+//! step refines the whole mesh. A step whose mesh
 //! is the previous one (a mesher that keeps a finer size of its own) is not compared.
 //!
 //! Conforming finite elements converge from above at a rate h^p (p = 2 for 4-node, 4 for
