@@ -107,4 +107,3 @@ pub use world::{
     BodyState, ContactReport, DcrWorld, ElasticHandle, ElasticObjectDesc, ImpulseEvent,
     ObjectStepInfo, Pose, WorldError, WorldParams, WorldStepInfo,
 };
-

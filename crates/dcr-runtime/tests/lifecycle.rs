@@ -386,7 +386,11 @@ fn bodies_resting_on_a_reenabled_or_added_object_are_not_impacts() {
     for _ in 0..6 {
         let ev = w.step(&[heavy], &[boxy(7)]);
         assert!(ev.is_empty());
-        assert_eq!(w.object_info(h).impacts, 0, "added mid-run: resting, not new");
+        assert_eq!(
+            w.object_info(h).impacts,
+            0,
+            "added mid-run: resting, not new"
+        );
     }
     // A hit after the window is an impact and moves the resting box.
     let mut ball = contact(90, 9, 1, [0.5, 0.3, 0.0], 2.0);

@@ -343,14 +343,22 @@ impl ModesFile {
                 self.meta.format_version
             )));
         }
+        self.check_lengths().map_err(inv)?;
+        self.check_values().map_err(inv)?;
+        self.check_material_and_meta().map_err(inv)?;
+        self.check_sections().map_err(inv)?;
+        Ok(())
+    }
+
+    /// Counts and entry lengths against the surface and mode counts (`validate`'s first step).
+    fn check_lengths(&self) -> Result<(), String> {
         let m = self.num_modes();
         let ns = self.num_surface_vertices();
-        let nv = self.meta.volume_nodes;
         if m == 0 {
-            return Err(inv("no modes".into()));
+            return Err("no modes".into());
         }
         if ns == 0 || self.surface_triangles.is_empty() {
-            return Err(inv("empty surface".into()));
+            return Err("empty surface".into());
         }
         // Lengths: (entry, length, expected, expected as a formula).
         let lengths = [
@@ -360,11 +368,20 @@ impl ModesFile {
         ];
         for (entry, len, expected, formula) in lengths {
             if len != expected {
-                return Err(inv(format!(
+                return Err(format!(
                     "{entry} holds {len} values, expected {formula} = {expected} (ns = {ns} surface vertices, m = {m} modes)"
-                )));
+                ));
             }
         }
+        Ok(())
+    }
+
+    /// Every value's range and every index's bound (the rule tables), ascending eigenvalues and
+    /// a supported surface extent.
+    fn check_values(&self) -> Result<(), String> {
+        let m = self.num_modes();
+        let ns = self.num_surface_vertices();
+        let nv = self.meta.volume_nodes;
         let modes_shape = [3, m];
         let reals = [
             RealRule::new("eigenvalues", &self.eigenvalues, &[], ValueRule::Positive),
@@ -403,20 +420,27 @@ impl ModesFile {
             },
         ];
         for rule in &reals {
-            rule.check().map_err(inv)?;
+            rule.check()?;
         }
         for rule in &indices {
-            rule.check().map_err(inv)?;
+            rule.check()?;
         }
         if let Some(j) = (1..m).find(|&j| self.eigenvalues[j] < self.eigenvalues[j - 1]) {
-            return Err(inv(format!("eigenvalues not ascending at mode {j}")));
+            return Err(format!("eigenvalues not ascending at mode {j}"));
         }
         let extent = surface_extent(&self.surface_vertices);
         if !(extent >= MIN_EXTENT_M) {
-            return Err(inv(format!(
+            return Err(format!(
                 "surface extent {extent:.2e} m (bounding-box diagonal) is below the supported {MIN_EXTENT_M:e} m"
-            )));
+            ));
         }
+        Ok(())
+    }
+
+    /// The material (SI) and the metadata's mass, node count and rigid-mode count.
+    fn check_material_and_meta(&self) -> Result<(), String> {
+        let ns = self.num_surface_vertices();
+        let nv = self.meta.volume_nodes;
         let MaterialSi {
             youngs,
             poisson,
@@ -424,52 +448,59 @@ impl ModesFile {
         } = self.material;
         let positive = |x: f64| x.is_finite() && x > 0.0;
         if !(positive(youngs) && positive(density) && poisson > -1.0 && poisson < 0.5) {
-            return Err(inv(format!(
+            return Err(format!(
                 "material out of range: E={youngs} ν={poisson} ρ={density} (E, ρ finite and > 0, −1 < ν < 0.5)"
-            )));
+            ));
         }
         let meta = &self.meta;
         if !positive(meta.mass_kg) {
-            return Err(inv(format!(
+            return Err(format!(
                 "meta.mass_kg = {} (must be finite and > 0)",
                 meta.mass_kg
-            )));
+            ));
         }
         if nv < ns {
-            return Err(inv(format!(
+            return Err(format!(
                 "meta.volume_nodes = {nv} is below the {ns} surface vertices"
-            )));
+            ));
         }
         if !matches!(meta.rigid_modes_excluded, 0 | 6) {
-            return Err(inv(format!(
+            return Err(format!(
                 "meta.rigid_modes_excluded = {} (must be 0, fixed, or 6, free-free)",
                 meta.rigid_modes_excluded
-            )));
+            ));
         }
+        Ok(())
+    }
+
+    /// The optional sections: the transfer table, the second-order surface, the surface order.
+    fn check_sections(&self) -> Result<(), String> {
+        let m = self.num_modes();
+        let ns = self.num_surface_vertices();
         if let Some(t) = &self.transfer {
-            t.check(ns).map_err(inv)?;
+            t.check(ns)?;
         }
         if let Some(q) = &self.quadratic {
-            q.check(ns, m, &self.surface_triangles).map_err(inv)?;
+            q.check(ns, m, &self.surface_triangles)?;
             if self.transfer.is_some() {
-                return Err(inv(
+                return Err(
                     "a peak-transfer table on a second-order base is not supported (the table interpolates P1 midpoint rows)".into(),
-                ));
+                );
             }
         }
         if let Some(order) = &self.surface_order {
             if order.len() != ns {
-                return Err(inv(format!(
+                return Err(format!(
                     "surface_order has {} entries for {ns} surface vertices",
                     order.len()
-                )));
+                ));
             }
             let mut seen = vec![false; ns];
             for (k, &v) in order.iter().enumerate() {
                 if v as usize >= ns || std::mem::replace(&mut seen[v as usize], true) {
-                    return Err(inv(format!(
+                    return Err(format!(
                         "surface_order is not a permutation: entry {k} is {v} (repeated or ≥ {ns})"
-                    )));
+                    ));
                 }
             }
         }

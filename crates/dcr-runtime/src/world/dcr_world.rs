@@ -861,4 +861,3 @@ impl DcrWorld {
             .filter(|&o| self.objects[o as usize].enabled)
     }
 }
-

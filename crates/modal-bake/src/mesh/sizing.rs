@@ -70,8 +70,9 @@ pub fn equivalent_size(surface: &SurfaceMesh, size: f64, curvature: bool) -> f64
     let mut area = Vec::with_capacity(tri.len());
     for t in tri {
         let [a, b, c] = t.map(|i| v[i]);
-        let cr = crate::vec3::cross(crate::vec3::sub(b, a), crate::vec3::sub(c, a));
-        let len = crate::vec3::norm2(cr).sqrt();
+        let cr =
+            dcr_runtime::math::cross(dcr_runtime::math::sub(b, a), dcr_runtime::math::sub(c, a));
+        let len = dcr_runtime::math::norm2(cr).sqrt();
         area.push(0.5 * len);
         normal.push(if len > 0.0 {
             cr.map(|x| x / len)
@@ -93,7 +94,7 @@ pub fn equivalent_size(surface: &SurfaceMesh, size: f64, curvature: bool) -> f64
     for w in edges.chunk_by(|x, y| x.0 == y.0) {
         let [(_, a), (_, b)] = w else { continue };
         let (a, b) = (*a, *b);
-        let cos = crate::vec3::dot(normal[a], normal[b]).clamp(-1.0, 1.0);
+        let cos = dcr_runtime::math::dot(normal[a], normal[b]).clamp(-1.0, 1.0);
         let theta = cos.acos();
         if !(theta > 0.0 && theta <= FEATURE_ANGLE) {
             continue;
@@ -102,7 +103,7 @@ pub fn equivalent_size(surface: &SurfaceMesh, size: f64, curvature: bool) -> f64
         // from the edge's line (the centroid distance itself also counts any offset along
         // the edge, large on slender triangles).
         let [p, q] = w[0].0;
-        let e = crate::vec3::norm2(crate::vec3::sub(v[p], v[q])).sqrt();
+        let e = dcr_runtime::math::norm2(dcr_runtime::math::sub(v[p], v[q])).sqrt();
         let d = if e > 0.0 {
             2.0 * (area[a] + area[b]) / (3.0 * e)
         } else {
@@ -169,8 +170,11 @@ pub fn thin_parts(surface: &SurfaceMesh) -> Option<f64> {
         .par_iter()
         .filter_map(|t| {
             let [a, b, c] = t.map(|i| v[i]);
-            let cr = crate::vec3::cross(crate::vec3::sub(b, a), crate::vec3::sub(c, a));
-            let len = crate::vec3::norm2(cr).sqrt();
+            let cr = dcr_runtime::math::cross(
+                dcr_runtime::math::sub(b, a),
+                dcr_runtime::math::sub(c, a),
+            );
+            let len = dcr_runtime::math::norm2(cr).sqrt();
             if !(len > 0.0) {
                 return None;
             }

@@ -437,7 +437,7 @@ pub fn read_manifest(
         });
     }
     // Outputs against inputs and each other, before anything is written.
-    let mut plan = dcr_runtime::format::OutputPlan::new();
+    let mut plan = dcr_files::OutputPlan::new();
     plan.input("the manifest", path);
     for e in &out {
         plan.input(&format!("the mesh of entries[{}]", e.index), &e.args.mesh);
@@ -479,7 +479,7 @@ fn read_entry(
         Ok(m) => bail!(
             "{at}.mesh {} is {}, not a mesh file",
             mesh.display(),
-            dcr_runtime::format::describe_file_type(m.file_type())
+            dcr_files::describe_file_type(m.file_type())
         ),
         Err(e) => bail!("{at}.mesh {}: {e}", mesh.display()),
     }

@@ -140,7 +140,7 @@ pub fn run(args: &BatchArgs) -> anyhow::Result<ExitCode> {
     let text = serde_json::to_string_pretty(&report)? + "\n";
     if let Some(path) = &args.report {
         super::create_parent(path)?;
-        dcr_runtime::format::write_atomic(path, text.as_bytes())?;
+        dcr_files::write_atomic(path, text.as_bytes())?;
     }
     line(
         start,
