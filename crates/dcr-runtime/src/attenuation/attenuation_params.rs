@@ -85,8 +85,8 @@ pub struct AttenuationParams {
     /// impact (or per contact, if there are fewer contacts).
     pub cache_capacity: usize,
     /// Solve each new heat-method distance field on two threads where that pays (see
-    /// [`crate::attenuation::HeatWorkspace::set_parallel`]): bit-identical results, down to 0.6× the time
-    /// on a 5k-vertex surface when a second core is free. Off by default.
+    /// [`crate::attenuation::HeatWorkspace::set_parallel`]): bit-identical results, faster on
+    /// large surfaces when a second core is free (timings in `docs/benchmarks.md`). Off by default.
     pub parallel_heat: bool,
 }
 
