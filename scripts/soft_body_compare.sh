@@ -18,7 +18,7 @@ SCENES=(dinner)
 [ $# -gt 0 ] && SCENES=("$@")
 BUDGET_MIN="${BUDGET_MIN:-20}"
 TARGET="${CARGO_TARGET_DIR:-target}"
-cargo build --release -p dcr-lab >&2
+cargo build --release --workspace --bins >&2
 LOAD_BEFORE=$(uptime)
 START=$(date -u +%Y-%m-%dT%H:%MZ)
 "$TARGET/release/dcr-lab" soft-body compare "${SCENES[@]}" --budget-min "$BUDGET_MIN" \

@@ -7,8 +7,8 @@ use std::process::{Command, Stdio};
 use anyhow::{bail, Context, Result};
 use clap::{Args, Subcommand, ValueEnum};
 use dcr_lab::soft_body::{
-    render_markdown, run_side, sweep_substeps, SceneComparison, SideMethod, SideRow,
-    SoftSceneParams, SweepParams,
+    render_markdown, run_side, sweep_substeps, with_projectiles_advanced, SceneComparison,
+    SideMethod, SideRow, SoftSceneParams, SweepParams,
 };
 use dcr_scenes::scene::SceneDesc;
 
@@ -55,9 +55,20 @@ pub struct RunArgs {
     /// Default rapier's (20).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..=100000))]
     pub cg_iterations: Option<u64>,
+    /// rapier-fem: soft bodies with at most N degrees of freedom (3 per particle) answer their
+    /// contacts through a direct (skyline Cholesky) factorization of the step matrix, exact;
+    /// larger ones through the conjugate gradient capped at --cg-iterations. Default rapier's
+    /// (600; the dinner table has 3,048).
+    #[arg(long, value_name = "N")]
+    pub max_dense_dofs: Option<usize>,
     /// Simulated time (s). Default the scene's `seconds`.
     #[arg(long, value_name = "S")]
     pub seconds: Option<f64>,
+    /// Start the projectiles (props with an initial velocity) K steps into their free flight:
+    /// the same impact, K steps earlier (see `with_projectiles_advanced`). K must end before
+    /// the original first contact. Default 0.
+    #[arg(long, value_name = "K", default_value_t = 0)]
+    pub advance_steps: usize,
     /// Repository root (scenes, meshes, `out/bases`).
     #[arg(long, value_name = "DIR", default_value = ".")]
     pub root: PathBuf,
@@ -89,13 +100,22 @@ pub struct CompareArgs {
     /// Default rapier's (20).
     #[arg(long, value_name = "N")]
     pub cg_iterations: Option<usize>,
-    /// Extra rapier-fem rows after the sweep, SUBSTEPS:CG (repeatable), e.g. `4:1000` for rapier's
-    /// default substeps with a conjugate gradient run to its tolerance.
-    #[arg(long, value_name = "SUBSTEPS:CG", value_parser = parse_extra)]
-    pub extra: Vec<(usize, usize)>,
+    /// Direct-factorization limit of the sweep's rows (rapier's `SoftFemParameters::max_dense_dofs`,
+    /// dofs). Default rapier's (600).
+    #[arg(long, value_name = "N")]
+    pub max_dense_dofs: Option<usize>,
+    /// Extra rapier-fem rows after the sweep, SUBSTEPS:CG[:DENSE] (repeatable), e.g. `4:1000` for
+    /// rapier's default substeps with a conjugate gradient run to its tolerance, `8:1000:4000`
+    /// for 8 substeps with the contact responses from a direct factorization as well.
+    #[arg(long, value_name = "SUBSTEPS:CG[:DENSE]", value_parser = parse_extra)]
+    pub extra: Vec<(usize, usize, usize)>,
     /// Simulated time of every row (s). Default each scene's `seconds`.
     #[arg(long, value_name = "S")]
     pub seconds: Option<f64>,
+    /// Every row: start the projectiles K steps into their free flight (the same impact, K steps
+    /// earlier; see `soft-body run --advance-steps`).
+    #[arg(long, value_name = "K", default_value_t = 0)]
+    pub advance_steps: usize,
     /// Repository root.
     #[arg(long, value_name = "DIR", default_value = ".")]
     pub root: PathBuf,
@@ -111,19 +131,28 @@ pub struct CompareArgs {
     pub json: PathBuf,
 }
 
-/// `SUBSTEPS:CG`, both at least 1.
-fn parse_extra(s: &str) -> Result<(usize, usize), String> {
-    let (a, b) = s
-        .split_once(':')
-        .ok_or_else(|| format!("{s:?}: expected SUBSTEPS:CG, e.g. 4:1000"))?;
-    let n = |x: &str| -> Result<usize, String> {
+/// `SUBSTEPS:CG[:DENSE]`, SUBSTEPS and CG at least 1; DENSE defaults to rapier's.
+fn parse_extra(s: &str) -> Result<(usize, usize, usize), String> {
+    let parts: Vec<&str> = s.split(':').collect();
+    if !(2..=3).contains(&parts.len()) {
+        return Err(format!(
+            "{s:?}: expected SUBSTEPS:CG[:DENSE], e.g. 4:1000 or 8:1000:4000"
+        ));
+    }
+    let n = |x: &str, min: usize| -> Result<usize, String> {
         x.trim()
             .parse::<usize>()
             .ok()
-            .filter(|&v| v >= 1)
-            .ok_or_else(|| format!("{s:?}: SUBSTEPS and CG must be whole numbers ≥ 1"))
+            .filter(|&v| v >= min)
+            .ok_or_else(|| {
+                format!("{s:?}: SUBSTEPS and CG must be whole numbers ≥ 1, DENSE a whole number")
+            })
     };
-    Ok((n(a)?, n(b)?))
+    let dense = match parts.get(2) {
+        Some(d) => n(d, 0)?,
+        None => SoftSceneParams::new(PathBuf::new()).max_dense_dofs,
+    };
+    Ok((n(parts[0], 1)?, n(parts[1], 1)?, dense))
 }
 
 fn scene_path(root: &Path, s: &str) -> PathBuf {
@@ -148,6 +177,7 @@ fn side_method(a: &RunArgs) -> SideMethod {
         MethodArg::RapierFem => SideMethod::RapierFem {
             substeps: a.substeps.map_or(d.substeps, |n| n as usize),
             cg_iterations: a.cg_iterations.map_or(d.cg_iterations, |n| n as usize),
+            max_dense_dofs: a.max_dense_dofs.unwrap_or(d.max_dense_dofs),
         },
         MethodArg::Modal => SideMethod::Modal,
         MethodArg::Transfer => SideMethod::Transfer,
@@ -156,8 +186,10 @@ fn side_method(a: &RunArgs) -> SideMethod {
 }
 
 fn run_one(a: &RunArgs) -> Result<()> {
-    if a.method != MethodArg::RapierFem && (a.substeps.is_some() || a.cg_iterations.is_some()) {
-        bail!("--substeps and --cg-iterations apply to --method rapier-fem only");
+    if a.method != MethodArg::RapierFem
+        && (a.substeps.is_some() || a.cg_iterations.is_some() || a.max_dense_dofs.is_some())
+    {
+        bail!("--substeps, --cg-iterations and --max-dense-dofs apply to --method rapier-fem only");
     }
     if let Some(s) = a.seconds {
         if !(s > 0.0 && s.is_finite()) {
@@ -165,7 +197,7 @@ fn run_one(a: &RunArgs) -> Result<()> {
         }
     }
     let path = scene_path(&a.root, &a.scene);
-    let desc = SceneDesc::read(&path)?;
+    let desc = with_projectiles_advanced(&SceneDesc::read(&path)?, a.advance_steps)?;
     let method = side_method(a);
     let row = run_side(&desc, &method, a.root.clone(), a.seconds, a.progress)?;
     let json = serde_json::to_string_pretty(&row)? + "\n";
@@ -205,6 +237,7 @@ fn run_child(
     scene: &str,
     method: &SideMethod,
     seconds: Option<f64>,
+    advance_steps: usize,
 ) -> Result<SideRow> {
     let exe = std::env::current_exe().context("locating the dcr-lab binary")?;
     let mut cmd = Command::new(exe);
@@ -220,11 +253,14 @@ fn run_child(
         SideMethod::RapierFem {
             substeps,
             cg_iterations,
+            max_dense_dofs,
         } => {
             cmd.args(["--method", "rapier-fem", "--substeps"])
                 .arg(substeps.to_string())
                 .arg("--cg-iterations")
-                .arg(cg_iterations.to_string());
+                .arg(cg_iterations.to_string())
+                .arg("--max-dense-dofs")
+                .arg(max_dense_dofs.to_string());
         }
         SideMethod::Modal => {
             cmd.args(["--method", "modal"]);
@@ -239,6 +275,7 @@ fn run_child(
     if let Some(s) = seconds {
         cmd.arg("--seconds").arg(s.to_string());
     }
+    cmd.arg("--advance-steps").arg(advance_steps.to_string());
     eprintln!("[dcr-lab] {scene}: {} …", method.label());
     let out = cmd
         .stderr(Stdio::inherit())
@@ -266,16 +303,19 @@ fn compare(a: &CompareArgs) -> Result<()> {
     }
     let mut out = Vec::new();
     for scene in &a.scenes {
-        // Read (and check) the scene before spending minutes on it.
-        SceneDesc::read(&scene_path(&a.root, scene))?;
+        // Read (and check) the scene and the advance before spending minutes on it.
+        with_projectiles_advanced(
+            &SceneDesc::read(&scene_path(&a.root, scene))?,
+            a.advance_steps,
+        )?;
         // Bake the bases first, in a row of their own that is not kept: a row whose process
         // bakes would report the eigensolver's memory and time, not the run's.
         for m in [SideMethod::Modal, SideMethod::Transfer] {
-            run_child(&a.root, scene, &m, Some(0.01))?;
+            run_child(&a.root, scene, &m, Some(0.01), 0)?;
         }
         let mut rows = Vec::new();
         for m in [SideMethod::Off, SideMethod::Modal, SideMethod::Transfer] {
-            rows.push(run_child(&a.root, scene, &m, a.seconds)?);
+            rows.push(run_child(&a.root, scene, &m, a.seconds, a.advance_steps)?);
         }
         let params = SweepParams {
             budget_s: a.budget_min * 60.0,
@@ -285,16 +325,20 @@ fn compare(a: &CompareArgs) -> Result<()> {
         };
         let params = SweepParams {
             cg_iterations: a.cg_iterations.unwrap_or(params.cg_iterations),
+            max_dense_dofs: a.max_dense_dofs.unwrap_or(params.max_dense_dofs),
             ..params
         };
-        let (soft, end) = sweep_substeps(&params, |m| run_child(&a.root, scene, m, a.seconds))?;
+        let (soft, end) = sweep_substeps(&params, |m| {
+            run_child(&a.root, scene, m, a.seconds, a.advance_steps)
+        })?;
         let mut all = soft;
-        for &(substeps, cg_iterations) in &a.extra {
+        for &(substeps, cg_iterations, max_dense_dofs) in &a.extra {
             let m = SideMethod::RapierFem {
                 substeps,
                 cg_iterations,
+                max_dense_dofs,
             };
-            all.push(run_child(&a.root, scene, &m, a.seconds)?);
+            all.push(run_child(&a.root, scene, &m, a.seconds, a.advance_steps)?);
         }
         all.extend(rows);
         out.push(SceneComparison {

@@ -20,8 +20,8 @@ mod tet_soft_body;
 
 pub use peak_rss::peak_rss_bytes;
 pub use side_by_side::{
-    outcome_change, run_side, sweep_substeps, with_transfer_region, SideMethod, SideRow, SweepEnd,
-    SweepParams,
+    outcome_change, run_side, sweep_substeps, with_projectiles_advanced, with_transfer_region,
+    SideMethod, SideRow, SweepEnd, SweepParams,
 };
 pub use side_report::{render_markdown, SceneComparison};
 pub use soft_scene::{run_soft_scene, SoftObjectInfo, SoftRunReport, SoftSceneParams};

@@ -24,6 +24,9 @@ pub enum SideMethod {
         substeps: usize,
         /// CG iteration cap per substep.
         cg_iterations: usize,
+        /// Bodies up to this many degrees of freedom answer their contacts through a direct
+        /// factorization (rapier's `max_dense_dofs`), larger ones through the capped CG.
+        max_dense_dofs: usize,
     },
     /// Rigid objects, the distant response over the 20-mode base (`--method modal`).
     Modal,
@@ -42,13 +45,17 @@ impl SideMethod {
             SideMethod::RapierFem {
                 substeps,
                 cg_iterations,
+                max_dense_dofs,
             } => {
-                let cg = SoftSceneParams::new(PathBuf::new()).cg_iterations;
-                if *cg_iterations == cg {
-                    format!("rapier-fem, {substeps} substeps")
-                } else {
-                    format!("rapier-fem, {substeps} substeps, CG ≤ {cg_iterations}")
+                let d = SoftSceneParams::new(PathBuf::new());
+                let mut s = format!("rapier-fem, {substeps} substeps");
+                if *cg_iterations != d.cg_iterations {
+                    s.push_str(&format!(", CG ≤ {cg_iterations}"));
                 }
+                if *max_dense_dofs != d.max_dense_dofs {
+                    s.push_str(&format!(", direct ≤ {max_dense_dofs} dofs"));
+                }
+                s
             }
             SideMethod::Modal => "dcr, 20 modes (rigid table)".into(),
             SideMethod::Transfer => "dcr, ★ table (rigid table)".into(),
@@ -110,6 +117,46 @@ pub fn with_transfer_region(desc: &SceneDesc) -> SceneDesc {
     d
 }
 
+/// `desc` with its projectiles (props with a non-zero initial velocity) started `steps` steps
+/// into their free flight: translation `x + k h v + ½ g h² k (k + 1)` and velocity `v + k h g`,
+/// which is where and how fast rapier's symplectic Euler (velocity first, then position) carries
+/// them after `k = steps` free steps of length `h`. The impact happens `k` steps earlier, at the
+/// same place, with the same velocity; what rests on the scene has `k h` seconds less to settle
+/// before it. Used to shorten the costly soft rows (and every other row of the same comparison).
+/// `steps` must end before the first contact of the original flight (the caller's choice: the
+/// free flight is not checked against the scene).
+///
+/// # Errors
+/// A projectile that spins (`angvel`), is damped or is placed relative to an elastic object (the
+/// shift is written for plain translation in the world frame).
+pub fn with_projectiles_advanced(desc: &SceneDesc, steps: usize) -> Result<SceneDesc> {
+    let mut d = desc.clone();
+    if steps == 0 {
+        return Ok(d);
+    }
+    let (k, h, g) = (steps as f64, desc.h, desc.gravity);
+    for p in &mut d.props {
+        if p.fixed || p.linvel == [0.0; 3] {
+            continue;
+        }
+        if p.angvel != [0.0; 3] || p.linear_damping != 0.0 || p.relative_to.is_some() {
+            anyhow::bail!(
+                "scene {}: prop {} is a projectile that spins, is damped or is placed relative \
+                 to an elastic object; advancing its flight is only written for plain \
+                 translation (run this scene without --advance-steps)",
+                desc.name,
+                p.name
+            );
+        }
+        let t = &mut p.pose.translation;
+        for a in 0..3 {
+            t[a] += k * h * p.linvel[a] + 0.5 * g[a] * h * h * k * (k + 1.0);
+            p.linvel[a] += k * h * g[a];
+        }
+    }
+    Ok(d)
+}
+
 /// Runs one row in this process (its peak memory is this process's).
 ///
 /// # Errors
@@ -126,10 +173,12 @@ pub fn run_side(
         SideMethod::RapierFem {
             substeps,
             cg_iterations,
+            max_dense_dofs,
         } => {
             let mut p = SoftSceneParams::new(root);
             p.substeps = *substeps;
             p.cg_iterations = *cg_iterations;
+            p.max_dense_dofs = *max_dense_dofs;
             p.seconds = seconds;
             p.progress = progress;
             let r = run_soft_scene(desc, &p)?;
@@ -234,6 +283,8 @@ pub struct SweepParams {
     pub budget_s: f64,
     /// CG iteration cap of the sweep's rows. Default rapier's (20).
     pub cg_iterations: usize,
+    /// Direct-factorization limit of the sweep's rows (dofs). Default rapier's (600).
+    pub max_dense_dofs: usize,
 }
 
 impl Default for SweepParams {
@@ -245,6 +296,7 @@ impl Default for SweepParams {
             floor: 1e-3,
             budget_s: 1200.0,
             cg_iterations: SoftSceneParams::new(PathBuf::new()).cg_iterations,
+            max_dense_dofs: SoftSceneParams::new(PathBuf::new()).max_dense_dofs,
         }
     }
 }
@@ -272,6 +324,7 @@ pub fn sweep_substeps(
         let row = run(&SideMethod::RapierFem {
             substeps: n,
             cg_iterations: params.cg_iterations,
+            max_dense_dofs: params.max_dense_dofs,
         })?;
         if let Some(prev) = rows.last() {
             end.last_change = outcome_change(prev, &row, params.floor);
