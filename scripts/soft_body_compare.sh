@@ -9,6 +9,9 @@
 #   BUDGET_MIN=20 scripts/soft_body_compare.sh dinner roof
 #   COMPARE_ARGS="--seconds 0.5 --extra 1:200" scripts/soft_body_compare.sh dinner
 #     (COMPARE_ARGS: more `dcr-lab soft-body compare` options: run length, extra rows SUBSTEPS:CG)
+#   DCR_LAB=/path/to/dcr-lab scripts/soft_body_compare.sh dinner
+#     (run that binary instead of building one: a long run then survives rebuilds of the target
+#      directory, since `compare` re-runs its own executable for every row)
 #
 # Writes out/soft_body/compare.{md,json} and replaces the generated block of docs/benchmarks.md
 # (between the `soft-body-compare` markers) with the table, the command, date and load.
@@ -18,10 +21,13 @@ SCENES=(dinner)
 [ $# -gt 0 ] && SCENES=("$@")
 BUDGET_MIN="${BUDGET_MIN:-20}"
 TARGET="${CARGO_TARGET_DIR:-target}"
-cargo build --release --workspace --bins >&2
+if [ -z "${DCR_LAB:-}" ]; then
+  cargo build --release --workspace --bins >&2
+  DCR_LAB="$TARGET/release/dcr-lab"
+fi
 LOAD_BEFORE=$(uptime)
 START=$(date -u +%Y-%m-%dT%H:%MZ)
-"$TARGET/release/dcr-lab" soft-body compare "${SCENES[@]}" --budget-min "$BUDGET_MIN" \
+"$DCR_LAB" soft-body compare "${SCENES[@]}" --budget-min "$BUDGET_MIN" \
   --md out/soft_body/compare.md --json out/soft_body/compare.json ${COMPARE_ARGS:-}
 LOAD_AFTER=$(uptime)
 CPU=$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//')

@@ -1,8 +1,11 @@
 //! The rapier FEM soft body built from a tetrahedral mesh (`dcr_lab::soft_body`): the builder
 //! keeps the mesh, pinned particles stay put, a cantilever sags as linear elasticity says, and
-//! the dinner scene with a soft table and nothing hitting it keeps its plates at rest.
+//! the dinner scene with a soft table and nothing hitting it keeps its plates at rest, and a
+//! projectile started k steps into its flight continues rapier's own flight.
 
-use dcr_lab::soft_body::{run_soft_scene, tet_soft_body, SoftSceneParams, TetSoftBodyDesc};
+use dcr_lab::soft_body::{
+    run_soft_scene, tet_soft_body, with_projectiles_advanced, SoftSceneParams, TetSoftBodyDesc,
+};
 use faer::linalg::solvers::Solve;
 use modal_bake::fem::{assemble_clamped, Material};
 use modal_bake::mesh::TetMesh;
@@ -198,4 +201,50 @@ fn dinner_soft_table_at_rest_keeps_plates_down() {
             "{name}: {lift} mm with nothing hitting the table"
         );
     }
+}
+
+/// The pot of the dinner scene started `k` steps into its free flight
+/// (`with_projectiles_advanced`) is where rapier's own flight has it `k` steps after the
+/// scene's start, with the same velocity, at every step until it lands (rigid world of
+/// `build_world`, nothing else moves in flight), at 1 and at 4 substeps per step; the props at
+/// rest are not moved; a spinning projectile (the roof's toolbox) is refused by name.
+#[test]
+fn advanced_projectiles_continue_the_original_flight() {
+    use dcr_scenes::scene::{build_world, SceneDesc};
+    let root = dcr_scenes::repo_root();
+    let desc = SceneDesc::read(&root.join("scenes/dinner.json")).unwrap();
+    let k = 10;
+    let pot_after = |d: &SceneDesc, substeps: usize, steps: usize| {
+        let mut b = build_world(d, &root).unwrap();
+        b.world.integration_parameters.num_solver_iterations = substeps;
+        for _ in 0..steps {
+            b.world.step();
+        }
+        let i = b.bodies.iter().position(|x| x.name == "pot").unwrap();
+        let rb = &b.world.bodies[b.bodies[i].handle];
+        (rb.translation(), rb.linvel())
+    };
+    for substeps in [1, 4] {
+        let adv = with_projectiles_advanced(&desc, k, substeps).unwrap();
+        // The original pot lands after ~20 steps (0.4 m from 1 m/s, h = 0.01 s).
+        for j in [0, 1, 4, 8] {
+            let (x0, v0) = pot_after(&desc, substeps, k + j);
+            let (x1, v1) = pot_after(&adv, substeps, j);
+            assert!(
+                (x0 - x1).length() < 1e-12 && (v0 - v1).length() < 1e-12,
+                "{substeps} substeps, step {j}: original {x0:?} {v0:?}, advanced {x1:?} {v1:?}"
+            );
+        }
+        for (a, b) in desc.props.iter().zip(&adv.props) {
+            if a.name != "pot" {
+                assert_eq!(a.pose.translation, b.pose.translation, "{} moved", a.name);
+                assert_eq!(a.linvel, b.linvel);
+            }
+        }
+    }
+    let roof = SceneDesc::read(&root.join("scenes/roof.json")).unwrap();
+    let err = with_projectiles_advanced(&roof, 1, 4)
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("toolbox"), "{err}");
 }

@@ -61,6 +61,10 @@ pub struct RunArgs {
     /// (600; the dinner table has 3,048).
     #[arg(long, value_name = "N")]
     pub max_dense_dofs: Option<usize>,
+    /// rapier-fem: relative residual at which each conjugate gradient stops. Default rapier's
+    /// (1e-5).
+    #[arg(long, value_name = "TOL")]
+    pub cg_tolerance: Option<f64>,
     /// Simulated time (s). Default the scene's `seconds`.
     #[arg(long, value_name = "S")]
     pub seconds: Option<f64>,
@@ -178,6 +182,7 @@ fn side_method(a: &RunArgs) -> SideMethod {
             substeps: a.substeps.map_or(d.substeps, |n| n as usize),
             cg_iterations: a.cg_iterations.map_or(d.cg_iterations, |n| n as usize),
             max_dense_dofs: a.max_dense_dofs.unwrap_or(d.max_dense_dofs),
+            cg_tolerance: a.cg_tolerance.unwrap_or(d.cg_tolerance),
         },
         MethodArg::Modal => SideMethod::Modal,
         MethodArg::Transfer => SideMethod::Transfer,
@@ -187,9 +192,20 @@ fn side_method(a: &RunArgs) -> SideMethod {
 
 fn run_one(a: &RunArgs) -> Result<()> {
     if a.method != MethodArg::RapierFem
-        && (a.substeps.is_some() || a.cg_iterations.is_some() || a.max_dense_dofs.is_some())
+        && (a.substeps.is_some()
+            || a.cg_iterations.is_some()
+            || a.max_dense_dofs.is_some()
+            || a.cg_tolerance.is_some())
     {
-        bail!("--substeps, --cg-iterations and --max-dense-dofs apply to --method rapier-fem only");
+        bail!(
+            "--substeps, --cg-iterations, --max-dense-dofs and --cg-tolerance apply to --method \
+             rapier-fem only"
+        );
+    }
+    if let Some(t) = a.cg_tolerance {
+        if !(t > 0.0 && t < 1.0) {
+            bail!("--cg-tolerance {t}: must be a relative residual in (0, 1), e.g. 1e-8");
+        }
     }
     if let Some(s) = a.seconds {
         if !(s > 0.0 && s.is_finite()) {
@@ -197,8 +213,13 @@ fn run_one(a: &RunArgs) -> Result<()> {
         }
     }
     let path = scene_path(&a.root, &a.scene);
-    let desc = with_projectiles_advanced(&SceneDesc::read(&path)?, a.advance_steps)?;
     let method = side_method(a);
+    let substeps = match method {
+        SideMethod::RapierFem { substeps, .. } => substeps,
+        // `dcr-scenes` runs rapier's default substeps.
+        _ => rapier3d_f64::prelude::IntegrationParameters::default().num_solver_iterations,
+    };
+    let desc = with_projectiles_advanced(&SceneDesc::read(&path)?, a.advance_steps, substeps)?;
     let row = run_side(&desc, &method, a.root.clone(), a.seconds, a.progress)?;
     let json = serde_json::to_string_pretty(&row)? + "\n";
     match &a.json {
@@ -254,13 +275,16 @@ fn run_child(
             substeps,
             cg_iterations,
             max_dense_dofs,
+            cg_tolerance,
         } => {
             cmd.args(["--method", "rapier-fem", "--substeps"])
                 .arg(substeps.to_string())
                 .arg("--cg-iterations")
                 .arg(cg_iterations.to_string())
                 .arg("--max-dense-dofs")
-                .arg(max_dense_dofs.to_string());
+                .arg(max_dense_dofs.to_string())
+                .arg("--cg-tolerance")
+                .arg(cg_tolerance.to_string());
         }
         SideMethod::Modal => {
             cmd.args(["--method", "modal"]);
@@ -307,6 +331,7 @@ fn compare(a: &CompareArgs) -> Result<()> {
         with_projectiles_advanced(
             &SceneDesc::read(&scene_path(&a.root, scene))?,
             a.advance_steps,
+            1,
         )?;
         // Bake the bases first, in a row of their own that is not kept: a row whose process
         // bakes would report the eigensolver's memory and time, not the run's.
@@ -337,6 +362,7 @@ fn compare(a: &CompareArgs) -> Result<()> {
                 substeps,
                 cg_iterations,
                 max_dense_dofs,
+                cg_tolerance: params.cg_tolerance,
             };
             all.push(run_child(&a.root, scene, &m, a.seconds, a.advance_steps)?);
         }

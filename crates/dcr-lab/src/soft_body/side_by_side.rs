@@ -27,6 +27,9 @@ pub enum SideMethod {
         /// Bodies up to this many degrees of freedom answer their contacts through a direct
         /// factorization (rapier's `max_dense_dofs`), larger ones through the capped CG.
         max_dense_dofs: usize,
+        /// Relative residual at which each conjugate gradient stops (rapier's
+        /// `linear_tolerance`).
+        cg_tolerance: f64,
     },
     /// Rigid objects, the distant response over the 20-mode base (`--method modal`).
     Modal,
@@ -46,6 +49,7 @@ impl SideMethod {
                 substeps,
                 cg_iterations,
                 max_dense_dofs,
+                cg_tolerance,
             } => {
                 let d = SoftSceneParams::new(PathBuf::new());
                 let mut s = format!("rapier-fem, {substeps} substeps");
@@ -54,6 +58,9 @@ impl SideMethod {
                 }
                 if *max_dense_dofs != d.max_dense_dofs {
                     s.push_str(&format!(", direct ≤ {max_dense_dofs} dofs"));
+                }
+                if *cg_tolerance != d.cg_tolerance {
+                    s.push_str(&format!(", CG to {cg_tolerance:.0e}"));
                 }
                 s
             }
@@ -118,23 +125,33 @@ pub fn with_transfer_region(desc: &SceneDesc) -> SceneDesc {
 }
 
 /// `desc` with its projectiles (props with a non-zero initial velocity) started `steps` steps
-/// into their free flight: translation `x + k h v + ½ g h² k (k + 1)` and velocity `v + k h g`,
-/// which is where and how fast rapier's symplectic Euler (velocity first, then position) carries
-/// them after `k = steps` free steps of length `h`. The impact happens `k` steps earlier, at the
-/// same place, with the same velocity; what rests on the scene has `k h` seconds less to settle
-/// before it. Used to shorten the costly soft rows (and every other row of the same comparison).
-/// `steps` must end before the first contact of the original flight (the caller's choice: the
-/// free flight is not checked against the scene).
+/// into their free flight in a world of `substeps` substeps per step: with `m = steps ·
+/// substeps` substeps of `δ = h / substeps`, translation `x + m δ v + ½ g δ² m (m + 1)` and
+/// velocity `v + m δ g`, which is where and how fast rapier's symplectic Euler (velocity first,
+/// then position, once per substep) carries them. The impact then happens `steps` steps earlier,
+/// at the same place, with the same velocity, as in the whole scene run with the same substeps;
+/// what rests on the scene has `steps · h` seconds less to settle before it. Used to shorten the
+/// costly soft rows (and every other row of the same comparison). `steps` must end before the
+/// first contact of the original flight (the caller's choice: the flight is not checked against
+/// the scene).
 ///
 /// # Errors
 /// A projectile that spins (`angvel`), is damped or is placed relative to an elastic object (the
-/// shift is written for plain translation in the world frame).
-pub fn with_projectiles_advanced(desc: &SceneDesc, steps: usize) -> Result<SceneDesc> {
+/// shift is written for plain translation in the world frame); `substeps` 0.
+pub fn with_projectiles_advanced(
+    desc: &SceneDesc,
+    steps: usize,
+    substeps: usize,
+) -> Result<SceneDesc> {
+    if substeps == 0 {
+        anyhow::bail!("substeps must be at least 1");
+    }
     let mut d = desc.clone();
     if steps == 0 {
         return Ok(d);
     }
-    let (k, h, g) = (steps as f64, desc.h, desc.gravity);
+    let m = (steps * substeps) as f64;
+    let (dt, g) = (desc.h / substeps as f64, desc.gravity);
     for p in &mut d.props {
         if p.fixed || p.linvel == [0.0; 3] {
             continue;
@@ -150,8 +167,8 @@ pub fn with_projectiles_advanced(desc: &SceneDesc, steps: usize) -> Result<Scene
         }
         let t = &mut p.pose.translation;
         for a in 0..3 {
-            t[a] += k * h * p.linvel[a] + 0.5 * g[a] * h * h * k * (k + 1.0);
-            p.linvel[a] += k * h * g[a];
+            t[a] += m * dt * p.linvel[a] + 0.5 * g[a] * dt * dt * m * (m + 1.0);
+            p.linvel[a] += m * dt * g[a];
         }
     }
     Ok(d)
@@ -174,8 +191,10 @@ pub fn run_side(
             substeps,
             cg_iterations,
             max_dense_dofs,
+            cg_tolerance,
         } => {
             let mut p = SoftSceneParams::new(root);
+            p.cg_tolerance = *cg_tolerance;
             p.substeps = *substeps;
             p.cg_iterations = *cg_iterations;
             p.max_dense_dofs = *max_dense_dofs;
@@ -285,6 +304,8 @@ pub struct SweepParams {
     pub cg_iterations: usize,
     /// Direct-factorization limit of the sweep's rows (dofs). Default rapier's (600).
     pub max_dense_dofs: usize,
+    /// Relative residual of the sweep's conjugate gradients. Default rapier's (1e-5).
+    pub cg_tolerance: f64,
 }
 
 impl Default for SweepParams {
@@ -297,6 +318,7 @@ impl Default for SweepParams {
             budget_s: 1200.0,
             cg_iterations: SoftSceneParams::new(PathBuf::new()).cg_iterations,
             max_dense_dofs: SoftSceneParams::new(PathBuf::new()).max_dense_dofs,
+            cg_tolerance: SoftSceneParams::new(PathBuf::new()).cg_tolerance,
         }
     }
 }
@@ -325,6 +347,7 @@ pub fn sweep_substeps(
             substeps: n,
             cg_iterations: params.cg_iterations,
             max_dense_dofs: params.max_dense_dofs,
+            cg_tolerance: params.cg_tolerance,
         })?;
         if let Some(prev) = rows.last() {
             end.last_change = outcome_change(prev, &row, params.floor);
