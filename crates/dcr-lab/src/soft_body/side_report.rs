@@ -5,6 +5,7 @@ use std::fmt::Write as _;
 use serde::{Deserialize, Serialize};
 
 use super::side_by_side::{SideMethod, SideRow, SweepEnd};
+use super::soft_scene::SoftSceneParams;
 
 /// One scene's rows: the rapier-FEM sweep, the dcr rows and the no-response row.
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -85,7 +86,15 @@ pub fn render_markdown(scenes: &[SceneComparison]) -> String {
         for r in &sc.rows {
             let mut label = r.method.label();
             if let SideMethod::RapierFem { substeps, .. } = r.method {
-                if substeps == sc.default_substeps {
+                // rapier's default: its substeps and every solver setting at rapier's own value.
+                let d = SoftSceneParams::new(std::path::PathBuf::new());
+                let default = SideMethod::RapierFem {
+                    substeps: sc.default_substeps,
+                    cg_iterations: d.cg_iterations,
+                    max_dense_dofs: d.max_dense_dofs,
+                    cg_tolerance: d.cg_tolerance,
+                };
+                if r.method == default {
                     label.push_str(" (rapier's default)");
                 }
                 if sc.sweep.converged && substeps == sc.sweep.last_substeps {
