@@ -112,6 +112,12 @@ fn pinned_particles_do_not_move() {
 /// under gravity: `K u = M g` on the same mesh with the baker's assembly (lumped mass, the
 /// clamped dofs removed), solved densely; the mean over the tip face's nodes.
 fn p1_static_tip_deflection() -> f64 {
+    p1_tip_deflection(true, &[])
+}
+
+/// The same model's static tip deflection (m, downward positive) under its own weight (when
+/// `gravity`) and downward nodal forces `loads` (node, N).
+fn p1_tip_deflection(gravity: bool, loads: &[(usize, f64)]) -> f64 {
     let mesh = cantilever_mesh();
     let mat = Material::new(1.0e7, 0.0, 100.0).unwrap();
     let fixed = mesh.groups["xmin"].clone();
@@ -120,10 +126,15 @@ fn p1_static_tip_deflection() -> f64 {
     let kd = k.to_dense();
     let md = m.to_dense();
     let mut f = faer::Mat::<f64>::zeros(n, 1);
-    for (i, &dof) in map.free_dofs().iter().enumerate() {
-        if dof % 3 == 1 {
-            f[(i, 0)] = -9.81 * md[(i, i)];
+    if gravity {
+        for (i, &dof) in map.free_dofs().iter().enumerate() {
+            if dof % 3 == 1 {
+                f[(i, 0)] = -9.81 * md[(i, i)];
+            }
         }
+    }
+    for &(node, force) in loads {
+        f[(map.free_index(3 * node + 1).unwrap(), 0)] -= force;
     }
     let llt = kd.llt(faer::Side::Lower).unwrap();
     let u = llt.solve(&f);
@@ -247,4 +258,76 @@ fn advanced_projectiles_continue_the_original_flight() {
         .unwrap_err()
         .to_string();
     assert!(err.contains("toolbox"), "{err}");
+}
+
+/// A 0.5 kg box resting on the cantilever's free end, its contact answered through rapier's
+/// direct factorization (`max_dense_dofs` above the body's 189 dofs) and through the conjugate
+/// gradient (`max_dense_dofs` 0), both run to tolerance: the two settle to the same tip sag
+/// (within 1 %), and the sag the box adds is what the P1 static model gives for its weight
+/// (within 2 %: where the box's contact points fall inside the element is the one modelling
+/// choice), put on the top nodes of the last element's cross-section lines x = 0.95 m and
+/// 1 m half each (the box's centre is midway), 1 : 2 : 1 across the width.
+#[test]
+fn box_on_cantilever_sags_it_as_p1_through_either_contact_solve() {
+    let mesh = cantilever_mesh();
+    let (bare_world, bare_h, start) = settle_cantilever(300, 1000);
+    let tip = &mesh.groups["xmax"];
+    let mean_sag = |world: &PhysicsWorld, h: SoftBodyHandle| {
+        tip.iter()
+            .map(|&n| start[n][1] - world.soft_bodies[h].particle_position(n).y)
+            .sum::<f64>()
+            / tip.len() as f64
+    };
+    let bare = mean_sag(&bare_world, bare_h);
+
+    let (mass, g) = (0.5, 9.81);
+    let loaded = |max_dense_dofs: usize| {
+        let sb = tet_soft_body(&mesh, &cantilever_desc()).unwrap();
+        let mut world = PhysicsWorld::new();
+        let fem = &mut world.integration_parameters.soft_bodies.fem;
+        fem.max_linear_iterations = 1000;
+        fem.max_dense_dofs = max_dense_dofs;
+        let h = world.insert_soft_body(sb.builder);
+        // 2 cm × 2 cm × 8 cm over the middle of the last element's top (y = 0.1 m).
+        world.insert(
+            RigidBodyBuilder::dynamic().translation(Vector::new(0.975, 0.1 + 0.0102, 0.05)),
+            ColliderBuilder::cuboid(0.01, 0.01, 0.04)
+                .mass(mass)
+                .friction(0.8),
+        );
+        for _ in 0..300 {
+            world.step();
+        }
+        mean_sag(&world, h)
+    };
+    let direct = loaded(10_000);
+    let cg = loaded(0);
+    assert!(
+        (direct - cg).abs() < 0.01 * direct,
+        "tip sag with the box: direct {direct} m, CG {cg} m"
+    );
+
+    let weight = mass * g;
+    let mut loads = Vec::new();
+    for (n, p) in mesh.nodes.iter().enumerate() {
+        let top = (p[1] - 0.1).abs() < 1e-9;
+        let line = (p[0] - 0.95).abs() < 1e-9 || (p[0] - 1.0).abs() < 1e-9;
+        if top && line {
+            let across = if (p[2] - 0.05).abs() < 1e-9 {
+                0.5
+            } else {
+                0.25
+            };
+            loads.push((n, 0.5 * across * weight));
+        }
+    }
+    assert_eq!(loads.len(), 6);
+    let added_p1 = p1_tip_deflection(false, &loads);
+    for (name, sag) in [("direct", direct), ("CG", cg)] {
+        let added = sag - bare;
+        assert!(
+            (added - added_p1).abs() < 0.02 * added_p1,
+            "{name}: the box adds {added} m of tip sag, P1 static {added_p1} m"
+        );
+    }
 }
