@@ -42,7 +42,7 @@ pub enum SideMethod {
 }
 
 impl SideMethod {
-    /// A short label for tables (`rapier-fem 8 substeps`, `dcr 20 modes`, ...).
+    /// A short label for tables (`rapier-fem, 8 substeps`, `dcr, 20 modes (rigid object)`, ...).
     pub fn label(&self) -> String {
         match self {
             SideMethod::RapierFem {
@@ -64,9 +64,9 @@ impl SideMethod {
                 }
                 s
             }
-            SideMethod::Modal => "dcr, 20 modes (rigid table)".into(),
-            SideMethod::Transfer => "dcr, ★ table (rigid table)".into(),
-            SideMethod::Off => "no response (rigid table)".into(),
+            SideMethod::Modal => "dcr, 20 modes (rigid object)".into(),
+            SideMethod::Transfer => "dcr, ★ table (rigid object)".into(),
+            SideMethod::Off => "no response (rigid object)".into(),
         }
     }
 }
