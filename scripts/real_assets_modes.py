@@ -252,8 +252,11 @@ def render(rows):
         d, ref = r["default"], r.get("reference")
         if not d["ok"]:
             msg = d["error"].splitlines()[0][:200]
-            if "refused" in d["error"]:
-                msg = "refused by the default budget: " + msg.split(": ", 2)[-1]
+            est = re.search(r"refused before meshing or baking: estimated (.*?) is over",
+                            d["error"])
+            if est:
+                when = "" if "backend" in d else " before meshing"
+                msg = f"refused{when} by the default budget: {est.group(1)}"
             meshed = f"meshed in {d['mesh_s']} s; " if "backend" in d else ""
             lines.append(f"{head} | {d.get('backend', '—')} | {meshed}{msg} | | | | | {load} |")
             continue

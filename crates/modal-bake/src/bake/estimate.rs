@@ -76,6 +76,11 @@ impl Default for Budget {
     }
 }
 
+/// How many times the model's tetrahedra fTetWild makes at the same `--size`: the geometric
+/// mean over the three real assets it meshes at the defaults (Suzanne, the teapot, the dragon:
+/// 3.1, 1.9 and 2.9 times; docs/artist-guide.md § 7).
+pub const FTETWILD_ELEMENTS: f64 = 2.5;
+
 /// Tetrahedra per V/h³ (c_V) and per boundary triangle (c_F).
 const TETS_PER_VOLUME: f64 = 3.6;
 const TETS_PER_BOUNDARY_TRI: f64 = 1.7;
@@ -210,6 +215,21 @@ impl SizeEstimate {
         };
         e.bake();
         e
+    }
+
+    /// The same estimate for a mesher that makes `k` times the tetrahedra (and nodes) of the
+    /// model: fTetWild fills a surface with about [`FTETWILD_ELEMENTS`] times what gmsh makes
+    /// at the same `--size` (its edge length is an ideal, refined near the envelope).
+    pub fn scaled(mut self, k: f64) -> SizeEstimate {
+        let k = if k.is_finite() && k > 0.0 { k } else { 1.0 };
+        self.mesh_s += MESH_S_PER_TET * (k - 1.0) * self.tets;
+        self.mesh_bytes += MESH_B_PER_TET * (k - 1.0) * self.tets;
+        self.tets *= k;
+        self.nodes *= k;
+        self.dofs *= k;
+        self.boundary *= k;
+        self.bake();
+        self
     }
 
     /// The estimate for baking `modes` modes of a tetrahedral mesh with `nodes` nodes (mid-edge

@@ -83,9 +83,23 @@ impl BudgetOptions {
         // alone: estimate at the equivalent uniform size.
         let curvature = !asset.uniform_size && !asset.keep_surface;
         let thickness = !asset.no_thickness_sizing && !asset.keep_surface;
+        // fTetWild (forced, or auto on a surface that does not bound one solid as it is)
+        // makes more elements than gmsh at the same size.
+        let ftetwild = match asset.mesher {
+            super::mesh::MesherArg::Ftetwild => true,
+            super::mesh::MesherArg::Gmsh => false,
+            super::mesh::MesherArg::Auto => {
+                !modal_bake::mesh::surface::inspect_surface(&s).is_solid()
+            }
+        };
+        let k = if ftetwild {
+            modal_bake::bake::FTETWILD_ELEMENTS
+        } else {
+            1.0
+        };
         let est = |size: f64, order: u8| {
             let h = modal_bake::mesh::sizing::equivalent_size(&s, size, curvature, thickness);
-            SizeEstimate::of_surface(&measures, h, asset.keep_surface, order, modes)
+            SizeEstimate::of_surface(&measures, h, asset.keep_surface, order, modes).scaled(k)
         };
         let fits = |e: &SizeEstimate| e.fits(&budget);
         let e = est(size, order);
@@ -99,6 +113,11 @@ impl BudgetOptions {
                 format!(
                     ", --keep-surface: its {:.4e} m triangles set the size",
                     measures.mean_edge()
+                )
+            } else if ftetwild {
+                format!(
+                    ", fTetWild: about {} times gmsh's elements",
+                    modal_bake::bake::FTETWILD_ELEMENTS
                 )
             } else if curvature || thickness {
                 format!(

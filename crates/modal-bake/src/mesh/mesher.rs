@@ -393,8 +393,7 @@ pub fn mesh_surface(
         surface,
         &inspection,
         params,
-        curvature,
-        grid.as_ref(),
+        (curvature, grid.as_ref()),
         file,
         progress,
     );
@@ -416,8 +415,7 @@ pub fn mesh_surface(
                 surface,
                 &inspection,
                 params,
-                curvature,
-                grid.as_ref(),
+                (curvature, grid.as_ref()),
                 file,
                 progress,
             ) {
@@ -509,8 +507,7 @@ fn run_backend(
     surface: &SurfaceMesh,
     inspection: &SurfaceInspection,
     params: &MeshParams,
-    curvature: Option<u32>,
-    grid: Option<&super::sizing::SizeGrid>,
+    (curvature, grid): (Option<u32>, Option<&super::sizing::SizeGrid>),
     file: &str,
     progress: &dyn Fn(&str),
 ) -> Result<(Made, MeshReport), AssetError> {
