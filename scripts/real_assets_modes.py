@@ -126,8 +126,9 @@ def stl_diagonal(path):
     return float(np.linalg.norm(pts.max(0) - pts.min(0)))
 
 
-def run(cmd, timeout):
-    """Runs `cmd` under /usr/bin/time -v; returns (ok, stdout, stderr tail, wall s, peak MiB)."""
+def run(cmd, timeout, full_err=None):
+    """Runs `cmd` under /usr/bin/time -v; returns (ok, stdout, stderr tail, wall s, peak MiB).
+    `full_err`, a list, receives the whole stderr."""
     t = time.time()
     p = subprocess.Popen(["/usr/bin/time", "-v"] + [str(c) for c in cmd], stdout=subprocess.PIPE,
                          stderr=subprocess.PIPE, text=True, start_new_session=True)
@@ -138,6 +139,8 @@ def run(cmd, timeout):
         out, err = p.communicate()
         return False, "", f"stopped after {timeout} s", time.time() - t, None
     wall = time.time() - t
+    if full_err is not None:
+        full_err.append(err)
     rss = re.search(r"Maximum resident set size \(kbytes\): (\d+)", err)
     peak = int(rss.group(1)) / 1024 if rss else None
     return p.returncode == 0, out, err.strip()[-2000:], wall, peak
@@ -153,14 +156,20 @@ def mesh_and_bake(binary, asset, tag, units, material, size, timeout, extra=()):
     if size is not None:
         cmd += ["--size", repr(size)]
     cmd += list(extra)
-    ok, out, err, wall, peak = run(cmd, timeout)
+    full = []
+    ok, out, err, wall, peak = run(cmd, timeout, full)
     r = {"mesh_cmd": " ".join(str(c) for c in cmd[1:]), "mesh_s": round(wall, 1),
          "mesh_peak_mib": peak and round(peak, 1)}
+    # The size estimate printed before meshing: "size estimate for …: ~N tetrahedra (order
+    # o), ~N nodes, ~N dofs; …".
+    est = re.search(r"size estimate for .*?~([\d,]+) dofs", full[0] if full else "")
+    r["estimated_dofs"] = int(est.group(1).replace(",", "")) if est else None
     if not ok:
         return {**r, "ok": False, "error": f"mesh: {err}"}
     m = json.loads(out)
     rep = m["report"]
     r.update(backend=rep["backend"], fallback=rep["fallback_from"], tets=m["tets"], size_m=rep["size_m"],
+             sizing=rep.get("sizing"), wall_size_m=rep.get("wall_size_m"),
              nodes=m["nodes"], dofs=m["dofs"], hausdorff_rel=rep["distance"]["relative"])
     cmd = [binary, "bake", msh, "-o", modes, "--material", material, "--json", *extra]
     ok, out, err, wall, peak = run(cmd, timeout)
@@ -243,8 +252,11 @@ def render(rows):
         d, ref = r["default"], r.get("reference")
         if not d["ok"]:
             msg = d["error"].splitlines()[0][:200]
-            if "refused" in d["error"]:
-                msg = "refused by the default budget: " + msg.split(": ", 2)[-1]
+            est = re.search(r"refused before meshing or baking: estimated (.*?) is over",
+                            d["error"])
+            if est:
+                when = "" if "backend" in d else " before meshing"
+                msg = f"refused{when} by the default budget: {est.group(1)}"
             meshed = f"meshed in {d['mesh_s']} s; " if "backend" in d else ""
             lines.append(f"{head} | {d.get('backend', '—')} | {meshed}{msg} | | | | | {load} |")
             continue

@@ -331,7 +331,10 @@ fn real_asset_mesh_bake_probe_and_a_holed_copy() {
     let mesh_args = |out: &Path| {
         let mut c = bin();
         c.arg("mesh").arg(&asset).arg("-o").arg(out);
+        // One size per curvature (no thickness-aware sizing): a light mesh of the real asset,
+        // the same as before thickness-aware sizing existed.
         c.args(["--units", "mm", "--size", "0.006", "--order", "2"]);
+        c.arg("--no-thickness-sizing");
         c
     };
     run(&mut mesh_args(&msh));

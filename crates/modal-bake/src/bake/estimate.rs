@@ -16,12 +16,18 @@
 //!   m = 20 + 6 modes as calibrated; the Lanczos half assumed linear in m), peak memory
 //!   B_o + b_o n^(4/3) + 24 n · max(0, m − 26) bytes (the sparse factor's fill grows as
 //!   n^(4/3) for 3-D meshes under nested dissection; each further mode adds Lanczos vectors).
+//!   At order 2, b₂ runs linearly from 170 bytes for a thin-walled mesh (r = T/F ≤ 1.6
+//!   tetrahedra per boundary triangle: all boundary layer, whose separators are those of a
+//!   surface) to 300 bytes for a compact one (r ≥ 6).
 //!
 //! Calibration: the coefficients are least-squares fits (relative residuals; log space for the
 //! power law) to nine `modal-bake mesh` + `bake` runs under `/usr/bin/time` — gmsh's tutorial
 //! STL (1,580 triangles, a thin-walled part) at three sizes and a 0.1 m box at four, both
 //! orders, 20 modes — plus the tutorial STL refined to 50,864 triangles for k_tri and β_tri
-//! (`scripts/calibrate_estimate.sh`, figures in docs/benchmarks.md § Size estimates). Times
+//! (`scripts/calibrate_estimate.sh`, figures in docs/benchmarks.md § Size estimates); b₂'s
+//! two ends from the box's order-2 bakes (r 6–8: 295–328 bytes) and four order-2 bakes of the
+//! tutorial part with thickness-aware sizing, 0.9–3.0·10⁵ dofs (r 1.5–1.7: 156–185 bytes;
+//! docs/benchmarks.md § Size estimates). Times
 //! are CPU seconds (user + system), which is the wall time of an otherwise idle machine; the
 //! machine was loaded when they were measured, so its wall times were longer. How close the
 //! estimates came over those runs is in the same section. The estimate aims at the order of
@@ -38,6 +44,8 @@ pub struct SizeEstimate {
     pub nodes: f64,
     /// Degrees of freedom (3 per node).
     pub dofs: f64,
+    /// Boundary triangles of the tetrahedral mesh (0 when unknown: taken as compact).
+    pub boundary: f64,
     /// Modes requested (elastic, plus six rigid ones free-free).
     pub modes: usize,
     /// Wall time of gmsh (s); 0 for a mesh already tetrahedral.
@@ -68,6 +76,11 @@ impl Default for Budget {
     }
 }
 
+/// How many times the model's tetrahedra fTetWild makes at the same `--size`: the geometric
+/// mean over the three real assets it meshes at the defaults (Suzanne, the teapot, the dragon:
+/// 3.1, 1.9 and 2.9 times; docs/artist-guide.md § 7).
+pub const FTETWILD_ELEMENTS: f64 = 2.5;
+
 /// Tetrahedra per V/h³ (c_V) and per boundary triangle (c_F).
 const TETS_PER_VOLUME: f64 = 3.6;
 const TETS_PER_BOUNDARY_TRI: f64 = 1.7;
@@ -84,9 +97,15 @@ const MESH_B_PER_TET: f64 = 425.0;
 /// Bake CPU time: seconds at 10⁴ free dofs per order, and the exponent.
 const BAKE_T: [f64; 2] = [0.30, 0.27];
 const BAKE_T_EXP: f64 = 1.64;
-/// Bake memory per order: base (bytes) and factor bytes per n^(4/3).
+/// Bake memory per order: base (bytes) and factor bytes per n^(4/3) (order 2: of a compact
+/// mesh, [`R_SOLID`] or more tetrahedra per boundary triangle).
 const BAKE_B0: [f64; 2] = [17e6, 85e6];
-const BAKE_B_FILL: [f64; 2] = [330.0, 240.0];
+const BAKE_B_FILL: [f64; 2] = [330.0, 300.0];
+/// Order 2: factor bytes per n^(4/3) of a thin-walled mesh, [`R_THIN`] or fewer tetrahedra
+/// per boundary triangle (its separators are those of a surface: less fill).
+const BAKE_B_FILL_THIN: f64 = 170.0;
+const R_THIN: f64 = 1.6;
+const R_SOLID: f64 = 6.0;
 /// Modes (20 elastic + 6 rigid) the bake coefficients were measured at.
 const CALIBRATED_MODES: f64 = 26.0;
 
@@ -188,6 +207,7 @@ impl SizeEstimate {
             order,
             nodes,
             dofs: 3.0 * nodes,
+            boundary,
             modes,
             mesh_s: MESH_T0 + MESH_S_PER_TRI * rebuilt + MESH_S_PER_TET * tets,
             mesh_bytes: MESH_B0 + MESH_B_PER_TRI * s.triangles as f64 + MESH_B_PER_TET * tets,
@@ -197,19 +217,56 @@ impl SizeEstimate {
         e
     }
 
+    /// The same estimate for a mesher that makes `k` times the tetrahedra (and nodes) of the
+    /// model: fTetWild fills a surface with about [`FTETWILD_ELEMENTS`] times what gmsh makes
+    /// at the same `--size` (its edge length is an ideal, refined near the envelope).
+    pub fn scaled(mut self, k: f64) -> SizeEstimate {
+        let k = if k.is_finite() && k > 0.0 { k } else { 1.0 };
+        self.mesh_s += MESH_S_PER_TET * (k - 1.0) * self.tets;
+        self.mesh_bytes += MESH_B_PER_TET * (k - 1.0) * self.tets;
+        self.tets *= k;
+        self.nodes *= k;
+        self.dofs *= k;
+        self.boundary *= k;
+        self.bake();
+        self
+    }
+
     /// The estimate for baking `modes` modes of a tetrahedral mesh with `nodes` nodes (mid-edge
-    /// nodes included at order 2) and `tets` tetrahedra.
-    pub fn of_mesh(nodes: usize, tets: usize, order: u8, modes: usize) -> SizeEstimate {
+    /// nodes included at order 2), `tets` tetrahedra and `boundary` boundary triangles (0 when
+    /// unknown).
+    pub fn of_mesh(
+        nodes: usize,
+        tets: usize,
+        boundary: usize,
+        order: u8,
+        modes: usize,
+    ) -> SizeEstimate {
         let mut e = SizeEstimate {
             tets: tets as f64,
             order,
             nodes: nodes as f64,
             dofs: 3.0 * nodes as f64,
+            boundary: boundary as f64,
             modes,
             ..Default::default()
         };
         e.bake();
         e
+    }
+
+    /// The factor's bytes per n^(4/3) (b_o in the module doc): at order 2 from 170 (thin-walled,
+    /// T/F ≤ 1.6) to 300 (compact, T/F ≥ 6, or the boundary unknown).
+    fn fill_per_n43(&self) -> f64 {
+        if self.order != 2 {
+            return BAKE_B_FILL[0];
+        }
+        if !(self.boundary > 0.0) {
+            return BAKE_B_FILL[1];
+        }
+        let r = self.tets / self.boundary;
+        let w = ((r - R_THIN) / (R_SOLID - R_THIN)).clamp(0.0, 1.0);
+        BAKE_B_FILL_THIN + (BAKE_B_FILL[1] - BAKE_B_FILL_THIN) * w
     }
 
     /// Fills in the bake's time and memory from the dofs, order and modes.
@@ -219,7 +276,7 @@ impl SizeEstimate {
         let m = self.modes as f64;
         self.bake_s = BAKE_T[o] * (n / 1e4).powf(BAKE_T_EXP) * (1.0 + m / CALIBRATED_MODES) / 2.0;
         self.bake_bytes = BAKE_B0[o]
-            + BAKE_B_FILL[o] * n.powf(4.0 / 3.0)
+            + self.fill_per_n43() * n.powf(4.0 / 3.0)
             + 24.0 * n * (m - CALIBRATED_MODES).max(0.0);
     }
 

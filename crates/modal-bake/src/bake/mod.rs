@@ -30,6 +30,7 @@ pub use crate::mesh::extract_surface;
 pub use error::BakeError;
 pub use estimate::{
     format_bytes, format_count, format_seconds, Budget, SizeEstimate, SurfaceMeasures,
+    FTETWILD_ELEMENTS,
 };
 pub use fixed_near::{FixedNear, DEFAULT_DISTANCE_FRACTION};
 pub use hashing::{geometry_hash, round_16_digits};

@@ -82,9 +82,24 @@ impl BudgetOptions {
         // gmsh's curvature-driven sizes put more elements on a curved surface than `size`
         // alone: estimate at the equivalent uniform size.
         let curvature = !asset.uniform_size && !asset.keep_surface;
+        let thickness = !asset.no_thickness_sizing && !asset.keep_surface;
+        // fTetWild (forced, or auto on a surface that does not bound one solid as it is)
+        // makes more elements than gmsh at the same size.
+        let ftetwild = match asset.mesher {
+            super::mesh::MesherArg::Ftetwild => true,
+            super::mesh::MesherArg::Gmsh => false,
+            super::mesh::MesherArg::Auto => {
+                !modal_bake::mesh::surface::inspect_surface(&s).is_solid()
+            }
+        };
+        let k = if ftetwild {
+            modal_bake::bake::FTETWILD_ELEMENTS
+        } else {
+            1.0
+        };
         let est = |size: f64, order: u8| {
-            let h = modal_bake::mesh::sizing::equivalent_size(&s, size, curvature);
-            SizeEstimate::of_surface(&measures, h, asset.keep_surface, order, modes)
+            let h = modal_bake::mesh::sizing::equivalent_size(&s, size, curvature, thickness);
+            SizeEstimate::of_surface(&measures, h, asset.keep_surface, order, modes).scaled(k)
         };
         let fits = |e: &SizeEstimate| e.fits(&budget);
         let e = est(size, order);
@@ -99,10 +114,20 @@ impl BudgetOptions {
                     ", --keep-surface: its {:.4e} m triangles set the size",
                     measures.mean_edge()
                 )
-            } else if curvature {
+            } else if ftetwild {
                 format!(
-                    ", finer where curved: as many elements as a uniform {:.4e} m",
-                    modal_bake::mesh::sizing::equivalent_size(&s, size, true)
+                    ", fTetWild: about {} times gmsh's elements",
+                    modal_bake::bake::FTETWILD_ELEMENTS
+                )
+            } else if curvature || thickness {
+                format!(
+                    ", finer where {}: as many elements as a uniform {:.4e} m",
+                    match (curvature, thickness) {
+                        (true, true) => "curved or thin",
+                        (true, false) => "curved",
+                        _ => "thin",
+                    },
+                    modal_bake::mesh::sizing::equivalent_size(&s, size, curvature, thickness)
                 )
             } else {
                 String::new()
@@ -121,7 +146,12 @@ impl BudgetOptions {
                 size,
                 SizeEstimate::of_surface(
                     &measures,
-                    modal_bake::mesh::sizing::equivalent_size(&s, size, !asset.uniform_size),
+                    modal_bake::mesh::sizing::equivalent_size(
+                        &s,
+                        size,
+                        !asset.uniform_size,
+                        !asset.no_thickness_sizing
+                    ),
                     false,
                     order,
                     modes
@@ -163,7 +193,8 @@ impl BudgetOptions {
     ) -> anyhow::Result<SizeEstimate> {
         let budget = self.budget()?;
         let order = if mesh.is_quadratic() { 2 } else { 1 };
-        let e = SizeEstimate::of_mesh(mesh.nodes.len(), mesh.tets.len(), order, modes);
+        let boundary = modal_bake::mesh::extract_surface(mesh).1.len();
+        let e = SizeEstimate::of_mesh(mesh.nodes.len(), mesh.tets.len(), boundary, order, modes);
         if e.bake_s >= 10.0 || !e.fits(&budget) {
             eprintln!("size estimate for baking {file}: {}", e.describe());
         }

@@ -127,6 +127,11 @@ pub struct AssetOptions {
     /// surface curves).
     #[arg(long)]
     pub uniform_size: bool,
+    /// Surface assets, gmsh remeshing: no thickness-aware sizing. By default the elements in a
+    /// wall thinner than half the size are at most twice its thickness (measured by rays cast
+    /// along the inward normals; never below size/4), so thin walls are not too stiff.
+    #[arg(long)]
+    pub no_thickness_sizing: bool,
     /// Surface assets: element order, 1 (4-node tetrahedra) or 2 (10-node, straight-sided;
     /// far more accurate per degree of freedom) [default: 2; 1 with --transfer-h, whose table
     /// needs 4-node tetrahedra].
@@ -179,6 +184,7 @@ impl AssetOptions {
             timeout: modal_bake::mesh::work::timeout_of(self.mesher_timeout)
                 .map_err(anyhow::Error::msg)?,
             curvature: !self.uniform_size,
+            thickness: !self.no_thickness_sizing,
         })
     }
 
@@ -190,6 +196,7 @@ impl AssetOptions {
             || self.gmsh.is_some()
             || self.keep_surface
             || self.uniform_size
+            || self.no_thickness_sizing
             || self.mesher != MesherArg::Auto
             || self.envelope.is_some()
             || self.ftetwild.is_some()
@@ -250,11 +257,13 @@ pub fn mesh_asset(asset: &Path, options: &AssetOptions) -> anyhow::Result<Meshed
     if let Some(f) = &r.fallback_from {
         eprintln!("  fallback: {f}");
     }
-    if let Some(t) = r.thin_parts_m.filter(|t| r.size_m > 2.0 * t) {
+    eprintln!("  sizing: {}", r.sizing);
+    let finest = r.wall_size_m.unwrap_or(r.size_m);
+    if let Some(t) = r.thin_parts_m.filter(|t| finest > 2.0 * t) {
         eprintln!(
-            "warning: {}: the thinnest parts (5 % of the surface) are {t:.3e} m thick and the size is {:.3e} m: walls thinner than half an element are too stiff in bending, so the lowest frequencies may come out high; check with --target-error PCT, or give --size {:.3e} (twice their thickness) if the budget allows",
+            "warning: {}: the thinnest parts (5 % of the surface) are {t:.3e} m thick and the elements there are up to {:.3e} m: walls thinner than half an element are too stiff in bending, so the lowest frequencies may come out high; check with --target-error PCT, or give --size {:.3e} (twice their thickness) if the budget allows",
             asset.display(),
-            r.size_m,
+            finest,
             2.0 * t
         );
     }

@@ -6,7 +6,9 @@
 //! triangles (exact decimal coordinates) with a `.geo` script that, by default, classifies it
 //! into patches (feature angle 40°), rebuilds a geometry and remeshes it at the requested size
 //! (gmsh tutorial t13) — uniformly, or finer where the surface curves
-//! ([`GmshParams::curvature_elements`], gmsh's `Mesh.MeshSizeFromCurvature`) — or keeps the
+//! ([`GmshParams::curvature_elements`], gmsh's `Mesh.MeshSizeFromCurvature`), and no larger
+//! than a thickness-aware size field in thin walls ([`GmshParams::size_grid`], gmsh's
+//! `Structured` background field read from `sizes.dat`) — or keeps the
 //! asset's triangles as the boundary (`keep_surface`), then fills the volume (Frontal-Delaunay 2D, Delaunay 3D). Second order uses straight-sided
 //! elements (`Mesh.SecondOrderLinear = 1`), which the P2 assembly requires.
 //!
@@ -51,6 +53,10 @@ pub struct GmshParams {
     /// never above `size`; 0 (the default here) for a uniform `size`. Ignored with
     /// `keep_surface`.
     pub curvature_elements: u32,
+    /// Thickness-aware sizes when remeshing ([`super::sizing::thickness_grid`]): gmsh's
+    /// `Structured` background field, combined with the size and the curvature sizes by
+    /// taking the smallest. `None` (the default here): none. Ignored with `keep_surface`.
+    pub size_grid: Option<super::sizing::SizeGrid>,
 }
 
 impl Default for GmshParams {
@@ -62,6 +68,7 @@ impl Default for GmshParams {
             keep_surface: false,
             timeout: Duration::from_secs_f64(DEFAULT_TIMEOUT_S),
             curvature_elements: 0,
+            size_grid: None,
         }
     }
 }
@@ -272,11 +279,29 @@ fn surface_msh(surface: &SurfaceMesh) -> String {
 }
 
 /// The `.geo` script meshing `surface.msh` into `volume.msh`.
-fn geo_script(size: f64, order: u8, keep_surface: bool, curvature_elements: u32) -> String {
+fn geo_script(
+    size: f64,
+    order: u8,
+    keep_surface: bool,
+    curvature_elements: u32,
+    size_grid: bool,
+) -> String {
     let remesh = if keep_surface {
         ""
     } else {
         "ClassifySurfaces{40 * Pi / 180, 1, 1, Pi};\nCreateGeometry;\n"
+    };
+    let field = if size_grid && !keep_surface {
+        format!(
+            "Field[1] = Structured;\n\
+             Field[1].FileName = \"sizes.dat\";\n\
+             Field[1].TextFormat = 1;\n\
+             Field[1].SetOutsideValue = 1;\n\
+             Field[1].OutsideValue = {size:?};\n\
+             Background Field = 1;\n"
+        )
+    } else {
+        String::new()
     };
     let curvature = if keep_surface { 0 } else { curvature_elements };
     format!(
@@ -294,6 +319,7 @@ fn geo_script(size: f64, order: u8, keep_surface: bool, curvature_elements: u32)
          Mesh.SaveAll = 0;\n\
          Merge \"surface.msh\";\n\
          {remesh}\
+         {field}\
          Surface Loop(1) = Surface{{:}};\n\
          Volume(1) = {{1}};\n\
          Physical Volume(\"volume\") = {{1}};\n"
@@ -343,6 +369,10 @@ pub fn tetrahedralize_with_progress(
     let io = |e: std::io::Error| GmshError::Io(e.to_string());
     let dir = WorkDir::new("modal-bake-gmsh").map_err(io)?;
     std::fs::write(dir.path().join("surface.msh"), surface_msh(surface)).map_err(io)?;
+    let grid = params.size_grid.as_ref().filter(|_| !params.keep_surface);
+    if let Some(g) = grid {
+        std::fs::write(dir.path().join("sizes.dat"), g.to_gmsh_text()).map_err(io)?;
+    }
     std::fs::write(
         dir.path().join("volume.geo"),
         geo_script(
@@ -350,6 +380,7 @@ pub fn tetrahedralize_with_progress(
             params.order,
             params.keep_surface,
             params.curvature_elements,
+            grid.is_some(),
         ),
     )
     .map_err(io)?;

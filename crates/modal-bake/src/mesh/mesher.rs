@@ -92,6 +92,10 @@ pub struct MeshParams {
     /// [`super::sizing::curvature_elements`] per full turn (6 at the default size, in
     /// proportion to 1/size). Default true.
     pub curvature: bool,
+    /// gmsh remeshing: elements no larger than [`super::sizing::WALL_SIZE_FACTOR`] times the
+    /// local wall thickness where the asset is thin ([`super::sizing::thickness_grid`]).
+    /// Default true.
+    pub thickness: bool,
 }
 
 impl Default for MeshParams {
@@ -106,6 +110,7 @@ impl Default for MeshParams {
             keep_surface: false,
             timeout: Duration::from_secs_f64(DEFAULT_TIMEOUT_S),
             curvature: true,
+            thickness: true,
         }
     }
 }
@@ -135,6 +140,12 @@ pub struct MeshReport {
     /// gmsh remeshing: elements per full turn of curvature (finer elements where the surface
     /// curves); `None` for a uniform size, `keep_surface` and fTetWild.
     pub curvature_elements: Option<u32>,
+    /// Which sizing ran and why, in words: uniform, curvature, thickness-aware (with the
+    /// share of the surface it refined and the smallest wall size), or why not.
+    pub sizing: String,
+    /// Thickness-aware sizing: the smallest element size it asked for (m); `None` when it
+    /// did not run or refined nothing.
+    pub wall_size_m: Option<f64>,
     /// fTetWild's envelope (m); `None` for gmsh.
     pub envelope_m: Option<f64>,
     /// Whether the backend's output is reproducible (same input → same bytes).
@@ -369,6 +380,10 @@ pub fn mesh_surface(
     progress(&format!("meshing with {}: {reason}", backend.name()));
     let curvature = (params.curvature && !params.keep_surface)
         .then(|| super::sizing::curvature_elements(size, diagonal(inspection.bbox)));
+    let diameters = super::sizing::shape_diameters(surface);
+    let grid = (params.thickness && !params.keep_surface)
+        .then(|| super::sizing::thickness_grid_from(surface, &diameters, size))
+        .flatten();
     let params = &MeshParams {
         size: Some(size),
         ..params.clone()
@@ -378,7 +393,7 @@ pub fn mesh_surface(
         surface,
         &inspection,
         params,
-        curvature,
+        (curvature, grid.as_ref()),
         file,
         progress,
     );
@@ -400,7 +415,7 @@ pub fn mesh_surface(
                 surface,
                 &inspection,
                 params,
-                curvature,
+                (curvature, grid.as_ref()),
                 file,
                 progress,
             ) {
@@ -434,12 +449,52 @@ pub fn mesh_surface(
         ..mesh.mesh.clone()
     };
     report.distance = surface_distance(surface, &linear);
-    report.thin_parts_m = super::sizing::thin_parts(surface);
+    report.thin_parts_m = super::sizing::thin_parts_from(surface, &diameters);
+    report.sizing = sizing_words(&report, params, grid.as_ref());
+    if report.backend == Backend::Gmsh {
+        report.wall_size_m = grid.as_ref().map(|g| g.smallest_m);
+    }
     Ok(MeshedAsset {
         mesh: mesh.mesh,
         msh: mesh.msh,
         report,
     })
+}
+
+/// The report's `sizing` line.
+fn sizing_words(
+    report: &MeshReport,
+    params: &MeshParams,
+    grid: Option<&super::sizing::SizeGrid>,
+) -> String {
+    use super::sizing::{MAX_WALL_REFINEMENT, WALL_SIZE_FACTOR};
+    let size = report.size_m;
+    if report.backend == Backend::Ftetwild {
+        return format!(
+            "fTetWild: one ideal edge length {size:.4e} m everywhere (fTetWild takes no size field: neither curvature nor thickness sizing applies)"
+        );
+    }
+    if params.keep_surface {
+        return "gmsh --keep-surface: the asset's triangles set the sizes near the surface, at most the size inside".into();
+    }
+    let mut parts = vec![match report.curvature_elements {
+        Some(n) => {
+            format!("size {size:.4e} m, finer where the surface curves ({n} elements per turn)")
+        }
+        None => format!("uniform size {size:.4e} m (--uniform-size)"),
+    }];
+    parts.push(match (params.thickness, grid) {
+        (false, _) => "thickness-aware sizing off".into(),
+        (true, None) => format!(
+            "thickness-aware sizing: no wall thinner than half the size, nothing refined (elements at most {WALL_SIZE_FACTOR}× the local thickness)"
+        ),
+        (true, Some(g)) => format!(
+            "and thickness-aware: elements at most {WALL_SIZE_FACTOR}× the local wall thickness, never below size/{MAX_WALL_REFINEMENT} — {:.1} % of the surface refined, down to {:.4e} m",
+            100.0 * g.refined_area_fraction,
+            g.smallest_m
+        ),
+    });
+    parts.join("; ")
 }
 
 struct Made {
@@ -452,7 +507,7 @@ fn run_backend(
     surface: &SurfaceMesh,
     inspection: &SurfaceInspection,
     params: &MeshParams,
-    curvature: Option<u32>,
+    (curvature, grid): (Option<u32>, Option<&super::sizing::SizeGrid>),
     file: &str,
     progress: &dyn Fn(&str),
 ) -> Result<(Made, MeshReport), AssetError> {
@@ -468,6 +523,7 @@ fn run_backend(
                 keep_surface: params.keep_surface,
                 timeout: params.timeout,
                 curvature_elements: curvature.unwrap_or(0),
+                size_grid: grid.cloned(),
             };
             let out = gmsh::tetrahedralize_with_progress(&s, &g, file, &tick)?;
             let volume = out.mesh.volume();
@@ -485,6 +541,8 @@ fn run_backend(
                 size_m: out.info.size_m,
                 thin_parts_m: None,
                 curvature_elements: curvature,
+                sizing: String::new(),
+                wall_size_m: None,
                 envelope_m: None,
                 reproducible: true,
                 seconds: out.info.seconds,
@@ -544,6 +602,8 @@ fn run_backend(
                 size_m: info.size_m,
                 thin_parts_m: None,
                 curvature_elements: None,
+                sizing: String::new(),
+                wall_size_m: None,
                 envelope_m: Some(info.envelope_m),
                 reproducible: info.reproducible,
                 seconds: info.seconds,

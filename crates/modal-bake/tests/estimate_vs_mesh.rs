@@ -1,0 +1,251 @@
+//! The size estimate before meshing ([`modal_bake::bake::SizeEstimate::of_surface`] at
+//! [`modal_bake::mesh::sizing::equivalent_size`], as `modal-bake mesh` and `bake` print it)
+//! against the degrees of freedom gmsh then really makes at the defaults (order 2, 1/20 of the
+//! diagonal, curvature and thickness-aware sizing): within [`FACTOR`] either way on compact,
+//! curved and thin-walled shapes and on gmsh's thin-walled tutorial part (when the PyPI gmsh
+//! ships it), within [`CURVED_FACTOR`] on a slender rod, whose elements gmsh's curvature
+//! sizing sets.
+//!
+//! Skips with a message when gmsh is missing, unless `DCR_REQUIRE_GMSH=1`.
+//!
+//! `cargo test --release --workspace --test estimate_vs_mesh -- --nocapture` prints the ratios.
+
+use modal_bake::bake::{SizeEstimate, SurfaceMeasures};
+use modal_bake::mesh::sizing::{default_size, equivalent_size};
+use modal_bake::mesh::surface::SurfaceMesh;
+use modal_bake::mesh::{mesh_surface, MeshParams};
+
+/// The estimate is within this factor of the meshed degrees of freedom, either way, where
+/// its terms (volume, boundary at the equivalent size, thin walls) describe what gmsh does.
+const FACTOR: f64 = 1.35;
+
+/// Where gmsh's curvature sizing sets the elements (a slender rod), the estimate's curvature
+/// term is only this good: it sees up to 1.5/R on long strips ([`equivalent_size`]), and
+/// gmsh's own curvature estimate differs from asset to asset (docs/artist-guide.md § 7).
+const CURVED_FACTOR: f64 = 2.6;
+
+/// An axis-aligned box [0, l] as 12 triangles.
+fn box_surface(l: [f64; 3]) -> SurfaceMesh {
+    extrude_caps(
+        &[[0.0, 0.0], [l[0], 0.0], [l[0], l[1]], [0.0, l[1]]],
+        &[vec![0, 1, 2, 3]],
+        l[2],
+        1,
+    )
+}
+
+/// The prism of a simple polygon `p` (counter-clockwise, m) extruded along z by `depth`, its
+/// caps split into the convex polygons `caps` (indices into `p`, counter-clockwise), its sides
+/// in `stacks` rows of triangles; outward.
+fn extrude_caps(p: &[[f64; 2]], caps: &[Vec<usize>], depth: f64, stacks: usize) -> SurfaceMesh {
+    let n = p.len();
+    let vertices: Vec<[f64; 3]> = (0..=stacks)
+        .flat_map(|s| {
+            let z = depth * s as f64 / stacks as f64;
+            p.iter().map(move |q| [q[0], q[1], z])
+        })
+        .collect();
+    let top = n * stacks;
+    let mut triangles = Vec::new();
+    for c in caps {
+        for k in 1..c.len() - 1 {
+            triangles.push([c[0], c[k + 1], c[k]]);
+            triangles.push([top + c[0], top + c[k], top + c[k + 1]]);
+        }
+    }
+    for s in 0..stacks {
+        let (a, b) = (s * n, (s + 1) * n);
+        for i in 0..n {
+            let j = (i + 1) % n;
+            triangles.push([a + i, a + j, b + j]);
+            triangles.push([a + i, b + j, b + i]);
+        }
+    }
+    SurfaceMesh {
+        vertices,
+        triangles,
+    }
+}
+
+/// A U-channel (width `w`, height `h`, wall `t`, length `len`, m): a thin-walled part,
+/// `stacks` triangle rows along its length.
+fn channel(w: f64, h: f64, t: f64, len: f64, stacks: usize) -> SurfaceMesh {
+    let p = [
+        [0.0, 0.0],
+        [w, 0.0],
+        [w, t],
+        [w, h],
+        [w - t, h],
+        [w - t, t],
+        [t, t],
+        [t, h],
+        [0.0, h],
+        [0.0, t],
+    ];
+    let caps = vec![vec![0, 1, 2, 5, 6, 9], vec![5, 2, 3, 4], vec![9, 6, 7, 8]];
+    extrude_caps(&p, &caps, len, stacks)
+}
+
+/// A UV sphere of radius `r` (m).
+fn uv_sphere(r: f64, rings: usize, segments: usize) -> SurfaceMesh {
+    use std::f64::consts::PI;
+    let mut v = vec![[0.0, 0.0, r]];
+    for i in 1..rings {
+        let th = PI * i as f64 / rings as f64;
+        for j in 0..segments {
+            let ph = 2.0 * PI * j as f64 / segments as f64;
+            v.push([
+                r * th.sin() * ph.cos(),
+                r * th.sin() * ph.sin(),
+                r * th.cos(),
+            ]);
+        }
+    }
+    v.push([0.0, 0.0, -r]);
+    let south = v.len() - 1;
+    let at = |i: usize, j: usize| 1 + (i - 1) * segments + j % segments;
+    let mut t = Vec::new();
+    for j in 0..segments {
+        t.push([0, at(1, j), at(1, j + 1)]);
+        t.push([south, at(rings - 1, j + 1), at(rings - 1, j)]);
+    }
+    for i in 1..rings - 1 {
+        for j in 0..segments {
+            t.push([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
+            t.push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
+        }
+    }
+    SurfaceMesh {
+        vertices: v,
+        triangles: t,
+    }
+}
+
+/// A closed cylinder along x from 0 to `len`, radius `r` (m): `segments` around, `stacks`
+/// along, flat caps fanned from their centres; outward.
+fn cylinder(r: f64, len: f64, segments: usize, stacks: usize) -> SurfaceMesh {
+    use std::f64::consts::TAU;
+    let mut v = Vec::new();
+    for i in 0..=stacks {
+        let x = len * i as f64 / stacks as f64;
+        for j in 0..segments {
+            let ph = TAU * j as f64 / segments as f64;
+            v.push([x, r * ph.cos(), r * ph.sin()]);
+        }
+    }
+    let at = |i: usize, j: usize| i * segments + j % segments;
+    let mut t = Vec::new();
+    for i in 0..stacks {
+        for j in 0..segments {
+            t.push([at(i, j), at(i, j + 1), at(i + 1, j + 1)]);
+            t.push([at(i, j), at(i + 1, j + 1), at(i + 1, j)]);
+        }
+    }
+    let (c0, c1) = (v.len(), v.len() + 1);
+    v.push([0.0, 0.0, 0.0]);
+    v.push([len, 0.0, 0.0]);
+    for j in 0..segments {
+        t.push([c0, at(0, j + 1), at(0, j)]);
+        t.push([c1, at(stacks, j), at(stacks, j + 1)]);
+    }
+    SurfaceMesh {
+        vertices: v,
+        triangles: t,
+    }
+}
+
+/// gmsh's tutorial STL (mm), shipped by the PyPI gmsh under `<prefix>/share/doc/gmsh`.
+fn t13() -> Option<SurfaceMesh> {
+    let out = std::process::Command::new("python3")
+        .args(["-c", "import sys; print(sys.prefix)"])
+        .output()
+        .ok()?;
+    let prefix = String::from_utf8(out.stdout).ok()?;
+    let path = std::path::Path::new(prefix.trim()).join("share/doc/gmsh/tutorials/t13_data.stl");
+    let mut s = modal_bake::mesh::surface::read_surface(&path).ok()?;
+    s.scale(1e-3);
+    Some(s)
+}
+
+/// (estimated dofs, meshed dofs) at the defaults, order 2 (`curvature` false: one size
+/// apart from thin walls, `--uniform-size`).
+fn estimate_and_mesh(name: &str, s: &SurfaceMesh, curvature: bool) -> (f64, usize) {
+    let size = default_size(s.bounding_box());
+    let measures = SurfaceMeasures::of(&s.vertices, &s.triangles);
+    let h = equivalent_size(s, size, curvature, true);
+    let e = SizeEstimate::of_surface(&measures, h, false, 2, 26);
+    let p = MeshParams {
+        order: 2,
+        curvature,
+        ..Default::default()
+    };
+    let m = mesh_surface(s, &p, name, &|_| {}).unwrap_or_else(|e| panic!("{name}: {e}"));
+    (e.dofs, m.mesh.dofs())
+}
+
+#[test]
+fn estimated_dofs_are_within_the_stated_factor_of_the_mesh() {
+    if let Err(e) = modal_bake::mesh::gmsh::gmsh_version(None) {
+        if std::env::var("DCR_REQUIRE_GMSH").as_deref() == Ok("1") {
+            panic!("DCR_REQUIRE_GMSH=1 but {e}");
+        }
+        eprintln!("SKIPPED estimated_dofs_are_within_the_stated_factor_of_the_mesh: {e}");
+        return;
+    }
+    // (name, surface, curvature sizing on, allowed factor)
+    let mut corpus: Vec<(&str, SurfaceMesh, bool, f64)> = vec![
+        ("cube 0.1 m", box_surface([0.1, 0.1, 0.1]), true, FACTOR),
+        (
+            "box 0.3 × 0.2 × 0.1 m",
+            box_surface([0.3, 0.2, 0.1]),
+            true,
+            FACTOR,
+        ),
+        (
+            "slab 0.3 × 0.3 × 0.006 m",
+            box_surface([0.3, 0.3, 0.006]),
+            true,
+            FACTOR,
+        ),
+        ("sphere r 0.05 m", uv_sphere(0.05, 24, 48), true, FACTOR),
+        (
+            "rod r 0.025 × 1 m",
+            cylinder(0.025, 1.0, 48, 40),
+            true,
+            CURVED_FACTOR,
+        ),
+        // gmsh's curvature sizing refines the 4 mm rims of a faceted channel and the faces
+        // beside them far below what the estimate's curvature term sees (docs/artist-guide.md
+        // § 7): the thickness term is checked with one size elsewhere.
+        (
+            "U-channel 0.1 × 0.06 m, 4 mm wall, 0.3 m, --uniform-size",
+            channel(0.1, 0.06, 0.004, 0.3, 30),
+            false,
+            FACTOR,
+        ),
+    ];
+    match t13() {
+        Some(s) => corpus.push(("gmsh tutorial t13 (mm)", s, true, FACTOR)),
+        None => {
+            eprintln!("t13_data.stl not found beside the PyPI gmsh; the corpus goes without it")
+        }
+    }
+    let mut worst: f64 = 1.0;
+    let mut failures = Vec::new();
+    for (name, s, curvature, factor) in &corpus {
+        let (est, dofs) = estimate_and_mesh(name, s, *curvature);
+        let ratio = est / dofs as f64;
+        eprintln!("{name}: estimated {est:.0} dofs, meshed {dofs}: ratio {ratio:.3}");
+        worst = worst.max(ratio.max(1.0 / ratio));
+        if !(ratio <= *factor && ratio >= 1.0 / factor) {
+            failures.push(format!(
+                "{name}: estimated {est:.0}, meshed {dofs} (ratio {ratio:.3})"
+            ));
+        }
+    }
+    eprintln!("worst factor {worst:.3} (allowed {FACTOR}, {CURVED_FACTOR} for the rod)");
+    assert!(
+        failures.is_empty(),
+        "outside the allowed factor: {failures:?}"
+    );
+}
