@@ -258,12 +258,22 @@ pub fn write_outcomes_page(out: &Path, scenes: &[SceneComparison], header: &str)
             "- steps (largest outcome change from the previous step, wall time): {}",
             steps.join(", ")
         )?;
+        if let Some(h) = &t.double_k {
+            writeln!(
+                md,
+                "- stiffness: with k doubled ({:.1e} N/m) at the finest step the outcomes move by {:.2} % ({:.0} s)",
+                2.0 * t.params.contact_stiffness,
+                100.0 * h.change.unwrap_or(0.0),
+                h.wall_s
+            )?;
+        }
         if let Some(h) = &t.half_modes {
             writeln!(
                 md,
-                "- modes: with half the modes ({}) at the finest step the outcomes move by {:.2} %",
+                "- modes: with half the modes ({}) at the finest step the outcomes move by {:.2} % ({:.0} s)",
                 h.modes,
-                100.0 * h.change.unwrap_or(0.0)
+                100.0 * h.change.unwrap_or(0.0),
+                h.wall_s
             )?;
         }
         writeln!(
