@@ -231,7 +231,10 @@ fn implicit_coupling_is_stable_at_any_stiffness() {
         Ok(r) => {
             let g = energy_gain(&r);
             eprintln!("explicit: energy gain {g} J (drop {drop} J)");
-            assert!(g > drop, "the explicit exchange should be unstable here: gain {g} J");
+            assert!(
+                g > drop,
+                "the explicit exchange should be unstable here: gain {g} J"
+            );
         }
     }
     p.scheme = CouplingScheme::Implicit;
@@ -242,11 +245,18 @@ fn implicit_coupling_is_stable_at_any_stiffness() {
         r.max_penetration
     );
     assert!(g <= 1e-9 * drop, "the implicit coupling gained {g} J");
-    assert!(r.max_penetration < 1e-4, "penetration {}", r.max_penetration);
+    assert!(
+        r.max_penetration < 1e-4,
+        "penetration {}",
+        r.max_penetration
+    );
     p.contact_stiffness = 2e9;
     let r2 = run_coupled(&desc, &root, &prep, &p).expect("implicit run, 2k");
     let (h1, h2) = (rebound(&r.trajectory), rebound(&r2.trajectory));
     eprintln!("rebound at k 1e9: {h1} m, 2e9: {h2} m");
     assert!(h1 > 1e-4, "the ball should rebound: {h1}");
-    assert!((h2 - h1).abs() < 0.05 * h1, "rebound moved with k: {h1} → {h2}");
+    assert!(
+        (h2 - h1).abs() < 0.05 * h1,
+        "rebound moved with k: {h1} → {h2}"
+    );
 }

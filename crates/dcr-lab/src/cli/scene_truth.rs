@@ -24,7 +24,7 @@ pub struct SceneTruthArgs {
     #[arg(required = true)]
     pub scenes: Vec<String>,
     /// First coupling step (s); the scene's h must be a whole multiple of it.
-    #[arg(long, value_name = "S", default_value_t = 2e-5)]
+    #[arg(long, value_name = "S", default_value_t = 1e-5)]
     pub dt: f64,
     /// Most halvings of the step.
     #[arg(long, value_name = "N", default_value_t = 3)]
@@ -48,8 +48,9 @@ pub struct SceneTruthArgs {
     /// entries are keyed by the object's stiffness and mass matrices).
     #[arg(long, value_name = "DIR")]
     pub eigen_cache: Option<PathBuf>,
-    /// Penalty stiffness per contact point (N/m).
-    #[arg(long, value_name = "N_PER_M", default_value_t = 1e7)]
+    /// Penalty stiffness per contact point (N/m); large is rigid contact (the coupling is
+    /// implicit in the forces, stable for any stiffness).
+    #[arg(long, value_name = "N_PER_M", default_value_t = 1e9)]
     pub contact_stiffness: f64,
     /// Largest free dofs of the dense eigensolve (memory ~ 3·n²·8 bytes).
     #[arg(long, value_name = "N", default_value_t = 6000)]

@@ -108,7 +108,11 @@ pub fn solve_penalty_block(a: &[f64], kappa: &[f64], b: &[f64], f: &mut [f64]) -
 }
 
 fn row_dot(a: &[f64], n: usize, i: usize, f: &[f64]) -> f64 {
-    a[i * n..(i + 1) * n].iter().zip(f).map(|(x, y)| x * y).sum()
+    a[i * n..(i + 1) * n]
+        .iter()
+        .zip(f)
+        .map(|(x, y)| x * y)
+        .sum()
 }
 
 fn residual(a: &[f64], kappa: &[f64], b: &[f64], f: &[f64]) -> f64 {
@@ -177,7 +181,10 @@ mod tests {
                 }
                 if residual(&a, &kappa, &b, &g) < 1e-9 && g.iter().all(|x| *x >= -1e-12) {
                     for i in 0..n {
-                        assert!((g[i] - f[i]).abs() < 1e-7 * (1.0 + g[i].abs()), "case {case}");
+                        assert!(
+                            (g[i] - f[i]).abs() < 1e-7 * (1.0 + g[i].abs()),
+                            "case {case}"
+                        );
                     }
                     found = true;
                     break;

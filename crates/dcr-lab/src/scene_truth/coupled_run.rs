@@ -359,8 +359,13 @@ pub fn run_coupled(
                 let nb = idx.len();
                 let mm = elastic.modes();
                 nrows.resize(nb * mm, 0.0);
-                let (mut g0, mut gfree, mut vn_surf, mut kap, mut bb) =
-                    (vec![0.0; nb], vec![0.0; nb], vec![0.0; nb], vec![0.0; nb], vec![0.0; nb]);
+                let (mut g0, mut gfree, mut vn_surf, mut kap, mut bb) = (
+                    vec![0.0; nb],
+                    vec![0.0; nb],
+                    vec![0.0; nb],
+                    vec![0.0; nb],
+                    vec![0.0; nb],
+                );
                 let rb_o = &built.world.bodies[*ob];
                 let rb_e = &built.world.bodies[e_handle];
                 for (a, &i) in idx.iter().enumerate() {
