@@ -147,6 +147,8 @@ pub struct TruthLevel {
     pub dt: f64,
     /// Modes summed.
     pub modes: usize,
+    /// Penalty stiffness per contact point (N/m).
+    pub contact_stiffness: f64,
     /// Outcomes: name → (value, unit).
     pub outcomes: BTreeMap<String, (f64, String)>,
     /// Largest relative change of an outcome from the previous level (`None` for the first).
@@ -395,6 +397,7 @@ pub fn scene_truth(desc: &SceneDesc, root: &Path, params: &SceneTruthParams) -> 
         levels.push(TruthLevel {
             dt,
             modes,
+            contact_stiffness: params.contact_stiffness,
             outcomes: run.outcomes.clone(),
             change,
             max_penetration: run.max_penetration,
@@ -423,6 +426,7 @@ pub fn scene_truth(desc: &SceneDesc, root: &Path, params: &SceneTruthParams) -> 
         Ok(TruthLevel {
             dt,
             modes: m,
+            contact_stiffness: k,
             outcomes: h.outcomes,
             change: Some(change),
             max_penetration: h.max_penetration,
