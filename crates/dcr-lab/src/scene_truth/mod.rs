@@ -32,7 +32,9 @@
 //! other, each seeing the modal load of the ones before (block Gauss–Seidel: the elastic
 //! coupling between two props within one step is that of the modes slow enough to carry it,
 //! a small fraction of the local compliance). Coulomb friction (the colliders' mean
-//! coefficient) is regularised below a slip speed and stays explicit (bounded by μ f). The
+//! coefficient) is regularised below a slip speed v_s (viscous η = μ f / max(|v_t|, v_s)) and
+//! made implicit in the prop's slip only (f_t = −η v_t / (1 + η Δt W_t)), so it never reverses
+//! the slip within a step; it acts on the modes explicitly, bounded by μ f. The
 //! prop receives f Δt at its contact point; the elastic modes receive −f at the surface point
 //! (Eq. 9 with the force), and, for a dynamic object, its rigid body −f Δt. Every other
 //! contact (prop on prop) stays rapier's.
