@@ -315,10 +315,11 @@ pub fn run_coupled(
                             };
                             let x_e = pe.transform_point(lp_e);
                             let x_o = po.transform_point(lp_o);
+                            // Every point rapier reports (rigid gap within its prediction
+                            // distance, 2 cm by default) is taken: the elastic surface can
+                            // rise by more than a small rigid gap, and a point skipped there
+                            // would wake up deep inside the surface and pop the prop out.
                             let dist = (x_o - x_e).dot(n);
-                            if dist > 1e-3 {
-                                continue;
-                            }
                             // The contact on the elastic surface, in the object frame.
                             let xl = e_pose.inverse_transform_point(x_e);
                             let key = [xl.x, xl.y, xl.z].map(|v| (v * 2e3).round() as i64);

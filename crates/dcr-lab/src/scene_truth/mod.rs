@@ -13,7 +13,9 @@
 //! # Coupling: penalty contacts, implicit in the forces
 //! Rapier still detects the elastic object's contacts (its narrow phase, the scene's colliders)
 //! but does not solve them (the object's colliders get empty solver groups). At each coupling
-//! step every contact point between a prop and the object is mapped to the object's surface in
+//! step every contact point between a prop and the object that rapier reports (rigid gap within
+//! its prediction distance, 2 cm by default, which must exceed the surface's largest elastic
+//! displacement) is mapped to the object's surface in
 //! the object's frame (closest point, barycentric weights — the mapping the runtime uses), and
 //! gets a spring–dashpot normal force of its *end-of-step* gap g (rigid gap along the contact
 //! normal minus the elastic surface displacement there, so the surface moves under the
