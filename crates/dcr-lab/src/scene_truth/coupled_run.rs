@@ -12,7 +12,22 @@ use modal_bake::full_order::{FullOrderSystem, ModalAll};
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::*;
 
+use super::contact_solve::solve_penalty_block;
 use super::elastic_body::ElasticBody;
+
+/// How the contact forces of a coupling step are found (module doc of [`super`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum CouplingScheme {
+    /// Implicit in the forces: each prop's point forces are the clamped spring–dashpot of the
+    /// *end-of-step* gaps, which are affine in the held forces through the elastic step
+    /// compliance and the bodies' inverse effective masses; one small complementarity solve
+    /// per prop and step. Stable for any stiffness and step.
+    #[default]
+    Implicit,
+    /// The start-of-step gap and velocities set the forces (explicit exchange): stable only
+    /// while k times the surface's step compliance is small. Kept to show the difference.
+    Explicit,
+}
 
 /// Settings of one coupled run.
 #[derive(Clone, Debug)]
@@ -34,6 +49,8 @@ pub struct CoupledParams {
     pub restitution: f64,
     /// Progress lines on stderr.
     pub progress: bool,
+    /// How the contact forces are found. Default [`CouplingScheme::Implicit`].
+    pub scheme: CouplingScheme,
 }
 
 /// What a coupled run measured.
@@ -59,6 +76,8 @@ pub struct CoupledRun {
     pub momentum: [[f64; 3]; 2],
     /// Coupling steps taken.
     pub steps: usize,
+    /// Contact blocks whose active-set solve fell back to projected Gauss–Seidel.
+    pub solver_fallbacks: usize,
     /// Wall time (s).
     pub wall_s: f64,
 }
@@ -76,6 +95,71 @@ const CACHE_MAX: usize = 4096;
 
 fn arr(v: Vector) -> [f64; 3] {
     [v.x, v.y, v.z]
+}
+
+/// One penalty contact point between a prop and the elastic object in a coupling step.
+struct ContactPoint {
+    /// The prop.
+    ob: RigidBodyHandle,
+    /// Unit normal from the object towards the prop (world).
+    n: Vector,
+    /// The normal in the object frame.
+    nl: [f64; 3],
+    /// The contact point on the prop and on the object's rigid surface (world, m).
+    x_o: Vector,
+    x_e: Vector,
+    /// Rigid gap along `n` (m, negative: overlap).
+    dist: f64,
+    /// Key of the surface point's cached modal rows.
+    key: [i64; 3],
+    /// Friction coefficient.
+    mu: f64,
+    /// Dashpot (N·s/m).
+    damp: f64,
+}
+
+/// A rigid body's inverse mass (1/kg), world inverse inertia (1/(kg·m²)) and centre of mass.
+struct BodyMass {
+    inv_mass: f64,
+    inv_inertia: [[f64; 3]; 3],
+    com: Vector,
+}
+
+impl BodyMass {
+    /// Velocity change along `na` at `xa` per unit impulse along `nb` at `xb` (1/kg):
+    /// `na·nb/m + (ra × na)ᵀ I⁻¹ (rb × nb)` (Eq. 17 off the diagonal; symmetric).
+    fn coupling(&self, xa: Vector, na: Vector, xb: Vector, nb: Vector) -> f64 {
+        let ra = arr((xa - self.com).cross(na));
+        let rb = arr((xb - self.com).cross(nb));
+        let mut quad = 0.0;
+        for i in 0..3 {
+            for j in 0..3 {
+                quad += ra[i] * self.inv_inertia[i][j] * rb[j];
+            }
+        }
+        self.inv_mass * na.dot(nb) + quad
+    }
+}
+
+fn body_mass(rb: &RigidBody) -> BodyMass {
+    if !rb.is_dynamic() {
+        return BodyMass {
+            inv_mass: 0.0,
+            inv_inertia: [[0.0; 3]; 3],
+            com: rb.center_of_mass(),
+        };
+    }
+    let mp = rb.mass_properties();
+    let ii = mp.effective_world_inv_inertia;
+    BodyMass {
+        inv_mass: mp.effective_inv_mass.x,
+        inv_inertia: [
+            [ii.m11, ii.m12, ii.m13],
+            [ii.m12, ii.m22, ii.m23],
+            [ii.m13, ii.m23, ii.m33],
+        ],
+        com: rb.center_of_mass(),
+    }
 }
 
 /// Runs `desc` with its elastic object coupled to the rigid bodies through penalty contacts.
@@ -180,6 +264,10 @@ pub fn run_coupled(
     let wall = Instant::now();
     let mut last = Instant::now();
     let mut forces: Vec<(RigidBodyHandle, Vector, Vector, Vector, f64, f64)> = Vec::new();
+    let mut pts: Vec<ContactPoint> = Vec::new();
+    let mut blocks: Vec<(RigidBodyHandle, Vec<usize>)> = Vec::new();
+    let mut nrows: Vec<f64> = Vec::new();
+    let mut solver_fallbacks = 0usize;
     let energy0 = total_energy(&built, gravity, &elastic, 0.0);
     energy[0] = energy0;
     for kh in 0..steps_h {
@@ -187,6 +275,7 @@ pub fn run_coupled(
         apply_drivers(&drivers, &mut built, t_h);
         for ks in 0..sub {
             forces.clear();
+            pts.clear();
             spring_energy = 0.0;
             let e_pose = *built.world.bodies[e_handle].position();
             for &ech in &e_colliders {
@@ -215,11 +304,7 @@ pub fn run_coupled(
                     let prop_mass = built.world.bodies[ob].mass();
                     for m in &rc.manifolds {
                         let npts = m.points.len().max(1) as f64;
-                        let (ln_e, _) = if e_first {
-                            (m.local_n1, m.local_n2)
-                        } else {
-                            (m.local_n2, m.local_n1)
-                        };
+                        let ln_e = if e_first { m.local_n1 } else { m.local_n2 };
                         let n = (pe.rotation * ln_e).normalize();
                         let damp = 2.0 * zeta * (p.contact_stiffness * prop_mass / npts).sqrt();
                         for c in &m.points {
@@ -230,10 +315,11 @@ pub fn run_coupled(
                             };
                             let x_e = pe.transform_point(lp_e);
                             let x_o = po.transform_point(lp_o);
+                            // Every point rapier reports (rigid gap within its prediction
+                            // distance, 2 cm by default) is taken: the elastic surface can
+                            // rise by more than a small rigid gap, and a point skipped there
+                            // would wake up deep inside the surface and pop the prop out.
                             let dist = (x_o - x_e).dot(n);
-                            if dist > 1e-3 {
-                                continue;
-                            }
                             // The contact on the elastic surface, in the object frame.
                             let xl = e_pose.inverse_transform_point(x_e);
                             let key = [xl.x, xl.y, xl.z].map(|v| (v * 2e3).round() as i64);
@@ -247,35 +333,128 @@ pub fn run_coupled(
                                 let verts = surface.triangles[sp.triangle as usize];
                                 cache.insert(key, elastic.axis_rows(verts, sp.bary));
                             }
-                            let rows = &cache[&key];
-                            let nl = e_pose.rotation.inverse() * n;
-                            let (u_n, v_n) = elastic.motion_along(rows, arr(nl));
-                            let gap = dist - u_n;
-                            if gap >= 0.0 {
-                                continue;
-                            }
-                            max_pen = max_pen.max(-gap);
-                            let v_surf =
-                                built.world.bodies[e_handle].velocity_at_point(x_e) + n * v_n;
-                            let v_o = built.world.bodies[ob].velocity_at_point(x_o);
-                            let rel = v_o - v_surf;
-                            let vn = rel.dot(n);
-                            let fn_ = (p.contact_stiffness * (-gap) - damp * vn).max(0.0);
-                            spring_energy += 0.5 * p.contact_stiffness * gap * gap;
-                            let vt = rel - n * vn;
-                            let s = vt.length();
-                            let ft = if s > 0.0 {
-                                vt * (-mu * fn_ / s.max(p.friction_velocity))
-                            } else {
-                                Vector::ZERO
-                            };
-                            let f = n * fn_ + ft;
-                            forces.push((ob, f, x_o, x_e, v_n, fn_));
-                            // On the elastic modes: −f at the surface point (object frame).
-                            let fl = e_pose.rotation.inverse() * (-f);
-                            elastic.add_force_rows(rows, arr(fl));
+                            pts.push(ContactPoint {
+                                ob,
+                                n,
+                                nl: arr(e_pose.rotation.inverse() * n),
+                                x_o,
+                                x_e,
+                                dist,
+                                key,
+                                mu,
+                                damp,
+                            });
                         }
                     }
+                }
+            }
+            // Blocks: each prop's points, in the order the props first appear.
+            blocks.clear();
+            for (i, c) in pts.iter().enumerate() {
+                match blocks.iter_mut().find(|(b, _)| *b == c.ob) {
+                    Some((_, v)) => v.push(i),
+                    None => blocks.push((c.ob, vec![i])),
+                }
+            }
+            for (ob, idx) in &blocks {
+                let nb = idx.len();
+                let mm = elastic.modes();
+                nrows.resize(nb * mm, 0.0);
+                let (mut g0, mut gfree, mut vn_surf, mut kap, mut bb) = (
+                    vec![0.0; nb],
+                    vec![0.0; nb],
+                    vec![0.0; nb],
+                    vec![0.0; nb],
+                    vec![0.0; nb],
+                );
+                let rb_o = &built.world.bodies[*ob];
+                let rb_e = &built.world.bodies[e_handle];
+                for (a, &i) in idx.iter().enumerate() {
+                    let c = &pts[i];
+                    let r = &mut nrows[a * mm..(a + 1) * mm];
+                    elastic.normal_row(&cache[&c.key], c.nl, r);
+                    let (u, v, u_end) = elastic.motion_normal(r);
+                    g0[a] = c.dist - u;
+                    vn_surf[a] = v;
+                    let v_o = rb_o.velocity_at_point(c.x_o) + gravity * rb_o.gravity_scale() * p.dt;
+                    let mut v_e = rb_e.velocity_at_point(c.x_e);
+                    if e_dynamic {
+                        v_e += gravity * rb_e.gravity_scale() * p.dt;
+                    }
+                    gfree[a] = c.dist + p.dt * (v_o - v_e).dot(c.n) - u_end;
+                    kap[a] = p.contact_stiffness + c.damp / p.dt;
+                    bb[a] = -kap[a] * gfree[a] + c.damp / p.dt * g0[a].min(0.0);
+                }
+                let mut fnv = vec![0.0; nb];
+                match p.scheme {
+                    CouplingScheme::Implicit => {
+                        let mut amat = vec![0.0; nb * nb];
+                        let (bo, be) = (body_mass(rb_o), body_mass(rb_e));
+                        for a in 0..nb {
+                            for b in a..nb {
+                                let (ca, cb) = (&pts[idx[a]], &pts[idx[b]]);
+                                let mut v = elastic.step_compliance(
+                                    &nrows[a * mm..(a + 1) * mm],
+                                    &nrows[b * mm..(b + 1) * mm],
+                                );
+                                v += p.dt * p.dt * bo.coupling(ca.x_o, ca.n, cb.x_o, cb.n);
+                                if e_dynamic {
+                                    v += p.dt * p.dt * be.coupling(ca.x_e, ca.n, cb.x_e, cb.n);
+                                }
+                                amat[a * nb + b] = v;
+                                amat[b * nb + a] = v;
+                            }
+                        }
+                        let info = solve_penalty_block(&amat, &kap, &bb, &mut fnv);
+                        solver_fallbacks += usize::from(info.fallback);
+                    }
+                    CouplingScheme::Explicit => {
+                        for a in 0..nb {
+                            let c = &pts[idx[a]];
+                            if g0[a] >= 0.0 {
+                                continue;
+                            }
+                            let v_surf = rb_e.velocity_at_point(c.x_e) + c.n * vn_surf[a];
+                            let vn = (rb_o.velocity_at_point(c.x_o) - v_surf).dot(c.n);
+                            fnv[a] = (p.contact_stiffness * (-g0[a]) - c.damp * vn).max(0.0);
+                        }
+                    }
+                }
+                for a in 0..nb {
+                    let c = &pts[idx[a]];
+                    if g0[a] < 0.0 {
+                        max_pen = max_pen.max(-g0[a]);
+                        spring_energy += 0.5 * p.contact_stiffness * g0[a] * g0[a];
+                    }
+                    let fn_ = fnv[a];
+                    if fn_ <= 0.0 {
+                        continue;
+                    }
+                    let v_surf = rb_e.velocity_at_point(c.x_e) + c.n * vn_surf[a];
+                    let rel = rb_o.velocity_at_point(c.x_o) - v_surf;
+                    let vt = rel - c.n * rel.dot(c.n);
+                    let s = vt.length();
+                    let ft = if s > 0.0 {
+                        // Regularised Coulomb, η = μ f / max(|v_t|, v_s), implicit in the
+                        // prop's slip: f_t = −η v_t / (1 + η Δt n_b W_t), W_t the inverse
+                        // effective mass along the slip shared by the block's n_b points, so
+                        // friction never reverses the slip within a step.
+                        let eta = c.mu * fn_ / s.max(p.friction_velocity);
+                        let t = vt / s;
+                        let mut wt = body_mass(rb_o).coupling(c.x_o, t, c.x_o, t);
+                        if e_dynamic {
+                            wt += body_mass(rb_e).coupling(c.x_e, t, c.x_e, t);
+                        }
+                        vt * (-eta / (1.0 + eta * p.dt * nb as f64 * wt))
+                    } else {
+                        Vector::ZERO
+                    };
+                    forces.push((c.ob, c.n * fn_ + ft, c.x_o, c.x_e, vn_surf[a], fn_));
+                    // On the elastic modes: −f at the surface point (object frame), the
+                    // normal part along the point's normal row.
+                    elastic.add_force_normal(&nrows[a * mm..(a + 1) * mm], -fn_);
+                    let ftl = e_pose.rotation.inverse() * (-ft);
+                    elastic.add_force_rows(&cache[&c.key], arr(ftl));
                 }
             }
             for &(ob, f, x_o, x_e, v_n, fn_) in &forces {
@@ -316,6 +495,27 @@ pub fn run_coupled(
             );
         }
     }
+    if p.progress {
+        // Each dynamic body's largest lift (mm) and slide (mm), to see which body an outcome is.
+        let lifts: Vec<String> = (0..traj.names.len())
+            .map(|b| {
+                let y0 = traj.pos(0, b)[1];
+                let lift = (0..traj.rows())
+                    .map(|k| traj.pos(k, b)[1] - y0)
+                    .fold(0.0f64, f64::max);
+                format!("{} {:.1}", traj.names[b], lift * 1e3)
+            })
+            .collect();
+        eprintln!(
+            "[scene-truth] {} dt {:.2e} s, k {:.1e} N/m: lift (mm) {}; largest penetration {:.3} mm, {} solver fallbacks",
+            desc.name,
+            p.dt,
+            p.contact_stiffness,
+            lifts.join(", "),
+            max_pen * 1e3,
+            solver_fallbacks
+        );
+    }
     let mut outcomes = BTreeMap::new();
     for o in &desc.outcomes {
         if let Some(v) = measure_outcome(o, &traj) {
@@ -345,6 +545,7 @@ pub fn run_coupled(
         energy,
         momentum: [momentum0, momentum(&built)],
         steps: steps_h * sub,
+        solver_fallbacks,
         wall_s: wall.elapsed().as_secs_f64(),
     })
 }

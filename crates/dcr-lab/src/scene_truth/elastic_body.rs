@@ -128,6 +128,55 @@ impl ElasticBody {
         }
     }
 
+    /// The modal row of the surface point whose [`ElasticBody::axis_rows`] are `rows` along the
+    /// unit direction `d` (object frame): `Σ_a d_a rows_a`, written into `out` (length m).
+    pub fn normal_row(&self, rows: &[f64], d: [f64; 3], out: &mut [f64]) {
+        let m = self.m;
+        out.fill(0.0);
+        for (axis, da) in d.iter().enumerate() {
+            if *da == 0.0 {
+                continue;
+            }
+            for (o, x) in out.iter_mut().zip(&rows[axis * m..(axis + 1) * m]) {
+                *o += da * x;
+            }
+        }
+    }
+
+    /// Along a [`ElasticBody::normal_row`] `r`: the displacement now (m), the velocity now
+    /// (m/s) and the displacement at the end of the next step (m) under the force accumulated
+    /// so far, `Σ_j r_j (c_j q_j + g_j q̇_j + F_j r̃_j)` (module doc, F_j the forced-q coefficient).
+    pub fn motion_normal(&self, r: &[f64]) -> (f64, f64, f64) {
+        let (mut u, mut v, mut e) = (0.0, 0.0, 0.0);
+        for j in 0..self.m {
+            let [c, g, _, fq, _] = self.coef[j];
+            let (q, qd) = (self.q[j], self.qd[j]);
+            u += r[j] * q;
+            v += r[j] * qd;
+            e += r[j] * (c * q + g * qd + fq * self.force[j]);
+        }
+        (u, v, e)
+    }
+
+    /// The step compliance between two points (m/N): the displacement along `ra` at the end of
+    /// the next step per unit force held along `rb` during it, `Σ_j ra_j rb_j (1 − c_j)/ω_j²`
+    /// (for an undamped mode `(1 − cos ω_j Δt)/ω_j²`). Symmetric and positive semi-definite
+    /// over any set of points.
+    pub fn step_compliance(&self, ra: &[f64], rb: &[f64]) -> f64 {
+        ra.iter()
+            .zip(rb)
+            .zip(&self.coef)
+            .map(|((a, b), c)| a * b * c[3])
+            .sum()
+    }
+
+    /// Adds a force of `s` N along the [`ElasticBody::normal_row`] `r` to the next step's load.
+    pub fn add_force_normal(&mut self, r: &[f64], s: f64) {
+        for (acc, x) in self.force.iter_mut().zip(r) {
+            *acc += s * x;
+        }
+    }
+
     /// Advances every mode by one step under the accumulated force, then clears it.
     pub fn step(&mut self) {
         for j in 0..self.m {

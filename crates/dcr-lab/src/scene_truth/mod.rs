@@ -10,47 +10,76 @@
 //! ([`modal_bake::full_order::ModalAll`]), each mode advanced exactly over Δt under the force
 //! held during the step ([`ElasticBody`]), so the elastic side adds no time-discretisation error.
 //!
-//! # Coupling: penalty contacts at small steps
+//! # Coupling: penalty contacts, implicit in the forces
 //! Rapier still detects the elastic object's contacts (its narrow phase, the scene's colliders)
 //! but does not solve them (the object's colliders get empty solver groups). At each coupling
-//! step every contact point between a prop and the object is mapped to the object's surface in
+//! step every contact point between a prop and the object that rapier reports (rigid gap within
+//! its prediction distance, 2 cm by default, which must exceed the surface's largest elastic
+//! displacement) is mapped to the object's surface in
 //! the object's frame (closest point, barycentric weights — the mapping the runtime uses), and
-//! gets a spring–dashpot normal force
-//! f_n = max(0, k (−g) − c v_n,rel), g = d − u_n,
-//! where d is the rigid gap along the contact normal, u_n the elastic surface displacement at
-//! the point along the normal (so the surface *moves* under the contact), v_n,rel the prop's
-//! normal velocity relative to the moving surface, k the stiffness per point and c the dashpot
-//! that gives the scene's restitution e against a rigid surface (c = 2ζ√(k m/points), ζ such
-//! that the clamped spring–dashpot rebounds with ratio e); Coulomb friction (the colliders' mean coefficient) is regularised below
-//! a slip speed. The prop receives f Δt at its contact point; the elastic modes receive −f at
-//! the surface point (Eq. 9 with the force), and, for a dynamic object, its rigid body −f Δt.
-//! Every other contact (prop on prop) stays rapier's.
+//! gets a spring–dashpot normal force of its *end-of-step* gap g (rigid gap along the contact
+//! normal minus the elastic surface displacement there, so the surface moves under the
+//! contact):
+//! f = max(0, −k g − (c/Δt)(g − min(g₀, 0))),
+//! k the stiffness per point, g₀ the gap at the start of the step and c the dashpot that gives
+//! the scene's restitution e against a rigid surface (c = 2ζ√(k m/points), ζ such that the
+//! clamped spring–dashpot rebounds with ratio e). Over one step with the forces held, the
+//! end-of-step gaps are affine in the forces, g = g_free + A f: the elastic part of A is the
+//! exact step compliance of the modal propagator,
+//! C_ab = Σ_j (φ_j·n_a)(φ_j·n_b)(1 − cos ω_jΔt)/ω_j² (its damped form with Rayleigh damping),
+//! and the rigid part is Δt² times the prop's (and a dynamic object's) inverse effective mass
+//! between the points (Eq. 17; rapier's symplectic Euler moves the prop by Δt v⁺). Each
+//! prop's points are solved together ([`solve_penalty_block`]: a small complementarity
+//! problem, symmetric positive definite, unique solution); the props are taken one after the
+//! other, each seeing the modal load of the ones before (block Gauss–Seidel: the elastic
+//! coupling between two props within one step is that of the modes slow enough to carry it,
+//! a small fraction of the local compliance). Coulomb friction (the colliders' mean
+//! coefficient) is regularised below a slip speed v_s (viscous η = μ f / max(|v_t|, v_s)) and
+//! made implicit in the prop's slip only (f_t = −η v_t / (1 + η Δt W_t)), so it never reverses
+//! the slip within a step; it acts on the modes explicitly, bounded by μ f. The
+//! prop receives f Δt at its contact point; the elastic modes receive −f at the surface point
+//! (Eq. 9 with the force), and, for a dynamic object, its rigid body −f Δt. Every other
+//! contact (prop on prop) stays rapier's.
+//!
+//! Why implicit: with the start-of-step gap (the explicit exchange, [`CouplingScheme::Explicit`])
+//! the force of a step is answered within that step by the high modes under the point, whose
+//! step compliance is large next to 1/k; when k·C_aa is not small the exchange feeds energy to
+//! the props and blows up, and near that edge the outcomes depend on Δt, k and the mode count
+//! instead of converging. Solving for the end-of-step gap is stable for any k and Δt, costs
+//! one small dense solve per prop and step (the C block is a few dot products over the modes),
+//! and as k → ∞ tends to rigid contact with a moving surface (g ≥ 0 at the end of each step),
+//! so k is a convergence axis like Δt and the modes.
 //!
 //! Why not rapier's rigid contact with a moving surface (solver hooks setting the contact's
 //! target velocity from the surface velocity): that staggers an *explicit* surface velocity
 //! against an implicit rigid contact, and the surface's response to the contact impulse within
 //! one step is that of the nodal mass under the point — far below a plate's or a pot's mass —
 //! so the exchange diverges (the added-mass instability of partitioned schemes). The penalty
-//! force keeps the exchange stable when k is below the surface's local stiffness and Δt resolves
-//! √(k/m); its compliance is part of the model (the largest penetration is reported) and its
+//! force's compliance is part of the model (the largest penetration is reported) and its
 //! limit for a very stiff object is rigid contact with restitution e (tested).
 //!
 //! # Convergence
 //! [`scene_truth`] runs the scene at Δt, Δt/2, … until no outcome changes by more than the
-//! tolerance (2 %) between two successive steps, then checks the modes: the same run with half
-//! the modes must also be within the tolerance, else the reference is reported as not converged
-//! in modes. The work is bounded before it starts (dense size, steps × modes × bodies).
+//! tolerance (2 %) between two successive steps, then checks the contact stiffness (the same
+//! step with k doubled) and the modes (half the modes): each must also be within the
+//! tolerance, else the reference is reported as not converged. The estimated error is the
+//! largest of the three changes. The work is bounded before it starts (dense size, steps ×
+//! modes × bodies); the dense eigensolve can be cached on disk ([`read_eigen`]).
 
+mod contact_solve;
 mod coupled_run;
+mod eigen_cache;
 mod elastic_body;
 mod outcomes_page;
 
-pub use coupled_run::{run_coupled, CoupledParams, CoupledRun, ElasticPrep};
+pub use contact_solve::{solve_penalty_block, BlockSolveInfo};
+pub use coupled_run::{run_coupled, CoupledParams, CoupledRun, CouplingScheme, ElasticPrep};
+pub use eigen_cache::{eigen_key, eigen_path, read_eigen, write_eigen};
 pub use elastic_body::ElasticBody;
 pub use outcomes_page::{compare_scene, write_outcomes_page, MethodOutcome, SceneComparison};
 
 use std::collections::BTreeMap;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
@@ -60,7 +89,7 @@ use modal_bake::full_order::{FullOrderSystem, MaterialSi, ModalAll, SystemParams
 /// Settings of [`scene_truth`] (defaults in [`SceneTruthParams::default`]).
 #[derive(Clone, Debug)]
 pub struct SceneTruthParams {
-    /// First coupling step (s). Default 2e-5 s (the scene's h must be a whole multiple).
+    /// First coupling step (s). Default 1e-5 s (the scene's h must be a whole multiple).
     pub dt: f64,
     /// Largest number of halvings of the step. Default 3.
     pub max_halvings: usize,
@@ -72,7 +101,8 @@ pub struct SceneTruthParams {
     pub modes: Option<usize>,
     /// Check the modes (the converged step with half the modes). Default true.
     pub check_modes: bool,
-    /// Penalty stiffness per contact point (N/m). Default 1e7.
+    /// Penalty stiffness per contact point (N/m). Default 1e9: near rigid contact (sub-0.1 mm
+    /// penetrations under the scenes' props), which the implicit coupling keeps stable.
     pub contact_stiffness: f64,
     /// Slip speed of the friction regularisation (m/s). Default 1e-3.
     pub friction_velocity: f64,
@@ -84,6 +114,10 @@ pub struct SceneTruthParams {
     pub max_dense_dofs: usize,
     /// Largest coupling steps × modes × bodies of one run. Default 2e11.
     pub max_work: f64,
+    /// Check the contact stiffness (the finest step with k doubled). Default true.
+    pub check_stiffness: bool,
+    /// Folder of the eigensolve cache (`None`: no cache).
+    pub eigen_cache: Option<PathBuf>,
     /// Progress on stderr.
     pub progress: bool,
 }
@@ -91,18 +125,20 @@ pub struct SceneTruthParams {
 impl Default for SceneTruthParams {
     fn default() -> Self {
         SceneTruthParams {
-            dt: 2e-5,
+            dt: 1e-5,
             max_halvings: 3,
             tolerance: 0.02,
             seconds: None,
             modes: None,
             check_modes: true,
-            contact_stiffness: 1e7,
+            contact_stiffness: 1e9,
             friction_velocity: 1e-3,
             youngs_scale: 1.0,
             rayleigh: None,
             max_dense_dofs: 6000,
             max_work: 2e11,
+            check_stiffness: true,
+            eigen_cache: None,
             progress: false,
         }
     }
@@ -115,6 +151,8 @@ pub struct TruthLevel {
     pub dt: f64,
     /// Modes summed.
     pub modes: usize,
+    /// Penalty stiffness per contact point (N/m).
+    pub contact_stiffness: f64,
     /// Outcomes: name → (value, unit).
     pub outcomes: BTreeMap<String, (f64, String)>,
     /// Largest relative change of an outcome from the previous level (`None` for the first).
@@ -139,6 +177,8 @@ pub struct SceneTruth {
     pub levels: Vec<TruthLevel>,
     /// The half-mode check at the finest step (its change from the full run), if run.
     pub half_modes: Option<TruthLevel>,
+    /// The stiffness check at the finest step: k doubled (its change from the full run), if run.
+    pub double_k: Option<TruthLevel>,
     /// Whether the step converged (last change < tolerance).
     pub converged: bool,
     /// The finest run (its trajectory and energies).
@@ -150,18 +190,18 @@ pub struct SceneTruth {
 }
 
 impl SceneTruth {
-    /// The estimated error: the last change between two successive steps (and the mode check,
-    /// whichever is larger).
+    /// The estimated error: the last change between two successive steps, the mode check and
+    /// the stiffness check, whichever is largest.
     pub fn estimated_error(&self) -> f64 {
         let step = self
             .levels
             .last()
             .and_then(|l| l.change)
             .unwrap_or(f64::NAN);
-        match &self.half_modes {
-            Some(h) => step.max(h.change.unwrap_or(0.0)),
-            None => step,
-        }
+        [&self.half_modes, &self.double_k]
+            .into_iter()
+            .flatten()
+            .fold(step, |e, h| e.max(h.change.unwrap_or(0.0)))
     }
 }
 
@@ -185,15 +225,18 @@ pub fn load_scene(root: &Path, scene: &str) -> Result<SceneDesc> {
 }
 
 /// The full-order system and every mode of the scene's one elastic object (Young's modulus
-/// scaled by `youngs_scale`).
+/// scaled by `youngs_scale`); the eigensolve is read from / written to `cache` when given
+/// ([`read_eigen`]).
 ///
 /// # Errors
-/// No or several elastic objects, a mesh error, more free dofs than `max_dense_dofs`.
+/// No or several elastic objects, a mesh error, more free dofs than `max_dense_dofs`, a cache
+/// entry that cannot be written.
 pub fn prepare_elastic(
     desc: &SceneDesc,
     root: &Path,
     youngs_scale: f64,
     max_dense_dofs: usize,
+    cache: Option<&Path>,
 ) -> Result<ElasticPrep> {
     if desc.elastic.len() != 1 {
         bail!(
@@ -226,7 +269,27 @@ pub fn prepare_elastic(
             sys.n()
         );
     }
-    let all = ModalAll::new(&sys, max_dense_dofs)?;
+    let key = eigen_key(&sys);
+    let cached = match cache.map(|dir| read_eigen(dir, &key)) {
+        Some(Ok(Some(all))) if all.vectors.nrows() == sys.n() => Some(all),
+        Some(Err(msg)) => {
+            eprintln!("[scene-truth] eigensolve cache: {msg}; solving again and replacing it");
+            None
+        }
+        _ => None,
+    };
+    let all = match cached {
+        Some(all) => all,
+        None => {
+            let all = ModalAll::new(&sys, max_dense_dofs)?;
+            if let Some(dir) = cache {
+                write_eigen(dir, &key, &all).with_context(|| {
+                    format!("writing the eigensolve cache in {}", dir.display())
+                })?;
+            }
+            all
+        }
+    };
     // Every elastic eigenvalue must be positive; a non-positive one is a lost mode (the dense
     // solve at an extreme stiffness or a mesh with a mechanism), which would let the surface
     // drift under a held load.
@@ -240,8 +303,9 @@ pub fn prepare_elastic(
     Ok(ElasticPrep { sys, all })
 }
 
-/// The largest relative change between two outcome sets (a floor of 0.01 in each outcome's
-/// unit keeps figures near zero from dominating).
+/// The largest relative change between two outcome sets: |a − b| / max(|b|, 1 unit). The
+/// floor of one unit (1 mm of lift or slide, 1° of tilt) compares figures below it absolutely,
+/// so a sub-millimetre lift that flickers between 0 and 0.5 mm does not dominate.
 pub fn outcome_change(
     a: &BTreeMap<String, (f64, String)>,
     b: &BTreeMap<String, (f64, String)>,
@@ -249,7 +313,7 @@ pub fn outcome_change(
     let mut worst = 0.0f64;
     for (k, (vb, _)) in b {
         let va = a.get(k).map_or(0.0, |x| x.0);
-        worst = worst.max((va - vb).abs() / vb.abs().max(0.01));
+        worst = worst.max((va - vb).abs() / vb.abs().max(1.0));
     }
     worst
 }
@@ -260,7 +324,13 @@ pub fn outcome_change(
 /// As [`prepare_elastic`] and [`run_coupled`]; a run over the work budget.
 pub fn scene_truth(desc: &SceneDesc, root: &Path, params: &SceneTruthParams) -> Result<SceneTruth> {
     let t0 = Instant::now();
-    let prep = prepare_elastic(desc, root, params.youngs_scale, params.max_dense_dofs)?;
+    let prep = prepare_elastic(
+        desc,
+        root,
+        params.youngs_scale,
+        params.max_dense_dofs,
+        params.eigen_cache.as_deref(),
+    )?;
     let eigen_s = t0.elapsed().as_secs_f64();
     let seconds = params.seconds.unwrap_or(desc.seconds);
     let modes = params
@@ -289,22 +359,28 @@ pub fn scene_truth(desc: &SceneDesc, root: &Path, params: &SceneTruthParams) -> 
             eigen_s
         );
     }
-    let coupled = |dt: f64, modes: usize| CoupledParams {
+    let coupled = |dt: f64, modes: usize, k: f64| CoupledParams {
         dt,
         seconds,
         modes: Some(modes),
-        contact_stiffness: params.contact_stiffness,
+        contact_stiffness: k,
         friction_velocity: params.friction_velocity,
         rayleigh: params.rayleigh.unwrap_or(desc.elastic[0].rayleigh),
         restitution: desc.restitution,
         progress: params.progress,
+        scheme: CouplingScheme::Implicit,
     };
     let mut levels: Vec<TruthLevel> = Vec::new();
     let mut dt = params.dt;
     let mut run;
     let mut converged = false;
     loop {
-        run = run_coupled(desc, root, &prep, &coupled(dt, modes))?;
+        run = run_coupled(
+            desc,
+            root,
+            &prep,
+            &coupled(dt, modes, params.contact_stiffness),
+        )?;
         let change = levels
             .last()
             .map(|l| outcome_change(&l.outcomes, &run.outcomes));
@@ -325,6 +401,7 @@ pub fn scene_truth(desc: &SceneDesc, root: &Path, params: &SceneTruthParams) -> 
         levels.push(TruthLevel {
             dt,
             modes,
+            contact_stiffness: params.contact_stiffness,
             outcomes: run.outcomes.clone(),
             change,
             max_penetration: run.max_penetration,
@@ -339,17 +416,38 @@ pub fn scene_truth(desc: &SceneDesc, root: &Path, params: &SceneTruthParams) -> 
         }
         dt /= 2.0;
     }
-    let half_modes = if params.check_modes && modes >= 2 {
-        let h = run_coupled(desc, root, &prep, &coupled(dt, modes / 2))?;
+    let check = |name: &str, m: usize, k: f64| -> Result<TruthLevel> {
+        let h = run_coupled(desc, root, &prep, &coupled(dt, m, k))?;
         let change = outcome_change(&h.outcomes, &run.outcomes);
-        Some(TruthLevel {
+        if params.progress {
+            eprintln!(
+                "[scene-truth] {}: {name} (dt {dt:.3e} s, {m} modes, k {k:.2e} N/m): change {:.2} % in {:.0} s",
+                desc.name,
+                100.0 * change,
+                h.wall_s
+            );
+        }
+        Ok(TruthLevel {
             dt,
-            modes: modes / 2,
+            modes: m,
+            contact_stiffness: k,
             outcomes: h.outcomes,
             change: Some(change),
             max_penetration: h.max_penetration,
             wall_s: h.wall_s,
         })
+    };
+    let double_k = if params.check_stiffness {
+        Some(check("k doubled", modes, 2.0 * params.contact_stiffness)?)
+    } else {
+        None
+    };
+    let half_modes = if params.check_modes && modes >= 2 {
+        Some(check(
+            "half the modes",
+            modes / 2,
+            params.contact_stiffness,
+        )?)
     } else {
         None
     };
@@ -360,6 +458,7 @@ pub fn scene_truth(desc: &SceneDesc, root: &Path, params: &SceneTruthParams) -> 
         eigen_s,
         levels,
         half_modes,
+        double_k,
         converged,
         run,
         seconds,

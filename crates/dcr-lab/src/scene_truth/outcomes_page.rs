@@ -236,7 +236,7 @@ pub fn write_outcomes_page(out: &Path, scenes: &[SceneComparison], header: &str)
         writeln!(md, "{}\n", c.desc.description)?;
         writeln!(
             md,
-            "- reference: {} free dofs, every one of its {} elastic modes (dense eigensolve {:.0} s), \
+            "- reference: {} free dofs, every one of its {} elastic modes (dense eigensolve {:.0} s; ~0 s: read from the cache), \
              {:.2} s simulated, penalty k = {:.1e} N/m per point (largest penetration {:.3} mm)",
             t.free_dofs,
             t.modes_available,
@@ -258,14 +258,69 @@ pub fn write_outcomes_page(out: &Path, scenes: &[SceneComparison], header: &str)
             "- steps (largest outcome change from the previous step, wall time): {}",
             steps.join(", ")
         )?;
+        if let Some(h) = &t.double_k {
+            writeln!(
+                md,
+                "- stiffness: with k doubled ({:.1e} N/m) at the finest step the outcomes move by {:.2} % ({:.0} s)",
+                2.0 * t.params.contact_stiffness,
+                100.0 * h.change.unwrap_or(0.0),
+                h.wall_s
+            )?;
+        }
         if let Some(h) = &t.half_modes {
             writeln!(
                 md,
-                "- modes: with half the modes ({}) at the finest step the outcomes move by {:.2} %",
+                "- modes: with half the modes ({}) at the finest step the outcomes move by {:.2} % ({:.0} s)",
                 h.modes,
-                100.0 * h.change.unwrap_or(0.0)
+                100.0 * h.change.unwrap_or(0.0),
+                h.wall_s
             )?;
         }
+        // Every run of the refinement with its outcomes.
+        let onames: Vec<&String> = t.run.outcomes.keys().collect();
+        write!(md, "\n| run | Δt (s) | k (N/m) | modes |")?;
+        for n in &onames {
+            write!(md, " {n} ({}) |", t.run.outcomes[*n].1)?;
+        }
+        writeln!(md, " change | wall (s) |")?;
+        writeln!(
+            md,
+            "|---|---|---|---|{}---|---|",
+            "---|".repeat(onames.len())
+        )?;
+        let rows = t
+            .levels
+            .iter()
+            .enumerate()
+            .map(|(i, l)| (format!("step {}", i + 1), l))
+            .chain(t.double_k.iter().map(|l| ("k doubled".to_string(), l)))
+            .chain(
+                t.half_modes
+                    .iter()
+                    .map(|l| ("half the modes".to_string(), l)),
+            );
+        for (name, l) in rows {
+            write!(
+                md,
+                "| {name} | {:.2e} | {:.1e} | {} |",
+                l.dt, l.contact_stiffness, l.modes
+            )?;
+            for n in &onames {
+                write!(
+                    md,
+                    " {} |",
+                    l.outcomes.get(*n).map_or("–".into(), |x| fmt(x.0))
+                )?;
+            }
+            writeln!(
+                md,
+                " {} | {:.0} |",
+                l.change
+                    .map_or("–".into(), |c| format!("{:.1} %", 100.0 * c)),
+                l.wall_s
+            )?;
+        }
+        writeln!(md)?;
         writeln!(
             md,
             "- **{}** at Δt = {:.2e} s, estimated error {:.2} % (tolerance {:.0} %)\n",
