@@ -155,6 +155,11 @@ impl FullOrderSystem {
         }
     }
 
+    /// Free-free: the rigid modes R̃ (n_free × 6, m·kg^-1/2), R̃ᵀ M R̃ = I; `None` when clamped.
+    pub fn rigid_modes(&self) -> Option<&Mat<f64>> {
+        self.rigid.as_ref()
+    }
+
     /// Free-free: `x ← x − M R̃ (R̃ᵀ x)` for a dual vector x (a load, or a measurement row).
     ///
     /// For a load f this removes exactly the part that drives rigid motion (R̃ᵀ f_e = 0); for a

@@ -2,7 +2,17 @@
 //! the exact damped impulse response of each mode.
 //!
 //! K φ = λ M φ is solved densely: M = L Lᵀ (Cholesky), C = L⁻¹ K L⁻ᵀ (symmetrised), C = Q Λ Qᵀ
-//! (faer `self_adjoint_eigen`), Φ = L⁻ᵀ Q, so Φᵀ M Φ = I. With Rayleigh damping every mode
+//! (faer `self_adjoint_eigen`), Φ = L⁻ᵀ Q, so Φᵀ M Φ = I.
+//!
+//! Free-free, the rigid modes are deflated before the eigensolve: with Y = Lᵀ R̃ (orthonormal,
+//! R̃ the M-orthonormal rigid modes) the solve is of P C P, P = I − Y Yᵀ. In exact arithmetic
+//! C Y = 0; the rigid directions are then moved to distinct values far below the elastic
+//! spectrum (−σ, −2σ, …, σ = max |C_ij|) and reported as exact zeros. The six near-zero
+//! eigenvalues of C form a tight cluster that the dense symmetric eigensolver resolved wrongly
+//! (on a coarse order-1 steel box: five within ±400 rad²/s² and one at 1.05e7, against a first
+//! elastic λ of 9.9e9 that the Lanczos bake confirms, though ‖C y‖ ≈ 2.5e-4 for every rigid y),
+//! so the rigid-mode count failed; the deflated problem has no such cluster, its rigid vectors
+//! are R̃ and its elastic eigenpairs are M-orthogonal to them. With Rayleigh damping every mode
 //! decouples (paper Eq. 8) and an impulse f at t = 0 gives the exact displacement
 //! u(t) = Σ_j φ_j (φ_jᵀ f) g_j(t), with g_j the mass-normalised impulse response for
 //! ξ_j = ½(α0/ω_j + α1 ω_j) in every regime (ξ < 1, = 1, > 1) — `dcr_runtime::filter::ModeFilter`.
@@ -55,7 +65,8 @@ impl ModalAll {
             });
         }
         let t = Instant::now();
-        let (vals, phi) = dense_generalized_eigen(&sys.k.to_dense(), sys.m.to_dense())?;
+        let (vals, phi) =
+            dense_generalized_eigen(&sys.k.to_dense(), sys.m.to_dense(), sys.rigid_modes())?;
         let rigid = if sys.free_free() { 6 } else { 0 };
         if rigid > 0 {
             let lam7 = vals.get(rigid).copied().unwrap_or(f64::INFINITY).abs();
@@ -206,6 +217,7 @@ const DENSE_PAR: Par = Par::Rayon(match NonZeroUsize::new(2) {
 fn dense_generalized_eigen(
     k: &Mat<f64>,
     mut l: Mat<f64>,
+    rigid: Option<&Mat<f64>>,
 ) -> Result<(Vec<f64>, Mat<f64>), FullOrderError> {
     use faer::linalg::cholesky::llt::factor::{cholesky_in_place, cholesky_in_place_scratch};
     use faer::linalg::evd::{self_adjoint_evd, self_adjoint_evd_scratch, ComputeEigenvectors};
@@ -233,7 +245,11 @@ fn dense_generalized_eigen(
     solve_lower_triangular_in_place(l, x.as_mut(), DENSE_PAR);
     let mut c = x.transpose().to_owned();
     solve_lower_triangular_in_place(l, c.as_mut(), DENSE_PAR);
-    let c = Mat::from_fn(n, n, |i, j| 0.5 * (c[(i, j)] + c[(j, i)]));
+    let mut c = Mat::from_fn(n, n, |i, j| 0.5 * (c[(i, j)] + c[(j, i)]));
+    let rigid_count = rigid.map_or(0, |r| r.ncols());
+    if let Some(r) = rigid {
+        deflate(&mut c, l, r);
+    }
     let mut s = Diag::<f64>::zeros(n);
     let mut u = Mat::<f64>::zeros(n, n);
     self_adjoint_evd(
@@ -246,7 +262,13 @@ fn dense_generalized_eigen(
     )
     .map_err(|e| FullOrderError::Eigen(format!("dense eigensolver failed: {e:?}")))?;
     solve_upper_triangular_in_place(l.transpose(), u.as_mut(), DENSE_PAR);
-    Ok(((0..n).map(|i| s[i]).collect(), u))
+    // The deflated rigid directions sit at −σ, −2σ, … (the lowest, in that order): exactly zero.
+    Ok((
+        (0..n)
+            .map(|i| if i < rigid_count { 0.0 } else { s[i] })
+            .collect(),
+        u,
+    ))
 }
 
 /// The time profile of the load in [`ModalAll::response_peaks`].
@@ -256,4 +278,50 @@ pub enum ModalInput {
     Impulse,
     /// A force switched on at t = 0 and held (load in N).
     Step,
+}
+
+/// `C ← P C P − σ Y D Yᵀ` with `P = I − Y Yᵀ`, `Y = Lᵀ R̃` (orthonormal: R̃ᵀ M R̃ = I,
+/// M = L Lᵀ), D = diag(1, 2, …, 6) and σ = max |C_ij|: the rigid directions become exact, distinct
+/// eigenvectors far below the elastic spectrum, which P C P leaves unchanged (see the module doc).
+/// `l` holds L in its lower triangle.
+fn deflate(c: &mut Mat<f64>, l: faer::MatRef<'_, f64>, r: &Mat<f64>) {
+    let n = c.nrows();
+    let k = r.ncols();
+    // Y = Lᵀ R̃: Y[i, j] = Σ_{p ≥ i} L[p, i] R̃[p, j] (lower triangle of l only).
+    let y = Mat::from_fn(n, k, |i, j| {
+        (i..n).map(|p| l[(p, i)] * r[(p, j)]).sum::<f64>()
+    });
+    let cy = Mat::from_fn(n, k, |i, j| {
+        (0..n).map(|p| c[(i, p)] * y[(p, j)]).sum::<f64>()
+    });
+    let ycy = Mat::from_fn(k, k, |a, b| {
+        (0..n).map(|p| y[(p, a)] * cy[(p, b)]).sum::<f64>()
+    });
+    let sigma = (0..n)
+        .flat_map(|j| (0..n).map(move |i| (i, j)))
+        .fold(0.0f64, |m, (i, j)| m.max(c[(i, j)].abs()));
+    // P C P − σ Y D Yᵀ = C − (CY) Yᵀ − Y (CY)ᵀ + W Yᵀ, W = Y (Yᵀ C Y − σ D).
+    let w = Mat::from_fn(n, k, |i, b| {
+        (0..k).map(|a| y[(i, a)] * ycy[(a, b)]).sum::<f64>() - sigma * (b + 1) as f64 * y[(i, b)]
+    });
+    let cols: Vec<Vec<f64>> = (0..n)
+        .into_par_iter()
+        .map(|j| {
+            (0..n)
+                .map(|i| {
+                    let mut v = c[(i, j)];
+                    for a in 0..k {
+                        v += -cy[(i, a)] * y[(j, a)] - y[(i, a)] * cy[(j, a)]
+                            + w[(i, a)] * y[(j, a)];
+                    }
+                    v
+                })
+                .collect()
+        })
+        .collect();
+    for (j, col) in cols.iter().enumerate() {
+        for (i, &v) in col.iter().enumerate() {
+            c[(i, j)] = v;
+        }
+    }
 }
