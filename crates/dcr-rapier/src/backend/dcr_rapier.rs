@@ -309,8 +309,8 @@ impl DcrRapier {
         }
         self.rank_colliders();
         // The step's buffers sized at set-up (as the world's): room for each object's
-        // prepared number of resting contacts and their bodies.
-        let n = PREPARED_CONTACTS * self.objects.len();
+        // prepared number of resting contacts and their bodies, for up to eight objects.
+        let n = PREPARED_CONTACTS * self.objects.len().min(8);
         self.reports.reserve(n.saturating_sub(self.reports.len()));
         self.sources.reserve(n.saturating_sub(self.sources.len()));
         self.states.reserve(n.saturating_sub(self.states.len()));

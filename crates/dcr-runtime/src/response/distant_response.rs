@@ -51,7 +51,8 @@ impl MethodResponse {
 /// Set up once per object ([`DistantResponse::new`]); call [`DistantResponse::step`] once per
 /// rigid-body step with the step's new impacts and the current resting contacts. After warm-up
 /// (buffers are sized at set-up for [`PREPARED_CONTACTS`] resting contacts and grown on first
-/// sight of more) a step does not allocate. Everything is in the object frame of the model (m, s, N·s).
+/// sight of more) a step does not allocate. Everything is in the object frame of the model (m,
+/// s, N·s).
 ///
 /// ```
 /// use std::sync::Arc;

@@ -19,6 +19,10 @@ use crate::response::{
     prepared_vec, DistantResponse, Impact, RestingContact, ServedBy, PREPARED_CONTACTS,
 };
 
+/// Objects whose contacts the world's per-step buffers are sized for at set-up (beyond them
+/// the buffers grow on first sight, as before), so that set-up memory stays bounded.
+const PREPARED_OBJECTS: usize = 8;
+
 /// One elastic object.
 #[derive(Debug)]
 struct Object {
@@ -396,10 +400,10 @@ impl DcrWorld {
     }
 
     /// Sizes the per-step buffers for [`PREPARED_CONTACTS`] resting contacts (and as many
-    /// bodies) per object and writes them once: set-up, not the first world steps, pays their
-    /// allocation and first touch.
+    /// bodies) per object, for at most [`PREPARED_OBJECTS`] objects, and writes them once:
+    /// set-up, not the first world steps, pays their allocation and first touch.
     fn prepare_buffers(&mut self) {
-        let n = PREPARED_CONTACTS * self.objects.len();
+        let n = PREPARED_CONTACTS * self.objects.len().min(PREPARED_OBJECTS);
         let event = ImpulseEvent {
             body: 0,
             point: [0.0; 3],
