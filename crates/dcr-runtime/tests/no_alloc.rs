@@ -18,7 +18,7 @@ use std::sync::Arc;
 use dcr_runtime::attenuation::HeatGeodesic;
 use dcr_runtime::response::{
     AmplitudeKind, AttenuationLaw, AttenuationParams, DistanceKind, ForceInput, Impact,
-    RestingContact, Variant,
+    RestingContact, Variant, PREPARED_CONTACTS,
 };
 use dcr_runtime::testing::{box_surface, geometric_omegas, synthetic_base, SplitMix64};
 use dcr_runtime::{
@@ -105,6 +105,7 @@ fn steps_do_not_allocate_after_warm_up() {
             .collect(),
     });
     let model = Arc::new(ModalModel::from_base(base).unwrap());
+    first_step_does_not_allocate(&model);
     // Several random streams: which buffers the warm-up fills first depends on the inputs.
     for seed in [99, 7, 23] {
         steps_do_not_allocate_with(&model, seed, false);
@@ -125,6 +126,50 @@ fn steps_do_not_allocate_after_warm_up() {
         .build()
         .unwrap();
     pool.install(|| steps_do_not_allocate_with(&model, 5, true));
+}
+
+/// Set-up sizes a response for `PREPARED_CONTACTS` resting contacts: its very first step, with
+/// that many contacts all mapped now and an impact, allocates nothing (both variants).
+fn first_step_does_not_allocate(model: &Arc<ModalModel>) {
+    let mut rng = SplitMix64(3);
+    let resting: Vec<RestingContact> = (0..PREPARED_CONTACTS as u64)
+        .map(|i| RestingContact {
+            id: 500 + i,
+            point: surface_point(&mut rng),
+        })
+        .collect();
+    let impacts = [Impact {
+        point: [0.5, 0.3, 0.4],
+        direction: [0.0, 0.0, -1.0],
+        impulse: 2.0,
+    }];
+    // The default method (the base's transfer table, with the modal method for what it cannot
+    // serve) and the modal method.
+    let methods = [ResponseParams::default().method, Method::Modal];
+    for (method, variant) in methods
+        .into_iter()
+        .flat_map(|m| [(m.clone(), Variant::PerContact), (m, Variant::PerNode)])
+    {
+        let params = ResponseParams {
+            variant,
+            method: method.clone(),
+            ..ResponseParams::default()
+        };
+        let mut resp = DistantResponse::new(model.clone(), params).unwrap();
+        let before = ALLOCS.load(Ordering::Relaxed);
+        let out = resp.step(&impacts, &resting);
+        let allocs = ALLOCS.load(Ordering::Relaxed) - before;
+        assert_eq!(out.len(), PREPARED_CONTACTS);
+        assert!(out.iter().all(|r| r.mapped) && out.iter().any(|r| r.delta_v > 0.0));
+        assert_eq!(
+            resp.last_step_info().contacts_mapped_now as usize,
+            PREPARED_CONTACTS
+        );
+        assert_eq!(
+            allocs, 0,
+            "{method:?}, {variant:?}: the first step allocated {allocs} times"
+        );
+    }
 }
 
 /// `parallel`: only the heat configurations, with two-thread queries.

@@ -3,7 +3,7 @@
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use dcr_runtime::math::{add, dot, norm, scale, sub};
-use dcr_runtime::response::inverse_effective_mass;
+use dcr_runtime::response::{inverse_effective_mass, PREPARED_CONTACTS};
 use dcr_runtime::{
     BodyState, ContactReport, DcrWorld, ElasticHandle, ElasticObjectDesc, ImpulseEvent, Pose,
     WorldError, WorldParams,
@@ -308,6 +308,12 @@ impl DcrRapier {
             }
         }
         self.rank_colliders();
+        // The step's buffers sized at set-up (as the world's): room for each object's
+        // prepared number of resting contacts and their bodies, for up to eight objects.
+        let n = PREPARED_CONTACTS * self.objects.len().min(8);
+        self.reports.reserve(n.saturating_sub(self.reports.len()));
+        self.sources.reserve(n.saturating_sub(self.sources.len()));
+        self.states.reserve(n.saturating_sub(self.states.len()));
         Ok(handle)
     }
 

@@ -5,6 +5,7 @@ use std::collections::HashMap;
 use super::id_hasher::BuildIdHasher;
 use crate::math::{norm, sub};
 use crate::model::{ModalModel, SurfacePoint};
+use crate::response::prepared_vec;
 
 /// One cached resting contact.
 #[derive(Clone, Copy, Debug)]
@@ -37,13 +38,23 @@ pub struct ContactCache {
 
 impl ContactCache {
     /// An empty cache for an m-mode model; a contact whose query point moves farther than
-    /// `remap_tolerance` (m) from the point it was mapped from is mapped again.
-    pub fn new(m: usize, remap_tolerance: f64) -> Self {
+    /// `remap_tolerance` (m) from the point it was mapped from is mapped again. Storage for
+    /// `contacts` contacts is allocated now (the hash table; the slots, rows and free list also
+    /// written once), so the first steps with up to that many contacts neither allocate nor
+    /// touch fresh memory.
+    pub fn new(m: usize, remap_tolerance: f64, contacts: usize) -> Self {
+        let empty = CachedContact {
+            id: 0,
+            query: [0.0; 3],
+            surface: None,
+            last_seen: 0,
+            live: false,
+        };
         ContactCache {
-            map: HashMap::default(),
-            slots: Vec::new(),
-            rows: Vec::new(),
-            free: Vec::new(),
+            map: HashMap::with_capacity_and_hasher(contacts, BuildIdHasher::default()),
+            slots: prepared_vec(contacts, empty),
+            rows: prepared_vec(contacts * m, 0.0),
+            free: prepared_vec(contacts, 0),
             m,
             remap_tolerance,
             misses: 0,

@@ -9,7 +9,7 @@
 
 use super::impulse_table::ImpulseTable;
 use super::step_ctx::{mapped_response, unmapped_response, StepCtx};
-use super::{ForceInput, Impact, ParamsError, RestingContact, ServedBy};
+use super::{ForceInput, Impact, ParamsError, RestingContact, ServedBy, PREPARED_CONTACTS};
 use crate::attenuation::{
     AmplitudeKind, AttenuationLaw, AttenuationParams, DistanceCache, DistanceKind, GeodesicTable,
     HeatWorkspace,
@@ -152,7 +152,7 @@ impl AttenuationResponse {
             mean,
             fields: DistanceCache::new(ns, capacity),
             ws,
-            hits: Vec::new(),
+            hits: Vec::with_capacity(PREPARED_CONTACTS),
             hit_fields: Vec::new(),
         })
     }

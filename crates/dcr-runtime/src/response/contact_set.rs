@@ -1,7 +1,7 @@
 //! [`ContactSet`]: the mapping step every method shares — the step's resting contacts looked
 //! up in (or added to) the per-object contact cache, evicted when unseen.
 
-use super::{RestingContact, StepInfo};
+use super::{prepared_vec, RestingContact, StepInfo, PREPARED_CONTACTS};
 use crate::mapping::{CachedContact, ContactCache};
 use crate::model::ModalModel;
 
@@ -18,13 +18,14 @@ pub(crate) struct ContactSet {
 }
 
 impl ContactSet {
-    /// An empty set for an m-mode model; contacts farther than `max_map` (m) from the surface
-    /// are not mapped, contacts moved farther than `remap_tolerance` (m) are mapped again, and
-    /// contacts unseen for more than `evict_after` steps are evicted.
+    /// An empty set for an m-mode model, its storage sized for [`PREPARED_CONTACTS`] contacts;
+    /// contacts farther than `max_map` (m) from the surface are not mapped, contacts moved
+    /// farther than `remap_tolerance` (m) are mapped again, and contacts unseen for more than
+    /// `evict_after` steps are evicted.
     pub fn new(m: usize, remap_tolerance: f64, max_map: f64, evict_after: u32) -> ContactSet {
         ContactSet {
-            cache: ContactCache::new(m, remap_tolerance),
-            slots: Vec::new(),
+            cache: ContactCache::new(m, remap_tolerance, PREPARED_CONTACTS),
+            slots: prepared_vec(PREPARED_CONTACTS, 0),
             max_map,
             evict_after,
         }

@@ -11,11 +11,11 @@ use super::contact_set::ContactSet;
 use super::impulse_table::ImpulseTable;
 use super::lateral_kick::LateralKick;
 use super::modal_response::ModalResponse;
-use super::step_ctx::StepCtx;
+use super::step_ctx::{unmapped_response, StepCtx};
 use super::transfer_response::TransferResponse;
 use super::{
-    ContactResponse, ForceInput, Impact, Method, ParamsError, ResponseParams, RestingContact,
-    StepInfo, TableFallback, TablePolicy, TableStatus,
+    prepared_vec, ContactResponse, ForceInput, Impact, Method, ParamsError, ResponseParams,
+    RestingContact, StepInfo, TableFallback, TablePolicy, TableStatus, PREPARED_CONTACTS,
 };
 use crate::model::ModalModel;
 
@@ -50,8 +50,9 @@ impl MethodResponse {
 ///
 /// Set up once per object ([`DistantResponse::new`]); call [`DistantResponse::step`] once per
 /// rigid-body step with the step's new impacts and the current resting contacts. After warm-up
-/// (buffers are sized at set-up and grown on first sight of more contacts) a step does not
-/// allocate. Everything is in the object frame of the model (m, s, N·s).
+/// (buffers are sized at set-up for [`PREPARED_CONTACTS`] resting contacts and grown on first
+/// sight of more) a step does not allocate. Everything is in the object frame of the model (m,
+/// s, N·s).
 ///
 /// ```
 /// use std::sync::Arc;
@@ -150,11 +151,11 @@ impl DistantResponse {
                 (MethodResponse::Attenuation(att), TableStatus::NotRequested)
             }
             Method::Modal => (
-                MethodResponse::Modal(ModalResponse::new(table, p.h)),
+                MethodResponse::Modal(ModalResponse::new(table, p.h, p.variant)),
                 TableStatus::NotRequested,
             ),
             Method::Transfer => {
-                let modal = ModalResponse::new(table, p.h);
+                let modal = ModalResponse::new(table, p.h, p.variant);
                 match TransferResponse::check(&model, p.h, rayleigh, p.carry_over) {
                     Ok(()) => (
                         MethodResponse::Transfer(TransferResponse::new(&model, modal)),
@@ -176,7 +177,13 @@ impl DistantResponse {
             method,
             lateral,
             table_status,
-            out: Vec::new(),
+            out: prepared_vec(
+                PREPARED_CONTACTS,
+                unmapped_response(&RestingContact {
+                    id: 0,
+                    point: [0.0; 3],
+                }),
+            ),
             step_index: 0,
             info: StepInfo::default(),
             idle,

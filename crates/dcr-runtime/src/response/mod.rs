@@ -31,6 +31,21 @@ pub use response_params::{Method, ParamsError, ResponseParams, TablePolicy, Tabl
 pub use resting_contact::RestingContact;
 pub use step_info::{StepInfo, TableFallback};
 
+/// Resting contacts per object that the buffers of a response ([`DistantResponse::new`]) and
+/// of the world's objects are sized for at set-up: the first steps with up to this many
+/// contacts neither allocate nor touch fresh memory; more grow the buffers on first sight (a
+/// step does not allocate after that warm-up).
+pub const PREPARED_CONTACTS: usize = 64;
+
+/// An empty vector with room for `n` elements whose memory has been written once (with
+/// `fill`): set-up pays the allocation and the first touch of its pages, not the first step.
+pub(crate) fn prepared_vec<T: Clone>(n: usize, fill: T) -> Vec<T> {
+    let mut v = Vec::with_capacity(n);
+    v.resize(n, fill);
+    v.clear();
+    v
+}
+
 // The knobs of the attenuation method and of filter sampling, beside the other response
 // settings (their home modules define them).
 pub use crate::attenuation::{AmplitudeKind, AttenuationLaw, AttenuationParams, DistanceKind};

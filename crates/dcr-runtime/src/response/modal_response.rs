@@ -11,7 +11,9 @@
 use super::impulse_table::ImpulseTable;
 use super::peak_kernel::{peak_abs_rows, LANES};
 use super::step_ctx::{mapped_response, unmapped_response, StepCtx};
-use super::{ForceInput, Impact, RestingContact, ServedBy, Variant};
+use super::{
+    prepared_vec, ForceInput, Impact, RestingContact, ServedBy, Variant, PREPARED_CONTACTS,
+};
 use crate::filter::ModalBank;
 use crate::math::normalize;
 
@@ -53,8 +55,9 @@ pub(crate) struct ModalResponse {
 }
 
 impl ModalResponse {
-    /// The method's state over the filters of `table` (h = `h` s).
-    pub fn new(table: ImpulseTable, h: f64) -> ModalResponse {
+    /// The method's state over the filters of `table` (h = `h` s), its buffers sized for
+    /// [`PREPARED_CONTACTS`] resting contacts of `variant`'s channels.
+    pub fn new(table: ImpulseTable, h: f64, variant: Variant) -> ModalResponse {
         let ImpulseTable {
             samples,
             bank,
@@ -62,6 +65,9 @@ impl ModalResponse {
             ..
         } = table;
         let m = bank.filters().len();
+        // Channels per contact: one, or one per corner of its triangle.
+        let width = if variant == Variant::PerNode { 3 } else { 1 };
+        let channels = width * PREPARED_CONTACTS;
         let stride = samples.div_ceil(LANES) * LANES;
         let mut g_t = vec![0.0; m * stride];
         for k in 0..samples {
@@ -76,6 +82,10 @@ impl ModalResponse {
             .zip(&g_end)
             .map(|(f, g)| f.free_response(h) - 2.0 * f.xi * f.omega * g)
             .collect();
+        // The kernel's first call detects the CPU's SIMD features (CPUID, a trap to the
+        // hypervisor in a virtual machine): done here, at set-up, not in the first step.
+        let mut peak = [0.0];
+        peak_abs_rows(&[0.0; LANES], LANES, 1, &[0.0], 1, &mut peak);
         ModalResponse {
             m,
             samples,
@@ -89,12 +99,12 @@ impl ModalResponse {
             f: vec![0.0; m],
             tmp_q: vec![0.0; m],
             tmp_v: vec![0.0; m],
-            chan: Vec::new(),
-            w_step: Vec::new(),
-            w_key: (u64::MAX, Vec::new()),
-            w_scaled: Vec::new(),
+            chan: prepared_vec(PREPARED_CONTACTS, 0),
+            w_step: prepared_vec(channels * m, 0.0),
+            w_key: (u64::MAX, prepared_vec(PREPARED_CONTACTS, 0)),
+            w_scaled: prepared_vec(channels * m, 0.0),
             q_stale: false,
-            peaks: Vec::new(),
+            peaks: prepared_vec(channels, 0.0),
             asleep: true,
             energy_ref: 0.0,
             bank,

@@ -38,7 +38,9 @@
 
 use super::modal_response::{ModalResponse, UNMAPPED};
 use super::step_ctx::{mapped_response, unmapped_response, StepCtx};
-use super::{ForceInput, Impact, RestingContact, ServedBy, TableFallback, TableStatus};
+use super::{
+    ForceInput, Impact, RestingContact, ServedBy, TableFallback, TableStatus, PREPARED_CONTACTS,
+};
 use crate::math::{dot, normalize};
 use crate::model::ModalModel;
 
@@ -239,8 +241,9 @@ impl TransferResponse {
             local,
             order: t.order,
             tri_pts,
-            hits: Vec::new(),
-            peaks: Vec::new(),
+            // Sized at set-up as the modal method's buffers (impacts are fewer than contacts).
+            hits: Vec::with_capacity(PREPARED_CONTACTS),
+            peaks: Vec::with_capacity(PREPARED_CONTACTS),
             modal,
         }
     }

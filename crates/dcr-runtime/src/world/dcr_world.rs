@@ -15,7 +15,13 @@ use super::{
     ImpulseEvent, ObjectStepInfo, ObjectTotals, Pose, WorldError, WorldParams, WorldStepInfo,
 };
 use crate::mapping::BuildIdHasher;
-use crate::response::{DistantResponse, Impact, RestingContact};
+use crate::response::{
+    prepared_vec, DistantResponse, Impact, RestingContact, ServedBy, PREPARED_CONTACTS,
+};
+
+/// Objects whose contacts the world's per-step buffers are sized for at set-up (beyond them
+/// the buffers grow on first sight, as before), so that set-up memory stays bounded.
+const PREPARED_OBJECTS: usize = 8;
 
 /// One elastic object.
 #[derive(Debug)]
@@ -363,14 +369,66 @@ impl DcrWorld {
             threshold,
             response,
             last_called: None,
-            impacts: Vec::new(),
-            resting: Vec::new(),
-            sources: Vec::new(),
+            impacts: prepared_vec(
+                PREPARED_CONTACTS,
+                Impact {
+                    point: [0.0; 3],
+                    direction: [0.0; 3],
+                    impulse: 0.0,
+                },
+            ),
+            resting: prepared_vec(
+                PREPARED_CONTACTS,
+                RestingContact {
+                    id: 0,
+                    point: [0.0; 3],
+                },
+            ),
+            sources: prepared_vec(
+                PREPARED_CONTACTS,
+                Source {
+                    body: 0,
+                    point: [0.0; 3],
+                },
+            ),
             depth: 0,
             info: ObjectStepInfo::default(),
         });
         self.reindex();
+        self.prepare_buffers();
         Ok(handle)
+    }
+
+    /// Sizes the per-step buffers for [`PREPARED_CONTACTS`] resting contacts (and as many
+    /// bodies) per object, for at most [`PREPARED_OBJECTS`] objects, and writes them once:
+    /// set-up, not the first world steps, pays their allocation and first touch.
+    fn prepare_buffers(&mut self) {
+        let n = PREPARED_CONTACTS * self.objects.len().min(PREPARED_OBJECTS);
+        let event = ImpulseEvent {
+            body: 0,
+            point: [0.0; 3],
+            impulse: [0.0; 3],
+            normal: [0.0; 3],
+            delta_v: 0.0,
+            contact: 0,
+            object: ElasticHandle::from_raw_parts(0, 0),
+            served_by: ServedBy::Modal,
+            chained: false,
+        };
+        let impact = Impact {
+            point: [0.0; 3],
+            direction: [0.0; 3],
+            impulse: 0.0,
+        };
+        self.body_index
+            .reserve(n.saturating_sub(self.body_index.len()));
+        prepare(&mut self.body_ids, n, 0);
+        prepare(&mut self.tracked, n, Tracked::UNTOUCHED);
+        prepare(&mut self.touched, n, Touched::default());
+        // An event per contact and a support event per body.
+        prepare(&mut self.events, 2 * n, event);
+        prepare(&mut self.pushed, 2 * n, (0, 0));
+        prepare(&mut self.handed, n, (0, impact, 0));
     }
 
     /// Rebuilds everything indexed by position in `objects` (set-up and removal only).
@@ -859,5 +917,16 @@ impl DcrWorld {
     fn enabled_at(&self, body: u64) -> Option<u32> {
         self.object_at(body)
             .filter(|&o| self.objects[o as usize].enabled)
+    }
+}
+
+/// Grows `v`'s capacity to at least `n` elements and writes the spare room once with `fill`
+/// (set-up only; the contents are unchanged).
+fn prepare<T: Clone>(v: &mut Vec<T>, n: usize, fill: T) {
+    if v.capacity() < n {
+        let len = v.len();
+        v.reserve(n - len);
+        v.resize(n, fill);
+        v.truncate(len);
     }
 }
