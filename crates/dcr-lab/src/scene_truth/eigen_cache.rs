@@ -17,7 +17,7 @@ use modal_bake::full_order::{FullOrderSystem, ModalAll};
 use sha2::{Digest, Sha256};
 
 /// Version of the entry layout and key recipe.
-const MAGIC: &[u8; 16] = b"dcr-modalall-v1\n";
+const MAGIC: &[u8; 16] = b"dcr-modalall-v2\n";
 
 /// The cache key of `sys`'s eigensolve (hex SHA-256).
 pub fn eigen_key(sys: &FullOrderSystem) -> String {
