@@ -24,6 +24,22 @@ use sha2::{Digest, Sha256};
 /// Version of the entry layout and key recipe.
 const VERSION: &[u8] = b"dcr-truth-cache-v1";
 
+/// Feeds a sparse matrix to `h`: its size, structure and the exact bit patterns of its values
+/// (the part of a cache key that names a stiffness or mass matrix).
+pub(crate) fn hash_sparse(h: &mut Sha256, a: &SparseColMat<usize, f64>) {
+    let s = a.symbolic();
+    h.update((s.nrows() as u64).to_le_bytes());
+    for &p in s.col_ptr() {
+        h.update((p as u64).to_le_bytes());
+    }
+    for &r in s.row_idx() {
+        h.update((r as u64).to_le_bytes());
+    }
+    for &v in a.val() {
+        h.update(v.to_bits().to_le_bytes());
+    }
+}
+
 /// The cache key of `t` on `sys` (hex SHA-256).
 pub fn key(sys: &FullOrderSystem, t: &TruthProblem) -> String {
     let mut h = Sha256::new();
@@ -35,21 +51,8 @@ pub fn key(sys: &FullOrderSystem, t: &TruthProblem) -> String {
             h.update((m.unwrap_or(usize::MAX) as u64).to_le_bytes());
         }
     }
-    let mat = |h: &mut Sha256, a: &SparseColMat<usize, f64>| {
-        let s = a.symbolic();
-        h.update((s.nrows() as u64).to_le_bytes());
-        for &p in s.col_ptr() {
-            h.update((p as u64).to_le_bytes());
-        }
-        for &r in s.row_idx() {
-            h.update((r as u64).to_le_bytes());
-        }
-        for &v in a.val() {
-            h.update(v.to_bits().to_le_bytes());
-        }
-    };
-    mat(&mut h, &sys.k);
-    mat(&mut h, &sys.m);
+    hash_sparse(&mut h, &sys.k);
+    hash_sparse(&mut h, &sys.m);
     let floats = |h: &mut Sha256, xs: &[f64]| {
         h.update((xs.len() as u64).to_le_bytes());
         for x in xs {

@@ -11,10 +11,11 @@
 
 use std::path::{Path, PathBuf};
 
-use faer::sparse::SparseColMat;
 use faer::Mat;
 use modal_bake::full_order::{FullOrderSystem, ModalAll};
 use sha2::{Digest, Sha256};
+
+use crate::accuracy::truth_cache::hash_sparse;
 
 /// Version of the entry layout and key recipe.
 const MAGIC: &[u8; 16] = b"dcr-modalall-v2\n";
@@ -23,21 +24,8 @@ const MAGIC: &[u8; 16] = b"dcr-modalall-v2\n";
 pub fn eigen_key(sys: &FullOrderSystem) -> String {
     let mut h = Sha256::new();
     h.update(MAGIC);
-    let mat = |h: &mut Sha256, a: &SparseColMat<usize, f64>| {
-        let s = a.symbolic();
-        h.update((s.nrows() as u64).to_le_bytes());
-        for &p in s.col_ptr() {
-            h.update((p as u64).to_le_bytes());
-        }
-        for &r in s.row_idx() {
-            h.update((r as u64).to_le_bytes());
-        }
-        for &v in a.val() {
-            h.update(v.to_bits().to_le_bytes());
-        }
-    };
-    mat(&mut h, &sys.k);
-    mat(&mut h, &sys.m);
+    hash_sparse(&mut h, &sys.k);
+    hash_sparse(&mut h, &sys.m);
     h.finalize().iter().map(|b| format!("{b:02x}")).collect()
 }
 
