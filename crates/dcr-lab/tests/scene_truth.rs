@@ -79,6 +79,7 @@ fn params(dt: f64, seconds: f64, rayleigh: [f64; 2], restitution: f64) -> Couple
         restitution,
         progress: false,
         scheme: CouplingScheme::Implicit,
+        perturbation: (0, 0.0),
     }
 }
 

@@ -58,6 +58,15 @@ pub struct SceneTruthArgs {
     /// Largest coupling steps × modes × props of one run.
     #[arg(long, value_name = "W", default_value_t = 2e11)]
     pub max_work: f64,
+    /// Runs per level: member 0 is the scene as written, the others start the scene's
+    /// projectile (the bodies launched with a velocity) --perturbation (m) away across gravity; outcomes are the members' mean, and a step or stiffness
+    /// change within the members' noise counts as converged (chaotic outcomes such as a
+    /// rattling plate's largest lift cannot converge run by run). 1: single runs.
+    #[arg(long, value_name = "N", default_value_t = 6, value_parser = clap::value_parser!(u32).range(1..=64))]
+    pub members: u32,
+    /// Placement distance of the ensemble's members (m).
+    #[arg(long, value_name = "M", default_value_t = 1e-4)]
+    pub perturbation: f64,
     /// Also run the distant response's methods at gain 1 and write DIR/outcomes.md and
     /// DIR/outcomes/SCENE_lift.svg.
     #[arg(long, value_name = "DIR")]
@@ -74,6 +83,12 @@ pub struct SceneTruthArgs {
 pub fn run(a: &SceneTruthArgs) -> anyhow::Result<ExitCode> {
     if !(a.dt > 0.0 && a.dt.is_finite()) {
         anyhow::bail!("--dt must be a positive step in seconds, got {}", a.dt);
+    }
+    if !(a.perturbation >= 0.0 && a.perturbation < 0.01) {
+        anyhow::bail!(
+            "--perturbation must be a placement distance in [0, 0.01) m, got {}",
+            a.perturbation
+        );
     }
     if !(a.tol > 0.0 && a.contact_stiffness > 0.0) {
         anyhow::bail!("--tol and --contact-stiffness must be positive");
@@ -96,6 +111,8 @@ pub fn run(a: &SceneTruthArgs) -> anyhow::Result<ExitCode> {
         contact_stiffness: a.contact_stiffness,
         max_dense_dofs: a.max_dense_dofs,
         max_work: a.max_work,
+        members: a.members as usize,
+        perturbation: a.perturbation,
         progress: true,
         ..SceneTruthParams::default()
     };
@@ -119,7 +136,7 @@ pub fn run(a: &SceneTruthArgs) -> anyhow::Result<ExitCode> {
                         truth.levels.last().map_or(0, |l| l.modes),
                         100.0 * truth.estimated_error()
                     );
-                    for (k, (v, u)) in &truth.run.outcomes {
+                    for (k, (v, u)) in &truth.finest().outcomes {
                         out.push_str(&format!("  {k}: {v:.4} {u}\n"));
                     }
                     let cmp = if a.page.is_some() {

@@ -10,6 +10,9 @@ use dcr_scenes::runner::{measure_outcome, unit_of, Trajectory};
 use dcr_scenes::scene::{build_world, BodyKind, BuiltWorld, SceneDesc};
 use modal_bake::full_order::{FullOrderSystem, ModalAll};
 use rapier3d_f64::math::Vector;
+use rapier3d_f64::parry::query::{
+    ContactManifold, ContactManifoldsWorkspace, DefaultQueryDispatcher, PersistentQueryDispatcher,
+};
 use rapier3d_f64::prelude::*;
 
 use super::contact_solve::solve_penalty_block;
@@ -51,6 +54,9 @@ pub struct CoupledParams {
     pub progress: bool,
     /// How the contact forces are found. Default [`CouplingScheme::Implicit`].
     pub scheme: CouplingScheme,
+    /// Ensemble member and placement distance (m): the launched bodies start moved as
+    /// [`dcr_scenes::scene::BuiltWorld::perturb_placement`] says (`(0, 0.0)`: as written).
+    pub perturbation: (usize, f64),
 }
 
 /// What a coupled run measured.
@@ -190,6 +196,7 @@ pub fn run_coupled(
     }
     let steps_h = (p.seconds / desc.h).round() as usize;
     let mut built: BuiltWorld = build_world(desc, root)?;
+    built.perturb_placement(p.perturbation.0, p.perturbation.1);
     built.world.integration_parameters.dt = p.dt;
     let eb = built.elastic_body[0];
     let e_handle = built.bodies[eb].handle;
@@ -268,6 +275,7 @@ pub fn run_coupled(
     let mut blocks: Vec<(RigidBodyHandle, Vec<usize>)> = Vec::new();
     let mut nrows: Vec<f64> = Vec::new();
     let mut solver_fallbacks = 0usize;
+    let mut manifolds: Vec<ContactManifold<(), ()>> = Vec::new();
     let energy0 = total_energy(&built, gravity, &elastic, 0.0);
     energy[0] = energy0;
     for kh in 0..steps_h {
@@ -278,13 +286,15 @@ pub fn run_coupled(
             pts.clear();
             spring_energy = 0.0;
             let e_pose = *built.world.bodies[e_handle].position();
+            let prediction = built.world.integration_parameters.prediction_distance();
+            // Bounded memory: the cache is emptied between steps, never within one (the
+            // step's points index it).
+            if cache.len() >= CACHE_MAX {
+                cache.clear();
+            }
             for &ech in &e_colliders {
                 for pair in built.world.narrow_phase.contact_pairs_with(ech) {
-                    let PairContacts::Rigid(rc) = &pair.contacts else {
-                        continue;
-                    };
-                    let e_first = pair.collider1 == ech;
-                    let other = if e_first {
+                    let other = if pair.collider1 == ech {
                         pair.collider2
                     } else {
                         pair.collider1
@@ -302,31 +312,53 @@ pub fn run_coupled(
                     let mu = 0.5 * (co_e.friction() + co_o.friction());
                     let (pe, po) = (*co_e.position(), *co_o.position());
                     let prop_mass = built.world.bodies[ob].mass();
-                    for m in &rc.manifolds {
+                    // Fresh manifolds of the pair (object first): rapier's narrow phase keeps
+                    // a manifold's points while the pair turns by less than 1° and slides by
+                    // less than 1 mm, so the true deepest point of a curved prop (a plate's
+                    // rim between the points of its cap's square) can sink unseen and then
+                    // appear at once up to a millimetre deep; recomputed every step, the
+                    // deepest point is always one of the points (its gap continuous in time).
+                    manifolds.clear();
+                    let mut workspace: Option<ContactManifoldsWorkspace> = None;
+                    if DefaultQueryDispatcher
+                        .contact_manifolds(
+                            &pe.inv_mul(&po),
+                            co_e.shape(),
+                            co_o.shape(),
+                            prediction,
+                            &mut manifolds,
+                            &mut workspace,
+                        )
+                        .is_err()
+                    {
+                        bail!(
+                            "scene {}: no contact manifold between the elastic object and {}'s \
+                             collider shape",
+                            desc.name,
+                            built.bodies[body_of[&ob]].name
+                        );
+                    }
+                    for m in &manifolds {
+                        let first = pts.len();
                         let npts = m.points.len().max(1) as f64;
-                        let ln_e = if e_first { m.local_n1 } else { m.local_n2 };
-                        let n = (pe.rotation * ln_e).normalize();
+                        let n = (pe.rotation * m.local_n1).normalize();
                         let damp = 2.0 * zeta * (p.contact_stiffness * prop_mass / npts).sqrt();
                         for c in &m.points {
-                            let (lp_e, lp_o) = if e_first {
-                                (c.local_p1, c.local_p2)
-                            } else {
-                                (c.local_p2, c.local_p1)
-                            };
-                            let x_e = pe.transform_point(lp_e);
-                            let x_o = po.transform_point(lp_o);
-                            // Every point rapier reports (rigid gap within its prediction
-                            // distance, 2 cm by default) is taken: the elastic surface can
-                            // rise by more than a small rigid gap, and a point skipped there
-                            // would wake up deep inside the surface and pop the prop out.
+                            let x_e = pe.transform_point(c.local_p1);
+                            let x_o = po.transform_point(c.local_p2);
+                            // The manifold's extra closest point can repeat a clipped one.
+                            if pts[first..].iter().any(|q| (q.x_o - x_o).length() < 1e-9) {
+                                continue;
+                            }
+                            // Every point within the prediction distance (2 cm by default) is
+                            // taken: the elastic surface can rise by more than a small rigid
+                            // gap, and a point skipped there would wake up deep inside the
+                            // surface and pop the prop out.
                             let dist = (x_o - x_e).dot(n);
                             // The contact on the elastic surface, in the object frame.
                             let xl = e_pose.inverse_transform_point(x_e);
                             let key = [xl.x, xl.y, xl.z].map(|v| (v * 2e3).round() as i64);
                             if !cache.contains_key(&key) {
-                                if cache.len() >= CACHE_MAX {
-                                    cache.clear();
-                                }
                                 let sp = surface
                                     .project(arr(xl))
                                     .context("contact point off the elastic surface")?;

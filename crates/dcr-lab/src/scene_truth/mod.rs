@@ -13,9 +13,13 @@
 //! # Coupling: penalty contacts, implicit in the forces
 //! Rapier still detects the elastic object's contacts (its narrow phase, the scene's colliders)
 //! but does not solve them (the object's colliders get empty solver groups). At each coupling
-//! step every contact point between a prop and the object that rapier reports (rigid gap within
-//! its prediction distance, 2 cm by default, which must exceed the surface's largest elastic
-//! displacement) is mapped to the object's surface in
+//! step, for every prop collider rapier pairs with the object, the pair's contact manifolds are
+//! computed afresh by parry's dispatcher on the same shapes (rapier's narrow phase would reuse
+//! a manifold's points while the pair turns by less than 1° and slides by less than 1 mm, so a
+//! curved prop's true deepest point — a plate's rim between the four points of its cap's square
+//! — could sink unseen and then appear a millimetre deep and pop the prop out). Every point
+//! within the prediction distance (2 cm by default, which must exceed the surface's largest
+//! elastic displacement) is mapped to the object's surface in
 //! the object's frame (closest point, barycentric weights — the mapping the runtime uses), and
 //! gets a spring–dashpot normal force of its *end-of-step* gap g (rigid gap along the contact
 //! normal minus the elastic surface displacement there, so the surface moves under the
@@ -58,13 +62,25 @@
 //! force's compliance is part of the model (the largest penetration is reported) and its
 //! limit for a very stiff object is rigid contact with restitution e (tested).
 //!
-//! # Convergence
-//! [`scene_truth`] runs the scene at Δt, Δt/2, … until no outcome changes by more than the
-//! tolerance (2 %) between two successive steps, then checks the contact stiffness (the same
-//! step with k doubled) and the modes (half the modes): each must also be within the
-//! tolerance, else the reference is reported as not converged. The estimated error is the
-//! largest of the three changes. The work is bounded before it starts (dense size, steps ×
-//! modes × bodies); the dense eigensolve can be cached on disk ([`read_eigen`]).
+//! # Convergence: ensembles, because the outcomes are chaotic
+//! A plate rattling on a ringing table is a bouncing ball on a vibrating plate, the textbook
+//! chaotic system: its largest lift over a scene depends on every detail of the run (a change
+//! of the contact stiffness far below its own effect moves the outcomes by tens of percent,
+//! `docs/outcomes-analysis.md`), so no single run converges as the step shrinks. Each level is therefore an **ensemble**: member 0 is the
+//! scene as written, the others start the projectile a tenth of a millimetre away across
+//! gravity ([`dcr_scenes::scene::BuiltWorld::perturb_placement`]); an outcome is the members'
+//! mean, with their sample standard deviation. [`scene_truth`] runs the scene at Δt, Δt/2, …
+//! until no outcome's mean changes between two successive steps by more than the tolerance
+//! (2 %) or by more than two standard errors of the difference of the means
+//! ([`level_change`]), then checks the contact stiffness (the same step with k doubled) and,
+//! when fewer than every mode is summed, the modes (half the modes), each by the same rule;
+//! else the reference is reported as not converged. The estimated error is the largest of the
+//! last step change, the checks and the finest level's statistical uncertainty (two standard
+//! errors of the means, [`TruthLevel::uncertainty`]), which only more members shrink (as 1/√N).
+//! With every mode of the mesh summed there is no truncation; a half-mode run then shows how
+//! much the upper half of the spectrum matters and is reported beside. The work is bounded
+//! before it starts (dense size, steps × modes × bodies per run); the dense eigensolve can be
+//! cached on disk ([`read_eigen`]).
 
 mod contact_solve;
 mod coupled_run;
@@ -85,6 +101,7 @@ use std::time::Instant;
 use anyhow::{bail, Context, Result};
 use dcr_scenes::scene::SceneDesc;
 use modal_bake::full_order::{FullOrderSystem, MaterialSi, ModalAll, SystemParams};
+use rayon::prelude::*;
 
 /// Settings of [`scene_truth`] (defaults in [`SceneTruthParams::default`]).
 #[derive(Clone, Debug)]
@@ -118,6 +135,10 @@ pub struct SceneTruthParams {
     pub check_stiffness: bool,
     /// Folder of the eigensolve cache (`None`: no cache).
     pub eigen_cache: Option<PathBuf>,
+    /// Runs per level (members of the ensemble; member 0 is the scene as written). Default 6.
+    pub members: usize,
+    /// Placement distance of the ensemble's members (m). Default 1e-4.
+    pub perturbation: f64,
     /// Progress on stderr.
     pub progress: bool,
 }
@@ -139,6 +160,8 @@ impl Default for SceneTruthParams {
             max_work: 2e11,
             check_stiffness: true,
             eigen_cache: None,
+            members: 6,
+            perturbation: 1e-4,
             progress: false,
         }
     }
@@ -153,14 +176,38 @@ pub struct TruthLevel {
     pub modes: usize,
     /// Penalty stiffness per contact point (N/m).
     pub contact_stiffness: f64,
-    /// Outcomes: name → (value, unit).
+    /// Outcomes, the mean over the members: name → (value, unit).
     pub outcomes: BTreeMap<String, (f64, String)>,
-    /// Largest relative change of an outcome from the previous level (`None` for the first).
+    /// Sample standard deviation of each outcome over the members (the outcome's unit; 0 for
+    /// one member).
+    pub spread: BTreeMap<String, f64>,
+    /// Members run.
+    pub members: usize,
+    /// Largest relative change of an outcome's mean from the level it is compared with (the
+    /// previous step, or the finest step for a check; `None` for the first level).
     pub change: Option<f64>,
-    /// Largest penetration (m).
+    /// Whether every outcome's change is within the tolerance or within the two members'
+    /// statistical noise (two standard errors of the difference of the means); `None` for the
+    /// first level.
+    pub within_noise: Option<bool>,
+    /// Largest penetration over the members (m).
     pub max_penetration: f64,
-    /// Wall time (s).
+    /// Wall time of the level (s; members run side by side).
     pub wall_s: f64,
+}
+
+impl TruthLevel {
+    /// Two standard errors of each outcome's mean, relative to max(|mean|, 1 unit): the
+    /// ensemble's statistical uncertainty at 95 %; the largest over the outcomes.
+    pub fn uncertainty(&self) -> f64 {
+        let n = self.members.max(1) as f64;
+        self.outcomes
+            .iter()
+            .map(|(k, (m, _))| {
+                2.0 * self.spread.get(k).copied().unwrap_or(0.0) / n.sqrt() / m.abs().max(1.0)
+            })
+            .fold(0.0, f64::max)
+    }
 }
 
 /// The converged (or not) coupled reference of a scene.
@@ -179,10 +226,11 @@ pub struct SceneTruth {
     pub half_modes: Option<TruthLevel>,
     /// The stiffness check at the finest step: k doubled (its change from the full run), if run.
     pub double_k: Option<TruthLevel>,
-    /// Whether the step converged (last change < tolerance).
+    /// Whether the step and the stiffness converged: their last changes within the tolerance
+    /// or within the ensemble's statistical noise.
     pub converged: bool,
-    /// The finest run (its trajectory and energies).
-    pub run: CoupledRun,
+    /// The finest level's runs, member 0 (the scene as written) first.
+    pub runs: Vec<CoupledRun>,
     /// Simulated seconds.
     pub seconds: f64,
     /// The settings.
@@ -190,19 +238,89 @@ pub struct SceneTruth {
 }
 
 impl SceneTruth {
-    /// The estimated error: the last change between two successive steps, the mode check and
-    /// the stiffness check, whichever is largest.
+    /// Member 0 of the finest level: the scene as written.
+    pub fn run(&self) -> &CoupledRun {
+        &self.runs[0]
+    }
+
+    /// The finest level.
+    pub fn finest(&self) -> &TruthLevel {
+        self.levels
+            .last()
+            .expect("a reference has at least one level")
+    }
+
+    /// Whether the mode check counts: only when fewer than every mode is summed (with every
+    /// mode of the mesh there is no truncation; the half-mode run then shows how much the
+    /// upper half of the spectrum matters, reported beside).
+    pub fn modes_truncated(&self) -> bool {
+        self.finest().modes < self.modes_available
+    }
+
+    /// The estimated error: the largest of the last change between two successive steps, the
+    /// stiffness check, the mode check (when modes are truncated) and the ensemble's
+    /// statistical uncertainty ([`TruthLevel::uncertainty`]).
     pub fn estimated_error(&self) -> f64 {
         let step = self
             .levels
             .last()
             .and_then(|l| l.change)
             .unwrap_or(f64::NAN);
-        [&self.half_modes, &self.double_k]
+        let modes = if self.modes_truncated() {
+            self.half_modes.as_ref()
+        } else {
+            None
+        };
+        [modes, self.double_k.as_ref()]
             .into_iter()
             .flatten()
             .fold(step, |e, h| e.max(h.change.unwrap_or(0.0)))
+            .max(self.finest().uncertainty())
     }
+}
+
+/// The mean and sample standard deviation of every outcome over `runs`.
+pub fn ensemble_stats(
+    runs: &[&BTreeMap<String, (f64, String)>],
+) -> (BTreeMap<String, (f64, String)>, BTreeMap<String, f64>) {
+    let mut mean = BTreeMap::new();
+    let mut spread = BTreeMap::new();
+    let Some(first) = runs.first() else {
+        return (mean, spread);
+    };
+    let n = runs.len() as f64;
+    for (k, (_, unit)) in first.iter() {
+        let vals: Vec<f64> = runs.iter().map(|r| r.get(k).map_or(0.0, |x| x.0)).collect();
+        let m = vals.iter().sum::<f64>() / n;
+        let var = if runs.len() > 1 {
+            vals.iter().map(|v| (v - m) * (v - m)).sum::<f64>() / (n - 1.0)
+        } else {
+            0.0
+        };
+        mean.insert(k.clone(), (m, unit.clone()));
+        spread.insert(k.clone(), var.sqrt());
+    }
+    (mean, spread)
+}
+
+/// Compares level `b` with level `a`: the largest relative change of an outcome's mean
+/// ([`outcome_change`]) and whether every outcome's change is within `tol` or within two
+/// standard errors of the difference of the two means (the ensembles' noise).
+pub fn level_change(a: &TruthLevel, b: &TruthLevel, tol: f64) -> (f64, bool) {
+    let change = outcome_change(&a.outcomes, &b.outcomes);
+    let mut within = true;
+    for (k, (vb, _)) in &b.outcomes {
+        let va = a.outcomes.get(k).map_or(0.0, |x| x.0);
+        let scale = vb.abs().max(1.0);
+        let sa = a.spread.get(k).copied().unwrap_or(0.0);
+        let sb = b.spread.get(k).copied().unwrap_or(0.0);
+        let noise =
+            2.0 * (sa * sa / a.members.max(1) as f64 + sb * sb / b.members.max(1) as f64).sqrt();
+        if (va - vb).abs() > (tol * scale).max(noise) {
+            within = false;
+        }
+    }
+    (change, within)
 }
 
 /// Loads `scenes/NAME.json` (or a path) under `root`.
@@ -369,45 +487,79 @@ pub fn scene_truth(desc: &SceneDesc, root: &Path, params: &SceneTruthParams) -> 
         restitution: desc.restitution,
         progress: params.progress,
         scheme: CouplingScheme::Implicit,
+        perturbation: (0, 0.0),
+    };
+    let members = params.members.max(1);
+    // One level: every member, side by side (one rayon task each; member 0 reports progress).
+    let ensemble = |dt: f64, modes: usize, k: f64| -> Result<(TruthLevel, Vec<CoupledRun>)> {
+        let t = Instant::now();
+        let runs = (0..members)
+            .into_par_iter()
+            .map(|m| {
+                let mut p = coupled(dt, modes, k);
+                p.perturbation = (m, params.perturbation);
+                p.progress = params.progress && m == 0;
+                run_coupled(desc, root, &prep, &p)
+            })
+            .collect::<Result<Vec<_>>>()?;
+        let (outcomes, spread) =
+            ensemble_stats(&runs.iter().map(|r| &r.outcomes).collect::<Vec<_>>());
+        let level = TruthLevel {
+            dt,
+            modes,
+            contact_stiffness: k,
+            outcomes,
+            spread,
+            members,
+            change: None,
+            within_noise: None,
+            max_penetration: runs.iter().map(|r| r.max_penetration).fold(0.0, f64::max),
+            wall_s: t.elapsed().as_secs_f64(),
+        };
+        Ok((level, runs))
+    };
+    let describe = |l: &TruthLevel| -> String {
+        l.outcomes
+            .iter()
+            .map(|(k, v)| {
+                format!(
+                    "{k} {:.4} ± {:.4}",
+                    v.0,
+                    l.spread.get(k).copied().unwrap_or(0.0)
+                )
+            })
+            .collect::<Vec<_>>()
+            .join(", ")
     };
     let mut levels: Vec<TruthLevel> = Vec::new();
     let mut dt = params.dt;
-    let mut run;
+    let mut runs;
     let mut converged = false;
     loop {
-        run = run_coupled(
-            desc,
-            root,
-            &prep,
-            &coupled(dt, modes, params.contact_stiffness),
-        )?;
-        let change = levels
-            .last()
-            .map(|l| outcome_change(&l.outcomes, &run.outcomes));
+        let (mut level, r) = ensemble(dt, modes, params.contact_stiffness)?;
+        runs = r;
+        if let Some(prev) = levels.last() {
+            let (change, within) = level_change(prev, &level, params.tolerance);
+            level.change = Some(change);
+            level.within_noise = Some(within);
+        }
         if params.progress {
             eprintln!(
-                "[scene-truth] {}: dt {:.3e} s, {} modes: {:?} (change {}) in {:.0} s",
+                "[scene-truth] {}: dt {:.3e} s, {} modes, {} members: {} (change {}) in {:.0} s",
                 desc.name,
                 dt,
                 modes,
-                run.outcomes
-                    .iter()
-                    .map(|(k, v)| format!("{k} {:.4}", v.0))
-                    .collect::<Vec<_>>(),
-                change.map_or("–".into(), |c| format!("{:.2} %", 100.0 * c)),
-                run.wall_s
+                members,
+                describe(&level),
+                level
+                    .change
+                    .map_or("–".into(), |c| format!("{:.2} %", 100.0 * c)),
+                level.wall_s
             );
         }
-        levels.push(TruthLevel {
-            dt,
-            modes,
-            contact_stiffness: params.contact_stiffness,
-            outcomes: run.outcomes.clone(),
-            change,
-            max_penetration: run.max_penetration,
-            wall_s: run.wall_s,
-        });
-        if change.is_some_and(|c| c < params.tolerance) {
+        let done = level.within_noise == Some(true);
+        levels.push(level);
+        if done {
             converged = true;
             break;
         }
@@ -416,38 +568,37 @@ pub fn scene_truth(desc: &SceneDesc, root: &Path, params: &SceneTruthParams) -> 
         }
         dt /= 2.0;
     }
+    let finest = levels.last().expect("one level at least").clone();
     let check = |name: &str, m: usize, k: f64| -> Result<TruthLevel> {
-        let h = run_coupled(desc, root, &prep, &coupled(dt, m, k))?;
-        let change = outcome_change(&h.outcomes, &run.outcomes);
+        let (mut h, _) = ensemble(dt, m, k)?;
+        let (change, within) = level_change(&finest, &h, params.tolerance);
+        h.change = Some(change);
+        h.within_noise = Some(within);
         if params.progress {
             eprintln!(
-                "[scene-truth] {}: {name} (dt {dt:.3e} s, {m} modes, k {k:.2e} N/m): change {:.2} % in {:.0} s",
+                "[scene-truth] {}: {name} (dt {dt:.3e} s, {m} modes, k {k:.2e} N/m): {} (change {:.2} %{}) in {:.0} s",
                 desc.name,
+                describe(&h),
                 100.0 * change,
+                if within { ", within noise" } else { "" },
                 h.wall_s
             );
         }
-        Ok(TruthLevel {
-            dt,
-            modes: m,
-            contact_stiffness: k,
-            outcomes: h.outcomes,
-            change: Some(change),
-            max_penetration: h.max_penetration,
-            wall_s: h.wall_s,
-        })
+        Ok(h)
     };
     let double_k = if params.check_stiffness {
-        Some(check("k doubled", modes, 2.0 * params.contact_stiffness)?)
+        let h = check("k doubled", modes, 2.0 * params.contact_stiffness)?;
+        converged &= h.within_noise == Some(true);
+        Some(h)
     } else {
         None
     };
     let half_modes = if params.check_modes && modes >= 2 {
-        Some(check(
-            "half the modes",
-            modes / 2,
-            params.contact_stiffness,
-        )?)
+        let h = check("half the modes", modes / 2, params.contact_stiffness)?;
+        if modes < prep.all.eigenvalues.len() {
+            converged &= h.within_noise == Some(true);
+        }
+        Some(h)
     } else {
         None
     };
@@ -460,7 +611,7 @@ pub fn scene_truth(desc: &SceneDesc, root: &Path, params: &SceneTruthParams) -> 
         half_modes,
         double_k,
         converged,
-        run,
+        runs,
         seconds,
         params: params.clone(),
     })

@@ -11,15 +11,20 @@ use dcr_scenes::runner::{run_scene, MethodChoice, RunParams, Trajectory};
 use dcr_scenes::scene::{name_matches, SceneDesc};
 use plotters::prelude::*;
 
-use super::SceneTruth;
+use super::{ensemble_stats, SceneTruth};
 
 /// One method's outcomes on a scene.
 #[derive(Clone, Debug)]
 pub struct MethodOutcome {
     /// What it is (`modal, 20 modes`, `★ table`, …).
     pub label: String,
-    /// Outcomes: name → (value, unit).
+    /// Outcomes, the mean over the ensemble's members: name → (value, unit).
     pub outcomes: BTreeMap<String, (f64, String)>,
+    /// Sample standard deviation of each outcome over the members (the outcome's unit).
+    pub spread: BTreeMap<String, f64>,
+    /// Members (runs differing only by the placements of
+    /// [`dcr_scenes::scene::BuiltWorld::perturb_placement`]).
+    pub members: usize,
     /// Kinetic energy the responses gave the props (J, the world's account; the reference: the
     /// work of the elastic surface's motion on the props).
     pub delivered_j: f64,
@@ -52,12 +57,17 @@ pub fn compare_scene(
     truth: SceneTruth,
     progress: bool,
 ) -> Result<SceneComparison> {
+    let refs: Vec<&BTreeMap<String, (f64, String)>> =
+        truth.runs.iter().map(|r| &r.outcomes).collect();
+    let (outcomes, spread) = ensemble_stats(&refs);
     let mut methods = vec![MethodOutcome {
         label: "coupled reference".into(),
-        outcomes: truth.run.outcomes.clone(),
-        delivered_j: truth.run.delivered.values().sum(),
-        delta_v: truth.run.surface_speed.clone(),
-        trajectory: truth.run.trajectory.clone(),
+        outcomes,
+        spread,
+        members: truth.runs.len(),
+        delivered_j: mean(truth.runs.iter().map(|r| r.delivered.values().sum())),
+        delta_v: mean_maps(truth.runs.iter().map(|r| &r.surface_speed)),
+        trajectory: truth.run().trajectory.clone(),
     }];
     // The ★ table over the object's upward faces (as docs/accuracy.md builds it) where the
     // scene names no transfer settings.
@@ -76,28 +86,44 @@ pub fn compare_scene(
     ];
     runs.push(("★ transfer table", true, MethodChoice::Transfer));
     runs.push(("attenuation (Eq. 14–16)", true, MethodChoice::Attenuation));
+    let members = truth.params.members.max(1);
     for (label, on, method) in runs {
         if progress {
-            eprintln!("[scene-truth] {}: {label}", desc.name);
+            eprintln!("[scene-truth] {}: {label} ({members} members)", desc.name);
         }
-        let mut p = RunParams::new(root.to_path_buf(), on);
-        p.seconds = Some(truth.seconds);
-        p.gain = Some(1.0);
-        p.method = method;
-        let r = run_scene(desc, &p).with_context(|| format!("{}: {label}", desc.name))?;
+        let reports = (0..members)
+            .map(|m| {
+                let mut p = RunParams::new(root.to_path_buf(), on);
+                p.seconds = Some(truth.seconds);
+                p.gain = Some(1.0);
+                p.method = method.clone();
+                p.perturbation = (m, truth.params.perturbation);
+                run_scene(desc, &p).with_context(|| format!("{}: {label}, member {m}", desc.name))
+            })
+            .collect::<Result<Vec<_>>>()?;
+        let (outcomes, spread) =
+            ensemble_stats(&reports.iter().map(|r| &r.outcomes).collect::<Vec<_>>());
+        let delta_v: Vec<BTreeMap<String, f64>> = reports
+            .iter()
+            .map(|r| {
+                if on {
+                    r.received
+                        .iter()
+                        .map(|(k, v)| (k.clone(), v.max_delta_v))
+                        .collect()
+                } else {
+                    BTreeMap::new()
+                }
+            })
+            .collect();
         methods.push(MethodOutcome {
             label: label.to_string(),
-            outcomes: r.outcomes,
-            delivered_j: r.injected_ke,
-            delta_v: if on {
-                r.received
-                    .iter()
-                    .map(|(k, v)| (k.clone(), v.max_delta_v))
-                    .collect()
-            } else {
-                BTreeMap::new()
-            },
-            trajectory: r.trajectory,
+            outcomes,
+            spread,
+            members,
+            delivered_j: mean(reports.iter().map(|r| r.injected_ke)),
+            delta_v: mean_maps(delta_v.iter()),
+            trajectory: reports[0].trajectory.clone(),
         });
     }
     Ok(SceneComparison {
@@ -105,6 +131,35 @@ pub fn compare_scene(
         methods,
         desc: desc.clone(),
     })
+}
+
+fn mean(v: impl Iterator<Item = f64>) -> f64 {
+    let (s, n) = v.fold((0.0, 0usize), |(s, n), x| (s + x, n + 1));
+    if n == 0 {
+        0.0
+    } else {
+        s / n as f64
+    }
+}
+
+/// Per key, the mean over the maps (a key missing from a map counts as 0).
+fn mean_maps<'a>(maps: impl Iterator<Item = &'a BTreeMap<String, f64>>) -> BTreeMap<String, f64> {
+    let maps: Vec<&BTreeMap<String, f64>> = maps.collect();
+    let mut out = BTreeMap::new();
+    for m in &maps {
+        for k in m.keys() {
+            out.entry(k.clone()).or_insert(0.0);
+        }
+    }
+    let n = maps.len().max(1) as f64;
+    for (k, v) in out.iter_mut() {
+        *v = maps
+            .iter()
+            .map(|m| m.get(k).copied().unwrap_or(0.0))
+            .sum::<f64>()
+            / n;
+    }
+    out
 }
 
 /// Largest instantaneous lift (mm) over the bodies matching `pattern` at each row.
@@ -205,6 +260,23 @@ fn fmt(v: f64) -> String {
     }
 }
 
+/// `v ± s` (`v` alone when `s` is 0).
+fn pm(v: f64, s: f64) -> String {
+    if s == 0.0 {
+        fmt(v)
+    } else {
+        format!("{} ± {}", fmt(v), fmt(s))
+    }
+}
+
+/// ", within noise" when a level's change is within the tolerance or the ensembles' noise.
+fn noise_note(l: &super::TruthLevel) -> &'static str {
+    match l.within_noise {
+        Some(true) => ", within noise",
+        _ => "",
+    }
+}
+
 /// The error of `v` against the reference `r` (%), or the absolute difference when the
 /// reference is near zero.
 fn err(v: f64, r: f64, unit: &str) -> String {
@@ -234,53 +306,86 @@ pub fn write_outcomes_page(out: &Path, scenes: &[SceneComparison], header: &str)
         let t = &c.truth;
         writeln!(md, "\n## {}\n", c.desc.name)?;
         writeln!(md, "{}\n", c.desc.description)?;
+        let fin = t.finest();
         writeln!(
             md,
-            "- reference: {} free dofs, every one of its {} elastic modes (dense eigensolve {:.0} s; ~0 s: read from the cache), \
-             {:.2} s simulated, penalty k = {:.1e} N/m per point (largest penetration {:.3} mm)",
+            "- reference: {} free dofs, every one of its {} elastic modes (dense eigensolve {:.0} s; \
+             ~0 s: read from the cache), {:.2} s simulated, penalty k = {:.1e} N/m per point \
+             (largest penetration {:.3} mm); each level an ensemble of {} runs, member 0 the \
+             scene as written and the others with the projectile (the bodies launched with a \
+             velocity) starting {} mm away in a fixed direction across gravity (values below: mean ± sample standard deviation over the members)",
             t.free_dofs,
             t.modes_available,
             t.eigen_s,
             t.seconds,
             t.params.contact_stiffness,
-            t.run.max_penetration * 1e3
+            fin.max_penetration * 1e3,
+            fin.members,
+            fmt(t.params.perturbation * 1e3),
         )?;
         let steps: Vec<String> = t
             .levels
             .iter()
             .map(|l| match l.change {
-                Some(ch) => format!("{:.2e} s ({:.2} %, {:.0} s)", l.dt, 100.0 * ch, l.wall_s),
+                Some(ch) => format!(
+                    "{:.2e} s ({:.2} %{}, {:.0} s)",
+                    l.dt,
+                    100.0 * ch,
+                    noise_note(l),
+                    l.wall_s
+                ),
                 None => format!("{:.2e} s ({:.0} s)", l.dt, l.wall_s),
             })
             .collect();
         writeln!(
             md,
-            "- steps (largest outcome change from the previous step, wall time): {}",
+            "- steps (largest change of an outcome's mean from the previous step, wall time): {}",
             steps.join(", ")
         )?;
         if let Some(h) = &t.double_k {
             writeln!(
                 md,
-                "- stiffness: with k doubled ({:.1e} N/m) at the finest step the outcomes move by {:.2} % ({:.0} s)",
+                "- stiffness: with k doubled ({:.1e} N/m) at the finest step the means move by {:.2} %{} ({:.0} s)",
                 2.0 * t.params.contact_stiffness,
                 100.0 * h.change.unwrap_or(0.0),
+                noise_note(h),
                 h.wall_s
             )?;
         }
         if let Some(h) = &t.half_modes {
             writeln!(
                 md,
-                "- modes: with half the modes ({}) at the finest step the outcomes move by {:.2} % ({:.0} s)",
+                "- modes: with half the modes ({}) at the finest step the means move by {:.2} %{} ({:.0} s){}",
                 h.modes,
                 100.0 * h.change.unwrap_or(0.0),
-                h.wall_s
+                noise_note(h),
+                h.wall_s,
+                if t.modes_truncated() {
+                    ""
+                } else {
+                    ": every mode of the mesh is summed, so this is not a truncation error (not \
+                     counted in the estimate); it shows how much the upper half of the mesh's \
+                     spectrum matters to the outcome"
+                }
+            )?;
+        } else if !t.modes_truncated() {
+            writeln!(
+                md,
+                "- modes: every mode of the mesh is summed (no truncation)"
             )?;
         }
-        // Every run of the refinement with its outcomes.
-        let onames: Vec<&String> = t.run.outcomes.keys().collect();
-        write!(md, "\n| run | Δt (s) | k (N/m) | modes |")?;
+        writeln!(
+            md,
+            "- statistical uncertainty of the finest level's means (two standard errors over {} \
+             members): {:.1} %",
+            fin.members,
+            100.0 * fin.uncertainty()
+        )?;
+        // Every level of the refinement with its outcomes.
+        let onames: Vec<&String> = fin.outcomes.keys().collect();
+        write!(md, "\n| level | Δt (s) | k (N/m) | modes |")?;
         for n in &onames {
-            write!(md, " {n} ({}) |", t.run.outcomes[*n].1)?;
+            write!(md, " {n} ({}) |", fin.outcomes[*n].1)?;
         }
         writeln!(md, " change | wall (s) |")?;
         writeln!(
@@ -309,29 +414,44 @@ pub fn write_outcomes_page(out: &Path, scenes: &[SceneComparison], header: &str)
                 write!(
                     md,
                     " {} |",
-                    l.outcomes.get(*n).map_or("–".into(), |x| fmt(x.0))
+                    l.outcomes.get(*n).map_or("–".into(), |x| pm(
+                        x.0,
+                        l.spread.get(*n).copied().unwrap_or(0.0)
+                    ))
                 )?;
             }
             writeln!(
                 md,
                 " {} | {:.0} |",
-                l.change
-                    .map_or("–".into(), |c| format!("{:.1} %", 100.0 * c)),
+                l.change.map_or("–".into(), |c| format!(
+                    "{:.1} %{}",
+                    100.0 * c,
+                    noise_note(l)
+                )),
                 l.wall_s
             )?;
         }
         writeln!(md)?;
+        let err_est = t.estimated_error();
         writeln!(
             md,
-            "- **{}** at Δt = {:.2e} s, estimated error {:.2} % (tolerance {:.0} %)\n",
-            if t.converged && t.estimated_error() < t.params.tolerance {
+            "- **{}** at Δt = {:.2e} s, estimated error {:.1} % (tolerance {:.0} %){}\n",
+            if t.converged && err_est < t.params.tolerance {
                 "converged"
+            } else if t.converged {
+                "converged within its statistical uncertainty"
             } else {
                 "NOT converged"
             },
-            t.levels.last().map_or(f64::NAN, |l| l.dt),
-            100.0 * t.estimated_error(),
-            100.0 * t.params.tolerance
+            fin.dt,
+            100.0 * err_est,
+            100.0 * t.params.tolerance,
+            if t.converged && err_est >= t.params.tolerance {
+                ": the step and the stiffness no longer move the means beyond the ensemble's \
+                 noise, and the noise itself is the error bar (more members shrink it as 1/√N)"
+            } else {
+                ""
+            }
         )?;
         // The table: one row per outcome, reference then each method with its error.
         let names: Vec<&String> = c.methods[0].outcomes.keys().collect();
@@ -347,10 +467,12 @@ pub fn write_outcomes_page(out: &Path, scenes: &[SceneComparison], header: &str)
         writeln!(md)?;
         for n in names {
             let (r, unit) = &c.methods[0].outcomes[n];
-            write!(md, "| {n} ({unit}) | **{}** |", fmt(*r))?;
+            let rs = c.methods[0].spread.get(n).copied().unwrap_or(0.0);
+            write!(md, "| {n} ({unit}) | **{}** |", pm(*r, rs))?;
             for m in &c.methods[1..] {
                 let v = m.outcomes.get(n).map_or(0.0, |x| x.0);
-                write!(md, " {} ({}) |", fmt(v), err(v, *r, unit))?;
+                let sp = m.spread.get(n).copied().unwrap_or(0.0);
+                write!(md, " {} ({}) |", pm(v, sp), err(v, *r, unit))?;
             }
             writeln!(md)?;
         }

@@ -74,6 +74,9 @@ pub struct RunParams {
     /// On which steps the contacts are read ([`AdapterParams::gate`]). Default
     /// [`StepGate::ImpactSteps`].
     pub gate: StepGate,
+    /// Ensemble member and placement distance (m): the launched bodies start moved as
+    /// [`crate::scene::BuiltWorld::perturb_placement`] says. Default `(0, 0.0)`: the scene as written.
+    pub perturbation: (usize, f64),
 }
 
 impl RunParams {
@@ -95,6 +98,7 @@ impl RunParams {
             lateral_kick: false,
             contact_recycling: true,
             gate: StepGate::ImpactSteps,
+            perturbation: (0, 0.0),
         }
     }
 }
@@ -528,6 +532,7 @@ pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
         .map_err(|e| anyhow::anyhow!("scene {}: {e}", desc.name))?;
     let seconds = params.seconds.unwrap_or(desc.seconds);
     let mut built = build_world(desc, &params.root)?;
+    built.perturb_placement(params.perturbation.0, params.perturbation.1);
     // Off runs measure only (impacts, what the responses would have been) and apply nothing.
     let apply = if params.dcr {
         params.apply

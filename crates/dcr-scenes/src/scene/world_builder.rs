@@ -43,6 +43,46 @@ impl BuiltWorld {
     pub fn body_index(&self, name: &str) -> Option<usize> {
         self.bodies.iter().position(|b| b.name == name)
     }
+
+    /// Moves every launched body (a dynamic body with a non-zero initial velocity: the
+    /// scene's projectile) by `distance` (m) in a direction perpendicular to gravity (world
+    /// frame), chosen per body from `member` by a fixed hash: member `m` of an ensemble of runs
+    /// that differ only by where the projectile starts, far below what a user could set (a
+    /// tenth of a millimetre), which shows how much an outcome depends on it. Resting bodies
+    /// stay where they are (moved across gravity on a slope they would start inside their
+    /// support). Member 0, a zero distance or zero gravity leaves the world as built. Call
+    /// before the first step.
+    pub fn perturb_placement(&mut self, member: usize, distance: f64) {
+        let g = self.world.gravity;
+        if member == 0 || distance == 0.0 || g.length() == 0.0 {
+            return;
+        }
+        let up = -g.normalize();
+        // Two unit vectors spanning the plane perpendicular to gravity.
+        let a = if up.x.abs() < 0.9 {
+            Vector::X
+        } else {
+            Vector::Z
+        };
+        let e1 = (a - up * a.dot(up)).normalize();
+        let e2 = up.cross(e1);
+        for (i, b) in self.bodies.iter().enumerate() {
+            if !b.dynamic || self.world.bodies[b.handle].linvel().length() == 0.0 {
+                continue;
+            }
+            // splitmix64 of (member, body): a fixed angle per pair.
+            let mut z = (member as u64)
+                .wrapping_mul(0x9e37_79b9_7f4a_7c15)
+                .wrapping_add((i as u64).wrapping_mul(0xbf58_476d_1ce4_e5b9));
+            z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+            z ^= z >> 31;
+            let theta = (z >> 11) as f64 / (1u64 << 53) as f64 * std::f64::consts::TAU;
+            let rb = &mut self.world.bodies[b.handle];
+            let t = rb.translation() + (e1 * theta.cos() + e2 * theta.sin()) * distance;
+            rb.set_translation(t, true);
+        }
+    }
 }
 
 /// A pose from its description (translation m, rotation scaled axis in degrees).
