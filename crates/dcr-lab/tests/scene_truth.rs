@@ -261,3 +261,69 @@ fn implicit_coupling_is_stable_at_any_stiffness() {
         "rebound moved with k: {h1} → {h2}"
     );
 }
+
+/// Ensemble statistics: the mean and the sample standard deviation over members, and a
+/// level change counted as converged when it is within the tolerance or within two standard
+/// errors of the difference of the means, not otherwise.
+#[test]
+fn ensemble_means_and_noise_rule() {
+    use dcr_lab::scene_truth::{ensemble_stats, level_change, TruthLevel};
+    use std::collections::BTreeMap;
+    let o = |v: f64| BTreeMap::from([("lift".to_string(), (v, "mm".to_string()))]);
+    let runs = [o(10.0), o(12.0), o(14.0), o(16.0)];
+    let (mean, spread) = ensemble_stats(&runs.iter().collect::<Vec<_>>());
+    assert!((mean["lift"].0 - 13.0).abs() < 1e-12);
+    // Sample variance: (9 + 1 + 1 + 9) / 3.
+    assert!((spread["lift"] - (20.0f64 / 3.0).sqrt()).abs() < 1e-12);
+    let level = |m: f64, s: f64, n: usize| TruthLevel {
+        dt: 1e-5,
+        modes: 10,
+        contact_stiffness: 1e9,
+        outcomes: o(m),
+        spread: BTreeMap::from([("lift".to_string(), s)]),
+        members: n,
+        change: None,
+        within_noise: None,
+        max_penetration: 0.0,
+        wall_s: 0.0,
+    };
+    // 10 % apart with no spread: not converged at 2 %.
+    let (c, within) = level_change(&level(10.0, 0.0, 1), &level(11.0, 0.0, 1), 0.02);
+    assert!((c - 1.0 / 11.0).abs() < 1e-12 && !within);
+    // The same gap inside the noise (2·sqrt(2·2²/4) = 2.83 mm > 1 mm): converged.
+    let (_, within) = level_change(&level(10.0, 2.0, 4), &level(11.0, 2.0, 4), 0.02);
+    assert!(within);
+    // Outside the noise (2·sqrt(2·0.2²/4) = 0.28 mm < 1 mm): not converged.
+    let (_, within) = level_change(&level(10.0, 0.2, 4), &level(11.0, 0.2, 4), 0.02);
+    assert!(!within);
+    // Within the tolerance whatever the noise.
+    let (_, within) = level_change(&level(10.0, 0.0, 4), &level(10.1, 0.0, 4), 0.02);
+    assert!(within);
+    // Uncertainty: 2 s / sqrt(N) / max(|mean|, 1).
+    assert!((level(10.0, 2.0, 4).uncertainty() - 0.2).abs() < 1e-12);
+}
+
+/// The advanced start: dinner's pot is placed where the rigid scene at h has it after the
+/// skipped steps, so the first contact of the advanced scene comes `ADVANCE_MARGIN_STEPS`
+/// steps in, as in the original minus the skipped steps.
+#[test]
+fn advanced_start_keeps_the_first_contact() {
+    use dcr_lab::scene_truth::{advance_steps, first_contact_step, ADVANCE_MARGIN_STEPS};
+    let root = dcr_scenes::repo_root();
+    let desc = dcr_lab::scene_truth::load_scene(&root, "dinner").expect("dinner loads");
+    let first = first_contact_step(&desc, &root)
+        .expect("world builds")
+        .expect("the pot lands");
+    let skip = advance_steps(&desc, &root)
+        .expect("world builds")
+        .expect("dinner can be advanced");
+    assert_eq!(skip, first - ADVANCE_MARGIN_STEPS);
+    let adv = dcr_lab::soft_body::with_projectiles_advanced(&desc, skip, 1).expect("advances");
+    let again = first_contact_step(&adv, &root)
+        .expect("world builds")
+        .expect("the pot still lands");
+    assert_eq!(
+        again, ADVANCE_MARGIN_STEPS,
+        "first contact {first}, skipped {skip}"
+    );
+}

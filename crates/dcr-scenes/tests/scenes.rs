@@ -254,3 +254,50 @@ fn stress_scene_responds_on_impact_steps_only() {
     );
     assert_eq!(on.models[0].distant_contacts, 400, "100 boxes × 4 contacts");
 }
+
+/// Ensemble placements: member 0 leaves the world as built; member m > 0 moves only the
+/// launched body (dinner's pot) by exactly the distance, across gravity, the same way each
+/// time, and a different way for another member.
+#[test]
+fn perturbed_placement_moves_the_projectile_across_gravity_only() {
+    let root = repo_root();
+    let desc = scene("dinner");
+    let base = dcr_scenes::scene::build_world(&desc, &root).expect("world builds");
+    let pos = |b: &dcr_scenes::scene::BuiltWorld| -> Vec<[f64; 3]> {
+        b.bodies
+            .iter()
+            .map(|i| {
+                let t = b.world.bodies[i.handle].translation();
+                [t.x, t.y, t.z]
+            })
+            .collect()
+    };
+    let p0 = pos(&base);
+    let moved = |member: usize| {
+        let mut b = dcr_scenes::scene::build_world(&desc, &root).expect("world builds");
+        b.perturb_placement(member, 1e-4);
+        pos(&b)
+    };
+    assert_eq!(moved(0), p0, "member 0 is the scene as written");
+    let pot = base.body_index("pot").expect("dinner has a pot");
+    let (p3, p3_again, p4) = (moved(3), moved(3), moved(4));
+    assert_eq!(p3, p3_again, "placements are deterministic");
+    for (i, (a, b)) in p0.iter().zip(&p3).enumerate() {
+        let d = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+        let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+        if i == pot {
+            assert!((len - 1e-4).abs() < 1e-12, "pot moved {len} m");
+            assert!(d[1].abs() < 1e-15, "pot moved along gravity: {d:?}");
+        } else {
+            assert_eq!(
+                len, 0.0,
+                "{} moved but was not launched",
+                base.bodies[i].name
+            );
+        }
+    }
+    assert_ne!(
+        p3[pot], p4[pot],
+        "members 3 and 4 start the pot at the same place"
+    );
+}

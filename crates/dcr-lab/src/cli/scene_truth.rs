@@ -58,6 +58,10 @@ pub struct SceneTruthArgs {
     /// Largest coupling steps × modes × props of one run.
     #[arg(long, value_name = "W", default_value_t = 2e11)]
     pub max_work: f64,
+    /// Start every run at t = 0 instead of skipping the projectile's free flight up to three
+    /// steps before its first contact (its exact discrete state there).
+    #[arg(long)]
+    pub no_advance: bool,
     /// Runs per level: member 0 is the scene as written, the others start the scene's
     /// projectile (the bodies launched with a velocity) --perturbation (m) away across gravity; outcomes are the members' mean, and a step or stiffness
     /// change within the members' noise counts as converged (chaotic outcomes such as a
@@ -112,6 +116,7 @@ pub fn run(a: &SceneTruthArgs) -> anyhow::Result<ExitCode> {
         max_dense_dofs: a.max_dense_dofs,
         max_work: a.max_work,
         members: a.members as usize,
+        advance: !a.no_advance,
         perturbation: a.perturbation,
         progress: true,
         ..SceneTruthParams::default()

@@ -99,8 +99,9 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
-use dcr_scenes::scene::SceneDesc;
+use dcr_scenes::scene::{build_world, SceneDesc};
 use modal_bake::full_order::{FullOrderSystem, MaterialSi, ModalAll, SystemParams};
+use rapier3d_f64::prelude::{ColliderHandle, PairContacts};
 use rayon::prelude::*;
 
 /// Settings of [`scene_truth`] (defaults in [`SceneTruthParams::default`]).
@@ -135,6 +136,10 @@ pub struct SceneTruthParams {
     pub check_stiffness: bool,
     /// Folder of the eigensolve cache (`None`: no cache).
     pub eigen_cache: Option<PathBuf>,
+    /// Start every run with the projectile advanced along its exact discrete free flight to
+    /// [`ADVANCE_MARGIN_STEPS`] steps before its first contact ([`advance_steps`]): the quiet
+    /// fall costs nothing then. Default true.
+    pub advance: bool,
     /// Runs per level (members of the ensemble; member 0 is the scene as written). Default 6.
     pub members: usize,
     /// Placement distance of the ensemble's members (m). Default 1e-4.
@@ -160,6 +165,7 @@ impl Default for SceneTruthParams {
             max_work: 2e11,
             check_stiffness: true,
             eigen_cache: None,
+            advance: true,
             members: 6,
             perturbation: 1e-4,
             progress: false,
@@ -235,6 +241,9 @@ pub struct SceneTruth {
     pub seconds: f64,
     /// The settings.
     pub params: SceneTruthParams,
+    /// Steps of h the projectile was advanced before every run (0: runs start at t = 0), or
+    /// why it was not.
+    pub advanced: std::result::Result<usize, String>,
 }
 
 impl SceneTruth {
@@ -321,6 +330,74 @@ pub fn level_change(a: &TruthLevel, b: &TruthLevel, tol: f64) -> (f64, bool) {
         }
     }
     (change, within)
+}
+
+/// Steps of h kept between the advanced start and the projectile's first contact.
+pub const ADVANCE_MARGIN_STEPS: usize = 3;
+
+/// The step (0-based, of h) after which a launched body (a dynamic body with a non-zero
+/// initial velocity) first has a contact point within 5 mm in the rigid scene run at h;
+/// `None` when none has one over the scene's `seconds`.
+///
+/// # Errors
+/// The world cannot be built.
+pub fn first_contact_step(desc: &SceneDesc, root: &Path) -> Result<Option<usize>> {
+    let mut built = build_world(desc, root)?;
+    let launched: Vec<ColliderHandle> = built
+        .collider_body
+        .iter()
+        .filter(|(_, &b)| {
+            let rb = &built.world.bodies[built.bodies[b].handle];
+            rb.is_dynamic() && rb.linvel().length() > 0.0
+        })
+        .map(|(&c, _)| c)
+        .collect();
+    if launched.is_empty() {
+        return Ok(None);
+    }
+    let steps = (desc.seconds / desc.h).round() as usize;
+    for k in 0..steps {
+        built.world.step_with_events(&(), &());
+        for &c in &launched {
+            for pair in built.world.narrow_phase.contact_pairs_with(c) {
+                let PairContacts::Rigid(rc) = &pair.contacts else {
+                    continue;
+                };
+                if rc
+                    .manifolds
+                    .iter()
+                    .any(|m| m.points.iter().any(|p| p.dist < 5e-3))
+                {
+                    return Ok(Some(k));
+                }
+            }
+        }
+    }
+    Ok(None)
+}
+
+/// How many steps of h every run of the reference (and of the methods beside it) skips: the
+/// projectile's free flight up to [`ADVANCE_MARGIN_STEPS`] steps before its first contact,
+/// replaced by its exact discrete state there
+/// ([`crate::soft_body::with_projectiles_advanced`]); `Err` says why the scene cannot be
+/// advanced (no launched body, drivers, a projectile placed relative to the object).
+///
+/// # Errors
+/// The world cannot be built.
+pub fn advance_steps(desc: &SceneDesc, root: &Path) -> Result<std::result::Result<usize, String>> {
+    if !desc.drivers.is_empty() {
+        return Ok(Err("the scene has drivers (timed impulses)".into()));
+    }
+    let Some(k) = first_contact_step(desc, root)? else {
+        return Ok(Err("no launched body touches anything".into()));
+    };
+    let steps = k.saturating_sub(ADVANCE_MARGIN_STEPS);
+    Ok(
+        match crate::soft_body::with_projectiles_advanced(desc, steps, 1) {
+            Ok(_) => Ok(steps),
+            Err(e) => Err(format!("{e:#}")),
+        },
+    )
 }
 
 /// Loads `scenes/NAME.json` (or a path) under `root`.
@@ -450,7 +527,36 @@ pub fn scene_truth(desc: &SceneDesc, root: &Path, params: &SceneTruthParams) -> 
         params.eigen_cache.as_deref(),
     )?;
     let eigen_s = t0.elapsed().as_secs_f64();
-    let seconds = params.seconds.unwrap_or(desc.seconds);
+    let advanced = if params.advance {
+        advance_steps(desc, root)?
+    } else {
+        Err("not asked for".into())
+    };
+    let skip = *advanced.as_ref().unwrap_or(&0);
+    let seconds = params.seconds.unwrap_or(desc.seconds) - skip as f64 * desc.h;
+    if seconds <= 0.0 {
+        bail!(
+            "scene {}: the projectile's first contact comes after the {} s simulated (raise --seconds)",
+            desc.name,
+            params.seconds.unwrap_or(desc.seconds)
+        );
+    }
+    if params.progress {
+        match &advanced {
+            Ok(k) => eprintln!(
+                "[scene-truth] {}: every run starts with the projectile {k} steps ({:.3} s) into its free flight, {} steps before its first contact",
+                desc.name,
+                *k as f64 * desc.h,
+                ADVANCE_MARGIN_STEPS
+            ),
+            Err(why) => eprintln!("[scene-truth] {}: runs start at t = 0 ({why})", desc.name),
+        }
+    }
+    // The scene each run of step `dt` starts from.
+    let start_desc = |dt: f64| -> Result<SceneDesc> {
+        let sub = (desc.h / dt).round().max(1.0) as usize;
+        crate::soft_body::with_projectiles_advanced(desc, skip, sub)
+    };
     let modes = params
         .modes
         .unwrap_or(usize::MAX)
@@ -499,7 +605,7 @@ pub fn scene_truth(desc: &SceneDesc, root: &Path, params: &SceneTruthParams) -> 
                 let mut p = coupled(dt, modes, k);
                 p.perturbation = (m, params.perturbation);
                 p.progress = params.progress && m == 0;
-                run_coupled(desc, root, &prep, &p)
+                run_coupled(&start_desc(dt)?, root, &prep, &p)
             })
             .collect::<Result<Vec<_>>>()?;
         let (outcomes, spread) =
@@ -614,5 +720,6 @@ pub fn scene_truth(desc: &SceneDesc, root: &Path, params: &SceneTruthParams) -> 
         runs,
         seconds,
         params: params.clone(),
+        advanced,
     })
 }
