@@ -2,6 +2,7 @@
 
 mod accuracy;
 mod fit_attenuation;
+mod fit_gain;
 mod progress;
 mod scene_truth;
 mod soft_body;
@@ -36,6 +37,9 @@ enum Command {
     SoftBody(soft_body::SoftBodyArgs),
     /// Coupled elastic–rigid reference of whole scenes; with --page, docs/outcomes.md.
     SceneTruth(scene_truth::SceneTruthArgs),
+    /// The response gain at which a method's outcome matches a target (the coupled reference's).
+    #[command(allow_negative_numbers = true)]
+    FitGain(fit_gain::FitGainArgs),
 }
 
 /// Writes `s` to stdout. A closed pipe (`dcr-lab truth … | head`) is not an error; any other
@@ -62,6 +66,7 @@ pub fn main() -> ExitCode {
         Command::Accuracy(a) => accuracy::run(&a).map(|()| ExitCode::SUCCESS),
         Command::SoftBody(a) => soft_body::run(&a).map(|()| ExitCode::SUCCESS),
         Command::SceneTruth(a) => scene_truth::run(&a),
+        Command::FitGain(a) => fit_gain::run(&a),
     };
     match result {
         Ok(code) => code,

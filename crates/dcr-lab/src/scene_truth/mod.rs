@@ -92,7 +92,10 @@ pub use contact_solve::{solve_penalty_block, BlockSolveInfo};
 pub use coupled_run::{run_coupled, CoupledParams, CoupledRun, CouplingScheme, ElasticPrep};
 pub use eigen_cache::{eigen_key, eigen_path, read_eigen, write_eigen};
 pub use elastic_body::ElasticBody;
-pub use outcomes_page::{compare_scene, write_outcomes_page, MethodOutcome, SceneComparison};
+pub use outcomes_page::{
+    compare_scene, method_ensemble, methods_desc, write_outcomes_page, EnsembleSpec, MethodOutcome,
+    SceneComparison,
+};
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};

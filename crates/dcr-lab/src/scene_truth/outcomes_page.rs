@@ -69,8 +69,43 @@ pub fn compare_scene(
         delta_v: mean_maps(truth.runs.iter().map(|r| &r.surface_speed)),
         trajectory: truth.run().trajectory.clone(),
     }];
-    // The ★ table over the object's upward faces (as docs/accuracy.md builds it) where the
-    // scene names no transfer settings.
+    let desc = &methods_desc(desc, truth.advanced.as_ref().ok().copied())?;
+    let mut runs: Vec<(&str, bool, MethodChoice)> = vec![
+        ("rigid (response off)", false, MethodChoice::Modal),
+        ("modal, 20 modes (Eq. 9–13)", true, MethodChoice::Modal),
+    ];
+    runs.push(("★ transfer table", true, MethodChoice::Transfer));
+    runs.push(("attenuation (Eq. 14–16)", true, MethodChoice::Attenuation));
+    let ens = EnsembleSpec {
+        members: truth.params.members.max(1),
+        perturbation: truth.params.perturbation,
+        seconds: truth.seconds,
+    };
+    for (label, on, method) in runs {
+        if progress {
+            eprintln!(
+                "[scene-truth] {}: {label} ({} members)",
+                desc.name, ens.members
+            );
+        }
+        let on = on.then_some(1.0);
+        methods.push(method_ensemble(desc, root, label, on, method, &ens)?);
+    }
+    Ok(SceneComparison {
+        truth,
+        methods,
+        desc: desc.clone(),
+    })
+}
+
+/// The scene the methods run beside the reference: the ★ table over the object's upward faces
+/// (as docs/accuracy.md builds it) where the scene names no transfer settings, and the
+/// projectile advanced by `advanced` steps of h (its exact state at h, one substep) when the
+/// reference's runs were.
+///
+/// # Errors
+/// A projectile that cannot be advanced.
+pub fn methods_desc(desc: &SceneDesc, advanced: Option<usize>) -> Result<SceneDesc> {
     let mut desc = desc.clone();
     for e in &mut desc.elastic {
         if e.transfer.is_none() {
@@ -79,62 +114,66 @@ pub fn compare_scene(
             )?);
         }
     }
-    // The methods start where the reference did: the projectile advanced by the same steps
-    // (its exact state at h, one substep).
-    if let Ok(k) = truth.advanced {
-        desc = crate::soft_body::with_projectiles_advanced(&desc, k, 1)?;
+    match advanced {
+        Some(k) => crate::soft_body::with_projectiles_advanced(&desc, k, 1),
+        None => Ok(desc),
     }
-    let desc = &desc;
-    let mut runs: Vec<(&str, bool, MethodChoice)> = vec![
-        ("rigid (response off)", false, MethodChoice::Modal),
-        ("modal, 20 modes (Eq. 9–13)", true, MethodChoice::Modal),
-    ];
-    runs.push(("★ transfer table", true, MethodChoice::Transfer));
-    runs.push(("attenuation (Eq. 14–16)", true, MethodChoice::Attenuation));
-    let members = truth.params.members.max(1);
-    for (label, on, method) in runs {
-        if progress {
-            eprintln!("[scene-truth] {}: {label} ({members} members)", desc.name);
-        }
-        let reports = (0..members)
-            .map(|m| {
-                let mut p = RunParams::new(root.to_path_buf(), on);
-                p.seconds = Some(truth.seconds);
-                p.gain = Some(1.0);
-                p.method = method.clone();
-                p.perturbation = (m, truth.params.perturbation);
-                run_scene(desc, &p).with_context(|| format!("{}: {label}, member {m}", desc.name))
-            })
-            .collect::<Result<Vec<_>>>()?;
-        let (outcomes, spread) =
-            ensemble_stats(&reports.iter().map(|r| &r.outcomes).collect::<Vec<_>>());
-        let delta_v: Vec<BTreeMap<String, f64>> = reports
-            .iter()
-            .map(|r| {
-                if on {
-                    r.received
-                        .iter()
-                        .map(|(k, v)| (k.clone(), v.max_delta_v))
-                        .collect()
-                } else {
-                    BTreeMap::new()
-                }
-            })
-            .collect();
-        methods.push(MethodOutcome {
-            label: label.to_string(),
-            outcomes,
-            spread,
-            members,
-            delivered_j: mean(reports.iter().map(|r| r.injected_ke)),
-            delta_v: mean_maps(delta_v.iter()),
-            trajectory: reports[0].trajectory.clone(),
-        });
-    }
-    Ok(SceneComparison {
-        truth,
-        methods,
-        desc: desc.clone(),
+}
+
+/// How a method's ensemble is run: members, placement distance (m) and simulated seconds.
+#[derive(Clone, Copy, Debug)]
+pub struct EnsembleSpec {
+    /// Members (member 0: the scene as written).
+    pub members: usize,
+    /// Placement distance of the members (m).
+    pub perturbation: f64,
+    /// Simulated seconds.
+    pub seconds: f64,
+}
+
+/// One method's ensemble on `desc`: `gain` `None` runs the rigid scene (response off), else the
+/// response at that gain (1 = Eq. 12 unscaled).
+///
+/// # Errors
+/// A failed run or bake.
+pub fn method_ensemble(
+    desc: &SceneDesc,
+    root: &Path,
+    label: &str,
+    gain: Option<f64>,
+    method: MethodChoice,
+    ens: &EnsembleSpec,
+) -> Result<MethodOutcome> {
+    let reports = (0..ens.members.max(1))
+        .map(|m| {
+            let mut p = RunParams::new(root.to_path_buf(), gain.is_some());
+            p.seconds = Some(ens.seconds);
+            p.gain = Some(gain.unwrap_or(1.0));
+            p.method = method.clone();
+            p.perturbation = (m, ens.perturbation);
+            run_scene(desc, &p).with_context(|| format!("{}: {label}, member {m}", desc.name))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let (outcomes, spread) =
+        ensemble_stats(&reports.iter().map(|r| &r.outcomes).collect::<Vec<_>>());
+    let delta_v: Vec<BTreeMap<String, f64>> = reports
+        .iter()
+        .map(|r| {
+            r.received
+                .iter()
+                .filter(|_| gain.is_some())
+                .map(|(k, v)| (k.clone(), v.max_delta_v))
+                .collect()
+        })
+        .collect();
+    Ok(MethodOutcome {
+        label: label.to_string(),
+        outcomes,
+        spread,
+        members: reports.len(),
+        delivered_j: mean(reports.iter().map(|r| r.injected_ke)),
+        delta_v: mean_maps(delta_v.iter()),
+        trajectory: reports[0].trajectory.clone(),
     })
 }
 
