@@ -17,7 +17,7 @@ pub const EXIT_NOT_CONVERGED: u8 = 3;
 /// of its mesh (dense eigensolve, exact per-mode integration), coupled to the scene's rapier
 /// bodies by penalty contacts implicit in the forces at a small step, the step halved until no
 /// outcome moves by more than --tol, then checked with the contact stiffness doubled and with
-/// half the modes. Exit status: 0 converged, 1 error, 3 not converged (results still printed).
+/// half the modes (when --modes truncates them). Exit status: 0 converged, 1 error, 3 not converged (results still printed).
 #[derive(Args, Clone, Debug)]
 pub struct SceneTruthArgs {
     /// Scene names (scenes/NAME.json) or .json paths relative to the repository root.
@@ -38,7 +38,8 @@ pub struct SceneTruthArgs {
     /// Elastic modes summed (default: every mode).
     #[arg(long, value_name = "N")]
     pub modes: Option<usize>,
-    /// Skip the check with half the modes at the finest step.
+    /// Skip the check with half the modes at the finest step (it runs only when --modes sums
+    /// fewer than every mode of the mesh).
     #[arg(long)]
     pub no_mode_check: bool,
     /// Skip the check with the contact stiffness doubled at the finest step.
