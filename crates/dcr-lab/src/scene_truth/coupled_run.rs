@@ -358,12 +358,14 @@ pub fn run_coupled(
                             // The contact on the elastic surface, in the object frame.
                             let xl = e_pose.inverse_transform_point(x_e);
                             let key = [xl.x, xl.y, xl.z].map(|v| (v * 2e3).round() as i64);
-                            if !cache.contains_key(&key) {
+                            if let std::collections::hash_map::Entry::Vacant(slot) =
+                                cache.entry(key)
+                            {
                                 let sp = surface
                                     .project(arr(xl))
                                     .context("contact point off the elastic surface")?;
                                 let verts = surface.triangles[sp.triangle as usize];
-                                cache.insert(key, elastic.axis_rows(verts, sp.bary));
+                                slot.insert(elastic.axis_rows(verts, sp.bary));
                             }
                             pts.push(ContactPoint {
                                 ob,

@@ -544,8 +544,12 @@ pub fn write_outcomes_page(out: &Path, scenes: &[SceneComparison], header: &str)
         }
         writeln!(md)?;
         // Δv per outcome's bodies: the largest over the matching bodies.
-        let mut patterns: Vec<&str> = c.desc.outcomes.iter().map(|o| o.bodies.as_str()).collect();
-        patterns.dedup();
+        let mut patterns: Vec<&str> = Vec::new();
+        for o in &c.desc.outcomes {
+            if !patterns.contains(&o.bodies.as_str()) {
+                patterns.push(o.bodies.as_str());
+            }
+        }
         for pat in patterns {
             write!(md, "| largest Δv, {pat} (m/s) |")?;
             for m in &c.methods {
