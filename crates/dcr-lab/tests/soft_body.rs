@@ -363,9 +363,16 @@ fn soft_ensemble_members_move_the_projectile_across_gravity_by_the_distance() {
             let dx = [x[0] - x0[0], x[1] - x0[1], x[2] - x0[2]];
             if n == "pot" {
                 let len = (dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2]).sqrt();
-                assert!((len - d).abs() < 1e-12, "member {member}: pot moved {len} m");
+                assert!(
+                    (len - d).abs() < 1e-12,
+                    "member {member}: pot moved {len} m"
+                );
                 // dinner's gravity is along −y.
-                assert!(dx[1].abs() < 1e-15, "member {member}: vertical move {}", dx[1]);
+                assert!(
+                    dx[1].abs() < 1e-15,
+                    "member {member}: vertical move {}",
+                    dx[1]
+                );
                 dirs.push(dx);
             } else {
                 assert_eq!(x0, x, "member {member}: {n} moved");
@@ -397,7 +404,10 @@ fn ensemble_members_agree_before_the_impact() {
         assert_eq!(m, &r.member_outcomes[0]);
     }
     for (name, sd) in &r.spread {
-        assert_eq!(*sd, 0.0, "{name}: standard deviation {sd} before the impact");
+        assert_eq!(
+            *sd, 0.0,
+            "{name}: standard deviation {sd} before the impact"
+        );
     }
     for (name, (mean, _)) in &r.outcomes {
         assert_eq!(*mean, r.member_outcomes[0][name], "{name}");

@@ -20,8 +20,8 @@ use dcr_scenes::scene::{MethodDesc, SceneDesc, TransferDesc};
 use serde::{Deserialize, Serialize};
 
 use super::peak_rss::peak_rss_bytes;
-use crate::scene_truth::{ensemble_stats, level_change, TruthLevel};
 use super::soft_scene::{run_soft_scene, SoftSceneParams};
+use crate::scene_truth::{ensemble_stats, level_change, TruthLevel};
 
 /// What a row of the comparison runs.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
