@@ -110,11 +110,9 @@ pub struct CompareArgs {
     /// Largest substep count of the sweep.
     #[arg(long, value_name = "N", default_value_t = 256)]
     pub max_substeps: usize,
-    /// The sweep stops once doubling the substeps moves every outcome by less than
-    /// --tolerance-pct, or (with --members ≥ 2) moves every outcome's mean by less than
-    /// max(--tolerance-pct, two standard errors of the difference of the means): converged
-    /// within the ensembles' noise.
-    /// Tolerance of the sweep (%).
+    /// Tolerance of the sweep (%): it stops once doubling the substeps moves every outcome by
+    /// less than this, or (with --members ≥ 2) every outcome's mean by less than max(this, two
+    /// standard errors of the difference of the means): converged within the ensembles' noise.
     #[arg(long, value_name = "PCT", default_value_t = 2.0)]
     pub tolerance_pct: f64,
     /// CG iteration cap of the sweep's rows (rapier's `SoftFemParameters::max_linear_iterations`).
