@@ -1,10 +1,15 @@
 //! The rapier FEM soft body built from a tetrahedral mesh (`dcr_lab::soft_body`): the builder
 //! keeps the mesh, pinned particles stay put, a cantilever sags as linear elasticity says, and
-//! the dinner scene with a soft table and nothing hitting it keeps its plates at rest, and a
-//! projectile started k steps into its flight continues rapier's own flight.
+//! the dinner scene with a soft table and nothing hitting it keeps its plates at rest, a
+//! projectile started k steps into its flight continues rapier's own flight, ensemble members
+//! differ only by where the projectile starts, and the substep sweep converges within an
+//! ensemble's noise only when the noise covers the change.
+
+use std::collections::BTreeMap;
 
 use dcr_lab::soft_body::{
-    run_soft_scene, tet_soft_body, with_projectiles_advanced, SoftSceneParams, TetSoftBodyDesc,
+    run_side, run_soft_scene, sweep_substeps, tet_soft_body, with_projectiles_advanced,
+    EnsembleParams, SideMethod, SideRow, SoftSceneParams, SweepParams, TetSoftBodyDesc,
 };
 use faer::linalg::solvers::Solve;
 use modal_bake::fem::{assemble_clamped, Material};
@@ -329,5 +334,138 @@ fn box_on_cantilever_sags_it_as_p1_through_either_contact_solve() {
             (added - added_p1).abs() < 0.02 * added_p1,
             "{name}: the box adds {added} m of tip sag, P1 static {added_p1} m"
         );
+    }
+}
+
+/// Ensemble member m > 0 of the soft dinner scene starts the pot (the one body with an initial
+/// velocity) exactly the perturbation distance away from member 0, across gravity (no vertical
+/// component), each member in its own direction; every other body starts where member 0 has it.
+#[test]
+fn soft_ensemble_members_move_the_projectile_across_gravity_by_the_distance() {
+    let root = dcr_scenes::repo_root();
+    let desc = dcr_scenes::scene::SceneDesc::read(&root.join("scenes/dinner.json")).unwrap();
+    let d = 1e-4;
+    let start = |member: usize| {
+        let mut p = SoftSceneParams::new(root.clone());
+        p.seconds = Some(desc.h);
+        p.perturbation = (member, d);
+        let t = run_soft_scene(&desc, &p).unwrap().trajectory;
+        (0..t.names.len())
+            .map(|b| (t.names[b].clone(), t.pos(0, b)))
+            .collect::<Vec<_>>()
+    };
+    let m0 = start(0);
+    let mut dirs = Vec::new();
+    for member in [1, 2] {
+        let m = start(member);
+        for ((n0, x0), (n, x)) in m0.iter().zip(&m) {
+            assert_eq!(n0, n);
+            let dx = [x[0] - x0[0], x[1] - x0[1], x[2] - x0[2]];
+            if n == "pot" {
+                let len = (dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2]).sqrt();
+                assert!(
+                    (len - d).abs() < 1e-12,
+                    "member {member}: pot moved {len} m"
+                );
+                // dinner's gravity is along −y.
+                assert!(
+                    dx[1].abs() < 1e-15,
+                    "member {member}: vertical move {}",
+                    dx[1]
+                );
+                dirs.push(dx);
+            } else {
+                assert_eq!(x0, x, "member {member}: {n} moved");
+            }
+        }
+    }
+    assert_eq!(dirs.len(), 2, "the dinner scene has a pot");
+    let cos = (dirs[0][0] * dirs[1][0] + dirs[0][2] * dirs[1][2]) / (d * d);
+    assert!(cos < 0.999, "members 1 and 2 move the pot the same way");
+}
+
+/// Before the pot lands (0.1 s of the dinner scene, the pot in flight until ~0.2 s) nothing
+/// chaotic has happened: an ensemble row of three members gives every member the same
+/// outcomes, bit for bit, and a standard deviation of exactly 0; the row says its members and
+/// pools their steps.
+#[test]
+fn ensemble_members_agree_before_the_impact() {
+    let root = dcr_scenes::repo_root();
+    let desc = dcr_scenes::scene::SceneDesc::read(&root.join("scenes/dinner.json")).unwrap();
+    let ens = EnsembleParams {
+        members: 3,
+        perturbation: 1e-4,
+    };
+    let r = run_side(&desc, &SideMethod::Off, root, Some(0.1), &ens, false).unwrap();
+    assert_eq!(r.members, 3);
+    assert_eq!(r.member_outcomes.len(), 3);
+    assert!(!r.outcomes.is_empty());
+    for m in &r.member_outcomes[1..] {
+        assert_eq!(m, &r.member_outcomes[0]);
+    }
+    for (name, sd) in &r.spread {
+        assert_eq!(
+            *sd, 0.0,
+            "{name}: standard deviation {sd} before the impact"
+        );
+    }
+    for (name, (mean, _)) in &r.outcomes {
+        assert_eq!(*mean, r.member_outcomes[0][name], "{name}");
+    }
+}
+
+/// A rapier-FEM row of the sweep with one outcome whose mean alternates ±10 % around 10 mm
+/// with each doubling, with `members` members of standard deviation `sd`.
+fn synthetic_row(method: &SideMethod, members: usize, sd: f64) -> SideRow {
+    let SideMethod::RapierFem { substeps, .. } = method else {
+        panic!("the sweep runs rapier-fem rows")
+    };
+    let k = substeps.trailing_zeros() as i32;
+    let v = 10.0 * (1.0 + 0.1 * f64::from((-1i32).pow(k as u32)));
+    SideRow {
+        scene: "synthetic".into(),
+        method: method.clone(),
+        steps: 1,
+        step_ms_median: 1.0,
+        step_ms_p99: 1.0,
+        response_ms: None,
+        peak_rss_mib: None,
+        wall_s: 0.0,
+        outcomes: BTreeMap::from([("lift".to_string(), (v, "mm".to_string()))]),
+        spread: BTreeMap::from([("lift".to_string(), sd)]),
+        members,
+        perturbation: 1e-4,
+        member_outcomes: Vec::new(),
+        surface_peak_mm: None,
+    }
+}
+
+/// The sweep's stopping rule: means that move by 2 mm (20 %) with each doubling stop the sweep
+/// at its second row only when two standard errors of the difference cover the move (4
+/// members of 3 mm: 4.2 mm), and reach the substep cap when they do not (4 members of 1 mm:
+/// 1.4 mm) or when the rows are single runs (no noise estimate, whatever their spread field
+/// says).
+#[test]
+fn sweep_converges_within_noise_only_when_the_noise_covers_the_change() {
+    let params = SweepParams {
+        first: 1,
+        max_substeps: 16,
+        budget_s: 1e9,
+        ..SweepParams::default()
+    };
+    let sweep = |members: usize, sd: f64| {
+        sweep_substeps(&params, |m| Ok(synthetic_row(m, members, sd))).unwrap()
+    };
+    let (rows, end) = sweep(4, 3.0);
+    assert_eq!(rows.len(), 2);
+    assert!(end.converged && end.within_noise, "{end:?}");
+    assert_eq!(end.reason, "converged within noise");
+    assert!((end.last_change - 2.0 / 11.0).abs() < 1e-12, "{end:?}");
+    for (members, sd) in [(4, 1.0), (1, 3.0)] {
+        let (rows, end) = sweep(members, sd);
+        assert_eq!(rows.len(), 5, "{members} members of {sd} mm");
+        assert!(!end.converged && !end.within_noise, "{end:?}");
+        assert_eq!(end.reason, "substep cap");
+        assert_eq!(end.last_substeps, 16);
     }
 }

@@ -7,8 +7,8 @@ use std::process::{Command, Stdio};
 use anyhow::{bail, Context, Result};
 use clap::{Args, Subcommand, ValueEnum};
 use dcr_lab::soft_body::{
-    render_markdown, run_side, sweep_substeps, with_projectiles_advanced, SceneComparison,
-    SideMethod, SideRow, SoftSceneParams, SweepParams,
+    render_markdown, run_side, sweep_substeps, with_projectiles_advanced, EnsembleParams,
+    SceneComparison, SideMethod, SideRow, SoftSceneParams, SweepParams,
 };
 use dcr_scenes::scene::SceneDesc;
 
@@ -24,8 +24,9 @@ pub enum SoftBodyCommand {
     /// rapier-fem`, the default), or rigid with dcr (`modal`, `transfer`) or without (`off`).
     Run(RunArgs),
     /// Every method side by side on each scene, one process per row (its peak memory is the
-    /// row's): rapier-FEM at 1, 2, 4, … substeps until the outcomes settle, dcr with 20 modes
-    /// and with the ★ table, no response. Writes a markdown table and the rows as JSON.
+    /// row's; its members run one after the other in it): rapier-FEM at 1, 2, 4, … substeps
+    /// until the outcomes settle, dcr with 20 modes and with the ★ table, no response. Writes a
+    /// markdown table and the rows as JSON.
     Compare(CompareArgs),
 }
 
@@ -73,6 +74,15 @@ pub struct RunArgs {
     /// the original first contact. Default 0.
     #[arg(long, value_name = "K", default_value_t = 0)]
     pub advance_steps: usize,
+    /// Runs per row (an ensemble): member 0 the scene as written, member m > 0 with the
+    /// projectiles (bodies with an initial velocity) started --perturbation away across gravity,
+    /// each member in its own direction. Outcomes are reported as mean ± sample standard
+    /// deviation over the members; step times over all members' steps.
+    #[arg(long, value_name = "N", default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..=1000))]
+    pub members: u64,
+    /// Distance (m) members m > 0 move the projectiles across gravity.
+    #[arg(long, value_name = "M", default_value_t = 1e-4)]
+    pub perturbation: f64,
     /// Repository root (scenes, meshes, `out/bases`).
     #[arg(long, value_name = "DIR", default_value = ".")]
     pub root: PathBuf,
@@ -94,10 +104,15 @@ pub struct CompareArgs {
     /// likely end past it (estimated as twice the previous row).
     #[arg(long, value_name = "MIN", default_value_t = 20.0)]
     pub budget_min: f64,
+    /// First substep count of the sweep (doubled each row).
+    #[arg(long, value_name = "N", default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..=4096))]
+    pub first_substeps: u64,
     /// Largest substep count of the sweep.
     #[arg(long, value_name = "N", default_value_t = 256)]
     pub max_substeps: usize,
-    /// The sweep stops once doubling the substeps changes every outcome by less than this (%).
+    /// Tolerance of the sweep (%): it stops once doubling the substeps moves every outcome by
+    /// less than this, or (with --members ≥ 2) every outcome's mean by less than max(this, two
+    /// standard errors of the difference of the means): converged within the ensembles' noise.
     #[arg(long, value_name = "PCT", default_value_t = 2.0)]
     pub tolerance_pct: f64,
     /// CG iteration cap of the sweep's rows (rapier's `SoftFemParameters::max_linear_iterations`).
@@ -120,6 +135,15 @@ pub struct CompareArgs {
     /// earlier; see `soft-body run --advance-steps`).
     #[arg(long, value_name = "K", default_value_t = 0)]
     pub advance_steps: usize,
+    /// Runs per row (an ensemble): member 0 the scene as written, member m > 0 with the
+    /// projectiles (bodies with an initial velocity) started --perturbation away across gravity,
+    /// each member in its own direction. Outcomes are reported as mean ± sample standard
+    /// deviation over the members; step times over all members' steps.
+    #[arg(long, value_name = "N", default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..=1000))]
+    pub members: u64,
+    /// Distance (m) members m > 0 move the projectiles across gravity.
+    #[arg(long, value_name = "M", default_value_t = 1e-4)]
+    pub perturbation: f64,
     /// Repository root.
     #[arg(long, value_name = "DIR", default_value = ".")]
     pub root: PathBuf,
@@ -175,6 +199,17 @@ fn write_file(path: &Path, text: &str) -> Result<()> {
         .with_context(|| format!("writing {}", path.display()))
 }
 
+/// The ensemble of `--members` and `--perturbation`, checked.
+fn ensemble(members: u64, perturbation: f64) -> Result<EnsembleParams> {
+    if !(perturbation > 0.0 && perturbation.is_finite()) {
+        bail!("--perturbation {perturbation}: must be a positive distance in metres, e.g. 1e-4");
+    }
+    Ok(EnsembleParams {
+        members: members as usize,
+        perturbation,
+    })
+}
+
 fn side_method(a: &RunArgs) -> SideMethod {
     let d = SoftSceneParams::new(PathBuf::new());
     match a.method {
@@ -212,6 +247,7 @@ fn run_one(a: &RunArgs) -> Result<()> {
             bail!("--seconds {s}: must be a positive number of seconds");
         }
     }
+    let ensemble = ensemble(a.members, a.perturbation)?;
     let path = scene_path(&a.root, &a.scene);
     let method = side_method(a);
     let substeps = match method {
@@ -220,7 +256,14 @@ fn run_one(a: &RunArgs) -> Result<()> {
         _ => rapier3d_f64::prelude::IntegrationParameters::default().num_solver_iterations,
     };
     let desc = with_projectiles_advanced(&SceneDesc::read(&path)?, a.advance_steps, substeps)?;
-    let row = run_side(&desc, &method, a.root.clone(), a.seconds, a.progress)?;
+    let row = run_side(
+        &desc,
+        &method,
+        a.root.clone(),
+        a.seconds,
+        &ensemble,
+        a.progress,
+    )?;
     let json = serde_json::to_string_pretty(&row)? + "\n";
     match &a.json {
         Some(p) if p.as_os_str() == "-" => crate::cli::emit(&json)?,
@@ -237,12 +280,17 @@ fn summary(r: &SideRow) -> String {
     let outcomes: Vec<String> = r
         .outcomes
         .iter()
-        .map(|(n, (v, u))| format!("{n} {v:.4} {u}"))
+        .map(|(n, (v, u))| match r.spread.get(n) {
+            Some(sd) if r.members > 1 => format!("{n} {v:.4} ± {sd:.4} {u}"),
+            _ => format!("{n} {v:.4} {u}"),
+        })
         .collect();
     format!(
-        "{} {}: {} steps, step median {:.3} ms, p99 {:.3} ms, peak RSS {} MiB, {:.1} s; {}\n",
+        "{} {}: {} member(s) of {} steps, step median {:.3} ms, p99 {:.3} ms, peak RSS {} MiB, \
+         {:.1} s; {}\n",
         r.scene,
         r.method.label(),
+        r.members,
         r.steps,
         r.step_ms_median,
         r.step_ms_p99,
@@ -259,6 +307,7 @@ fn run_child(
     method: &SideMethod,
     seconds: Option<f64>,
     advance_steps: usize,
+    ensemble: &EnsembleParams,
 ) -> Result<SideRow> {
     let exe = std::env::current_exe().context("locating the dcr-lab binary")?;
     let mut cmd = Command::new(exe);
@@ -300,6 +349,10 @@ fn run_child(
         cmd.arg("--seconds").arg(s.to_string());
     }
     cmd.arg("--advance-steps").arg(advance_steps.to_string());
+    cmd.arg("--members")
+        .arg(ensemble.members.to_string())
+        .arg("--perturbation")
+        .arg(ensemble.perturbation.to_string());
     eprintln!("[dcr-lab] {scene}: {} …", method.label());
     let out = cmd
         .stderr(Stdio::inherit())
@@ -325,6 +378,14 @@ fn compare(a: &CompareArgs) -> Result<()> {
     if !(a.tolerance_pct > 0.0) {
         bail!("--tolerance-pct {}: must be positive", a.tolerance_pct);
     }
+    if a.first_substeps as usize > a.max_substeps {
+        bail!(
+            "--first-substeps {} is above --max-substeps {}: the sweep would run no row",
+            a.first_substeps,
+            a.max_substeps
+        );
+    }
+    let ens = ensemble(a.members, a.perturbation)?;
     let mut out = Vec::new();
     for scene in &a.scenes {
         // Read (and check) the scene and the advance before spending minutes on it.
@@ -336,13 +397,28 @@ fn compare(a: &CompareArgs) -> Result<()> {
         // Bake the bases first, in a row of their own that is not kept: a row whose process
         // bakes would report the eigensolver's memory and time, not the run's.
         for m in [SideMethod::Modal, SideMethod::Transfer] {
-            run_child(&a.root, scene, &m, Some(0.01), 0)?;
+            run_child(
+                &a.root,
+                scene,
+                &m,
+                Some(0.01),
+                0,
+                &EnsembleParams::default(),
+            )?;
         }
         let mut rows = Vec::new();
         for m in [SideMethod::Off, SideMethod::Modal, SideMethod::Transfer] {
-            rows.push(run_child(&a.root, scene, &m, a.seconds, a.advance_steps)?);
+            rows.push(run_child(
+                &a.root,
+                scene,
+                &m,
+                a.seconds,
+                a.advance_steps,
+                &ens,
+            )?);
         }
         let params = SweepParams {
+            first: a.first_substeps as usize,
             budget_s: a.budget_min * 60.0,
             max_substeps: a.max_substeps,
             tolerance: a.tolerance_pct / 100.0,
@@ -354,7 +430,7 @@ fn compare(a: &CompareArgs) -> Result<()> {
             ..params
         };
         let (soft, end) = sweep_substeps(&params, |m| {
-            run_child(&a.root, scene, m, a.seconds, a.advance_steps)
+            run_child(&a.root, scene, m, a.seconds, a.advance_steps, &ens)
         })?;
         let mut all = soft;
         for &(substeps, cg_iterations, max_dense_dofs) in &a.extra {
@@ -364,7 +440,14 @@ fn compare(a: &CompareArgs) -> Result<()> {
                 max_dense_dofs,
                 cg_tolerance: params.cg_tolerance,
             };
-            all.push(run_child(&a.root, scene, &m, a.seconds, a.advance_steps)?);
+            all.push(run_child(
+                &a.root,
+                scene,
+                &m,
+                a.seconds,
+                a.advance_steps,
+                &ens,
+            )?);
         }
         all.extend(rows);
         out.push(SceneComparison {

@@ -9,8 +9,11 @@
 //! - [`run_soft_scene`]: a scene run with its elastic objects as soft bodies, the rest of the
 //!   world as `dcr-scenes run` builds it, the same outcome figures;
 //! - [`run_side`], [`sweep_substeps`], [`render_markdown`]: the comparison rows (rapier-FEM at
-//!   increasing substeps, dcr with 20 modes and with the ★ table, no response) and their table
-//!   (`dcr-lab soft-body compare`, `scripts/soft_body_compare.sh`, docs/benchmarks.md).
+//!   increasing substeps, dcr with 20 modes and with the ★ table, no response), each an
+//!   ensemble of runs with the projectile moved 0.1 mm ([`EnsembleParams`]: the outcomes are
+//!   chaotic, so a row reports their mean ± standard deviation and the sweep converges within
+//!   the ensemble's noise), and their table (`dcr-lab soft-body compare`,
+//!   `scripts/soft_body_compare.sh`, docs/benchmarks.md).
 
 mod peak_rss;
 mod side_by_side;
@@ -21,7 +24,7 @@ mod tet_soft_body;
 pub use peak_rss::peak_rss_bytes;
 pub use side_by_side::{
     outcome_change, run_side, sweep_substeps, with_projectiles_advanced, with_transfer_region,
-    SideMethod, SideRow, SweepEnd, SweepParams,
+    within_noise, EnsembleParams, SideMethod, SideRow, SweepEnd, SweepParams,
 };
 pub use side_report::{render_markdown, SceneComparison};
 pub use soft_scene::{run_soft_scene, SoftObjectInfo, SoftRunReport, SoftSceneParams};

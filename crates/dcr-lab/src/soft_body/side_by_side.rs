@@ -1,7 +1,15 @@
 //! One scene, side by side: rapier FEM soft bodies at increasing substeps against the distant
 //! response (20 modes, the ★ transfer table) on rigid objects and against no response — cost
 //! per step, peak memory and the scene's outcome figures.
-
+//!
+//! The outcomes (largest lift, tilt) are chaotic — props rattling on a ringing object — so each
+//! row can run an ensemble ([`EnsembleParams`]): member 0 is the scene as written, member m > 0
+//! starts the projectiles a fixed small distance away across gravity
+//! (`dcr_scenes::scene::BuiltWorld::perturb_placement`), and a row reports each outcome's mean
+//! and sample standard deviation over the members (`crate::scene_truth::ensemble_stats`). The
+//! substep sweep then stops when a doubling moves every mean by less than the tolerance or by
+//! less than two standard errors of the difference of the means
+//! (`crate::scene_truth::level_change`): converged within the ensemble's noise.
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -13,6 +21,7 @@ use serde::{Deserialize, Serialize};
 
 use super::peak_rss::peak_rss_bytes;
 use super::soft_scene::{run_soft_scene, SoftSceneParams};
+use crate::scene_truth::{ensemble_stats, level_change, TruthLevel};
 
 /// What a row of the comparison runs.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -92,10 +101,47 @@ pub struct SideRow {
     pub peak_rss_mib: Option<f64>,
     /// Wall time of the whole run (s).
     pub wall_s: f64,
-    /// Outcome figures: name → (value, unit).
+    /// Outcome figures, the mean over the members: name → (value, unit).
     pub outcomes: BTreeMap<String, (f64, String)>,
-    /// Soft rows: the largest displacement of the soft surface under a watched body (mm).
+    /// Sample standard deviation of each outcome over the members (the outcome's unit; 0 for
+    /// one member).
+    #[serde(default)]
+    pub spread: BTreeMap<String, f64>,
+    /// Members run (see [`EnsembleParams`]); the step times are pooled over all of them.
+    #[serde(default = "one")]
+    pub members: usize,
+    /// Distance the projectiles of members m > 0 start from the scene's placement (m).
+    #[serde(default)]
+    pub perturbation: f64,
+    /// Each member's outcomes, member 0 (the scene as written) first: name → value.
+    #[serde(default)]
+    pub member_outcomes: Vec<BTreeMap<String, f64>>,
+    /// Soft rows: the largest displacement of the soft surface under a watched body over the
+    /// members (mm).
     pub surface_peak_mm: Option<f64>,
+}
+
+fn one() -> usize {
+    1
+}
+
+/// The ensemble every row of a comparison runs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EnsembleParams {
+    /// Members (at least 1). Default 1: the scene as written only.
+    pub members: usize,
+    /// Distance (m) across gravity by which members m > 0 start their projectiles away from the
+    /// scene's placement, each member in its own direction. Default 1e-4 (0.1 mm).
+    pub perturbation: f64,
+}
+
+impl Default for EnsembleParams {
+    fn default() -> Self {
+        EnsembleParams {
+            members: 1,
+            perturbation: 1e-4,
+        }
+    }
 }
 
 fn percentile(v: &[f64], p: f64) -> f64 {
@@ -174,83 +220,98 @@ pub fn with_projectiles_advanced(
     Ok(d)
 }
 
-/// Runs one row in this process (its peak memory is this process's).
+/// Runs one row in this process, every member of `ensemble` one after the other (the peak
+/// memory is this process's): outcomes as mean and sample standard deviation over the members,
+/// the step times pooled over all members' steps.
 ///
 /// # Errors
-/// What [`run_soft_scene`] or `dcr_scenes::runner::run_scene` report.
+/// What [`run_soft_scene`] or `dcr_scenes::runner::run_scene` report; no member.
 pub fn run_side(
     desc: &SceneDesc,
     method: &SideMethod,
     root: PathBuf,
     seconds: Option<f64>,
+    ensemble: &EnsembleParams,
     progress: bool,
 ) -> Result<SideRow> {
+    if ensemble.members == 0 {
+        anyhow::bail!("members must be at least 1");
+    }
     let wall = Instant::now();
-    let row = match method {
-        SideMethod::RapierFem {
-            substeps,
-            cg_iterations,
-            max_dense_dofs,
-            cg_tolerance,
-        } => {
-            let mut p = SoftSceneParams::new(root);
-            p.cg_tolerance = *cg_tolerance;
-            p.substeps = *substeps;
-            p.cg_iterations = *cg_iterations;
-            p.max_dense_dofs = *max_dense_dofs;
-            p.seconds = seconds;
-            p.progress = progress;
-            let r = run_soft_scene(desc, &p)?;
-            SideRow {
-                scene: desc.name.clone(),
-                method: method.clone(),
-                steps: r.steps,
-                step_ms_median: percentile(&r.step_ms, 50.0),
-                step_ms_p99: percentile(&r.step_ms, 99.0),
-                response_ms: None,
-                peak_rss_mib: None,
-                wall_s: 0.0,
-                outcomes: r.outcomes,
-                surface_peak_mm: r.surface_peak_mm.values().copied().reduce(f64::max),
+    let mut whole: Vec<f64> = Vec::new();
+    let mut adapter: Vec<f64> = Vec::new();
+    let mut runs: Vec<BTreeMap<String, (f64, String)>> = Vec::new();
+    let mut surface_peak_mm: Option<f64> = None;
+    let mut steps = 0;
+    let dcr = matches!(method, SideMethod::Modal | SideMethod::Transfer);
+    for member in 0..ensemble.members {
+        let perturbation = (member, ensemble.perturbation);
+        match method {
+            SideMethod::RapierFem {
+                substeps,
+                cg_iterations,
+                max_dense_dofs,
+                cg_tolerance,
+            } => {
+                let mut p = SoftSceneParams::new(root.clone());
+                p.cg_tolerance = *cg_tolerance;
+                p.substeps = *substeps;
+                p.cg_iterations = *cg_iterations;
+                p.max_dense_dofs = *max_dense_dofs;
+                p.seconds = seconds;
+                p.perturbation = perturbation;
+                p.progress = progress;
+                let r = run_soft_scene(desc, &p)?;
+                steps = r.steps;
+                whole.extend(&r.step_ms);
+                if let Some(peak) = r.surface_peak_mm.values().copied().reduce(f64::max) {
+                    surface_peak_mm = Some(surface_peak_mm.map_or(peak, |s| s.max(peak)));
+                }
+                runs.push(r.outcomes);
+            }
+            SideMethod::Modal | SideMethod::Transfer | SideMethod::Off => {
+                let mut p = RunParams::new(root.clone(), dcr);
+                p.seconds = seconds;
+                p.progress = progress;
+                p.perturbation = perturbation;
+                let desc = if *method == SideMethod::Transfer {
+                    p.method = MethodChoice::Transfer;
+                    with_transfer_region(desc)
+                } else {
+                    p.method = MethodChoice::Modal;
+                    desc.clone()
+                };
+                let r = run_scene(&desc, &p)?;
+                steps = r.steps;
+                whole.extend(
+                    r.step_times
+                        .iter()
+                        .map(|t| (t.rapier_us + if dcr { t.adapter_us } else { 0.0 }) / 1e3),
+                );
+                adapter.extend(r.step_times.iter().map(|t| t.adapter_us / 1e3));
+                runs.push(r.outcomes.into_iter().collect());
             }
         }
-        SideMethod::Modal | SideMethod::Transfer | SideMethod::Off => {
-            let dcr = *method != SideMethod::Off;
-            let mut p = RunParams::new(root, dcr);
-            p.seconds = seconds;
-            p.progress = progress;
-            let desc = if *method == SideMethod::Transfer {
-                p.method = MethodChoice::Transfer;
-                with_transfer_region(desc)
-            } else {
-                p.method = MethodChoice::Modal;
-                desc.clone()
-            };
-            let r = run_scene(&desc, &p)?;
-            let whole: Vec<f64> = r
-                .step_times
-                .iter()
-                .map(|t| (t.rapier_us + if dcr { t.adapter_us } else { 0.0 }) / 1e3)
-                .collect();
-            let adapter: Vec<f64> = r.step_times.iter().map(|t| t.adapter_us / 1e3).collect();
-            SideRow {
-                scene: desc.name.clone(),
-                method: method.clone(),
-                steps: r.steps,
-                step_ms_median: percentile(&whole, 50.0),
-                step_ms_p99: percentile(&whole, 99.0),
-                response_ms: dcr.then(|| [percentile(&adapter, 50.0), percentile(&adapter, 99.0)]),
-                peak_rss_mib: None,
-                wall_s: 0.0,
-                outcomes: r.outcomes.into_iter().collect(),
-                surface_peak_mm: None,
-            }
-        }
-    };
+    }
+    let (outcomes, spread) = ensemble_stats(&runs.iter().collect::<Vec<_>>());
     Ok(SideRow {
+        scene: desc.name.clone(),
+        method: method.clone(),
+        steps,
+        step_ms_median: percentile(&whole, 50.0),
+        step_ms_p99: percentile(&whole, 99.0),
+        response_ms: dcr.then(|| [percentile(&adapter, 50.0), percentile(&adapter, 99.0)]),
         peak_rss_mib: peak_rss_bytes().map(|b| b as f64 / (1024.0 * 1024.0)),
         wall_s: wall.elapsed().as_secs_f64(),
-        ..row
+        outcomes,
+        spread,
+        members: ensemble.members,
+        perturbation: ensemble.perturbation,
+        member_outcomes: runs
+            .iter()
+            .map(|r| r.iter().map(|(k, v)| (k.clone(), v.0)).collect())
+            .collect(),
+        surface_peak_mm,
     })
 }
 
@@ -277,12 +338,43 @@ pub fn outcome_change(a: &SideRow, b: &SideRow, floor: f64) -> f64 {
 pub struct SweepEnd {
     /// Substeps of the last row run.
     pub last_substeps: usize,
-    /// Whether the last doubling changed every outcome by less than the tolerance.
+    /// Whether the last doubling moved every outcome (its mean, for ensembles) by less than
+    /// the tolerance or, for ensembles, by less than two standard errors of the difference.
     pub converged: bool,
+    /// Whether the sweep converged only by the second test: some mean moved by the tolerance or
+    /// more, but by less than the ensembles' noise.
+    #[serde(default)]
+    pub within_noise: bool,
     /// The largest outcome change of the last doubling (fraction).
     pub last_change: f64,
-    /// Why the sweep stopped (`converged`, `time budget`, `substep cap`).
+    /// Why the sweep stopped (`converged`, `converged within noise`, `time budget`, `substep
+    /// cap`).
     pub reason: String,
+}
+
+/// A row's outcomes as a level of the coupled reference's refinement, for
+/// [`crate::scene_truth::level_change`] (only outcomes, spread and members are read).
+fn as_level(r: &SideRow) -> TruthLevel {
+    TruthLevel {
+        dt: 0.0,
+        modes: 0,
+        contact_stiffness: 0.0,
+        outcomes: r.outcomes.clone(),
+        spread: r.spread.clone(),
+        members: r.members,
+        change: None,
+        within_noise: None,
+        max_penetration: 0.0,
+        wall_s: r.wall_s,
+    }
+}
+
+/// Whether row `b` agrees with row `a` within the ensembles' noise: every outcome's mean moved
+/// by at most max(`tolerance` · max(|b|, 1 unit), two standard errors of the difference of the
+/// means) — `crate::scene_truth::level_change`, the coupled reference's test. Rows of one
+/// member have no noise estimate: `false` unless both have at least two members.
+pub fn within_noise(a: &SideRow, b: &SideRow, tolerance: f64) -> bool {
+    a.members > 1 && b.members > 1 && level_change(&as_level(a), &as_level(b), tolerance).1
 }
 
 /// Settings of the substep sweep.
@@ -324,8 +416,9 @@ impl Default for SweepParams {
 }
 
 /// Runs rapier-FEM rows at `first`, 2·`first`, 4·`first`, … substeps with `run` until a
-/// doubling changes every outcome by less than the tolerance, the budget would be exceeded or
-/// the cap is reached. Returns the rows in order and how the sweep ended.
+/// doubling changes every outcome by less than the tolerance ([`outcome_change`]) or, for
+/// ensembles, moves every mean within the noise ([`within_noise`]), the budget would be
+/// exceeded or the cap is reached. Returns the rows in order and how the sweep ended.
 ///
 /// # Errors
 /// The first error `run` returns.
@@ -339,6 +432,7 @@ pub fn sweep_substeps(
     let mut end = SweepEnd {
         last_substeps: n,
         converged: false,
+        within_noise: false,
         last_change: f64::INFINITY,
         reason: "substep cap".into(),
     };
@@ -349,8 +443,10 @@ pub fn sweep_substeps(
             max_dense_dofs: params.max_dense_dofs,
             cg_tolerance: params.cg_tolerance,
         })?;
+        let mut noise = false;
         if let Some(prev) = rows.last() {
             end.last_change = outcome_change(prev, &row, params.floor);
+            noise = within_noise(prev, &row, params.tolerance);
         }
         end.last_substeps = n;
         let wall = row.wall_s;
@@ -358,6 +454,12 @@ pub fn sweep_substeps(
         if end.last_change < params.tolerance {
             end.converged = true;
             end.reason = "converged".into();
+            break;
+        }
+        if noise {
+            end.converged = true;
+            end.within_noise = true;
+            end.reason = "converged within noise".into();
             break;
         }
         if n * 2 > params.max_substeps {

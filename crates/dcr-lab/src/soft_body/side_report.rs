@@ -53,8 +53,9 @@ impl SceneComparison {
     }
 }
 
-/// The markdown table of each scene's rows, with a line per scene on where the sweep ended and
-/// how the converged soft object compares with dcr (cost per step, outcomes).
+/// The markdown table of each scene's rows (outcomes as mean ± sample standard deviation for
+/// ensembles), with a line per scene on where the sweep ended and how the converged soft
+/// object compares with dcr (cost per step, outcomes).
 pub fn render_markdown(scenes: &[SceneComparison]) -> String {
     let mut s = String::new();
     for sc in scenes {
@@ -69,6 +70,18 @@ pub fn render_markdown(scenes: &[SceneComparison]) -> String {
             })
             .unwrap_or_default();
         let _ = writeln!(s, "#### {}\n", sc.scene);
+        if let Some(r) = sc.rows.iter().find(|r| r.members > 1) {
+            let _ = writeln!(
+                s,
+                "Every row is an ensemble of {} runs: the scene as written and {} with the \
+                 projectile started {} mm away across gravity, each in its own direction. \
+                 Outcomes are the members' mean ± sample standard deviation; step times are over \
+                 all members' steps; run s is the whole ensemble.\n",
+                r.members,
+                r.members - 1,
+                fmt_sig(r.perturbation * 1e3)
+            );
+        }
         let _ = write!(
             s,
             "| method | step median ms | step p99 ms | × ★ table step | response median / p99 ms | peak RSS MiB |"
@@ -98,7 +111,11 @@ pub fn render_markdown(scenes: &[SceneComparison]) -> String {
                     label.push_str(" (rapier's default)");
                 }
                 if sc.sweep.converged && substeps == sc.sweep.last_substeps {
-                    label.push_str(" (converged)");
+                    label.push_str(if sc.sweep.within_noise {
+                        " (converged within noise)"
+                    } else {
+                        " (converged)"
+                    });
                 }
             }
             let ratio =
@@ -115,7 +132,12 @@ pub fn render_markdown(scenes: &[SceneComparison]) -> String {
             );
             for (n, _) in &names {
                 let v = r.outcomes.get(n).map_or(f64::NAN, |v| v.0);
-                let _ = write!(s, " {} |", fmt_sig(v));
+                if r.members > 1 {
+                    let sd = r.spread.get(n).copied().unwrap_or(f64::NAN);
+                    let _ = write!(s, " {} ± {} |", fmt_sig(v), fmt_sig(sd));
+                } else {
+                    let _ = write!(s, " {} |", fmt_sig(v));
+                }
             }
             let _ = writeln!(
                 s,
@@ -128,13 +150,18 @@ pub fn render_markdown(scenes: &[SceneComparison]) -> String {
         let end = &sc.sweep;
         let _ = writeln!(
             s,
-            "Sweep: stopped at {} substeps ({}; last doubling changed the outcomes by at most {}).",
+            "Sweep: stopped at {} substeps ({}; last doubling changed the outcomes by at most {}{}).",
             end.last_substeps,
             end.reason,
             if end.last_change.is_finite() {
                 format!("{:.1} %", 100.0 * end.last_change)
             } else {
                 "–".into()
+            },
+            if end.within_noise {
+                ", every mean within max(the tolerance, two standard errors of the difference)"
+            } else {
+                ""
             }
         );
         if let (Some(soft), Some(t), Some(m)) = (

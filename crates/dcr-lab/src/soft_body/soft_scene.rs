@@ -38,6 +38,11 @@ pub struct SoftSceneParams {
     pub max_dense_dofs: usize,
     /// Contact skin of the soft surfaces (m). Default 1e-4.
     pub particle_radius: f64,
+    /// Ensemble member and distance (m): member m > 0 starts the projectiles (bodies with a
+    /// non-zero initial velocity) `distance` away across gravity, in the direction
+    /// `dcr_scenes::scene::BuiltWorld::perturb_placement` gives that member. Default `(0, 0.0)`:
+    /// the scene as written.
+    pub perturbation: (usize, f64),
     /// Progress lines on stderr every 5 s.
     pub progress: bool,
 }
@@ -56,6 +61,7 @@ impl SoftSceneParams {
             cg_tolerance: fem.linear_tolerance,
             max_dense_dofs: fem.max_dense_dofs,
             particle_radius: TetSoftBodyDesc::default().particle_radius,
+            perturbation: (0, 0.0),
             progress: false,
         }
     }
@@ -122,7 +128,8 @@ pub struct SoftRunReport {
 /// Runs `desc` with every elastic object a rapier FEM soft body (see
 /// [`tet_soft_body()`](fn@super::tet_soft_body)): the world `dcr_scenes::scene::build_world` builds, the rigid
 /// bodies of the elastic objects (and their proxy colliders) replaced by their tetrahedral
-/// meshes, pinned at their `fixed` groups, with the scene's material and Rayleigh damping.
+/// meshes, pinned at their `fixed` groups, with the scene's material and Rayleigh damping;
+/// the projectiles moved as `params.perturbation` says.
 ///
 /// # Errors
 /// A dynamic elastic object (only static ones, pinned in place, are supported), a scene with
@@ -141,6 +148,7 @@ pub fn run_soft_scene(desc: &SceneDesc, params: &SoftSceneParams) -> Result<Soft
     let seconds = params.seconds.unwrap_or(desc.seconds);
     let steps = (seconds / desc.h).round() as usize;
     let mut built = build_world(desc, &params.root)?;
+    built.perturb_placement(params.perturbation.0, params.perturbation.1);
     {
         let ip = &mut built.world.integration_parameters;
         ip.num_solver_iterations = params.substeps;
@@ -251,9 +259,10 @@ pub fn run_soft_scene(desc: &SceneDesc, params: &SoftSceneParams) -> Result<Soft
         if params.progress && last_progress.elapsed().as_secs_f64() > 5.0 {
             last_progress = Instant::now();
             eprintln!(
-                "[dcr-lab] {} soft ({} substeps) step {}/{} ({:.1} s wall)",
+                "[dcr-lab] {} soft ({} substeps, member {}) step {}/{} ({:.1} s wall)",
                 desc.name,
                 params.substeps,
+                params.perturbation.0,
                 k + 1,
                 steps,
                 wall.elapsed().as_secs_f64()
