@@ -398,7 +398,11 @@ pub fn advance_steps(desc: &SceneDesc, root: &Path) -> Result<std::result::Resul
     Ok(
         match crate::soft_body::with_projectiles_advanced(desc, steps, 1) {
             Ok(_) => Ok(steps),
-            Err(e) => Err(format!("{e:#}")),
+            Err(_) => Err(
+                "a projectile spins, is damped or is placed relative to the elastic \
+                 object; its advanced flight is written for plain translation only"
+                    .into(),
+            ),
         },
     )
 }
