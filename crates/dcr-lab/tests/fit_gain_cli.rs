@@ -53,8 +53,8 @@ fn recovers_a_known_gain() {
     assert!((gain - 2.0).abs() < 0.05, "fitted gain {gain}, expected 2");
 }
 
-/// A malformed target, an unknown outcome and a target the range cannot reach are refused with
-/// a message naming the problem.
+/// A malformed target, an unknown outcome, a placement distance of half a metre and a target the
+/// range cannot reach are refused with a message naming the problem.
 #[test]
 fn bad_targets_are_refused() {
     for (args, needle) in [
@@ -63,6 +63,16 @@ fn bad_targets_are_refused() {
             "OUTCOME=VALUE",
         ),
         (vec!["dinner", "--target", "plates=1"], "no outcome plates"),
+        (
+            vec![
+                "dinner",
+                "--target",
+                "plates_max_lift=1",
+                "--perturbation",
+                "0.5",
+            ],
+            "outside [0, 0.01) m",
+        ),
         (
             vec![
                 "dinner",

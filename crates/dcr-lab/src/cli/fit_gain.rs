@@ -41,7 +41,7 @@ pub struct FitGainArgs {
     #[arg(long, value_name = "N", default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=64))]
     pub members: u32,
     /// Placement distance of the members (m).
-    #[arg(long, value_name = "M", default_value_t = 1e-4)]
+    #[arg(long, value_name = "M", default_value_t = 1e-4, value_parser = super::parse_perturbation)]
     pub perturbation: f64,
     /// Simulated seconds from the scene's t = 0, as `scene-truth --seconds` (default: the
     /// scene's `seconds`).
@@ -95,12 +95,6 @@ pub fn run(a: &FitGainArgs) -> Result<ExitCode> {
             "--min-gain {} and --max-gain {} must satisfy 0 < min < max",
             a.min_gain,
             a.max_gain
-        );
-    }
-    if !(a.perturbation >= 0.0 && a.perturbation < 0.01) {
-        bail!(
-            "--perturbation must be a placement distance in [0, 0.01) m, got {}",
-            a.perturbation
         );
     }
     let root = dcr_scenes::repo_root();

@@ -42,6 +42,22 @@ enum Command {
     FitGain(fit_gain::FitGainArgs),
 }
 
+/// Parses `--perturbation`: a placement distance in metres, in [0, 0.01) (the members of an
+/// ensemble move the projectile by it; a centimetre would be a different scene).
+pub(crate) fn parse_perturbation(s: &str) -> Result<f64, String> {
+    let v: f64 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("{s} is not a number (a distance in metres, e.g. 1e-4)"))?;
+    if (0.0..0.01).contains(&v) {
+        Ok(v)
+    } else {
+        Err(format!(
+            "{v} m is outside [0, 0.01) m (a placement distance, e.g. 1e-4)"
+        ))
+    }
+}
+
 /// Writes `s` to stdout. A closed pipe (`dcr-lab truth … | head`) is not an error; any other
 /// failed write (a full disk) is.
 pub fn emit(s: &str) -> anyhow::Result<()> {

@@ -81,7 +81,7 @@ pub struct RunArgs {
     #[arg(long, value_name = "N", default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..=1000))]
     pub members: u64,
     /// Distance (m) members m > 0 move the projectiles across gravity.
-    #[arg(long, value_name = "M", default_value_t = 1e-4)]
+    #[arg(long, value_name = "M", default_value_t = 1e-4, value_parser = super::parse_perturbation)]
     pub perturbation: f64,
     /// Repository root (scenes, meshes, `out/bases`).
     #[arg(long, value_name = "DIR", default_value = ".")]
@@ -142,7 +142,7 @@ pub struct CompareArgs {
     #[arg(long, value_name = "N", default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..=1000))]
     pub members: u64,
     /// Distance (m) members m > 0 move the projectiles across gravity.
-    #[arg(long, value_name = "M", default_value_t = 1e-4)]
+    #[arg(long, value_name = "M", default_value_t = 1e-4, value_parser = super::parse_perturbation)]
     pub perturbation: f64,
     /// Repository root.
     #[arg(long, value_name = "DIR", default_value = ".")]
@@ -201,9 +201,6 @@ fn write_file(path: &Path, text: &str) -> Result<()> {
 
 /// The ensemble of `--members` and `--perturbation`, checked.
 fn ensemble(members: u64, perturbation: f64) -> Result<EnsembleParams> {
-    if !(perturbation > 0.0 && perturbation.is_finite()) {
-        bail!("--perturbation {perturbation}: must be a positive distance in metres, e.g. 1e-4");
-    }
     Ok(EnsembleParams {
         members: members as usize,
         perturbation,
