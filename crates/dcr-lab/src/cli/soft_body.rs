@@ -199,12 +199,12 @@ fn write_file(path: &Path, text: &str) -> Result<()> {
         .with_context(|| format!("writing {}", path.display()))
 }
 
-/// The ensemble of `--members` and `--perturbation`, checked.
-fn ensemble(members: u64, perturbation: f64) -> Result<EnsembleParams> {
-    Ok(EnsembleParams {
+/// The ensemble of `--members` and `--perturbation` (both checked by their parsers).
+fn ensemble(members: u64, perturbation: f64) -> EnsembleParams {
+    EnsembleParams {
         members: members as usize,
         perturbation,
-    })
+    }
 }
 
 fn side_method(a: &RunArgs) -> SideMethod {
@@ -244,7 +244,7 @@ fn run_one(a: &RunArgs) -> Result<()> {
             bail!("--seconds {s}: must be a positive number of seconds");
         }
     }
-    let ensemble = ensemble(a.members, a.perturbation)?;
+    let ensemble = ensemble(a.members, a.perturbation);
     let path = scene_path(&a.root, &a.scene);
     let method = side_method(a);
     let substeps = match method {
@@ -382,7 +382,7 @@ fn compare(a: &CompareArgs) -> Result<()> {
             a.max_substeps
         );
     }
-    let ens = ensemble(a.members, a.perturbation)?;
+    let ens = ensemble(a.members, a.perturbation);
     let mut out = Vec::new();
     for scene in &a.scenes {
         // Read (and check) the scene and the advance before spending minutes on it.
