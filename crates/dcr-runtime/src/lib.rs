@@ -102,7 +102,7 @@ pub mod world;
 // and sampling settings, per-step diagnostics) live under `response`, the world's other types
 // (classification settings, energy reports, totals) under `world`.
 pub use model::{LoadError, ModalModel};
-pub use response::{DistantResponse, Method, ResponseParams};
+pub use response::{DistantResponse, Launch, Method, ResponseParams};
 pub use world::{
     BodyState, ContactReport, DcrWorld, ElasticHandle, ElasticObjectDesc, ImpulseEvent,
     ObjectStepInfo, Pose, WorldError, WorldParams, WorldStepInfo,

@@ -39,6 +39,13 @@ enum OnOff {
 enum MethodArg {
     /// The modal filters over the object's base (its `modes`, 20 by default; Eq. 9–13).
     Modal,
+    /// The modal filters carried over between steps with the moving-support rule: each
+    /// resting body's normal velocity raised to the surface's largest outward speed under it,
+    /// on every step the object rings (`Launch::SurfaceSpeed`; not the paper's rule).
+    SurfaceSpeed,
+    /// The modal filters carried over, Eq. 12's d/h applied as a target on every step the
+    /// object rings (`Launch::SustainedPeak`; not the paper's rule).
+    SustainedPeak,
     /// Spatial attenuation (Eq. 14–16): the object's own or `attenuation` settings, else C = 1,
     /// β = 1.
     Attenuation,
@@ -305,12 +312,22 @@ fn real_main() -> Result<()> {
                 }
             }
             let method = match (method, beta) {
-                (Some(MethodArg::Modal | MethodArg::Transfer), Some(_)) => {
+                (
+                    Some(
+                        MethodArg::Modal
+                        | MethodArg::SurfaceSpeed
+                        | MethodArg::SustainedPeak
+                        | MethodArg::Transfer,
+                    ),
+                    Some(_),
+                ) => {
                     bail!("--beta is the attenuation exponent: use it without --method or with --method attenuation")
                 }
                 (_, Some(b)) => MethodChoice::AttenuationBeta(b),
                 (Some(MethodArg::Attenuation), None) => MethodChoice::Attenuation,
                 (Some(MethodArg::Modal), None) => MethodChoice::Modal,
+                (Some(MethodArg::SurfaceSpeed), None) => MethodChoice::SurfaceSpeed,
+                (Some(MethodArg::SustainedPeak), None) => MethodChoice::SustainedPeak,
                 (Some(MethodArg::Transfer), None) => MethodChoice::Transfer,
                 (None, None) => MethodChoice::Scene,
             };

@@ -14,7 +14,7 @@ use super::modal_response::ModalResponse;
 use super::step_ctx::{unmapped_response, StepCtx};
 use super::transfer_response::TransferResponse;
 use super::{
-    prepared_vec, ContactResponse, ForceInput, Impact, Method, ParamsError, ResponseParams,
+    prepared_vec, ContactResponse, ForceInput, Impact, Launch, Method, ParamsError, ResponseParams,
     RestingContact, StepInfo, TableFallback, TablePolicy, TableStatus, PREPARED_CONTACTS,
 };
 use crate::model::ModalModel;
@@ -105,7 +105,9 @@ impl DistantResponse {
     /// [`ParamsError`] for a non-positive or non-finite h, sampling, threshold, map distance,
     /// negative Rayleigh coefficients, more than 10⁶ samples per step, invalid attenuation
     /// parameters, a surface the heat method cannot factor, or (under [`TablePolicy::Refuse`])
-    /// a transfer table that does not apply ([`ParamsError::TableRefused`]).
+    /// a transfer table that does not apply ([`ParamsError::TableRefused`]), or
+    /// a [`Launch`] other than [`Launch::PeakOverStep`] without `carry_over` or with the
+    /// attenuation method.
     pub fn new(model: Arc<ModalModel>, params: ResponseParams) -> Result<Self, ParamsError> {
         let p = &params;
         if !(p.h.is_finite() && p.h > 0.0) {
@@ -138,6 +140,27 @@ impl DistantResponse {
                 format!("{}", p.sleep_energy_rel),
             ));
         }
+        if p.launch != Launch::PeakOverStep {
+            if !p.carry_over {
+                return Err(invalid(
+                    "launch",
+                    format!(
+                        "{:?} reads the carried-over filters: set carry_over = true",
+                        p.launch
+                    ),
+                ));
+            }
+            if matches!(p.method, Method::Attenuation(_)) {
+                return Err(invalid(
+                    "launch",
+                    format!(
+                        "{:?} needs the modal filters; the attenuation method has none (use \
+                         Method::Modal)",
+                        p.launch
+                    ),
+                ));
+            }
+        }
         let table = ImpulseTable::new(&model, p, rayleigh)?;
         let (samples, period, m) = (table.samples, table.period, model.num_modes());
         let lateral = p
@@ -151,11 +174,11 @@ impl DistantResponse {
                 (MethodResponse::Attenuation(att), TableStatus::NotRequested)
             }
             Method::Modal => (
-                MethodResponse::Modal(ModalResponse::new(table, p.h, p.variant)),
+                MethodResponse::Modal(ModalResponse::new(table, p.h, p.variant, p.launch)),
                 TableStatus::NotRequested,
             ),
             Method::Transfer => {
-                let modal = ModalResponse::new(table, p.h, p.variant);
+                let modal = ModalResponse::new(table, p.h, p.variant, p.launch);
                 match TransferResponse::check(&model, p.h, rayleigh, p.carry_over) {
                     Ok(()) => (
                         MethodResponse::Transfer(TransferResponse::new(&model, modal)),

@@ -27,7 +27,9 @@ pub use force_input::ForceInput;
 pub use impact::Impact;
 #[cfg(feature = "bench-internals")]
 pub use peak_kernel::{peak_abs_projection, peak_abs_rows};
-pub use response_params::{Method, ParamsError, ResponseParams, TablePolicy, TableStatus, Variant};
+pub use response_params::{
+    Launch, Method, ParamsError, ResponseParams, TablePolicy, TableStatus, Variant,
+};
 pub use resting_contact::RestingContact;
 pub use step_info::{StepInfo, TableFallback};
 

@@ -13,6 +13,31 @@ pub enum Variant {
     PerNode,
 }
 
+/// How a resting contact's velocity change is formed from the modal response.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Launch {
+    /// The paper's rule (Eq. 12): `Δv = d/h` with d the step's peak normal displacement under
+    /// the contact, added to the body's velocity on the steps with impacts (default).
+    #[default]
+    PeakOverStep,
+    /// Eq. 12's `Δv = d/h` from the carried-over filters on every step the object rings, taken
+    /// as a **target** for the body's normal velocity at the contact (relative to the object's
+    /// rigid motion), like [`Launch::SurfaceSpeed`]: the paper's rule kept on after the impact
+    /// without adding up. Needs `carry_over = true` and the modal filters.
+    SustainedPeak,
+    /// The moving support: `Δv` = the largest outward normal speed of the surface under the
+    /// contact over the step, `max(0, max_k w_c · q̇(kT))` (m/s; q̇ the exact filter velocity
+    /// at each sample), taken as a **target**: [`crate::DcrWorld`] raises the body's normal
+    /// velocity at the contact (relative to the object's rigid motion) to it, a plastic
+    /// contact with the moving surface. It acts on every step the carried-over filters ring,
+    /// not only on the impact's step, so a prop keeps taking energy from the object after the
+    /// impact and leaves with the surface's speed. Needs `carry_over = true` and the modal
+    /// filters ([`Method::Modal`], or [`Method::Transfer`] served by the modal method because
+    /// of `carry_over`); set-up refuses it with [`Method::Attenuation`] or without carry-over.
+    /// Its energy bound in [`crate::DcrWorld`] also counts the object's modal energy.
+    SurfaceSpeed,
+}
+
 /// Which distant-response model is used.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub enum Method {
@@ -76,6 +101,9 @@ pub struct ResponseParams {
     /// which [`crate::DcrWorld`] adds to the impulse. Computed from the modal base (3 mode rows
     /// per vertex) whichever method serves the normal part. Default `false`.
     pub lateral_kick: bool,
+    /// How a resting contact's velocity change is formed. Default [`Launch::PeakOverStep`]
+    /// (Eq. 12).
+    pub launch: Launch,
 }
 
 /// What a [`Method::Transfer`] response does when the base's transfer table cannot serve it.
@@ -115,6 +143,7 @@ impl Default for ResponseParams {
             evict_after_steps: 120,
             table_policy: TablePolicy::FallBackToModal,
             lateral_kick: false,
+            launch: Launch::PeakOverStep,
         }
     }
 }

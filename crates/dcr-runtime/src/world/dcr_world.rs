@@ -389,6 +389,7 @@ impl DcrWorld {
                 Source {
                     body: 0,
                     point: [0.0; 3],
+                    touching: false,
                 },
             ),
             depth: 0,

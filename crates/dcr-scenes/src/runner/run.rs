@@ -12,7 +12,7 @@ use dcr_runtime::response::{
     AmplitudeKind, AttenuationLaw, AttenuationParams, DistanceKind, ServedBy, TableFallback,
     TablePolicy,
 };
-use dcr_runtime::{Method, ModalModel, ResponseParams};
+use dcr_runtime::{Launch, Method, ModalModel, ResponseParams};
 use ndarray::{Array1, Array2};
 use ndarray_npy::NpzWriter;
 use rapier3d_f64::math::Vector;
@@ -32,6 +32,14 @@ pub enum MethodChoice {
     Scene,
     /// Modal for every object.
     Modal,
+    /// Modal for every object with its filters carried over between steps and the moving
+    /// support rule ([`dcr_runtime::Launch::SurfaceSpeed`]): each resting body's normal
+    /// velocity is raised to the surface's largest outward speed under it, on every step
+    /// the object rings.
+    SurfaceSpeed,
+    /// Modal for every object with its filters carried over and Eq. 12's d/h applied as a
+    /// target on every step the object rings ([`dcr_runtime::Launch::SustainedPeak`]).
+    SustainedPeak,
     /// Spatial attenuation for every object (the object's `attenuation` settings, or its
     /// `method` if that is attenuation, or C = 1, β = 1, heat distances).
     Attenuation,
@@ -324,7 +332,11 @@ fn transfer_of<'a>(e: &'a ElasticDesc, choice: &MethodChoice) -> Result<Option<&
                 e.name
             ),
         },
-        MethodChoice::Modal | MethodChoice::Attenuation | MethodChoice::AttenuationBeta(_) => None,
+        MethodChoice::Modal
+        | MethodChoice::SurfaceSpeed
+        | MethodChoice::SustainedPeak
+        | MethodChoice::Attenuation
+        | MethodChoice::AttenuationBeta(_) => None,
     })
 }
 
@@ -341,7 +353,10 @@ fn attenuation_of(e: &ElasticDesc, choice: &MethodChoice) -> Option<(f64, f64, S
     let own = from(&e.method).or_else(|| e.attenuation.as_ref().and_then(from));
     match choice {
         MethodChoice::Scene => from(&e.method),
-        MethodChoice::Modal | MethodChoice::Transfer => None,
+        MethodChoice::Modal
+        | MethodChoice::SurfaceSpeed
+        | MethodChoice::SustainedPeak
+        | MethodChoice::Transfer => None,
         MethodChoice::Attenuation => {
             Some(own.unwrap_or((1.0, 1.0, "heat".into(), "per_vertex".into())))
         }
@@ -631,6 +646,15 @@ fn add_elastic_objects(
             max_map_distance: 0.1,
             method,
             lateral_kick: params.lateral_kick,
+            carry_over: matches!(
+                params.method,
+                MethodChoice::SurfaceSpeed | MethodChoice::SustainedPeak
+            ),
+            launch: match params.method {
+                MethodChoice::SurfaceSpeed => Launch::SurfaceSpeed,
+                MethodChoice::SustainedPeak => Launch::SustainedPeak,
+                _ => Launch::PeakOverStep,
+            },
             // The table was baked for this scene: a table that does not apply is an error,
             // not a silent modal run.
             table_policy: TablePolicy::Refuse,

@@ -30,6 +30,9 @@ pub(super) struct Source {
     pub(super) body: u32,
     /// Application point on the receiving body (m, world).
     pub(super) point: [f64; 3],
+    /// Whether the contact carried an impulse this step (touching, not only predicted): only
+    /// touching contacts carry the moving support of [`crate::Launch::SurfaceSpeed`].
+    pub(super) touching: bool,
 }
 
 impl DcrWorld {
@@ -125,6 +128,7 @@ impl DcrWorld {
                         obj.sources.push(Source {
                             body: b,
                             point: other_point,
+                            touching: c.impulse > 0.0,
                         });
                         obj.info.resting += 1;
                         self.info.resting += 1;

@@ -2,12 +2,14 @@
 //! `E_in = Σ_bodies (P·V + ½ PᵀM⁻¹P)`, is at most `η (D + R)` (D the energy the step's impacts
 //! on the object dissipated, R what chained impulses gave its body); over it, every impulse of
 //! the object is scaled by the largest s ∈ [0, 1] with `s A + s² B ≤ η (D + R)`. The rules and
-//! the estimate of D are in [`DcrWorld`]'s documentation, "Energy bound".
+//! the estimate of D are in [`DcrWorld`]'s documentation, "Energy bound". Under a carried
+//! [`Launch`] (not [`Launch::PeakOverStep`]) the budget also holds the object's modal energy at the step's end,
+//! `η (D + R + E_modal)`: the ringing the props draw on.
 
 use super::impulse_pass::Touched;
 use super::DcrWorld;
 use crate::math::{add, cross, dot, mat_vec, scale, sub};
-use crate::response;
+use crate::response::{self, Launch};
 use crate::world::{BodyState, ContactReport};
 
 impl DcrWorld {
@@ -26,10 +28,16 @@ impl DcrWorld {
             bq += tc.energy.1;
         }
         let requested = a + bq;
+        // Launch::SurfaceSpeed / SustainedPeak draw on the ringing object: its modal energy counts too.
+        let ringing = if obj.response.params().launch != Launch::PeakOverStep {
+            obj.response.modal_energy()
+        } else {
+            0.0
+        };
         let budget = self
             .params
             .energy_eta
-            .map(|eta| eta * (obj.info.energy.dissipated + obj.info.energy.received));
+            .map(|eta| eta * (obj.info.energy.dissipated + obj.info.energy.received + ringing));
         let s = match budget {
             Some(budget) if requested > budget => {
                 self.info.energy_limited += 1;

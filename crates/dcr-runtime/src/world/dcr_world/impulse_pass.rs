@@ -1,13 +1,16 @@
 //! The impulse pass (paper Eq. 17–18): an object's response, a normal velocity change `Δv` per
 //! resting contact, issued as impulses `j = m_eff (g Δv − a) n` on the resting bodies in one
 //! Gauss–Seidel pass per body (`a` what the impulses already issued this step produce at the
-//! point), with the support compensation for gravity. The rules are in [`DcrWorld`]'s
-//! documentation, "Impulses (Eq. 17–18) and one Gauss–Seidel pass per body".
+//! point), with the support compensation for gravity. Under [`Launch::SurfaceSpeed`] and
+//! [`Launch::SustainedPeak`] `Δv` is a
+//! target: `a` also counts the body's normal velocity at the point relative to the object's
+//! rigid motion, so the body is raised to the surface's speed, not pushed by it. The rules are
+//! in [`DcrWorld`]'s documentation, "Impulses (Eq. 17–18) and one Gauss–Seidel pass per body".
 
 use super::lateral_kick::add_lateral_impulse;
 use super::DcrWorld;
 use crate::math::{add, cross, dot, mat_vec, scale, sub};
-use crate::response::effective_mass;
+use crate::response::{effective_mass, Launch};
 use crate::world::pose::rotate;
 use crate::world::{BodyState, ImpulseEvent};
 
@@ -67,6 +70,14 @@ impl DcrWorld {
     pub(super) fn respond(&mut self, o: usize, bodies: &[BodyState]) {
         let step = self.step - 1;
         let obj = &mut self.objects[o];
+        // Launch::SurfaceSpeed / SustainedPeak: Δv is a target for the body's normal velocity relative to the
+        // object's rigid motion (the object's own body state, when it is dynamic).
+        let target = obj.response.params().launch != Launch::PeakOverStep;
+        let object_state = if target && obj.dynamic {
+            self.body_index.get(&obj.body).map(|&i| bodies[i as usize])
+        } else {
+            None
+        };
         if let Some(last) = obj.last_called {
             obj.response.skip_steps(step - last - 1);
         }
@@ -81,14 +92,22 @@ impl DcrWorld {
         self.touched.clear();
         for (resp, src) in out.iter().zip(&obj.sources) {
             let lateral = resp.lateral_delta_v != [0.0; 3];
-            if !resp.mapped || !(resp.delta_v > 0.0 || lateral) {
+            if !resp.mapped || !(resp.delta_v > 0.0 || lateral) || (target && !src.touching) {
                 continue;
             }
             let b = &bodies[src.body as usize];
             let n = rotate(&obj.rot, resp.normal);
             let r = sub(src.point, b.center_of_mass);
             let t = &mut self.tracked[src.body as usize];
-            let (mut j, need) = normal_impulse(obj.gain * resp.delta_v, b, r, n, t);
+            let mut want = obj.gain * resp.delta_v;
+            if target {
+                let v_rel = sub(
+                    point_velocity(b, src.point),
+                    object_state.map_or([0.0; 3], |s| point_velocity(&s, src.point)),
+                );
+                want -= dot(v_rel, n);
+            }
+            let (mut j, need) = normal_impulse(want, b, r, n, t);
             if lateral {
                 let tw = rotate(&obj.rot, resp.lateral_delta_v);
                 j = add_lateral_impulse(j, tw, obj.gain, b, r, t.dlin, t.dang);
@@ -146,6 +165,12 @@ impl DcrWorld {
         obj.info.response = obj.response.last_step_info();
         obj.info.events = (self.events.len() - first_event - supports) as u32;
     }
+}
+
+/// Velocity of body `b` at world point `p` (m/s, world frame).
+#[inline]
+fn point_velocity(b: &BodyState, p: [f64; 3]) -> [f64; 3] {
+    add(b.linvel, cross(b.angvel, sub(p, b.center_of_mass)))
 }
 
 /// The normal part of a resting contact's impulse (N·s, world) and the velocity change it asks
