@@ -18,8 +18,8 @@ use dcr_runtime::response::{
 };
 use dcr_runtime::testing::{plate_base, SplitMix64};
 use dcr_runtime::{
-    BodyState, ContactReport, DcrWorld, DistantResponse, ElasticHandle, ElasticObjectDesc, Method,
-    ModalModel, Pose, ResponseParams, WorldError, WorldParams,
+    BodyState, ContactReport, DcrWorld, DistantResponse, ElasticHandle, ElasticObjectDesc, Launch,
+    Method, ModalModel, Pose, ResponseParams, WorldError, WorldParams,
 };
 
 const PLATE: u64 = 1;
@@ -665,4 +665,91 @@ fn the_lateral_kick_is_the_tangential_peak() {
         .step(&imp, &resting)
         .iter()
         .all(|o| o.lateral_delta_v == [0.0; 3]));
+}
+
+/// [`Launch::SustainedPeak`]: set-up refuses it without carry-over or with attenuation; on
+/// the impact's step a resting body gets the paper's Δv = d/h; on the following steps, with no
+/// impact, it gets the carried filters' d/h as a target for its normal velocity — the full
+/// value at rest, the remainder when it already moves up, nothing when it moves faster or its
+/// contact only predicted (zero impulse) — and the energy bound (η = 1) lets it through,
+/// counting the ringing plate's modal energy. The paper's rule with carry-over adds instead.
+#[test]
+fn sustained_peak_raises_a_resting_body_to_the_carried_peak() {
+    let sustained = ResponseParams {
+        method: Method::Modal,
+        carry_over: true,
+        launch: Launch::SustainedPeak,
+        ..Default::default()
+    };
+    for bad in [
+        ResponseParams {
+            carry_over: false,
+            ..sustained.clone()
+        },
+        ResponseParams {
+            method: Method::Attenuation(Default::default()),
+            ..sustained.clone()
+        },
+    ] {
+        match DistantResponse::new(model(), bad) {
+            Err(ParamsError::Invalid {
+                field: "launch", ..
+            }) => {}
+            other => panic!("expected an invalid launch, got {other:?}"),
+        }
+    }
+
+    let contact = [0.8, 0.4, 0.0];
+    let hit_point = [0.3, 0.25, 0.0];
+    let imp = [Impact {
+        point: hit_point,
+        direction: [0.0, 0.0, -1.0],
+        impulse: 2.0,
+    }];
+    let resting = [RestingContact {
+        id: 0,
+        point: contact,
+    }];
+    // The standalone carried response: d/h on the impact's step and on the next one.
+    let mut resp = DistantResponse::new(model(), sustained.clone()).unwrap();
+    let first = resp.step(&imp, &resting)[0].delta_v;
+    let second = resp.step(&[], &resting)[0].delta_v;
+    assert!(first > 0.0 && second > 0.0, "{first} {second}");
+
+    let id = Pose::IDENTITY;
+    // The body's Δv along +z at the impact's step and the next, the next with the body moving
+    // up at `v_up` (m/s) and its contact carrying `impulse` (N·s).
+    let run = |params: &ResponseParams, eta: Option<f64>, v_up: f64, impulse: f64| {
+        let (mut w, _) = plate_world(id, eta, params.clone());
+        let mut b = body(7, 0.5, [0.8, 0.4, 0.05]);
+        let rest = [on_plate(&id, 0, 7, contact, 0.01)];
+        for _ in 0..4 {
+            w.step(&rest, &[b]);
+        }
+        let dv = |events: &[dcr_runtime::ImpulseEvent]| {
+            events.iter().map(|e| e.impulse[2] * 0.5).sum::<f64>()
+        };
+        let with_hit = [rest[0], on_plate(&id, 90, 9, hit_point, 2.0)];
+        let dv1 = dv(w.step(&with_hit, &[b]));
+        b.linvel = [0.0, 0.0, v_up];
+        let dv2 = dv(w.step(&[on_plate(&id, 0, 7, contact, impulse)], &[b]));
+        (dv1, dv2)
+    };
+    let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * b.abs().max(1e-300);
+    let (dv1, dv2) = run(&sustained, None, 0.0, 0.01);
+    assert!(close(dv1, first), "{dv1} vs {first}");
+    assert!(close(dv2, second), "{dv2} vs {second}");
+    let (_, half) = run(&sustained, None, 0.5 * second, 0.01);
+    assert!(close(half, 0.5 * second), "{half} vs {}", 0.5 * second);
+    assert_eq!(run(&sustained, None, 2.0 * second, 0.01).1, 0.0);
+    assert_eq!(run(&sustained, None, 0.0, 0.0).1, 0.0);
+    let (_, bounded) = run(&sustained, Some(1.0), 0.0, 0.01);
+    assert!(close(bounded, second), "{bounded} vs {second}");
+    // The paper's rule with carry-over: the same d/h, added to the body's own velocity.
+    let paper = ResponseParams {
+        launch: Launch::PeakOverStep,
+        ..sustained
+    };
+    let (_, added) = run(&paper, None, 2.0 * second, 0.01);
+    assert!(close(added, second), "{added} vs {second}");
 }

@@ -39,10 +39,6 @@ enum OnOff {
 enum MethodArg {
     /// The modal filters over the object's base (its `modes`, 20 by default; Eq. 9–13).
     Modal,
-    /// The modal filters carried over between steps with the moving-support rule: each
-    /// resting body's normal velocity raised to the surface's largest outward speed under it,
-    /// on every step the object rings (`Launch::SurfaceSpeed`; not the paper's rule).
-    SurfaceSpeed,
     /// The modal filters carried over, Eq. 12's d/h applied as a target on every step the
     /// object rings (`Launch::SustainedPeak`; not the paper's rule).
     SustainedPeak,
@@ -313,12 +309,7 @@ fn real_main() -> Result<()> {
             }
             let method = match (method, beta) {
                 (
-                    Some(
-                        MethodArg::Modal
-                        | MethodArg::SurfaceSpeed
-                        | MethodArg::SustainedPeak
-                        | MethodArg::Transfer,
-                    ),
+                    Some(MethodArg::Modal | MethodArg::SustainedPeak | MethodArg::Transfer),
                     Some(_),
                 ) => {
                     bail!("--beta is the attenuation exponent: use it without --method or with --method attenuation")
@@ -326,7 +317,6 @@ fn real_main() -> Result<()> {
                 (_, Some(b)) => MethodChoice::AttenuationBeta(b),
                 (Some(MethodArg::Attenuation), None) => MethodChoice::Attenuation,
                 (Some(MethodArg::Modal), None) => MethodChoice::Modal,
-                (Some(MethodArg::SurfaceSpeed), None) => MethodChoice::SurfaceSpeed,
                 (Some(MethodArg::SustainedPeak), None) => MethodChoice::SustainedPeak,
                 (Some(MethodArg::Transfer), None) => MethodChoice::Transfer,
                 (None, None) => MethodChoice::Scene,

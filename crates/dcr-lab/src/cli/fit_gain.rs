@@ -20,8 +20,6 @@ pub enum FitMethod {
     Modal,
     /// Spatial attenuation (Eq. 14–16).
     Attenuation,
-    /// The 20-mode filters carried over with the moving-support rule (`Launch::SurfaceSpeed`).
-    SurfaceSpeed,
     /// The 20-mode filters carried over, d/h as a target while they ring
     /// (`Launch::SustainedPeak`).
     SustainedPeak,
@@ -130,7 +128,6 @@ pub fn run(a: &FitGainArgs) -> Result<ExitCode> {
         FitMethod::Transfer => (MethodChoice::Transfer, "★ transfer table"),
         FitMethod::Modal => (MethodChoice::Modal, "modal, 20 modes"),
         FitMethod::Attenuation => (MethodChoice::Attenuation, "attenuation"),
-        FitMethod::SurfaceSpeed => (MethodChoice::SurfaceSpeed, "surface speed, 20 modes"),
         FitMethod::SustainedPeak => (MethodChoice::SustainedPeak, "sustained d/h, 20 modes"),
     };
     let ens = EnsembleSpec {

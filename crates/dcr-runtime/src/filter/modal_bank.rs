@@ -81,33 +81,8 @@ impl ModalBank {
     /// # Panics
     /// If `table` is shorter than `samples × m`.
     pub fn run(&mut self, samples: usize, force: Option<&[f64]>, table: &mut [f64]) {
-        self.run_sampled(samples, force, table, None);
-    }
-
-    /// As [`ModalBank::run`], also writing q̇ (kg^1/2·m/s) after each sample into row k of
-    /// `velocities` (row-major `samples × m`). Does not allocate.
-    ///
-    /// # Panics
-    /// If `table` or `velocities` is shorter than `samples × m`.
-    pub fn run_with_velocity(
-        &mut self,
-        samples: usize,
-        force: Option<&[f64]>,
-        table: &mut [f64],
-        velocities: &mut [f64],
-    ) {
-        self.run_sampled(samples, force, table, Some(velocities));
-    }
-
-    fn run_sampled(
-        &mut self,
-        samples: usize,
-        force: Option<&[f64]>,
-        table: &mut [f64],
-        mut velocities: Option<&mut [f64]>,
-    ) {
         let m = self.q.len();
-        for (k, row) in table[..samples * m].chunks_exact_mut(m).enumerate() {
+        for row in table[..samples * m].chunks_exact_mut(m) {
             match force {
                 None => {
                     for j in 0..m {
@@ -126,9 +101,6 @@ impl ModalBank {
                 }
             }
             row.copy_from_slice(&self.q);
-            if let Some(v) = velocities.as_deref_mut() {
-                v[k * m..(k + 1) * m].copy_from_slice(&self.qd);
-            }
         }
     }
 

@@ -14,9 +14,9 @@ pub struct ContactResponse {
     pub normal: [f64; 3],
     /// Peak normal displacement over the step (m, Eq. 11 / 13; Eq. 15 × s for attenuation).
     pub peak_displacement: f64,
-    /// Velocity change along +normal (m/s, Eq. 12 / 13 / 16): `peak_displacement / h`; under
-    /// [`crate::Launch::SurfaceSpeed`] the surface's largest outward speed under the contact
-    /// over the step, a target for the body's normal velocity rather than an increment.
+    /// Velocity change along +normal (m/s, Eq. 12 / 13 / 16): `peak_displacement / h` (under
+    /// [`crate::Launch::SustainedPeak`] a target for the body's normal velocity, not an
+    /// increment).
     pub delta_v: f64,
     /// Tangential velocity change (m/s, object frame, ⟂ `normal`): the peak tangential
     /// displacement over the step / h, along its direction at the peak (the lateral kick,

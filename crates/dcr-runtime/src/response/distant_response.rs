@@ -106,8 +106,7 @@ impl DistantResponse {
     /// negative Rayleigh coefficients, more than 10⁶ samples per step, invalid attenuation
     /// parameters, a surface the heat method cannot factor, or (under [`TablePolicy::Refuse`])
     /// a transfer table that does not apply ([`ParamsError::TableRefused`]), or
-    /// a [`Launch`] other than [`Launch::PeakOverStep`] without `carry_over` or with the
-    /// attenuation method.
+    /// [`Launch::SustainedPeak`] without `carry_over` or with the attenuation method.
     pub fn new(model: Arc<ModalModel>, params: ResponseParams) -> Result<Self, ParamsError> {
         let p = &params;
         if !(p.h.is_finite() && p.h > 0.0) {
@@ -174,11 +173,11 @@ impl DistantResponse {
                 (MethodResponse::Attenuation(att), TableStatus::NotRequested)
             }
             Method::Modal => (
-                MethodResponse::Modal(ModalResponse::new(table, p.h, p.variant, p.launch)),
+                MethodResponse::Modal(ModalResponse::new(table, p.h, p.variant)),
                 TableStatus::NotRequested,
             ),
             Method::Transfer => {
-                let modal = ModalResponse::new(table, p.h, p.variant, p.launch);
+                let modal = ModalResponse::new(table, p.h, p.variant);
                 match TransferResponse::check(&model, p.h, rayleigh, p.carry_over) {
                     Ok(()) => (
                         MethodResponse::Transfer(TransferResponse::new(&model, modal)),

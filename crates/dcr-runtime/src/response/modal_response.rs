@@ -6,15 +6,13 @@
 //! Eq. 13 per node) gives Δv = d/h. Without carry-over the filters start from rest every step,
 //! so q(k) = g(kT) ∘ r with the impulse-response table g_j(kT) precomputed at set-up; the
 //! per-step work is one dense multiply-max over S × m × contacts. With carry-over (or forces,
-//! held constant over the step) the bank is stepped sample by sample. Under
-//! [`Launch::SurfaceSpeed`] (carry-over) the bank also writes q̇(k) and each channel's
-//! `max(0, max_k w_c · q̇(k))`, the surface's outward speed, replaces d/h.
+//! held constant over the step) the bank is stepped sample by sample.
 
 use super::impulse_table::ImpulseTable;
 use super::peak_kernel::{peak_abs_rows, LANES};
 use super::step_ctx::{mapped_response, unmapped_response, StepCtx};
 use super::{
-    prepared_vec, ForceInput, Impact, Launch, RestingContact, ServedBy, Variant, PREPARED_CONTACTS,
+    prepared_vec, ForceInput, Impact, RestingContact, ServedBy, Variant, PREPARED_CONTACTS,
 };
 use crate::filter::ModalBank;
 use crate::math::normalize;
@@ -52,11 +50,6 @@ pub(crate) struct ModalResponse {
     w_scaled: Vec<f64>,
     q_stale: bool,
     peaks: Vec<f64>,
-    /// q̇(k), row-major S × m ([`Launch::SurfaceSpeed`] only; else empty).
-    v_table: Vec<f64>,
-    /// Each channel's largest outward surface speed over the step (m/s,
-    /// [`Launch::SurfaceSpeed`]).
-    speeds: Vec<f64>,
     asleep: bool,
     energy_ref: f64,
 }
@@ -64,7 +57,7 @@ pub(crate) struct ModalResponse {
 impl ModalResponse {
     /// The method's state over the filters of `table` (h = `h` s), its buffers sized for
     /// [`PREPARED_CONTACTS`] resting contacts of `variant`'s channels.
-    pub fn new(table: ImpulseTable, h: f64, variant: Variant, launch: Launch) -> ModalResponse {
+    pub fn new(table: ImpulseTable, h: f64, variant: Variant) -> ModalResponse {
         let ImpulseTable {
             samples,
             bank,
@@ -112,11 +105,6 @@ impl ModalResponse {
             w_scaled: prepared_vec(channels * m, 0.0),
             q_stale: false,
             peaks: prepared_vec(channels, 0.0),
-            v_table: match launch {
-                Launch::SurfaceSpeed => vec![0.0; samples * m],
-                Launch::PeakOverStep | Launch::SustainedPeak => Vec::new(),
-            },
-            speeds: prepared_vec(channels, 0.0),
             asleep: true,
             energy_ref: 0.0,
             bank,
@@ -259,9 +247,6 @@ impl ModalResponse {
         if self.peaks.len() < nch {
             self.peaks.resize(nch, 0.0);
         }
-        if self.speeds.len() < nch {
-            self.speeds.resize(nch, 0.0);
-        }
         if self.w_key.0 != contacts.generation() || self.w_key.1 != slots {
             self.w_key.0 = contacts.generation();
             self.w_key.1.clear();
@@ -316,8 +301,7 @@ impl ModalResponse {
             if !carry && !have_force {
                 self.peaks_from_rest(nch, peaks);
             } else {
-                let speed = ctx.params.launch == Launch::SurfaceSpeed;
-                self.peaks_by_stepping(nch, have_impulse, have_force, speed, peaks);
+                self.peaks_by_stepping(nch, have_impulse, have_force, peaks);
             }
             if carry {
                 self.asleep = false;
@@ -334,7 +318,6 @@ impl ModalResponse {
             }
         } else {
             peaks.iter_mut().for_each(|x| *x = 0.0);
-            self.speeds[..nch].iter_mut().for_each(|x| *x = 0.0);
             self.q_table.iter_mut().for_each(|x| *x = 0.0);
             self.q_stale = false;
             ctx.info.asleep = carry;
@@ -389,14 +372,12 @@ impl ModalResponse {
 
     /// The stepping path of [`ModalResponse::peak_displacements`] (carry-over or forces): the
     /// impulse applied to the filters, then S samples with the force held constant, the
-    /// samples transposed mode-major and the peaks taken; with `speed` also each channel's
-    /// largest outward speed `max(0, max_k w_c · q̇(k))` into `speeds`.
+    /// samples transposed mode-major and the peaks taken.
     fn peaks_by_stepping(
         &mut self,
         nch: usize,
         have_impulse: bool,
         have_force: bool,
-        speed: bool,
         peaks: &mut [f64],
     ) {
         let (m, s, stride) = (self.m, self.samples, self.stride);
@@ -404,24 +385,7 @@ impl ModalResponse {
             self.bank.apply_impulse(&self.r);
         }
         let force = if have_force { Some(&self.f[..]) } else { None };
-        if speed {
-            self.bank
-                .run_with_velocity(s, force, &mut self.q_table, &mut self.v_table);
-            let w = &self.w_step[..nch * m];
-            for (c, out) in self.speeds[..nch].iter_mut().enumerate() {
-                let mut best = 0.0f64;
-                for vk in self.v_table[..s * m].chunks_exact(m) {
-                    let mut u = 0.0;
-                    for (j, v) in vk.iter().enumerate() {
-                        u += w[j * nch + c] * v;
-                    }
-                    best = best.max(u);
-                }
-                *out = best;
-            }
-        } else {
-            self.bank.run(s, force, &mut self.q_table);
-        }
+        self.bank.run(s, force, &mut self.q_table);
         self.q_stale = false;
         if nch > 0 {
             for (k, qk) in self.q_table[..s * m].chunks_exact(m).enumerate() {
@@ -435,32 +399,25 @@ impl ModalResponse {
 
     /// Eq. 12–13: one response per resting contact into `ctx.out`, `Δv = d/h` with d the
     /// contact's channel peak (`PerNode`: the corners' peaks blended with its barycentric
-    /// weights), or under [`Launch::SurfaceSpeed`] the channel's outward surface speed
-    /// (blended the same way); an unmapped contact gets an unmapped response.
+    /// weights); an unmapped contact gets an unmapped response.
     fn velocity_changes(&self, ctx: &mut StepCtx<'_>, resting: &[RestingContact]) {
         let contacts = ctx.contacts;
         let slots = contacts.slots();
         let per_node = ctx.params.variant == Variant::PerNode;
         let h = ctx.params.h;
-        let speed = ctx.params.launch == Launch::SurfaceSpeed;
-        let blend = |v: &[f64], sp: &crate::model::SurfacePoint, c: u32| -> f64 {
-            if per_node {
-                (0..3).map(|i| sp.bary[i] * v[c as usize * 3 + i]).sum()
-            } else {
-                v[c as usize]
-            }
-        };
         ctx.out.clear();
         for ((rc, &s), &c) in resting.iter().zip(slots).zip(&self.chan) {
             let cached = contacts.slot(s);
             let resp = match cached.surface {
                 Some(sp) if c != UNMAPPED => {
-                    let d = blend(&self.peaks, &sp, c);
-                    let mut resp = mapped_response(rc, &sp, d, h, ServedBy::Modal);
-                    if speed {
-                        resp.delta_v = blend(&self.speeds, &sp, c);
-                    }
-                    resp
+                    let d = if per_node {
+                        (0..3)
+                            .map(|i| sp.bary[i] * self.peaks[c as usize * 3 + i])
+                            .sum()
+                    } else {
+                        self.peaks[c as usize]
+                    };
+                    mapped_response(rc, &sp, d, h, ServedBy::Modal)
                 }
                 _ => unmapped_response(rc),
             };

@@ -20,22 +20,18 @@ pub enum Launch {
     /// the contact, added to the body's velocity on the steps with impacts (default).
     #[default]
     PeakOverStep,
-    /// Eq. 12's `Δv = d/h` from the carried-over filters on every step the object rings, taken
-    /// as a **target** for the body's normal velocity at the contact (relative to the object's
-    /// rigid motion), like [`Launch::SurfaceSpeed`]: the paper's rule kept on after the impact
-    /// without adding up. Needs `carry_over = true` and the modal filters.
+    /// Eq. 12's `Δv = d/h`, d the peak normal displacement under the contact over the step of
+    /// the **carried-over** filters, on every step the object rings, not only on steps with
+    /// impacts; taken as a **target** for the body's normal velocity at the contact (relative
+    /// to the object's rigid motion) rather than added to it: [`crate::DcrWorld`] raises a
+    /// touching body (its contact carried an impulse this step) to it, so a prop keeps being
+    /// carried by a ringing object after the impact without the pushes adding up. Its energy
+    /// bound also counts the object's modal energy (`η (D + R + E_modal)`). Needs
+    /// `carry_over = true` and the modal filters ([`Method::Modal`], or [`Method::Transfer`]
+    /// served by the modal method because of `carry_over`); set-up refuses it with
+    /// [`Method::Attenuation`] or without carry-over. Measured against the coupled reference
+    /// in `docs/outcomes-analysis.md`.
     SustainedPeak,
-    /// The moving support: `Δv` = the largest outward normal speed of the surface under the
-    /// contact over the step, `max(0, max_k w_c · q̇(kT))` (m/s; q̇ the exact filter velocity
-    /// at each sample), taken as a **target**: [`crate::DcrWorld`] raises the body's normal
-    /// velocity at the contact (relative to the object's rigid motion) to it, a plastic
-    /// contact with the moving surface. It acts on every step the carried-over filters ring,
-    /// not only on the impact's step, so a prop keeps taking energy from the object after the
-    /// impact and leaves with the surface's speed. Needs `carry_over = true` and the modal
-    /// filters ([`Method::Modal`], or [`Method::Transfer`] served by the modal method because
-    /// of `carry_over`); set-up refuses it with [`Method::Attenuation`] or without carry-over.
-    /// Its energy bound in [`crate::DcrWorld`] also counts the object's modal energy.
-    SurfaceSpeed,
 }
 
 /// Which distant-response model is used.

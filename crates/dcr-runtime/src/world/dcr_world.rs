@@ -117,6 +117,11 @@ struct Slot {
 /// `g Δv ≤ a`. A plate on four contacts that all ask for Δv thus gets Δv, not four times it —
 /// one Gauss–Seidel pass, in contact-report order.
 ///
+/// Under [`crate::Launch::SustainedPeak`] (carried-over filters) `Δv` is a target: `a` also
+/// counts the body's own normal velocity at the point relative to the object's (from the
+/// [`BodyState`]s), only contacts that carried an impulse this step (touching) receive it, and
+/// it is asked for on every step the object's filters ring, not only on steps with impacts.
+///
 /// # Lateral kick
 /// With [`crate::ResponseParams::lateral_kick`] on an object, its responses also carry the
 /// tangential velocity change of §5.4 ([`crate::response::ContactResponse::lateral_delta_v`], rotated to
@@ -145,7 +150,9 @@ struct Slot {
 /// inertia — exact for rigid bodies), is at most `η (D + R)`: D the energy the step's impacts
 /// on the object dissipated, R the kinetic energy chained impulses gave its body. When over,
 /// all the object's impulses are scaled by the largest s ∈ [0, 1] with
-/// `s A + s² B ≤ η (D + R)` (E_in is quadratic in s; closed form).
+/// `s A + s² B ≤ η (D + R)` (E_in is quadratic in s; closed form). Under
+/// [`crate::Launch::SustainedPeak`] the budget is `η (D + R + E_modal)`, E_modal the object's
+/// modal energy at the step's end (J): the ringing the props draw on after the impact.
 ///
 /// D is estimated per impact from post-step data only: with λ the impact's normal impulse,
 /// `u⁺` the relative normal velocity of the two bodies at the contact after the step

@@ -32,11 +32,6 @@ pub enum MethodChoice {
     Scene,
     /// Modal for every object.
     Modal,
-    /// Modal for every object with its filters carried over between steps and the moving
-    /// support rule ([`dcr_runtime::Launch::SurfaceSpeed`]): each resting body's normal
-    /// velocity is raised to the surface's largest outward speed under it, on every step
-    /// the object rings.
-    SurfaceSpeed,
     /// Modal for every object with its filters carried over and Eq. 12's d/h applied as a
     /// target on every step the object rings ([`dcr_runtime::Launch::SustainedPeak`]).
     SustainedPeak,
@@ -333,7 +328,6 @@ fn transfer_of<'a>(e: &'a ElasticDesc, choice: &MethodChoice) -> Result<Option<&
             ),
         },
         MethodChoice::Modal
-        | MethodChoice::SurfaceSpeed
         | MethodChoice::SustainedPeak
         | MethodChoice::Attenuation
         | MethodChoice::AttenuationBeta(_) => None,
@@ -353,10 +347,7 @@ fn attenuation_of(e: &ElasticDesc, choice: &MethodChoice) -> Option<(f64, f64, S
     let own = from(&e.method).or_else(|| e.attenuation.as_ref().and_then(from));
     match choice {
         MethodChoice::Scene => from(&e.method),
-        MethodChoice::Modal
-        | MethodChoice::SurfaceSpeed
-        | MethodChoice::SustainedPeak
-        | MethodChoice::Transfer => None,
+        MethodChoice::Modal | MethodChoice::SustainedPeak | MethodChoice::Transfer => None,
         MethodChoice::Attenuation => {
             Some(own.unwrap_or((1.0, 1.0, "heat".into(), "per_vertex".into())))
         }
@@ -646,14 +637,11 @@ fn add_elastic_objects(
             max_map_distance: 0.1,
             method,
             lateral_kick: params.lateral_kick,
-            carry_over: matches!(
-                params.method,
-                MethodChoice::SurfaceSpeed | MethodChoice::SustainedPeak
-            ),
-            launch: match params.method {
-                MethodChoice::SurfaceSpeed => Launch::SurfaceSpeed,
-                MethodChoice::SustainedPeak => Launch::SustainedPeak,
-                _ => Launch::PeakOverStep,
+            carry_over: params.method == MethodChoice::SustainedPeak,
+            launch: if params.method == MethodChoice::SustainedPeak {
+                Launch::SustainedPeak
+            } else {
+                Launch::PeakOverStep
             },
             // The table was baked for this scene: a table that does not apply is an error,
             // not a silent modal run.

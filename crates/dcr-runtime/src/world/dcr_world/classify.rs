@@ -31,7 +31,7 @@ pub(super) struct Source {
     /// Application point on the receiving body (m, world).
     pub(super) point: [f64; 3],
     /// Whether the contact carried an impulse this step (touching, not only predicted): only
-    /// touching contacts carry the moving support of [`crate::Launch::SurfaceSpeed`].
+    /// touching contacts carry a body under [`crate::Launch::SustainedPeak`].
     pub(super) touching: bool,
 }
 

@@ -2,8 +2,8 @@
 //! `E_in = Σ_bodies (P·V + ½ PᵀM⁻¹P)`, is at most `η (D + R)` (D the energy the step's impacts
 //! on the object dissipated, R what chained impulses gave its body); over it, every impulse of
 //! the object is scaled by the largest s ∈ [0, 1] with `s A + s² B ≤ η (D + R)`. The rules and
-//! the estimate of D are in [`DcrWorld`]'s documentation, "Energy bound". Under a carried
-//! [`Launch`] (not [`Launch::PeakOverStep`]) the budget also holds the object's modal energy at the step's end,
+//! the estimate of D are in [`DcrWorld`]'s documentation, "Energy bound". Under
+//! [`Launch::SustainedPeak`] the budget also holds the object's modal energy at the step's end,
 //! `η (D + R + E_modal)`: the ringing the props draw on.
 
 use super::impulse_pass::Touched;
@@ -28,7 +28,7 @@ impl DcrWorld {
             bq += tc.energy.1;
         }
         let requested = a + bq;
-        // Launch::SurfaceSpeed / SustainedPeak draw on the ringing object: its modal energy counts too.
+        // Launch::SustainedPeak draws on the ringing object: its modal energy counts too.
         let ringing = if obj.response.params().launch != Launch::PeakOverStep {
             obj.response.modal_energy()
         } else {

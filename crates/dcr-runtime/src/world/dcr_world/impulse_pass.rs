@@ -1,10 +1,9 @@
 //! The impulse pass (paper Eq. 17–18): an object's response, a normal velocity change `Δv` per
 //! resting contact, issued as impulses `j = m_eff (g Δv − a) n` on the resting bodies in one
 //! Gauss–Seidel pass per body (`a` what the impulses already issued this step produce at the
-//! point), with the support compensation for gravity. Under [`Launch::SurfaceSpeed`] and
-//! [`Launch::SustainedPeak`] `Δv` is a
+//! point), with the support compensation for gravity. Under [`Launch::SustainedPeak`] `Δv` is a
 //! target: `a` also counts the body's normal velocity at the point relative to the object's
-//! rigid motion, so the body is raised to the surface's speed, not pushed by it. The rules are
+//! rigid motion, so the body is raised to it, not pushed by it. The rules are
 //! in [`DcrWorld`]'s documentation, "Impulses (Eq. 17–18) and one Gauss–Seidel pass per body".
 
 use super::lateral_kick::add_lateral_impulse;
@@ -70,7 +69,7 @@ impl DcrWorld {
     pub(super) fn respond(&mut self, o: usize, bodies: &[BodyState]) {
         let step = self.step - 1;
         let obj = &mut self.objects[o];
-        // Launch::SurfaceSpeed / SustainedPeak: Δv is a target for the body's normal velocity relative to the
+        // Launch::SustainedPeak: Δv is a target for the body's normal velocity relative to the
         // object's rigid motion (the object's own body state, when it is dynamic).
         let target = obj.response.params().launch != Launch::PeakOverStep;
         let object_state = if target && obj.dynamic {
