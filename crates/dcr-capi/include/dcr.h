@@ -283,6 +283,12 @@ typedef struct DcrAttenuationParams {
 typedef uint32_t DcrTablePolicy;
 
 /**
+ * How a resting contact's velocity change is formed (`DcrResponseParams.launch`): one of
+ * `DCR_LAUNCH_*`.
+ */
+typedef uint32_t DcrLaunch;
+
+/**
  * Parameters of a per-object response (`dcr_response_create`, and
  * `DcrElasticObjectDesc.response`). Fill with `dcr_response_params_default`, then change
  * fields; `struct_size` must stay `sizeof(DcrResponseParams)`.
@@ -363,6 +369,11 @@ typedef struct DcrResponseParams {
    * (`DcrContactResponse.lateral_delta_v`; the paper's lateral kick, §5.4). Default false.
    */
   bool lateral_kick;
+  /**
+   * How a resting contact's velocity change is formed, `DCR_LAUNCH_*`. Default
+   * `DCR_LAUNCH_PEAK_OVER_STEP`.
+   */
+  DcrLaunch launch;
 } DcrResponseParams;
 
 /**
@@ -1106,6 +1117,17 @@ typedef uint32_t DcrBaseSupport;
  * Eq. 13: per-vertex peaks blended with the barycentric weights.
  */
 #define DCR_VARIANT_PER_NODE 1
+
+/**
+ * The paper's rule (Eq. 12): Δv = d/h added to the body on steps with impacts (default).
+ */
+#define DCR_LAUNCH_PEAK_OVER_STEP 0
+
+/**
+ * d/h of the carried-over filters on every step the object rings, as a target for the
+ * touching body's normal velocity (needs `carry_over`; not with `DCR_METHOD_ATTENUATION`).
+ */
+#define DCR_LAUNCH_SUSTAINED_PEAK 1
 
 /**
  * Serve with the modal method and count the contacts in

@@ -6,7 +6,7 @@
 use dcr_runtime::response::{
     AmplitudeKind, AttenuationLaw, AttenuationParams, DistanceKind, Sampling, TablePolicy, Variant,
 };
-use dcr_runtime::{Method, ResponseParams};
+use dcr_runtime::{Launch, Method, ResponseParams};
 
 use crate::guard::guard;
 use crate::ptr::{arg_slice, check_struct_size, write_out};
@@ -38,6 +38,15 @@ pub type DcrVariant = u32;
 pub const DCR_VARIANT_PER_CONTACT: DcrVariant = 0;
 /// Eq. 13: per-vertex peaks blended with the barycentric weights.
 pub const DCR_VARIANT_PER_NODE: DcrVariant = 1;
+
+/// How a resting contact's velocity change is formed (`DcrResponseParams.launch`): one of
+/// `DCR_LAUNCH_*`.
+pub type DcrLaunch = u32;
+/// The paper's rule (Eq. 12): Δv = d/h added to the body on steps with impacts (default).
+pub const DCR_LAUNCH_PEAK_OVER_STEP: DcrLaunch = 0;
+/// d/h of the carried-over filters on every step the object rings, as a target for the
+/// touching body's normal velocity (needs `carry_over`; not with `DCR_METHOD_ATTENUATION`).
+pub const DCR_LAUNCH_SUSTAINED_PEAK: DcrLaunch = 1;
 
 /// What `DCR_METHOD_TRANSFER` does when the base's table cannot serve the run
 /// (`DcrResponseParams.table_policy`): one of `DCR_TABLE_POLICY_*`.
@@ -156,6 +165,9 @@ pub struct DcrResponseParams {
     /// Also report the peak tangential displacement as a tangential velocity change
     /// (`DcrContactResponse.lateral_delta_v`; the paper's lateral kick, §5.4). Default false.
     pub lateral_kick: bool,
+    /// How a resting contact's velocity change is formed, `DCR_LAUNCH_*`. Default
+    /// `DCR_LAUNCH_PEAK_OVER_STEP`.
+    pub launch: DcrLaunch,
 }
 
 impl DcrResponseParams {
@@ -200,6 +212,7 @@ impl DcrResponseParams {
             evict_after_steps: r.evict_after_steps,
             table_policy: DCR_TABLE_POLICY_FALL_BACK_TO_MODAL,
             lateral_kick: r.lateral_kick,
+            launch: DCR_LAUNCH_PEAK_OVER_STEP,
         }
     }
 
@@ -224,6 +237,11 @@ impl DcrResponseParams {
             DCR_VARIANT_PER_CONTACT => Variant::PerContact,
             DCR_VARIANT_PER_NODE => Variant::PerNode,
             c => return Err(bad("variant", c)),
+        };
+        let launch = match self.launch {
+            DCR_LAUNCH_PEAK_OVER_STEP => Launch::PeakOverStep,
+            DCR_LAUNCH_SUSTAINED_PEAK => Launch::SustainedPeak,
+            c => return Err(bad("launch", c)),
         };
         let table_policy = match self.table_policy {
             DCR_TABLE_POLICY_FALL_BACK_TO_MODAL => TablePolicy::FallBackToModal,
@@ -292,6 +310,7 @@ impl DcrResponseParams {
             evict_after_steps: self.evict_after_steps,
             table_policy,
             lateral_kick: self.lateral_kick,
+            launch,
         })
     }
 }

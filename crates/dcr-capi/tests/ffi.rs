@@ -1,6 +1,7 @@
 //! The `extern "C"` functions called from Rust (through the rlib): the C path gives
 //! bit-identical results to the Rust API, a too-small buffer changes no state, panics become a
-//! status, last errors are per thread, and a model serves several threads at once.
+//! status, last errors are per thread, a model serves several threads at once, and the launch
+//! codes reach the runtime.
 
 #![allow(unsafe_code)]
 
@@ -369,4 +370,40 @@ fn per_step_structs_share_the_runtime_layout() {
 #[test]
 fn world_step_structs_share_the_runtime_layout() {
     assert_eq!(world_zero_copy_layouts(), (true, true, true));
+}
+
+/// `DcrResponseParams.launch`: the default is the paper's rule; `DCR_LAUNCH_SUSTAINED_PEAK`
+/// reaches the runtime (accepted with carry-over, refused without it, naming the field); an
+/// unknown code is an invalid argument naming the field.
+#[test]
+fn launch_codes_reach_the_runtime() {
+    let dir = tempfile::tempdir().unwrap();
+    let cm = c_model(dir.path());
+    assert_eq!(
+        DcrResponseParams::defaults().launch,
+        DCR_LAUNCH_PEAK_OVER_STEP
+    );
+    for (launch, carry, ok) in [
+        (DCR_LAUNCH_SUSTAINED_PEAK, true, true),
+        (DCR_LAUNCH_SUSTAINED_PEAK, false, false),
+        (7, true, false),
+    ] {
+        let mut p = DcrResponseParams::defaults();
+        p.method = DCR_METHOD_MODAL;
+        p.carry_over = carry;
+        p.launch = launch;
+        let mut cr = std::ptr::null_mut();
+        // SAFETY: live model, valid params and out pointer.
+        let st = unsafe { dcr_response_create(cm, &p, &mut cr) };
+        if ok {
+            assert_eq!(st, DcrStatus::Ok, "{}", last_error());
+            // SAFETY: live handle, freed once.
+            unsafe { dcr_response_free(cr) };
+        } else {
+            assert_ne!(st, DcrStatus::Ok);
+            assert!(last_error().contains("launch"), "{}", last_error());
+        }
+    }
+    // SAFETY: live handle, freed once.
+    unsafe { dcr_model_free(cm) };
 }
