@@ -7,6 +7,7 @@ use anyhow::{bail, Context, Result};
 use clap::{Parser, Subcommand, ValueEnum};
 use dcr_files::OutputPlan;
 use dcr_rapier::f64::{ApplyMode, StepGate};
+use dcr_runtime::Launch;
 use dcr_scenes::export::{side_label, write_outcomes_svg, write_scene_glb, Side};
 use dcr_scenes::runner::{
     base_path, run_scene, stress_bench, table1, transfer_base_path, MethodChoice, RunParams,
@@ -39,9 +40,6 @@ enum OnOff {
 enum MethodArg {
     /// The modal filters over the object's base (its `modes`, 20 by default; Eq. 9–13).
     Modal,
-    /// The modal filters carried over, Eq. 12's d/h applied as a target on every step the
-    /// object rings (`Launch::SustainedPeak`; not the paper's rule).
-    SustainedPeak,
     /// Spatial attenuation (Eq. 14–16): the object's own or `attenuation` settings, else C = 1,
     /// β = 1.
     Attenuation,
@@ -90,6 +88,30 @@ struct ResponseArgs {
     /// with an impact (default), or every step.
     #[arg(long, value_enum, default_value = "impact-steps")]
     gate: GateArg,
+    /// How the resting bodies are launched: the paper's Δv = d/h added on the impact's step
+    /// (default), or d/h of the carried-over filters as a target for the body's normal velocity
+    /// on every step the object rings (turns carry-over on; with the transfer table, the larger
+    /// of its peak and the filters'). docs/outcomes-analysis.md measures both.
+    #[arg(long, value_enum, default_value = "peak-over-step")]
+    launch: LaunchArg,
+}
+
+/// A launch rule (`--launch`).
+#[derive(Clone, Copy, ValueEnum)]
+enum LaunchArg {
+    /// Eq. 12: Δv = d/h added to the body on the steps with impacts.
+    PeakOverStep,
+    /// d/h of the carried-over filters, a target on every step the object rings.
+    SustainedPeak,
+}
+
+impl From<LaunchArg> for Launch {
+    fn from(l: LaunchArg) -> Launch {
+        match l {
+            LaunchArg::PeakOverStep => Launch::PeakOverStep,
+            LaunchArg::SustainedPeak => Launch::SustainedPeak,
+        }
+    }
 }
 
 /// On which steps the adapter reads the contacts.
@@ -308,16 +330,12 @@ fn real_main() -> Result<()> {
                 }
             }
             let method = match (method, beta) {
-                (
-                    Some(MethodArg::Modal | MethodArg::SustainedPeak | MethodArg::Transfer),
-                    Some(_),
-                ) => {
+                (Some(MethodArg::Modal | MethodArg::Transfer), Some(_)) => {
                     bail!("--beta is the attenuation exponent: use it without --method or with --method attenuation")
                 }
                 (_, Some(b)) => MethodChoice::AttenuationBeta(b),
                 (Some(MethodArg::Attenuation), None) => MethodChoice::Attenuation,
                 (Some(MethodArg::Modal), None) => MethodChoice::Modal,
-                (Some(MethodArg::SustainedPeak), None) => MethodChoice::SustainedPeak,
                 (Some(MethodArg::Transfer), None) => MethodChoice::Transfer,
                 (None, None) => MethodChoice::Scene,
             };
@@ -379,6 +397,7 @@ fn real_main() -> Result<()> {
                         apply: response.apply.into(),
                         energy_eta: response.eta(),
                         lateral_kick: response.lateral_kick,
+                        launch: response.launch.into(),
                         contact_recycling: !response.no_contact_recycling,
                         gate: response.gate.into(),
                         ..RunParams::new(root.clone(), on)
@@ -457,6 +476,7 @@ fn real_main() -> Result<()> {
                 apply: response.apply.into(),
                 energy_eta: response.eta(),
                 lateral_kick: response.lateral_kick,
+                launch: response.launch.into(),
                 contact_recycling: !response.no_contact_recycling,
                 gate: response.gate.into(),
                 eta_sweep: energy_sweep,

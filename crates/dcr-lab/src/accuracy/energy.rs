@@ -30,6 +30,7 @@ pub fn energy_section(root: &Path) -> anyhow::Result<String> {
         apply: Default::default(),
         energy_eta: Some(1.0),
         lateral_kick: false,
+        launch: Default::default(),
         contact_recycling: true,
         gate: Default::default(),
         eta_sweep: ETAS.to_vec(),

@@ -9,6 +9,7 @@ use clap::{Args, ValueEnum};
 use dcr_lab::scene_truth::{
     advance_steps, load_scene, method_ensemble, methods_desc, EnsembleSpec, MethodOutcome,
 };
+use dcr_runtime::Launch;
 use dcr_scenes::runner::MethodChoice;
 
 /// The methods a gain is fitted for.
@@ -20,9 +21,6 @@ pub enum FitMethod {
     Modal,
     /// Spatial attenuation (Eq. 14–16).
     Attenuation,
-    /// The 20-mode filters carried over, d/h as a target while they ring
-    /// (`Launch::SustainedPeak`).
-    SustainedPeak,
 }
 
 /// Find the gain (the scale on the response's Δv, 1 = Eq. 12 unscaled) at which the method's
@@ -40,6 +38,11 @@ pub struct FitGainArgs {
     /// The method whose gain is fitted.
     #[arg(long, value_enum, default_value_t = FitMethod::Transfer)]
     pub method: FitMethod,
+    /// Run the method under the response option `Launch::SustainedPeak` (d/h of the
+    /// carried-over filters as a target on every step the object rings) instead of the
+    /// paper's rule.
+    #[arg(long)]
+    pub sustained: bool,
     /// Members of each ensemble.
     #[arg(long, value_name = "N", default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=64))]
     pub members: u32,
@@ -128,7 +131,11 @@ pub fn run(a: &FitGainArgs) -> Result<ExitCode> {
         FitMethod::Transfer => (MethodChoice::Transfer, "★ transfer table"),
         FitMethod::Modal => (MethodChoice::Modal, "modal, 20 modes"),
         FitMethod::Attenuation => (MethodChoice::Attenuation, "attenuation"),
-        FitMethod::SustainedPeak => (MethodChoice::SustainedPeak, "sustained d/h, 20 modes"),
+    };
+    let (launch, label) = if a.sustained {
+        (Launch::SustainedPeak, format!("{label}, sustained d/h"))
+    } else {
+        (Launch::PeakOverStep, label.to_string())
     };
     let ens = EnsembleSpec {
         members: a.members as usize,
@@ -142,7 +149,14 @@ pub fn run(a: &FitGainArgs) -> Result<ExitCode> {
         advanced.unwrap_or(0) as f64 * desc.h
     );
     let eval = |g: f64| -> Result<(f64, MethodOutcome)> {
-        let m = method_ensemble(&mdesc, &root, label, Some(g), method.clone(), &ens)?;
+        let m = method_ensemble(
+            &mdesc,
+            &root,
+            &label,
+            Some(g),
+            (method.clone(), launch),
+            &ens,
+        )?;
         let v = m.outcomes.get(name).map_or(0.0, |x| x.0);
         eprintln!("[fit-gain] gain {g:.4}: {}", describe(&m));
         Ok((v - target, m))

@@ -178,7 +178,7 @@ impl DistantResponse {
             ),
             Method::Transfer => {
                 let modal = ModalResponse::new(table, p.h, p.variant);
-                match TransferResponse::check(&model, p.h, rayleigh, p.carry_over) {
+                match TransferResponse::check(&model, p.h, rayleigh, p.carry_over, p.launch) {
                     Ok(()) => (
                         MethodResponse::Transfer(TransferResponse::new(&model, modal)),
                         TableStatus::Active,

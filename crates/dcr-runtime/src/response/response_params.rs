@@ -27,9 +27,11 @@ pub enum Launch {
     /// touching body (its contact carried an impulse this step) to it, so a prop keeps being
     /// carried by a ringing object after the impact without the pushes adding up. Its energy
     /// bound also counts the object's modal energy (`η (D + R + E_modal)`). Needs
-    /// `carry_over = true` and the modal filters ([`Method::Modal`], or [`Method::Transfer`]
-    /// served by the modal method because of `carry_over`); set-up refuses it with
-    /// [`Method::Attenuation`] or without carry-over. Measured against the coupled reference
+    /// `carry_over = true` and the modal filters: [`Method::Modal`], or [`Method::Transfer`],
+    /// whose table then serves together with the carried filters (each contact takes the
+    /// larger peak: the table's for the step's impacts, the filters' with the earlier ringing;
+    /// the filters alone on the steps after); set-up refuses it with [`Method::Attenuation`]
+    /// or without carry-over. Measured against the coupled reference
     /// in `docs/outcomes-analysis.md`.
     SustainedPeak,
 }
@@ -47,7 +49,8 @@ pub enum Method {
     /// impulse component only; several impacts' peaks are summed, an upper bound). The modal
     /// method serves instead — reported in `ContactResponse::served_by`, counted with its
     /// reason in [`crate::response::StepInfo`] — when the base has no table, its h or Rayleigh damping
-    /// differs (relative tolerance 1e-9) or `carry_over` is on (all decided at set-up, where
+    /// differs (relative tolerance 1e-9) or `carry_over` is on without
+    /// [`Launch::SustainedPeak`] (all decided at set-up, where
     /// [`TablePolicy::Refuse`] makes them errors instead), the step has forces, or an impact
     /// (whole step) or a contact (that contact) is outside the table's region. `sampling` and
     /// `variant` do not apply to table-served contacts (the table fixed its own sampling).
@@ -197,7 +200,8 @@ pub enum TableStatus {
         /// The response's [α0, α1].
         response: [f64; 2],
     },
-    /// `carry_over` is on: the table assumes filters at rest at every step's start.
+    /// `carry_over` is on without [`Launch::SustainedPeak`]: the table assumes filters at
+    /// rest at every step's start.
     CarryOver,
 }
 
@@ -223,7 +227,8 @@ impl std::fmt::Display for TableStatus {
             ),
             TableStatus::CarryOver => write!(
                 f,
-                "carry_over is on, but the table assumes filters at rest at each step's start"
+                "carry_over is on without launch SustainedPeak, but the table assumes filters \
+                 at rest at each step's start"
             ),
         }
     }

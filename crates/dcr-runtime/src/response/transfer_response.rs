@@ -35,11 +35,19 @@
 //! Whether the table applies to the run at all is decided at set-up
 //! ([`crate::response::TablePolicy`]); per-step fallbacks are counted with their reason
 //! ([`crate::response::StepInfo::table_fallback`]).
+//!
+//! Under [`Launch::SustainedPeak`] (carry-over) the table and the carried modal filters serve
+//! together: every step runs the modal method on its carried-over state (the step's impulse
+//! applied to it), and a contact the table can serve takes the larger of the two peaks — the
+//! table's, from rest and every mode, for this step's impacts, and the filters', which also hold
+//! the ringing of earlier impacts over the truncated base. On the steps after an impact (no
+//! impacts) the table's peak is 0 and the filters serve.
 
 use super::modal_response::{ModalResponse, UNMAPPED};
 use super::step_ctx::{mapped_response, unmapped_response, StepCtx};
 use super::{
-    ForceInput, Impact, RestingContact, ServedBy, TableFallback, TableStatus, PREPARED_CONTACTS,
+    ForceInput, Impact, Launch, RestingContact, ServedBy, TableFallback, TableStatus,
+    PREPARED_CONTACTS,
 };
 use crate::math::{dot, normalize};
 use crate::model::ModalModel;
@@ -197,12 +205,14 @@ fn close(a: f64, b: f64) -> bool {
 
 impl TransferResponse {
     /// Whether the base's table applies to steps of length `h` (s) with Rayleigh damping
-    /// `rayleigh` and `carry_over`: `Ok` or why not.
+    /// `rayleigh`, `carry_over` and `launch` (carry-over only with [`Launch::SustainedPeak`]):
+    /// `Ok` or why not.
     pub fn check(
         model: &ModalModel,
         h: f64,
         rayleigh: [f64; 2],
         carry_over: bool,
+        launch: Launch,
     ) -> Result<(), TableStatus> {
         let t = model.base().transfer.as_ref().ok_or(TableStatus::NoTable)?;
         if !close(t.h, h) {
@@ -214,7 +224,7 @@ impl TransferResponse {
                 response: rayleigh,
             });
         }
-        if carry_over {
+        if carry_over && launch != Launch::SustainedPeak {
             return Err(TableStatus::CarryOver);
         }
         Ok(())
@@ -336,6 +346,24 @@ impl TransferResponse {
             self.peaks.push(d);
         }
         let h = ctx.params.h;
+        if ctx.params.carry_over {
+            // Launch::SustainedPeak: the carried filters serve every contact (and count the
+            // impacts); the table's peak replaces theirs where it is larger.
+            self.modal.step(ctx, impacts, forces, resting);
+            if outside > 0 {
+                ctx.info.contacts_table_fallback += outside;
+                ctx.info.table_fallback = Some(TableFallback::ContactsOutsideRegion);
+            }
+            for (o, &d) in ctx.out.iter_mut().zip(&self.peaks) {
+                if d.is_finite() && o.mapped && d > o.peak_displacement {
+                    o.peak_displacement = d;
+                    o.delta_v = d / h;
+                    o.served_by = ServedBy::TransferTable;
+                    ctx.info.contacts_by_table += 1;
+                }
+            }
+            return;
+        }
         if outside > 0 {
             // Some contacts lie outside the region: the modal step serves them (and counts the
             // impacts); the in-region contacts take the table's values.

@@ -32,9 +32,6 @@ pub enum MethodChoice {
     Scene,
     /// Modal for every object.
     Modal,
-    /// Modal for every object with its filters carried over and Eq. 12's d/h applied as a
-    /// target on every step the object rings ([`dcr_runtime::Launch::SustainedPeak`]).
-    SustainedPeak,
     /// Spatial attenuation for every object (the object's `attenuation` settings, or its
     /// `method` if that is attenuation, or C = 1, β = 1, heat distances).
     Attenuation,
@@ -71,6 +68,9 @@ pub struct RunParams {
     pub energy_eta: Option<f64>,
     /// The lateral kick (paper §5.4) on every elastic object.
     pub lateral_kick: bool,
+    /// How every elastic object's resting contacts are launched ([`Launch`]; not
+    /// [`Launch::PeakOverStep`] turns the objects' carry-over on). Default the paper's rule.
+    pub launch: Launch,
     /// rapier's contact recycling on the elastic objects' colliders
     /// ([`AdapterParams::contact_recycling`]; always off in the solver path).
     pub contact_recycling: bool,
@@ -99,6 +99,7 @@ impl RunParams {
             apply: ApplyMode::AfterStep,
             energy_eta: WorldParams::default().energy_eta,
             lateral_kick: false,
+            launch: Launch::PeakOverStep,
             contact_recycling: true,
             gate: StepGate::ImpactSteps,
             perturbation: (0, 0.0),
@@ -255,6 +256,8 @@ pub struct RunReport {
     pub apply: String,
     /// Whether the lateral kick was on.
     pub lateral_kick: bool,
+    /// The launch rule (`peak_over_step`, the paper's; `sustained_peak`).
+    pub launch: String,
     /// Whether rapier's contact recycling was on for the elastic objects' colliders.
     pub contact_recycling: bool,
     /// On which steps the contacts were read (`every_step`, `impact_steps`).
@@ -327,10 +330,7 @@ fn transfer_of<'a>(e: &'a ElasticDesc, choice: &MethodChoice) -> Result<Option<&
                 e.name
             ),
         },
-        MethodChoice::Modal
-        | MethodChoice::SustainedPeak
-        | MethodChoice::Attenuation
-        | MethodChoice::AttenuationBeta(_) => None,
+        MethodChoice::Modal | MethodChoice::Attenuation | MethodChoice::AttenuationBeta(_) => None,
     })
 }
 
@@ -347,7 +347,7 @@ fn attenuation_of(e: &ElasticDesc, choice: &MethodChoice) -> Option<(f64, f64, S
     let own = from(&e.method).or_else(|| e.attenuation.as_ref().and_then(from));
     match choice {
         MethodChoice::Scene => from(&e.method),
-        MethodChoice::Modal | MethodChoice::SustainedPeak | MethodChoice::Transfer => None,
+        MethodChoice::Modal | MethodChoice::Transfer => None,
         MethodChoice::Attenuation => {
             Some(own.unwrap_or((1.0, 1.0, "heat".into(), "per_vertex".into())))
         }
@@ -637,12 +637,9 @@ fn add_elastic_objects(
             max_map_distance: 0.1,
             method,
             lateral_kick: params.lateral_kick,
-            carry_over: params.method == MethodChoice::SustainedPeak,
-            launch: if params.method == MethodChoice::SustainedPeak {
-                Launch::SustainedPeak
-            } else {
-                Launch::PeakOverStep
-            },
+            // A launch other than the paper's reads the carried-over filters.
+            carry_over: params.launch != Launch::PeakOverStep,
+            launch: params.launch,
             // The table was baked for this scene: a table that does not apply is an error,
             // not a silent modal run.
             table_policy: TablePolicy::Refuse,
@@ -945,6 +942,11 @@ impl RunRecord {
             }
             .to_string(),
             lateral_kick: params.lateral_kick,
+            launch: match params.launch {
+                Launch::PeakOverStep => "peak_over_step",
+                Launch::SustainedPeak => "sustained_peak",
+            }
+            .to_string(),
             contact_recycling: params.contact_recycling && apply != ApplyMode::InSolver,
             gate: match params.gate {
                 StepGate::EveryStep => "every_step",

@@ -77,6 +77,8 @@ pub struct Table1Params {
     pub energy_eta: Option<f64>,
     /// Lateral kick in the "on" runs.
     pub lateral_kick: bool,
+    /// Launch rule of the "on" runs (default the paper's, [`dcr_runtime::Launch::PeakOverStep`]).
+    pub launch: dcr_runtime::Launch,
     /// rapier's contact recycling on the elastic objects' colliders.
     pub contact_recycling: bool,
     /// On which steps the contacts are read.
@@ -233,6 +235,7 @@ fn run_one(
             apply: p.apply,
             energy_eta: eta,
             lateral_kick: p.lateral_kick,
+            launch: p.launch,
             contact_recycling: p.contact_recycling,
             gate: p.gate,
             ..RunParams::new(p.root.clone(), dcr)
