@@ -7,14 +7,15 @@
 //! several impacts add; only the normal impulse component counts; contacts outside the region
 //! are served by the modal method (same values as `Method::Modal`), and every step falls back to
 //! the modal method when an impact is outside the region, the step has forces, or h, Rayleigh
-//! damping or carry-over do not match the table.
+//! damping or carry-over (without `Launch::SustainedPeak`) do not match the table; under
+//! `Launch::SustainedPeak` the table and the carried filters serve together (the larger peak).
 
 use std::sync::Arc;
 
 use dcr_runtime::format::{ModesFile, TransferTable};
 use dcr_runtime::response::{ForceInput, Impact, RestingContact, ServedBy};
 use dcr_runtime::testing::{plate_base, SplitMix64};
-use dcr_runtime::{DistantResponse, Method, ModalModel, ResponseParams};
+use dcr_runtime::{DistantResponse, Launch, Method, ModalModel, ResponseParams};
 
 const H: f64 = 0.01;
 
@@ -458,4 +459,75 @@ fn order_three_lookup_reproduces_a_cubic_table() {
         worst2 > 1e-4,
         "P2 unexpectedly exact on a cubic kernel: {worst2:e}"
     );
+}
+
+/// `Launch::SustainedPeak` with the table: the table applies under carry-over; on a step with
+/// an impact each contact takes the larger of the table's peak (from rest) and the carried
+/// 20-mode filters' (the same as a `Method::Modal` carried response's), served by whichever
+/// gave it; on the following steps without impacts the carried filters serve alone, and
+/// contacts outside the region are the modal ones throughout.
+#[test]
+fn sustained_peak_takes_the_larger_of_table_and_carried_filters() {
+    let model = Arc::new(ModalModel::from_base(base_with_table()).unwrap());
+    let sustained = |method| ResponseParams {
+        carry_over: true,
+        launch: Launch::SustainedPeak,
+        ..params(method)
+    };
+    let mut hybrid = DistantResponse::new(model.clone(), sustained(Method::Transfer)).unwrap();
+    assert!(hybrid.transfer_active());
+    let mut carried = DistantResponse::new(model.clone(), sustained(Method::Modal)).unwrap();
+    let mut table = DistantResponse::new(model.clone(), params(Method::Transfer)).unwrap();
+    // In the region (x ≤ 0.5) near and far from the impact, and outside it.
+    let resting: Vec<RestingContact> = [[0.2, 0.3, 0.0], [0.45, 0.05, 0.0], [0.9, 0.5, 0.0]]
+        .iter()
+        .enumerate()
+        .map(|(i, &point)| RestingContact {
+            id: i as u64,
+            point,
+        })
+        .collect();
+    let imp = [Impact {
+        point: [0.1, 0.1, 0.0],
+        direction: [0.0, 0.0, -1.0],
+        impulse: 3.0,
+    }];
+    let (mut by_table, mut by_filters) = (0, 0);
+    for step in 0..4 {
+        let imps: &[Impact] = if step == 0 { &imp } else { &[] };
+        let got = hybrid.step(imps, &resting).to_vec();
+        let modal = carried.step(imps, &resting).to_vec();
+        let from_rest = table.step(imps, &resting).to_vec();
+        for ((g, m), t) in got.iter().zip(&modal).zip(&from_rest) {
+            let tag = format!("step {step} contact {}", g.id);
+            let in_region = t.served_by == ServedBy::TransferTable;
+            let want = if in_region {
+                m.peak_displacement.max(t.peak_displacement)
+            } else {
+                m.peak_displacement
+            };
+            assert_eq!(g.peak_displacement, want, "{tag}");
+            assert_eq!(g.delta_v, want / H, "{tag}");
+            let table_won = in_region && t.peak_displacement > m.peak_displacement;
+            let served = if table_won {
+                ServedBy::TransferTable
+            } else {
+                ServedBy::Modal
+            };
+            assert_eq!(g.served_by, served, "{tag}");
+            if table_won {
+                by_table += 1;
+            } else if g.peak_displacement > 0.0 {
+                by_filters += 1;
+            }
+            if step > 0 {
+                assert_eq!(
+                    t.peak_displacement, 0.0,
+                    "{tag}: no impact, nothing from rest"
+                );
+            }
+        }
+    }
+    // Both sources serve somewhere: the table on the impact's step, the ringing after it.
+    assert!(by_table > 0 && by_filters > 0, "{by_table} {by_filters}");
 }
