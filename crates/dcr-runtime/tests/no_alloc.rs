@@ -4,7 +4,8 @@
 //! impacts (some below threshold, some unmapped), forces, and cached resting contacts allocate
 //! nothing — for both variants, all methods (heat and Euclidean distances; the transfer table,
 //! with its modal fallback for contacts and impacts outside its region and for forces), with
-//! and without carry-over. The world (a static floor with a transfer table and a dynamic
+//! and without carry-over, and under the sustained launch (the table beside the carried filters,
+//! and the filters alone). The world (a static floor with a transfer table and a dynamic
 //! fridge) does not allocate either with impacts, resting contacts that come and go, chained
 //! impacts, the energy bound and the lateral kick on, and a stream of new contact ids. Counted with a global allocator wrapper; this file is its own test binary and
 //! holds a single test so no other test thread allocates concurrently.
@@ -22,8 +23,8 @@ use dcr_runtime::response::{
 };
 use dcr_runtime::testing::{box_surface, geometric_omegas, synthetic_base, SplitMix64};
 use dcr_runtime::{
-    BodyState, ContactReport, DcrWorld, DistantResponse, ElasticObjectDesc, Method, ModalModel,
-    Pose, ResponseParams, WorldParams,
+    BodyState, ContactReport, DcrWorld, DistantResponse, ElasticObjectDesc, Launch, Method,
+    ModalModel, Pose, ResponseParams, WorldParams,
 };
 
 struct Counting;
@@ -239,11 +240,21 @@ fn steps_do_not_allocate_with(model: &Arc<ModalModel>, seed: u64, parallel: bool
                 ..Default::default()
             });
         }
+        // The sustained launch: the table beside the carried filters, and the filters alone.
+        for method in [Method::Transfer, Method::Modal] {
+            configs.push(ResponseParams {
+                variant,
+                carry_over: true,
+                method,
+                launch: Launch::SustainedPeak,
+                ..Default::default()
+            });
+        }
     }
     for params in configs {
         let label = format!(
-            "seed {seed}: {:?} carry={} {:?}",
-            params.variant, params.carry_over, params.method
+            "seed {seed}: {:?} carry={} {:?} {:?}",
+            params.variant, params.carry_over, params.method, params.launch
         );
         let mut resp = DistantResponse::new(Arc::clone(model), params).unwrap();
         let mut impacts = Vec::with_capacity(4);

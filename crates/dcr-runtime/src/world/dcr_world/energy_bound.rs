@@ -82,7 +82,7 @@ impl DcrWorld {
 
 /// Velocity of body `b` at world point `p` (m/s; zero for a body without state).
 #[inline]
-fn velocity_at(b: Option<&BodyState>, p: [f64; 3]) -> [f64; 3] {
+pub(super) fn velocity_at(b: Option<&BodyState>, p: [f64; 3]) -> [f64; 3] {
     match b {
         Some(b) => add(b.linvel, cross(b.angvel, sub(p, b.center_of_mass))),
         None => [0.0; 3],

@@ -6,6 +6,7 @@
 //! rigid motion, so the body is raised to it, not pushed by it. The rules are
 //! in [`DcrWorld`]'s documentation, "Impulses (Eq. 17–18) and one Gauss–Seidel pass per body".
 
+use super::energy_bound::velocity_at;
 use super::lateral_kick::add_lateral_impulse;
 use super::DcrWorld;
 use crate::math::{add, cross, dot, mat_vec, scale, sub};
@@ -101,8 +102,8 @@ impl DcrWorld {
             let mut want = obj.gain * resp.delta_v;
             if target {
                 let v_rel = sub(
-                    point_velocity(b, src.point),
-                    object_state.map_or([0.0; 3], |s| point_velocity(&s, src.point)),
+                    velocity_at(Some(b), src.point),
+                    velocity_at(object_state.as_ref(), src.point),
                 );
                 want -= dot(v_rel, n);
             }
@@ -164,12 +165,6 @@ impl DcrWorld {
         obj.info.response = obj.response.last_step_info();
         obj.info.events = (self.events.len() - first_event - supports) as u32;
     }
-}
-
-/// Velocity of body `b` at world point `p` (m/s, world frame).
-#[inline]
-fn point_velocity(b: &BodyState, p: [f64; 3]) -> [f64; 3] {
-    add(b.linvel, cross(b.angvel, sub(p, b.center_of_mass)))
 }
 
 /// The normal part of a resting contact's impulse (N·s, world) and the velocity change it asks
