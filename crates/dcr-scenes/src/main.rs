@@ -339,6 +339,17 @@ fn real_main() -> Result<()> {
                 (Some(MethodArg::Transfer), None) => MethodChoice::Transfer,
                 (None, None) => MethodChoice::Scene,
             };
+            if matches!(response.launch, LaunchArg::SustainedPeak)
+                && matches!(
+                    method,
+                    MethodChoice::Attenuation | MethodChoice::AttenuationBeta(_)
+                )
+            {
+                bail!(
+                    "--launch sustained-peak reads the modal filters, which spatial attenuation \
+                     does not have: use it with --method modal or --method transfer"
+                );
+            }
             desc.run_steps(seconds)
                 .map_err(|e| anyhow::anyhow!("scene {}: {e}", path.display()))?;
             let split = out.is_none() || matches!(dcr, OnOff::Both);

@@ -301,9 +301,10 @@ fn run_gain_scales_every_response() {
 }
 
 /// The CLI: `run dinner --method transfer` (the table has no transfer settings) exits non-zero
-/// with one line naming the object, before any bake; `--gain -1` is refused by the parser.
+/// with one line naming the object, before any bake; `--gain -1` is refused by the parser;
+/// `--launch sustained-peak` with attenuation is refused before the run.
 #[test]
-fn cli_refuses_transfer_without_settings_and_a_negative_gain() {
+fn cli_refuses_transfer_without_settings_a_negative_gain_and_a_sustained_attenuation() {
     let exe = env!("CARGO_BIN_EXE_dcr-scenes");
     let bases = bases_dir("cli");
     let out = std::process::Command::new(exe)
@@ -329,4 +330,25 @@ fn cli_refuses_transfer_without_settings_and_a_negative_gain() {
         .expect("dcr-scenes runs");
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success() && err.contains("--gain"), "{err}");
+    // The sustained launch needs modal filters: refused with attenuation, before any run.
+    let out = std::process::Command::new(exe)
+        .args([
+            "run",
+            "dinner",
+            "--launch",
+            "sustained-peak",
+            "--method",
+            "attenuation",
+        ])
+        .arg("--out")
+        .arg(bases.join("run-launch"))
+        .current_dir(repo_root())
+        .output()
+        .expect("dcr-scenes runs");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && err.contains("--launch sustained-peak"),
+        "{err}"
+    );
+    assert!(!bases.join("run-launch").exists());
 }
