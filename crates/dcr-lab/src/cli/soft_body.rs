@@ -50,7 +50,7 @@ pub struct RunArgs {
     #[arg(long, value_enum, default_value = "rapier-fem")]
     pub method: MethodArg,
     /// rapier-fem: solver substeps per step. Default rapier's (4).
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..=4096))]
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..=65536))]
     pub substeps: Option<u64>,
     /// rapier-fem: cap on the conjugate-gradient iterations of each substep's elastic solve.
     /// Default rapier's (20).

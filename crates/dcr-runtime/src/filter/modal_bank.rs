@@ -110,6 +110,12 @@ impl ModalBank {
         self.qd.copy_from_slice(q_dot);
     }
 
+    /// Scales the state (q, q̇) by `s`: the modal energy by s², the phase of every mode kept.
+    pub fn scale_state(&mut self, s: f64) {
+        self.q.iter_mut().for_each(|x| *x *= s);
+        self.qd.iter_mut().for_each(|x| *x *= s);
+    }
+
     /// Modal energy ½ Σ (q̇² + ω² q²) (J for the mass-normalised base: kg·m²/s²).
     pub fn energy(&self) -> f64 {
         0.5 * self

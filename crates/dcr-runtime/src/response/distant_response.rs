@@ -302,6 +302,20 @@ impl DistantResponse {
         self.method.modal().map_or(0.0, |m| m.energy())
     }
 
+    /// Takes `energy` (J, ≥ 0) out of the carried modal filters at the end of the last step
+    /// (scaling every mode's state alike; at or above [`DistantResponse::modal_energy`] the
+    /// filters rest). Under [`Launch::SustainedPeak`] the world drains in this way the kinetic
+    /// energy the step's pushes gave the resting bodies: the ringing pays for what it lifts.
+    /// No effect without carry-over, for the attenuation method, or for `energy ≤ 0`.
+    pub fn drain(&mut self, energy: f64) {
+        if !self.params.carry_over {
+            return;
+        }
+        if let Some(m) = self.method.modal_mut() {
+            m.drain(energy);
+        }
+    }
+
     /// Modal displacements q (kg^1/2·m) at the end of the last step (zeros for the
     /// attenuation method).
     pub fn modal_state(&self) -> &[f64] {

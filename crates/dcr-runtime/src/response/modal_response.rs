@@ -145,6 +145,23 @@ impl ModalResponse {
         &self.q_table
     }
 
+    /// Takes `energy` (J, ≥ 0) out of the carried filter state by scaling every mode's (q, q̇)
+    /// by `√(1 − energy / E)` (E the modal energy), so the phases and the modal mix are kept;
+    /// at `energy ≥ E` the filters come to rest and sleep. The samples of the step already
+    /// run are not touched. No effect for `energy ≤ 0` or NaN.
+    pub fn drain(&mut self, energy: f64) {
+        if !(energy > 0.0) {
+            return;
+        }
+        let e = self.bank.energy();
+        if energy >= e {
+            self.bank.reset();
+            self.asleep = true;
+        } else {
+            self.bank.scale_state((1.0 - energy / e).sqrt());
+        }
+    }
+
     /// Returns the filters to rest.
     pub fn reset(&mut self) {
         self.bank.reset();

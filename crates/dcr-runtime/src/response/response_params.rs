@@ -26,7 +26,9 @@ pub enum Launch {
     /// to the object's rigid motion) rather than added to it: [`crate::DcrWorld`] raises a
     /// touching body (its contact carried an impulse this step) to it, so a prop keeps being
     /// carried by a ringing object after the impact without the pushes adding up. Its energy
-    /// bound also counts the object's modal energy (`η (D + R + E_modal)`). Needs
+    /// bound also counts the object's modal energy (`η (D + R + E_modal)`), and the kinetic
+    /// energy the pushes give is drained from the carried filters, so the ringing pays for what
+    /// it lifts ([`crate::DistantResponse::drain`]). Needs
     /// `carry_over = true` and the modal filters: [`Method::Modal`], or [`Method::Transfer`],
     /// whose table then serves together with the carried filters (each contact takes the
     /// larger peak: the table's for the step's impacts, the filters' with the earlier ringing;

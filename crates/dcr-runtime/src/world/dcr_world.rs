@@ -152,7 +152,10 @@ struct Slot {
 /// all the object's impulses are scaled by the largest s ∈ [0, 1] with
 /// `s A + s² B ≤ η (D + R)` (E_in is quadratic in s; closed form). Under
 /// [`crate::Launch::SustainedPeak`] the budget is `η (D + R + E_modal)`, E_modal the object's
-/// modal energy at the step's end (J): the ringing the props draw on after the impact.
+/// modal energy at the step's end (J): the ringing the props draw on after the impact. The
+/// energy the object's impulses then inject (after any scaling, when positive) is drained from
+/// its carried filters ([`crate::DistantResponse::drain`]: every mode's state scaled alike,
+/// the filters at rest once it reaches E_modal), so the ringing pays for what it lifts.
 ///
 /// D is estimated per impact from post-step data only: with λ the impact's normal impulse,
 /// `u⁺` the relative normal velocity of the two bodies at the contact after the step

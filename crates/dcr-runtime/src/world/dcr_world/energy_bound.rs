@@ -4,7 +4,10 @@
 //! the object is scaled by the largest s ∈ [0, 1] with `s A + s² B ≤ η (D + R)`. The rules and
 //! the estimate of D are in [`DcrWorld`]'s documentation, "Energy bound". Under
 //! [`Launch::SustainedPeak`] the budget also holds the object's modal energy at the step's end,
-//! `η (D + R + E_modal)`: the ringing the props draw on.
+//! `η (D + R + E_modal)`: the ringing the props draw on; and what the step's impulses injected
+//! is then drained from the carried filters ([`crate::DistantResponse::drain`]), so the
+//! ringing pays for what it lifts: the pushes of later steps never take energy the filters no
+//! longer hold.
 
 use super::impulse_pass::Touched;
 use super::DcrWorld;
@@ -76,7 +79,12 @@ impl DcrWorld {
                 }
             }
         }
-        self.objects[o].info.energy.injected = injected;
+        let obj = &mut self.objects[o];
+        obj.info.energy.injected = injected;
+        // Launch::SustainedPeak: the ringing pays for the kinetic energy its pushes gave.
+        if obj.response.params().launch != Launch::PeakOverStep {
+            obj.response.drain(injected);
+        }
     }
 }
 
