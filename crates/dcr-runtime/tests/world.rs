@@ -667,6 +667,16 @@ fn the_lateral_kick_is_the_tangential_peak() {
         .all(|o| o.lateral_delta_v == [0.0; 3]));
 }
 
+/// The 20-mode response with carried filters and the sustained launch.
+fn sustained_modal() -> ResponseParams {
+    ResponseParams {
+        method: Method::Modal,
+        carry_over: true,
+        launch: Launch::SustainedPeak,
+        ..Default::default()
+    }
+}
+
 /// [`Launch::SustainedPeak`]: set-up refuses it without carry-over or with attenuation; on
 /// the impact's step a resting body gets the paper's Δv = d/h; on the following steps, with no
 /// impact, it gets the carried filters' d/h as a target for its normal velocity — the full
@@ -675,12 +685,7 @@ fn the_lateral_kick_is_the_tangential_peak() {
 /// counting the ringing plate's modal energy. The paper's rule with carry-over adds instead.
 #[test]
 fn sustained_peak_raises_a_resting_body_to_the_carried_peak() {
-    let sustained = ResponseParams {
-        method: Method::Modal,
-        carry_over: true,
-        launch: Launch::SustainedPeak,
-        ..Default::default()
-    };
+    let sustained = sustained_modal();
     for bad in [
         ResponseParams {
             carry_over: false,
@@ -768,15 +773,10 @@ fn sustained_peak_raises_a_resting_body_to_the_carried_peak() {
 /// The sustained launch is paid for by the ringing: a heavy prop held at rest on a ringing plate
 /// is pushed on every step, and each push's kinetic energy is drained from the carried filters,
 /// so the energy given over all the steps after the impact never exceeds the modal energy the
-/// impact left (without the drain the same pushes would give it many times over).
+/// impact left (without the drain the same pushes would give it several times over).
 #[test]
 fn sustained_pushes_drain_the_ringing_that_pays_for_them() {
-    let sustained = ResponseParams {
-        method: Method::Modal,
-        carry_over: true,
-        launch: Launch::SustainedPeak,
-        ..Default::default()
-    };
+    let sustained = sustained_modal();
     let id = Pose::IDENTITY;
     let contact = [0.8, 0.4, 0.0];
     let hit_point = [0.3, 0.25, 0.0];
