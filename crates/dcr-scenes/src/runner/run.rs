@@ -546,6 +546,8 @@ pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
         ApplyMode::MeasureOnly
     };
     let mut dcr = new_adapter(desc, params, apply)?;
+    // The support compensation of after-step impulses reads rapier's gravity.
+    dcr.set_gravity(built.world.gravity);
     let objects = add_elastic_objects(desc, params, &mut built, &mut dcr)?;
     let drivers = resolve_drivers(desc, &built)?;
     let mut rec = RunRecord::new(desc, &built, steps);
