@@ -108,12 +108,13 @@ pub struct DcrWorldParams {
     /// Longest chain of responses through dynamic elastic objects in one step (an impulse on
     /// an elastic object's body becomes an impact on it); 0 disables chains. Default 4.
     pub max_chain_depth: u32,
-    /// Gravity (m/s², world frame) for the support compensation of impulses applied after the
-    /// step: a body a response lifts off (Δv ≥ g·h along the normal) also gets, at its centre
-    /// of mass, the normal velocity gravity takes off during the next step, so that it ends
-    /// that step with Δv. Default zero (no compensation): set it to the engine's gravity when
-    /// the events are applied after the step; leave it zero when the engine replays them in
-    /// its contact solver.
+    /// Gravity (m/s², world frame) for the support compensation: a body a response lifts off
+    /// (Δv ≥ g·h along the normal) also gets, at its centre of mass, the normal velocity
+    /// gravity takes off over the step in which it leaves (its own event, `delta_v` 0), so
+    /// that it ends that step with Δv. Default zero (no compensation): set it to the engine's
+    /// gravity — also when the engine replays the events in its contact solver as a bounce or
+    /// a velocity target, after which gravity acts over the body's first free step just the
+    /// same.
     pub gravity: [f64; 3],
 }
 

@@ -478,18 +478,16 @@ impl DcrRapier {
     }
 
     /// Tells the world rapier's gravity (m/s², world frame) for the support compensation of
-    /// [`ApplyMode::AfterStep`] ([`dcr_runtime::WorldParams::gravity`]): a resting body pushed
-    /// after the step also gets the support its contact would have given it during the next
-    /// step, so it ends that step with the response's Δv rather than Δv − g h. Ignored (zero) in
-    /// the other modes, where rapier's contact carries the body. O(1); [`DcrRapier::step`]
-    /// calls it with `PhysicsWorld::gravity`, callers of [`DcrRapier::after_step`] call it at
-    /// set-up and when gravity changes.
+    /// lifted bodies ([`dcr_runtime::WorldParams::gravity`]): a body a response lifts off also
+    /// gets the support its contact no longer gives it over the step in which it leaves, so its
+    /// positions follow the ballistic arc of a body leaving at the response's Δv. Both
+    /// application modes need it: after the step the body leaves during the next step; in the
+    /// solver the replay's restitution pass sends it off at the end of the replay step, and
+    /// gravity acts over the following one just the same. O(1); [`DcrRapier::step`] calls it
+    /// with `PhysicsWorld::gravity`, callers of [`DcrRapier::after_step`] call it at set-up and
+    /// when gravity changes.
     pub fn set_gravity(&mut self, gravity: Vector) {
-        let g = if self.params.apply == ApplyMode::AfterStep {
-            arr(gravity)
-        } else {
-            [0.0; 3]
-        };
+        let g = arr(gravity);
         if g != self.world.params().gravity {
             // Finite gravity only; rapier's own step fails on a non-finite one anyway.
             let _ = self.world.set_gravity(g);
@@ -886,22 +884,27 @@ impl DcrRapier {
             });
         }
         // One mark per collider pair (sorted by key for the hook), with the mean kick of its
-        // responses.
+        // responses that carry one (a support or a response without a tangential part has
+        // none).
         self.replays.sort_unstable_by_key(|r| r.key);
         let mut i = 0;
         while i < self.replays.len() {
             let key = self.replays[i].key;
             let mut j = i;
             let mut kick = [0.0; 3];
+            let mut kicks = 0;
             while j < self.replays.len() && self.replays[j].key == key {
-                kick = add(kick, self.replays[j].kick);
+                if self.replays[j].kick != [0.0; 3] {
+                    kick = add(kick, self.replays[j].kick);
+                    kicks += 1;
+                }
                 self.seeds[self.replays[j].seed as usize].mark = self.hooks.marks.len() as u32;
                 j += 1;
             }
             self.hooks.marks.push(PairMark {
                 key,
                 elastic: self.replays[i].elastic,
-                kick: vector(scale(kick, 1.0 / (j - i) as f64)),
+                kick: vector(scale(kick, 1.0 / kicks.max(1) as f64)),
                 seen: AtomicBool::new(false),
             });
             i = j;

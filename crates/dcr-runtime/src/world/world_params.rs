@@ -55,13 +55,16 @@ pub struct WorldParams {
     /// Longest chain of responses through dynamic elastic objects in one step (an impulse on an
     /// elastic object's body becomes an impact on it): 0 disables chains. Default 4.
     pub max_chain_depth: u32,
-    /// Gravity (m/s², world frame) for the support compensation of impulses applied after the
-    /// step: a resting body pushed along n also gets `max(0, −g·n) h` of normal velocity, the
-    /// support its contact would have given it during the next step, so that it leaves with
-    /// the response's Δv at the end of that step instead of Δv − g h (see [`crate::DcrWorld`],
-    /// "Impulses"). Zero (the default): no compensation — for engines that replay the
-    /// responses inside their contact solver, where the contact itself carries the body.
-    /// `dcr-rapier` sets it from rapier's gravity under its after-step application.
+    /// Gravity (m/s², world frame) for the support compensation: a body a response lifts off
+    /// along n (Δv ≥ g_n h, `g_n = max(0, −g·n)`) also gets `g_n h` of normal velocity at its
+    /// centre of mass, as its own event (`delta_v` 0) — the support its contact would have
+    /// given it over the step in which it leaves. So it ends its first step off the contact
+    /// with the response's Δv, gravity included: the separation velocity the response asks for
+    /// is the engine body's velocity once it is off (without it the body ends that step at Δv −
+    /// g_n h and flies g_n h² lower from then on: 0.98 mm at h = 10 ms). Zero (the default): no
+    /// compensation. `dcr-rapier` sets it from rapier's gravity in both application modes: in
+    /// the solver the replay's restitution pass sends the body off at the end of the replay
+    /// step, and gravity acts over the next one just the same.
     pub gravity: [f64; 3],
 }
 
