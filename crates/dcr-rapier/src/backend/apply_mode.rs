@@ -18,9 +18,10 @@ pub enum ApplyMode {
     /// the requested Δv), and [`super::DcrSolverHooks`] sets restitution 1 on those contact
     /// manifolds, so the solver's end-of-step restitution pass sends them off at Δv with the
     /// solver's own effective masses. The lateral kick goes through the manifold's
-    /// `tangent_velocity` (a friction-limited velocity target). Needs the hooks passed to
-    /// `step` and [`super::DcrRapier::before_step`]; see docs/engine-integration.md for the
-    /// source references and the one-step lag.
+    /// `tangent_velocity` (a friction-limited velocity target). The support of a lifted body
+    /// ([`super::DcrRapier::set_gravity`]) is replayed with its response. Needs the hooks
+    /// passed to `step` and [`super::DcrRapier::before_step`]; see docs/engine-integration.md
+    /// for the source references and the one-step lag.
     InSolver,
     /// Classify, query and account, but apply nothing (an "off" run that still measures the
     /// impacts and what the responses would have been).
