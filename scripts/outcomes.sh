@@ -8,17 +8,22 @@
 # and the distant response at gain 1 (20 modes, the transfer table, attenuation), each as the
 # same ensemble. The dense eigensolves are cached in $CARGO_TARGET_DIR/scene-truth-cache
 # (default target/; the scaffold's 14,997-dof solve needs ~15 GB of memory and ~20 minutes
-# once); SKIP_BUILD=1 uses the built binary as it is. Scenes default to dinner, roof and
-# scaffold; extra arguments go to `dcr-lab scene-truth` (`--seconds S`, `--dt S`,
-# `--max-halvings N`, `--members N`, `--no-mode-check`). Exit status 3: a reference did not
+# once); SKIP_BUILD=1 uses the built binary as it is. Scenes default to dinner, roof, scaffold
+# and lowrider (simulated 1.4 s: its truck lands 0.75 s in, `--scene-seconds lowrider=1.4`);
+# extra arguments go to `dcr-lab scene-truth` (`--seconds S`, `--scene-seconds SCENE=S`,
+# `--dt S`, `--max-halvings N`, `--members N`, `--no-mode-check`). Exit status 3: a reference did not
 # converge (the page is still written and says so). Needs data/scenes/*.msh
 # (scripts/gen_scene_meshes.sh).
 set -e
 cd "$(dirname "$0")/.."
 if [ -z "$SKIP_BUILD" ]; then cargo build --release --workspace --bins; fi
 TARGET=${CARGO_TARGET_DIR:-target}
-SCENES=${SCENES:-"dinner roof scaffold"}
-HEADER="Regenerate with \`scripts/outcomes.sh\` (\`SCENES=\"$SCENES\"\`; arguments: \`$*\`). Do not edit by hand. Generated $(date -u +%Y-%m-%d) on $(nproc) shared cores (load average at the start: $(cut -d' ' -f1-3 /proc/loadavg))."
+SCENES=${SCENES:-"dinner roof scaffold lowrider"}
+# The lowrider's outcome comes after its truck lands; a --scene-seconds among the arguments
+# overrides this one.
+LONG=""
+case " $SCENES " in *" lowrider "*) LONG="--scene-seconds lowrider=1.4" ;; esac
+HEADER="Regenerate with \`scripts/outcomes.sh\` (\`SCENES=\"$SCENES\"\`; arguments: \`$LONG $*\`). Do not edit by hand. Generated $(date -u +%Y-%m-%d) on $(nproc) shared cores (load average at the start: $(cut -d' ' -f1-3 /proc/loadavg))."
 # shellcheck disable=SC2086
 exec "$TARGET/release/dcr-lab" scene-truth $SCENES --page docs --page-header "$HEADER" \
-  --eigen-cache "$TARGET/scene-truth-cache" --max-dense-dofs 16000 "$@"
+  --eigen-cache "$TARGET/scene-truth-cache" --max-dense-dofs 16000 $LONG "$@"

@@ -35,6 +35,11 @@ pub struct SceneTruthArgs {
     /// Simulated seconds (default: the scene's `seconds`).
     #[arg(long, value_name = "S")]
     pub seconds: Option<f64>,
+    /// Simulated seconds of one scene, over --seconds (repeatable; the last for a scene wins):
+    /// for a scene whose outcome needs longer than the others', e.g. `lowrider=1.4` (its truck
+    /// lands 0.75 s in).
+    #[arg(long, value_name = "SCENE=S", value_parser = parse_scene_seconds)]
+    pub scene_seconds: Vec<(String, f64)>,
     /// Elastic modes summed (default: every mode).
     #[arg(long, value_name = "N")]
     pub modes: Option<usize>,
@@ -97,6 +102,12 @@ pub fn run(a: &SceneTruthArgs) -> anyhow::Result<ExitCode> {
             anyhow::bail!("--seconds must be positive, got {s}");
         }
     }
+    if let Some((name, _)) = a.scene_seconds.iter().find(|(n, _)| !a.scenes.contains(n)) {
+        anyhow::bail!(
+            "--scene-seconds names {name:?}, which is not among the scenes run ({})",
+            a.scenes.join(", ")
+        );
+    }
     let root = dcr_scenes::repo_root();
     let params = SceneTruthParams {
         dt: a.dt,
@@ -122,8 +133,13 @@ pub fn run(a: &SceneTruthArgs) -> anyhow::Result<ExitCode> {
             .scenes
             .iter()
             .map(|s| {
-                let (root, params) = (&root, &params);
+                let root = &root;
+                let mut params = params.clone();
+                if let Some(&(_, t)) = a.scene_seconds.iter().rev().find(|(n, _)| n == s) {
+                    params.seconds = Some(t);
+                }
                 scope.spawn(move || -> anyhow::Result<(bool, String, Option<_>)> {
+                    let params = &params;
                     let desc = load_scene(root, s)?;
                     let truth = scene_truth(&desc, root, params)?;
                     let ok = truth.converged && truth.estimated_error() < params.tolerance;
@@ -173,4 +189,21 @@ pub fn run(a: &SceneTruthArgs) -> anyhow::Result<ExitCode> {
         eprintln!("error: a reference did not converge within --max-halvings (see above)");
         ExitCode::from(EXIT_NOT_CONVERGED)
     })
+}
+
+/// Parses `SCENE=S` (S in seconds, positive and finite).
+fn parse_scene_seconds(v: &str) -> Result<(String, f64), String> {
+    let (name, t) = v
+        .split_once('=')
+        .ok_or_else(|| format!("expected SCENE=SECONDS (e.g. lowrider=1.4), got {v:?}"))?;
+    let t: f64 = t
+        .trim()
+        .parse()
+        .map_err(|e| format!("{t:?} in {v:?} is not a number of seconds: {e}"))?;
+    if name.is_empty() || !(t > 0.0 && t.is_finite()) {
+        return Err(format!(
+            "expected a scene name and positive seconds, got {v:?}"
+        ));
+    }
+    Ok((name.to_string(), t))
 }

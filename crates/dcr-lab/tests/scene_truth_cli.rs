@@ -1,0 +1,56 @@
+//! `dcr-lab scene-truth`'s per-scene simulated time: `--scene-seconds SCENE=S` reaches that
+//! scene's run over `--seconds`, and malformed or foreign values are refused before any run.
+
+use std::process::{Command, Output};
+
+fn scene_truth(args: &[&str]) -> Output {
+    let cache = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("scene_truth_cli_cache");
+    Command::new(env!("CARGO_BIN_EXE_dcr-lab"))
+        .arg("scene-truth")
+        .args(args)
+        .arg("--eigen-cache")
+        .arg(&cache)
+        .output()
+        .expect("dcr-lab runs")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).to_string()
+}
+
+/// Dinner's pot first touches the table 0.17 s in: 0.05 s for dinner alone (over a --seconds
+/// that would run) stops before its first contact, and the error quotes the scene's 0.05 s.
+#[test]
+fn scene_seconds_reach_their_scene() {
+    let o = scene_truth(&[
+        "dinner",
+        "--seconds",
+        "0.45",
+        "--scene-seconds",
+        "dinner=0.05",
+    ]);
+    let e = stderr(&o);
+    assert!(!o.status.success(), "{e}");
+    assert!(
+        e.contains("first contact comes after the 0.05 s simulated"),
+        "{e}"
+    );
+}
+
+/// Refused with the value and what is expected: no `=`, a non-number, a non-positive time, a
+/// scene not run.
+#[test]
+fn malformed_scene_seconds_are_refused() {
+    for (v, says) in [
+        ("dinner", "expected SCENE=SECONDS"),
+        ("dinner=soon", "is not a number of seconds"),
+        ("dinner=-1", "positive seconds"),
+        ("dinner=NaN", "positive seconds"),
+        ("roof=1", "not among the scenes run"),
+    ] {
+        let o = scene_truth(&["dinner", "--scene-seconds", v]);
+        let e = stderr(&o);
+        assert!(!o.status.success(), "{v}: {e}");
+        assert!(e.contains(says), "{v}: {e}");
+    }
+}
