@@ -1,5 +1,6 @@
-//! `dcr-lab scene-truth`'s per-scene simulated time: `--scene-seconds SCENE=S` reaches that
-//! scene's run over `--seconds`, and malformed or foreign values are refused before any run.
+//! `dcr-lab scene-truth`'s per-scene settings: `--scene-seconds SCENE=S` and `--scene-dt
+//! SCENE=S` reach that scene's run over `--seconds` and `--dt`, and malformed or foreign values of it and of `--scene-dt` are refused
+//! before any run.
 
 use std::process::{Command, Output};
 
@@ -37,6 +38,16 @@ fn scene_seconds_reach_their_scene() {
     );
 }
 
+/// A first step of 1 ns for dinner alone (over the default --dt, which fits) puts its finest
+/// run above the work budget, refused before it starts.
+#[test]
+fn scene_dt_reaches_its_scene() {
+    let o = scene_truth(&["dinner", "--seconds", "0.45", "--scene-dt", "dinner=1e-9"]);
+    let e = stderr(&o);
+    assert!(!o.status.success(), "{e}");
+    assert!(e.contains("above the budget"), "{e}");
+}
+
 /// Refused with the value and what is expected: no `=`, a non-number, a non-positive time, a
 /// scene not run.
 #[test]
@@ -48,9 +59,11 @@ fn malformed_scene_seconds_are_refused() {
         ("dinner=NaN", "positive seconds"),
         ("roof=1", "not among the scenes run"),
     ] {
-        let o = scene_truth(&["dinner", "--scene-seconds", v]);
-        let e = stderr(&o);
-        assert!(!o.status.success(), "{v}: {e}");
-        assert!(e.contains(says), "{v}: {e}");
+        for flag in ["--scene-seconds", "--scene-dt"] {
+            let o = scene_truth(&["dinner", flag, v]);
+            let e = stderr(&o);
+            assert!(!o.status.success(), "{flag} {v}: {e}");
+            assert!(e.contains(says), "{flag} {v}: {e}");
+        }
     }
 }

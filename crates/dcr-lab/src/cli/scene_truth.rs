@@ -40,6 +40,10 @@ pub struct SceneTruthArgs {
     /// lands 0.75 s in).
     #[arg(long, value_name = "SCENE=S", value_parser = parse_scene_seconds)]
     pub scene_seconds: Vec<(String, f64)>,
+    /// First coupling step of one scene, over --dt (repeatable; the last for a scene wins): for
+    /// a scene that is long or converges at a coarser step, e.g. `lowrider=1e-5`.
+    #[arg(long, value_name = "SCENE=S", value_parser = parse_scene_seconds)]
+    pub scene_dt: Vec<(String, f64)>,
     /// Elastic modes summed (default: every mode).
     #[arg(long, value_name = "N")]
     pub modes: Option<usize>,
@@ -102,11 +106,16 @@ pub fn run(a: &SceneTruthArgs) -> anyhow::Result<ExitCode> {
             anyhow::bail!("--seconds must be positive, got {s}");
         }
     }
-    if let Some((name, _)) = a.scene_seconds.iter().find(|(n, _)| !a.scenes.contains(n)) {
-        anyhow::bail!(
-            "--scene-seconds names {name:?}, which is not among the scenes run ({})",
-            a.scenes.join(", ")
-        );
+    for (flag, list) in [
+        ("--scene-seconds", &a.scene_seconds),
+        ("--scene-dt", &a.scene_dt),
+    ] {
+        if let Some((name, _)) = list.iter().find(|(n, _)| !a.scenes.contains(n)) {
+            anyhow::bail!(
+                "{flag} names {name:?}, which is not among the scenes run ({})",
+                a.scenes.join(", ")
+            );
+        }
     }
     let root = dcr_scenes::repo_root();
     let params = SceneTruthParams {
@@ -137,6 +146,9 @@ pub fn run(a: &SceneTruthArgs) -> anyhow::Result<ExitCode> {
                 let mut params = params.clone();
                 if let Some(&(_, t)) = a.scene_seconds.iter().rev().find(|(n, _)| n == s) {
                     params.seconds = Some(t);
+                }
+                if let Some(&(_, dt)) = a.scene_dt.iter().rev().find(|(n, _)| n == s) {
+                    params.dt = dt;
                 }
                 scope.spawn(move || -> anyhow::Result<(bool, String, Option<_>)> {
                     let params = &params;
@@ -191,7 +203,7 @@ pub fn run(a: &SceneTruthArgs) -> anyhow::Result<ExitCode> {
     })
 }
 
-/// Parses `SCENE=S` (S in seconds, positive and finite).
+/// Parses `SCENE=S` (S in seconds, positive and finite): `--scene-seconds`, `--scene-dt`.
 fn parse_scene_seconds(v: &str) -> Result<(String, f64), String> {
     let (name, t) = v
         .split_once('=')
