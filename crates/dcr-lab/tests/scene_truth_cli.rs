@@ -1,6 +1,6 @@
 //! `dcr-lab scene-truth`'s per-scene settings: `--scene-seconds SCENE=S` and `--scene-dt
-//! SCENE=S` reach that scene's run over `--seconds` and `--dt`, and malformed or foreign values of it and of `--scene-dt` are refused
-//! before any run.
+//! SCENE=S` reach that scene's run over `--seconds` and `--dt`, and malformed or foreign values
+//! of either are refused before any run.
 
 use std::process::{Command, Output};
 

@@ -479,13 +479,13 @@ impl DcrRapier {
 
     /// Tells the world rapier's gravity (m/s², world frame) for the support compensation of
     /// lifted bodies ([`dcr_runtime::WorldParams::gravity`]): a body a response lifts off also
-    /// gets the support its contact no longer gives it over the step in which it leaves, so its
-    /// positions follow the ballistic arc of a body leaving at the response's Δv. Both
-    /// application modes need it: after the step the body leaves during the next step; in the
-    /// solver the replay's restitution pass sends it off at the end of the replay step, and
-    /// gravity acts over the following one just the same. O(1); [`DcrRapier::step`] calls it
-    /// with `PhysicsWorld::gravity`, callers of [`DcrRapier::after_step`] call it at set-up and
-    /// when gravity changes.
+    /// gets the support its contact no longer gives it over the step in which it leaves, so it
+    /// ends that step with the response's Δv, gravity included. Both application modes need
+    /// it: after the step the body leaves during the next step; in the solver the replay's
+    /// restitution pass sends it off at the end of the replay step, and gravity acts over the
+    /// following one just the same. O(1); [`DcrRapier::step`] calls it with
+    /// `PhysicsWorld::gravity`, callers of [`DcrRapier::after_step`] call it at set-up and when
+    /// gravity changes.
     pub fn set_gravity(&mut self, gravity: Vector) {
         let g = arr(gravity);
         if g != self.world.params().gravity {
