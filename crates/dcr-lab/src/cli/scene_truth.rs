@@ -35,13 +35,14 @@ pub struct SceneTruthArgs {
     /// Simulated seconds (default: the scene's `seconds`).
     #[arg(long, value_name = "S")]
     pub seconds: Option<f64>,
-    /// Simulated seconds of one scene, over --seconds (repeatable; the last for a scene wins):
-    /// for a scene whose outcome needs longer than the others', e.g. `lowrider=1.4` (its truck
-    /// lands 0.75 s in).
+    /// Simulated seconds of one scene, named as in SCENES, over --seconds (repeatable; the last
+    /// for a scene wins): for a scene whose outcome needs longer than the others', e.g.
+    /// `lowrider=1.4` (its truck lands 0.75 s in).
     #[arg(long, value_name = "SCENE=S", value_parser = parse_scene_seconds)]
     pub scene_seconds: Vec<(String, f64)>,
-    /// First coupling step of one scene, over --dt (repeatable; the last for a scene wins): for
-    /// a scene that is long or converges at a coarser step, e.g. `lowrider=1e-5`.
+    /// First coupling step of one scene, named as in SCENES, over --dt (repeatable; the last for
+    /// a scene wins): for a scene that is long or converges at a coarser step, e.g.
+    /// `lowrider=1e-5`.
     #[arg(long, value_name = "SCENE=S", value_parser = parse_scene_seconds)]
     pub scene_dt: Vec<(String, f64)>,
     /// Elastic modes summed (default: every mode).
