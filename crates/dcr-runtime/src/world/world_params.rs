@@ -61,10 +61,12 @@ pub struct WorldParams {
     /// given it over the step in which it leaves. So it ends its first step off the contact
     /// with the response's Δv, gravity included: the separation velocity the response asks for
     /// is the engine body's velocity once it is off (without it the body ends that step at Δv −
-    /// g_n h and flies g_n h² lower from then on: 0.98 mm at h = 10 ms). Zero (the default): no
-    /// compensation. `dcr-rapier` sets it from rapier's gravity in both application modes: in
-    /// the solver the replay's restitution pass sends the body off at the end of the replay
-    /// step, and gravity acts over the next one just the same.
+    /// g_n h and flies g_n h² lower from then on: 0.98 mm at h = 10 ms). A smaller push gets
+    /// none and leaves the body on its contact, so µm/s responses do not make bodies hop and
+    /// land as new impacts. Zero (the default): no compensation. `dcr-rapier` sets it from
+    /// rapier's gravity in both application modes: in the solver the replay's restitution pass
+    /// sends the body off at the end of the replay step, and gravity acts over the next one
+    /// just the same.
     pub gravity: [f64; 3],
 }
 
