@@ -41,7 +41,8 @@ pub struct SceneDesc {
     /// Scripted impulses (a shaking machine, a hopping low-rider).
     #[serde(default)]
     pub drivers: Vec<DriverDesc>,
-    /// Outcome figures reported on vs off.
+    /// Outcome figures reported on vs off; the first is the scene's main outcome (the one
+    /// docs/outcomes.md judges the methods on).
     #[serde(default)]
     pub outcomes: Vec<OutcomeDesc>,
 }
