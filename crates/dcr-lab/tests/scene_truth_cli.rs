@@ -1,6 +1,6 @@
 //! `dcr-lab scene-truth`'s per-scene settings: `--scene-seconds SCENE=S` and `--scene-dt
 //! SCENE=S` reach that scene's run over `--seconds` and `--dt`, and malformed or foreign values
-//! of either are refused before any run.
+//! of either are refused before any run; `--no-prop-feedback` is refused with `--page`.
 
 use std::process::{Command, Output};
 
@@ -66,4 +66,24 @@ fn malformed_scene_seconds_are_refused() {
             assert!(e.contains(says), "{flag} {v}: {e}");
         }
     }
+}
+
+/// `--no-prop-feedback` measures an assumption; with `--page` it is refused before any run
+/// (the page compares the methods with the two-way reference).
+#[test]
+fn no_prop_feedback_is_refused_with_the_page() {
+    let page = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("no_feedback_page");
+    let o = scene_truth(&[
+        "dinner",
+        "--no-prop-feedback",
+        "--page",
+        page.to_str().expect("utf-8 path"),
+    ]);
+    let e = stderr(&o);
+    assert!(!o.status.success(), "{e}");
+    assert!(
+        e.contains("--no-prop-feedback") && e.contains("--page"),
+        "{e}"
+    );
+    assert!(!page.join("outcomes.md").exists(), "nothing written");
 }

@@ -82,6 +82,12 @@ pub struct SceneTruthArgs {
     /// Placement distance of the ensemble's members (m).
     #[arg(long, value_name = "M", default_value_t = 1e-4, value_parser = super::parse_perturbation)]
     pub perturbation: f64,
+    /// The props do not load the elastic object: only the launched and driven bodies' contacts
+    /// push on its modes, every other prop's see the surface move without pushing back — the
+    /// distant response's assumption that resting bodies give the object no feedback, to
+    /// measure what it costs against the default two-way reference.
+    #[arg(long)]
+    pub no_prop_feedback: bool,
     /// Also run the distant response's methods at gain 1 and write DIR/outcomes.md and
     /// DIR/outcomes/SCENE_lift.svg.
     #[arg(long, value_name = "DIR")]
@@ -107,6 +113,12 @@ pub fn run(a: &SceneTruthArgs) -> anyhow::Result<ExitCode> {
             anyhow::bail!("--seconds must be positive, got {s}");
         }
     }
+    if a.no_prop_feedback && a.page.is_some() {
+        anyhow::bail!(
+            "--no-prop-feedback measures the no-feedback assumption; the outcomes page (--page) \
+             compares the methods with the two-way reference: run them separately"
+        );
+    }
     for (flag, list) in [
         ("--scene-seconds", &a.scene_seconds),
         ("--scene-dt", &a.scene_dt),
@@ -127,6 +139,7 @@ pub fn run(a: &SceneTruthArgs) -> anyhow::Result<ExitCode> {
         modes: a.modes,
         check_modes: !a.no_mode_check,
         check_stiffness: !a.no_stiffness_check,
+        prop_feedback: !a.no_prop_feedback,
         eigen_cache: a.eigen_cache.clone(),
         contact_stiffness: a.contact_stiffness,
         max_dense_dofs: a.max_dense_dofs,

@@ -57,6 +57,13 @@ pub struct CoupledParams {
     /// Ensemble member and placement distance (m): the launched bodies start moved as
     /// [`dcr_scenes::scene::BuiltWorld::perturb_placement`] says (`(0, 0.0)`: as written).
     pub perturbation: (usize, f64),
+    /// Whether the props load the elastic object. `true` (the reference): every contact's
+    /// force acts on the object's modes. `false`: only the scene's sources do — the launched
+    /// bodies (a non-zero initial velocity) and the driven ones — while every other prop's
+    /// contacts see the surface move without pushing on it (its forces leave the modes out,
+    /// and its points' compliance is the prop's alone): the distant response's assumption that
+    /// resting bodies give the object no feedback, to measure what it costs.
+    pub prop_feedback: bool,
 }
 
 /// What a coupled run measured.
@@ -196,6 +203,18 @@ pub fn run_coupled(
     }
     let steps_h = (p.seconds / desc.h).round() as usize;
     let mut built: BuiltWorld = build_world(desc, root)?;
+    // The sources: launched bodies and driven ones (CoupledParams::prop_feedback).
+    let mut sources: Vec<RigidBodyHandle> = built
+        .bodies
+        .iter()
+        .filter(|b| b.dynamic && built.world.bodies[b.handle].linvel().length() > 0.0)
+        .map(|b| b.handle)
+        .collect();
+    for d in &desc.drivers {
+        if let Some(i) = built.body_index(&d.body) {
+            sources.push(built.bodies[i].handle);
+        }
+    }
     built.perturb_placement(p.perturbation.0, p.perturbation.1);
     built.world.integration_parameters.dt = p.dt;
     let eb = built.elastic_body[0];
@@ -403,6 +422,7 @@ pub fn run_coupled(
                 );
                 let rb_o = &built.world.bodies[*ob];
                 let rb_e = &built.world.bodies[e_handle];
+                let loads = p.prop_feedback || sources.contains(ob);
                 for (a, &i) in idx.iter().enumerate() {
                     let c = &pts[i];
                     let r = &mut nrows[a * mm..(a + 1) * mm];
@@ -427,10 +447,14 @@ pub fn run_coupled(
                         for a in 0..nb {
                             for b in a..nb {
                                 let (ca, cb) = (&pts[idx[a]], &pts[idx[b]]);
-                                let mut v = elastic.step_compliance(
-                                    &nrows[a * mm..(a + 1) * mm],
-                                    &nrows[b * mm..(b + 1) * mm],
-                                );
+                                let mut v = if loads {
+                                    elastic.step_compliance(
+                                        &nrows[a * mm..(a + 1) * mm],
+                                        &nrows[b * mm..(b + 1) * mm],
+                                    )
+                                } else {
+                                    0.0
+                                };
                                 v += p.dt * p.dt * bo.coupling(ca.x_o, ca.n, cb.x_o, cb.n);
                                 if e_dynamic {
                                     v += p.dt * p.dt * be.coupling(ca.x_e, ca.n, cb.x_e, cb.n);
@@ -486,9 +510,11 @@ pub fn run_coupled(
                     forces.push((c.ob, c.n * fn_ + ft, c.x_o, c.x_e, vn_surf[a], fn_));
                     // On the elastic modes: −f at the surface point (object frame), the
                     // normal part along the point's normal row.
-                    elastic.add_force_normal(&nrows[a * mm..(a + 1) * mm], -fn_);
-                    let ftl = e_pose.rotation.inverse() * (-ft);
-                    elastic.add_force_rows(&cache[&c.key], arr(ftl));
+                    if loads {
+                        elastic.add_force_normal(&nrows[a * mm..(a + 1) * mm], -fn_);
+                        let ftl = e_pose.rotation.inverse() * (-ft);
+                        elastic.add_force_rows(&cache[&c.key], arr(ftl));
+                    }
                 }
             }
             for &(ob, f, x_o, x_e, v_n, fn_) in &forces {

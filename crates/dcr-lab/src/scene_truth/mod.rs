@@ -147,6 +147,9 @@ pub struct SceneTruthParams {
     pub members: usize,
     /// Placement distance of the ensemble's members (m). Default 1e-4.
     pub perturbation: f64,
+    /// Whether the props load the elastic object ([`CoupledParams::prop_feedback`]). Default
+    /// true (the reference); false measures the distant response's no-feedback assumption.
+    pub prop_feedback: bool,
     /// Progress on stderr.
     pub progress: bool,
 }
@@ -171,6 +174,7 @@ impl Default for SceneTruthParams {
             advance: true,
             members: 6,
             perturbation: 1e-4,
+            prop_feedback: true,
             progress: false,
         }
     }
@@ -601,6 +605,7 @@ pub fn scene_truth(desc: &SceneDesc, root: &Path, params: &SceneTruthParams) -> 
         progress: params.progress,
         scheme: CouplingScheme::Implicit,
         perturbation: (0, 0.0),
+        prop_feedback: params.prop_feedback,
     };
     let members = params.members.max(1);
     // One level: every member, side by side (one rayon task each; member 0 reports progress).
