@@ -1,6 +1,7 @@
 //! `dcr-lab scene-truth`'s per-scene settings: `--scene-seconds SCENE=S` and `--scene-dt
 //! SCENE=S` reach that scene's run over `--seconds` and `--dt`, and malformed or foreign values
-//! of either are refused before any run; `--no-prop-feedback` is refused with `--page`.
+//! of either are refused before any run; `--no-prop-feedback` is refused with `--page`;
+//! every scene is planned before any runs.
 
 use std::process::{Command, Output};
 
@@ -86,4 +87,19 @@ fn no_prop_feedback_is_refused_with_the_page() {
         "{e}"
     );
     assert!(!page.join("outcomes.md").exists(), "nothing written");
+}
+
+/// Every scene is planned before any runs: the scaffold over a dense limit it exceeds stops the
+/// command with that scene named, and dinner (which could run) has not started a run.
+#[test]
+fn a_scene_that_cannot_run_stops_the_others_before_they_start() {
+    let o = scene_truth(&["dinner", "scaffold", "--max-dense-dofs", "6000"]);
+    let e = stderr(&o);
+    assert!(!o.status.success(), "{e}");
+    assert!(
+        e.contains("nothing was run; 1 of 2 scenes cannot be") && e.contains("scaffold:"),
+        "{e}"
+    );
+    assert!(e.contains("above the dense limit 6000"), "{e}");
+    assert!(!e.contains("dinner dt"), "dinner started a run: {e}");
 }

@@ -7,7 +7,7 @@ use std::process::ExitCode;
 
 use clap::Args;
 use dcr_lab::scene_truth::{
-    compare_scene, load_scene, scene_truth, write_outcomes_page, SceneTruthParams,
+    compare_scene, load_scene, plan_truth, run_truth, write_outcomes_page, SceneTruthParams,
 };
 
 /// Exit status when a reference did not converge (its outcomes are still printed and written).
@@ -150,24 +150,68 @@ pub fn run(a: &SceneTruthArgs) -> anyhow::Result<ExitCode> {
         progress: true,
         ..SceneTruthParams::default()
     };
+    let scene_params = |s: &String| {
+        let mut params = params.clone();
+        if let Some(&(_, t)) = a.scene_seconds.iter().rev().find(|(n, _)| n == s) {
+            params.seconds = Some(t);
+        }
+        if let Some(&(_, dt)) = a.scene_dt.iter().rev().find(|(n, _)| n == s) {
+            params.dt = dt;
+        }
+        params
+    };
+    // Every scene is planned first (side by side: the scene, its modes, the budget), so a bad
+    // setting for any of them is refused before the long runs; each error is also printed
+    // the moment it happens.
+    let plans: Vec<anyhow::Result<_>> = std::thread::scope(|scope| {
+        let jobs: Vec<_> = a
+            .scenes
+            .iter()
+            .map(|s| {
+                let (root, params) = (&root, scene_params(s));
+                scope.spawn(move || {
+                    let r = load_scene(root, s).and_then(|desc| {
+                        let plan = plan_truth(&desc, root, &params)?;
+                        Ok((desc, plan))
+                    });
+                    if let Err(e) = &r {
+                        eprintln!("[scene-truth] {s}: error: {e:#}");
+                    }
+                    r
+                })
+            })
+            .collect();
+        jobs.into_iter()
+            .map(|j| {
+                j.join()
+                    .unwrap_or_else(|_| Err(anyhow::anyhow!("a scene's plan panicked")))
+            })
+            .collect()
+    });
+    let failed: Vec<String> = plans
+        .iter()
+        .zip(&a.scenes)
+        .filter_map(|(p, s)| p.as_ref().err().map(|e| format!("{s}: {e:#}")))
+        .collect();
+    if !failed.is_empty() {
+        anyhow::bail!(
+            "nothing was run; {} of {} scenes cannot be:\n  {}",
+            failed.len(),
+            a.scenes.len(),
+            failed.join("\n  ")
+        );
+    }
     // The scenes run side by side (one thread each); results are reported in the given order.
     let results: Vec<anyhow::Result<(bool, String, Option<_>)>> = std::thread::scope(|scope| {
         let jobs: Vec<_> = a
             .scenes
             .iter()
-            .map(|s| {
-                let root = &root;
-                let mut params = params.clone();
-                if let Some(&(_, t)) = a.scene_seconds.iter().rev().find(|(n, _)| n == s) {
-                    params.seconds = Some(t);
-                }
-                if let Some(&(_, dt)) = a.scene_dt.iter().rev().find(|(n, _)| n == s) {
-                    params.dt = dt;
-                }
+            .zip(plans.into_iter().flatten())
+            .map(|(s, (desc, plan))| {
+                let (root, params) = (&root, scene_params(s));
                 scope.spawn(move || -> anyhow::Result<(bool, String, Option<_>)> {
                     let params = &params;
-                    let desc = load_scene(root, s)?;
-                    let truth = scene_truth(&desc, root, params)?;
+                    let truth = run_truth(&desc, root, params, plan)?;
                     let ok = truth.converged && truth.estimated_error() < params.tolerance;
                     let last = truth.levels.last().map_or(f64::NAN, |l| l.dt);
                     let mut out = format!(

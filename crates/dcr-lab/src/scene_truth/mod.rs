@@ -524,11 +524,34 @@ pub fn outcome_change(
     worst
 }
 
-/// Runs the coupled reference of `desc` with its step halved until converged (module doc).
+/// Runs the coupled reference of `desc` with its step halved until converged (module doc):
+/// [`plan_truth`] then [`run_truth`].
 ///
 /// # Errors
-/// As [`prepare_elastic`] and [`run_coupled`]; a run over the work budget.
+/// As [`plan_truth`] and [`run_truth`].
 pub fn scene_truth(desc: &SceneDesc, root: &Path, params: &SceneTruthParams) -> Result<SceneTruth> {
+    run_truth(desc, root, params, plan_truth(desc, root, params)?)
+}
+
+/// What a scene's reference needs before its first run: the elastic object's every mode, the
+/// projectile's advanced start and the simulated seconds, checked against the dense limit and
+/// the work budget. [`plan_truth`] makes it in seconds (minutes for an uncached eigensolve of
+/// a large object), so a command running several scenes can refuse a bad setting for any of
+/// them before the long runs start.
+pub struct TruthPlan {
+    prep: ElasticPrep,
+    eigen_s: f64,
+    advanced: std::result::Result<usize, String>,
+    seconds: f64,
+    modes: usize,
+}
+
+/// Plans the reference of `desc` (see [`TruthPlan`]).
+///
+/// # Errors
+/// As [`prepare_elastic`]; a projectile that cannot be advanced; a first contact after the
+/// simulated time; a run over the work budget.
+pub fn plan_truth(desc: &SceneDesc, root: &Path, params: &SceneTruthParams) -> Result<TruthPlan> {
     let t0 = Instant::now();
     let prep = prepare_elastic(
         desc,
@@ -563,11 +586,6 @@ pub fn scene_truth(desc: &SceneDesc, root: &Path, params: &SceneTruthParams) -> 
             Err(why) => eprintln!("[scene-truth] {}: runs start at t = 0 ({why})", desc.name),
         }
     }
-    // The scene each run of step `dt` starts from.
-    let start_desc = |dt: f64| -> Result<SceneDesc> {
-        let sub = (desc.h / dt).round().max(1.0) as usize;
-        crate::soft_body::with_projectiles_advanced(desc, skip, sub)
-    };
     let modes = params
         .modes
         .unwrap_or(usize::MAX)
@@ -594,6 +612,38 @@ pub fn scene_truth(desc: &SceneDesc, root: &Path, params: &SceneTruthParams) -> 
             eigen_s
         );
     }
+    Ok(TruthPlan {
+        prep,
+        eigen_s,
+        advanced,
+        seconds,
+        modes,
+    })
+}
+
+/// Runs the reference `plan` was made for (`desc` and `params` as given to [`plan_truth`]).
+///
+/// # Errors
+/// As [`run_coupled`].
+pub fn run_truth(
+    desc: &SceneDesc,
+    root: &Path,
+    params: &SceneTruthParams,
+    plan: TruthPlan,
+) -> Result<SceneTruth> {
+    let TruthPlan {
+        prep,
+        eigen_s,
+        advanced,
+        seconds,
+        modes,
+    } = plan;
+    let skip = *advanced.as_ref().unwrap_or(&0);
+    // The scene each run of step `dt` starts from.
+    let start_desc = |dt: f64| -> Result<SceneDesc> {
+        let sub = (desc.h / dt).round().max(1.0) as usize;
+        crate::soft_body::with_projectiles_advanced(desc, skip, sub)
+    };
     let coupled = |dt: f64, modes: usize, k: f64| CoupledParams {
         dt,
         seconds,
