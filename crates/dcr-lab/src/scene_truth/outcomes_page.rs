@@ -345,7 +345,7 @@ fn noise_note(l: &super::TruthLevel) -> &'static str {
 fn err(v: f64, r: f64, unit: &str) -> String {
     if r.abs() < 0.01 {
         let d = v - r;
-        format!("{}{} {unit}", if d >= 0.0 { "+" } else { "" }, fmt(d))
+        format!("{}{} {unit}", if d > 0.0 { "+" } else { "" }, fmt(d))
     } else {
         format!("{:+.0} %", 100.0 * (v - r) / r)
     }
@@ -730,5 +730,8 @@ mod tests {
             v.contains("0.830 (+0.830 mm)") && v.contains("near zero"),
             "{v}"
         );
+        // No difference: no sign.
+        let v = main_outcome_verdict("posts_fallen", (0.0, 0.0, 4, "bodies"), 0.0, 0.0);
+        assert!(v.contains("★ table 0 (0 bodies)"), "{v}");
     }
 }
