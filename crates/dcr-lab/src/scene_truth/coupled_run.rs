@@ -62,7 +62,9 @@ pub struct CoupledParams {
     /// bodies (a non-zero initial velocity) and the driven ones — while every other prop's
     /// contacts see the surface move without pushing on it (its forces leave the modes out,
     /// and its points' compliance is the prop's alone): the distant response's assumption that
-    /// resting bodies give the object no feedback, to measure what it costs.
+    /// resting bodies give the object no feedback, to measure what it costs. A dynamic object's
+    /// rigid body still takes every contact's force, and the energy account then misses the
+    /// work the props' forces would have done on the modes.
     pub prop_feedback: bool,
 }
 
