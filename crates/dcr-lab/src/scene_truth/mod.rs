@@ -213,14 +213,20 @@ impl TruthLevel {
     /// Two standard errors of each outcome's mean, relative to max(|mean|, 1 unit): the
     /// ensemble's statistical uncertainty at 95 %; the largest over the outcomes.
     pub fn uncertainty(&self) -> f64 {
-        let n = self.members.max(1) as f64;
         self.outcomes
             .iter()
             .map(|(k, (m, _))| {
-                2.0 * self.spread.get(k).copied().unwrap_or(0.0) / n.sqrt() / m.abs().max(1.0)
+                two_standard_errors(self.spread.get(k).copied().unwrap_or(0.0), self.members)
+                    / m.abs().max(1.0)
             })
             .fold(0.0, f64::max)
     }
+}
+
+/// Two standard errors of an ensemble mean (95 %): `2 s / √N` for the members' sample standard
+/// deviation `s` (the outcome's unit) over `N` members.
+pub(crate) fn two_standard_errors(spread: f64, members: usize) -> f64 {
+    2.0 * spread / (members.max(1) as f64).sqrt()
 }
 
 /// The converged (or not) coupled reference of a scene.

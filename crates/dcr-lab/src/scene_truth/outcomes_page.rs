@@ -650,7 +650,7 @@ fn main_outcome_verdict(
         return format!("{head}: the reference is near zero, compared by the difference.");
     }
     let e = (table - r) / r;
-    let noise = 2.0 * spread / (members.max(1) as f64).sqrt() / r.abs();
+    let noise = super::two_standard_errors(spread, members) / r.abs();
     if e.abs() <= GOAL {
         format!(
             "{head}: the ★ table is **within** the {:.0} % goal.",
