@@ -172,11 +172,14 @@ fn measured_samples_match_run_truth_at_the_same_points() {
 #[test]
 fn small_mesh_fit_is_finite_and_decays_with_distance() {
     let p = AttenuationFitParams {
-        fixed: vec!["zmin".into()],
-        material: dcr_lab::truth::MaterialSi {
-            youngs: 10e9,
-            poisson: 0.3,
-            density: 500.0,
+        system: SystemParams {
+            fixed: vec!["zmin".into()],
+            material: dcr_lab::truth::MaterialSi {
+                youngs: 10e9,
+                poisson: 0.3,
+                density: 500.0,
+            },
+            ..Default::default()
         },
         h: 5e-3,
         pairs: 60,
@@ -201,7 +204,10 @@ fn small_mesh_fit_is_finite_and_decays_with_distance() {
 #[test]
 fn sparse_truth_runs_and_decays_with_distance() {
     let p = AttenuationFitParams {
-        fixed: vec!["zmin".into()],
+        system: SystemParams {
+            fixed: vec!["zmin".into()],
+            ..Default::default()
+        },
         h: 5e-3,
         pairs: 40,
         truth: FitTruth::Modes,

@@ -377,3 +377,37 @@ fn without_prop_feedback_a_resting_prop_does_not_load_the_object() {
         "the ball went down to {y_min} m: it missed the beam"
     );
 }
+
+/// The reference fixes the object with the scene's half-spaces and boxes as a bake does: the
+/// beam held at x ≤ 0 m (its `clamp` group's nodes) has the clamped beam's free dofs and
+/// eigenvalues, and the same coupled run bit for bit.
+#[test]
+fn a_half_space_clamps_the_beam_as_its_group_does() {
+    use dcr_scenes::scene::{AxisDesc, FixedBelowDesc};
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let grouped = scene(false, -9.81, 0.15, 0.5, [0.8, 0.2, 0.05], [0.0, -2.0, 0.0]);
+    let mut below = grouped.clone();
+    below.elastic[0].fixed.clear();
+    below.elastic[0].fixed_below = vec![FixedBelowDesc {
+        axis: AxisDesc::X,
+        value: 0.0,
+    }];
+    let a = prepare_elastic(&grouped, &root, 1.0, 6000, None).expect("clamped beam");
+    let b = prepare_elastic(&below, &root, 1.0, 6000, None).expect("beam held at x ≤ 0");
+    assert_eq!(a.sys.n(), b.sys.n());
+    assert_eq!(a.all.eigenvalues, b.all.eigenvalues);
+    let p = params(2e-5, 0.02, [10.0, 1e-7], 0.15);
+    let ra = run_coupled(&grouped, &root, &a, &p).expect("coupled run");
+    let rb = run_coupled(&below, &root, &b, &p).expect("coupled run");
+    assert_eq!(ra.trajectory.positions, rb.trajectory.positions);
+    // A half-space that holds no node is refused, naming the mesh's extent.
+    below.elastic[0].fixed_below[0].value = -1.0;
+    let err = prepare_elastic(&below, &root, 1.0, 6000, None)
+        .err()
+        .expect("refused")
+        .to_string();
+    assert!(
+        err.contains("fixes no node") && err.contains("the mesh spans"),
+        "{err}"
+    );
+}

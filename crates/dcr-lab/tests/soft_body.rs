@@ -60,8 +60,8 @@ fn settle_cantilever(steps: usize, cg: usize) -> (PhysicsWorld, SoftBodyHandle, 
 }
 
 /// The builder keeps every node as a particle and every tetrahedron as a cell, in mesh order;
-/// lumped masses sum to ρV; pinned particles are exactly the fixed group. A second-order mesh
-/// keeps its corner nodes only.
+/// lumped masses sum to ρV; pinned particles are exactly the fixed group, or the same nodes
+/// given by a half-space or a box. A second-order mesh keeps its corner nodes only.
 #[test]
 fn builder_preserves_nodes_and_tets() {
     let mesh = cantilever_mesh();
@@ -94,6 +94,32 @@ fn builder_preserves_nodes_and_tets() {
     };
     let err = tet_soft_body(&mesh, &bad).unwrap_err().to_string();
     assert!(err.contains("nope") && err.contains("xmin"), "{err}");
+
+    // The baker's other selectors pin the same particles: x ≤ 0, or a box around x = 0.
+    let below = TetSoftBodyDesc {
+        fixed: Vec::new(),
+        fixed_below: vec![modal_bake::bake::FixedBelow {
+            axis: 0,
+            value: 0.0,
+        }],
+        ..cantilever_desc()
+    };
+    assert_eq!(tet_soft_body(&mesh, &below).unwrap().pinned, fixed);
+    let boxed = TetSoftBodyDesc {
+        fixed: Vec::new(),
+        fixed_boxes: vec![[-1.0, -1.0, -1.0, 1e-9, 1.0, 1.0]],
+        ..cantilever_desc()
+    };
+    assert_eq!(tet_soft_body(&mesh, &boxed).unwrap().pinned, fixed);
+    let nothing = TetSoftBodyDesc {
+        fixed_below: vec![modal_bake::bake::FixedBelow {
+            axis: 1,
+            value: -0.5,
+        }],
+        ..below
+    };
+    let err = tet_soft_body(&mesh, &nothing).unwrap_err().to_string();
+    assert!(err.contains("fixes no node"), "{err}");
 }
 
 /// Pinned particles do not move, bit for bit, while the rest of the beam sags.

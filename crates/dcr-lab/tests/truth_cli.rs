@@ -10,12 +10,15 @@ fn data(rel: &str) -> PathBuf {
 }
 
 fn truth(extra: &[&str]) -> Output {
+    truth_fixed(&["--fixed", "clamp"], extra)
+}
+
+/// `dcr-lab truth` on the beam with the fixed-node options `fixed`.
+fn truth_fixed(fixed: &[&str], extra: &[&str]) -> Output {
     let beam = data("meshes/beam.msh");
-    let mut a = vec![
-        "truth",
-        beam.to_str().unwrap(),
-        "--fixed",
-        "clamp",
+    let mut a = vec!["truth", beam.to_str().unwrap()];
+    a.extend_from_slice(fixed);
+    a.extend_from_slice(&[
         "--impact",
         "1.0,0.05,0.1",
         "--impulse",
@@ -24,7 +27,7 @@ fn truth(extra: &[&str]) -> Output {
         "0.5,0.05,0.1",
         "--contact",
         "0.8,0.0,0.05",
-    ];
+    ]);
     // The window and step unless `extra` sets them.
     for (flag, value) in [("--h", "0.002"), ("--dt", "5e-7")] {
         if !extra.contains(&flag) {
@@ -79,10 +82,31 @@ fn truth_json_methods_agree() {
     }
 }
 
+/// The reference takes the bake's fixed-node selectors: the beam clamped by `--fixed-below
+/// x=0` or a box around x = 0 (its `clamp` group's nodes) answers bit for bit as with
+/// `--fixed clamp`, and free-free differently.
+#[test]
+fn truth_takes_every_fixed_node_selector() {
+    let args = ["--json", "--method", "modal-all"];
+    let group = peaks(&truth(&args));
+    let below = peaks(&truth_fixed(&["--fixed-below", "x=0"], &args));
+    let boxed = peaks(&truth_fixed(&["--fixed-box", "-1,-1,-1,0,1,1"], &args));
+    assert_eq!(below, group);
+    assert_eq!(boxed, group);
+    let free = peaks(&truth_fixed(&[], &args));
+    assert!(
+        free.iter()
+            .zip(&group)
+            .all(|(f, g)| ((f - g) / g).abs() > 1e-3),
+        "{free:?} vs {group:?}"
+    );
+}
+
 #[test]
 fn truth_rejects_bad_input_with_a_clear_message() {
     for (extra, needle) in [
         (&["--fixed", "nope"][..], "no node group named"),
+        (&["--fixed-below", "x=-1"][..], "fixes no node"),
         (&["--dt", "0"][..], "dt = 0"),
         (&["--modes", "5"][..], "--method modal-all"),
         (&["--impulse", "nan"][..], "impulse"),

@@ -178,6 +178,30 @@ fn every_field_out_of_range_is_refused_naming_the_field() {
         ),
         (
             "roof",
+            vec!["elastic", "0", "fixed_below"],
+            json!([{"axis": "y", "value": 1e300}]),
+            "elastic[0].fixed_below[0].value must be finite",
+        ),
+        (
+            "roof",
+            vec!["elastic", "0", "fixed_below"],
+            json!([{"axis": "w", "value": 0}]),
+            "unknown variant `w`",
+        ),
+        (
+            "roof",
+            vec!["elastic", "0", "fixed_boxes"],
+            json!([[0, 1, 0, 1, 0, 1]]),
+            "elastic[0].fixed_boxes[0]: the minimum 1 of axis y is above its maximum 0",
+        ),
+        (
+            "roof",
+            vec!["elastic", "0", "fixed_boxes"],
+            json!(vec![[0, 0, 0, 1, 1, 1]; 65]),
+            "at most 64 fixed_below and 64 fixed_boxes",
+        ),
+        (
+            "roof",
             vec!["name"],
             json!("../../x"),
             "name \"../../x\" must be a plain file name",

@@ -202,6 +202,52 @@ fn same_scene_twice_gives_same_trajectory() {
     }
 }
 
+/// A scene fixes an asset that has no physical groups by half-spaces or boxes: dinner's table
+/// held at y ≤ 0 m (exactly the nodes of its `feet` group) bakes the same modes and gives the
+/// same run, bit for bit, as with `fixed: ["feet"]`; nothing fixed gives another base.
+#[test]
+fn a_half_space_fixes_the_table_as_its_feet_group_does() {
+    use dcr_scenes::scene::{AxisDesc, FixedBelowDesc};
+    let dir = tempfile::tempdir().unwrap();
+    let grouped = scene("dinner");
+    let mut below = grouped.clone();
+    below.elastic[0].fixed.clear();
+    below.elastic[0].fixed_below = vec![FixedBelowDesc {
+        axis: AxisDesc::Y,
+        value: 0.0,
+    }];
+    let mut boxed = grouped.clone();
+    boxed.elastic[0].fixed.clear();
+    boxed.elastic[0].fixed_boxes = vec![[-1.0, -0.01, -1.0, 1.0, 0.0, 1.0]];
+    let read = |p: PathBuf| dcr_runtime::format::ModesFile::read(&p).unwrap();
+    let (g, _) = ensure_base(&repo_root(), bases(), &grouped.elastic[0]).unwrap();
+    let g = read(g);
+    let reference = run(&grouped, true, MethodChoice::Scene);
+    for (what, desc) in [("fixed_below", below), ("fixed_boxes", boxed)] {
+        let sub = dir.path().join(what);
+        let (b, baked) = ensure_base(&repo_root(), &sub, &desc.elastic[0]).unwrap();
+        assert!(baked);
+        let b = read(b);
+        assert_eq!(b.fixed_nodes, g.fixed_nodes, "{what}");
+        assert_eq!(b.eigenvalues, g.eigenvalues, "{what}");
+        assert_eq!(b.modes, g.modes, "{what}");
+        let r = run_scene(
+            &desc,
+            &RunParams {
+                seconds: desc.test_seconds,
+                bases_dir: sub,
+                ..RunParams::new(repo_root(), true)
+            },
+        )
+        .unwrap();
+        assert_eq!(r.trajectory_hash, reference.trajectory_hash, "{what}");
+    }
+    let mut free = grouped.clone();
+    free.elastic[0].fixed.clear();
+    let (f, _) = ensure_base(&repo_root(), &dir.path().join("free"), &free.elastic[0]).unwrap();
+    assert!(read(f).fixed_nodes.is_empty());
+}
+
 /// Every scene file parses, names existing meshes, builds a world and records bodies.
 #[test]
 fn every_scene_file_builds() {

@@ -3,12 +3,12 @@
 
 use clap::Args;
 
-use crate::bake::MaterialSi;
+use crate::bake::{FixedBelow, FixedNear, MaterialSi};
 use crate::fem::MaterialPreset;
 use crate::full_order::SystemParams;
 
-/// The object's material, boundary conditions and damping (shared by `modal-bake bake`
-/// and `check`, and `dcr-lab truth` and `fit-attenuation`).
+/// The object's material, boundary conditions (fixed nodes) and damping (shared by
+/// `modal-bake bake` and `check`, and `dcr-lab truth` and `fit-attenuation`).
 #[derive(Args, Clone, Debug)]
 pub struct ModelOptions {
     /// Material preset: oak, pine, steel, aluminium, brass, cast-iron, glass, ceramic,
@@ -30,6 +30,23 @@ pub struct ModelOptions {
     /// six rigid-body modes, or the rigid-body part of a response, are excluded).
     #[arg(long, value_name = "NAME")]
     pub fixed: Vec<String>,
+    /// Fix every node at or below a coordinate, e.g. `y=0.01` (m, object frame; repeatable;
+    /// combines with --fixed and --fixed-box). A selector that fixes no node is an error.
+    #[arg(long, value_name = "AXIS=VALUE", value_parser = axis_value, allow_hyphen_values = true)]
+    pub fixed_below: Vec<FixedBelow>,
+    /// Fix every node inside a box X0,Y0,Z0,X1,Y1,Z1 (m, object frame, bounds included;
+    /// repeatable; combines with --fixed and --fixed-below).
+    #[arg(long, value_name = "X0,Y0,Z0,X1,Y1,Z1", value_parser = aabb, allow_hyphen_values = true)]
+    pub fixed_box: Vec<[f64; 6]>,
+    /// Fix every node within --fixed-near-distance of the points and faces in an OBJ file
+    /// (`v x y z` lines in m, object frame; optional `f` faces), e.g. a vertex group's
+    /// vertices and faces: exactly the region they cover (repeatable; combines with the other
+    /// selectors). The mid-edge node of an edge whose two ends are fixed is fixed too.
+    #[arg(long, value_name = "FILE.obj", value_parser = fixed_near)]
+    pub fixed_near: Vec<FixedNear>,
+    /// Distance (m) for --fixed-near [default: 1/200 of the mesh's bounding-box diagonal].
+    #[arg(long, value_name = "M", requires = "fixed_near")]
+    pub fixed_near_distance: Option<f64>,
     /// Rayleigh damping: α0 (1/s), α1 (s); `bake` stores it as the base's default.
     #[arg(long, value_name = "A0,A1", value_parser = pair, default_value = "10,1e-7")]
     pub rayleigh: [f64; 2],
@@ -224,15 +241,54 @@ impl ModelOptions {
         }
     }
 
-    /// The full-order system these options describe (material, fixed groups, damping, mass).
+    /// The `--fixed-near` sets, each with `--fixed-near-distance` when given.
+    pub fn fixed_near(&self) -> Vec<FixedNear> {
+        self.fixed_near
+            .iter()
+            .map(|f| FixedNear {
+                distance: self.fixed_near_distance.or(f.distance),
+                ..f.clone()
+            })
+            .collect()
+    }
+
+    /// The full-order system these options describe (material, every fixed-node selector,
+    /// damping, mass).
     pub fn system(&self) -> SystemParams {
         SystemParams {
             material: self.material(),
             fixed: self.fixed.clone(),
+            fixed_below: self.fixed_below.clone(),
+            fixed_boxes: self.fixed_box.clone(),
+            fixed_near: self.fixed_near(),
             rayleigh: self.rayleigh,
             lumped: self.lumped,
         }
     }
+}
+
+/// Parses `AXIS=VALUE` (`x`, `y` or `z`, then a finite number in m), e.g. `y=0.01`.
+pub fn axis_value(s: &str) -> Result<FixedBelow, String> {
+    let Some((axis, value)) = s.split_once('=') else {
+        return Err(format!("expected AXIS=VALUE such as `y=0.01`, got `{s}`"));
+    };
+    let axis = match axis.trim().to_ascii_lowercase().as_str() {
+        "x" => 0,
+        "y" => 1,
+        "z" => 2,
+        other => return Err(format!("axis `{other}` must be x, y or z (in `{s}`)")),
+    };
+    match value.trim().parse::<f64>() {
+        Ok(value) if value.is_finite() => Ok(FixedBelow { axis, value }),
+        _ => Err(format!(
+            "`{value}` is not a finite number of metres (in `{s}`)"
+        )),
+    }
+}
+
+/// Reads a `--fixed-near` file (an OBJ of points and optional faces, m).
+pub fn fixed_near(s: &str) -> Result<FixedNear, String> {
+    FixedNear::read(s.as_ref()).map_err(|e| e.to_string())
 }
 
 /// Parses `X,Y,Z` (three finite numbers).

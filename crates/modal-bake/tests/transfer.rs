@@ -449,3 +449,44 @@ fn check_is_fresh_after_a_default_table_bake() {
     assert_eq!(o.status.code(), Some(1), "{}", text(&o));
     assert!(text(&o).contains("transfer"), "{}", text(&o));
 }
+
+/// A table whose modes come from the dense all-mode eigensolve is built on the base's own
+/// boundary conditions whichever selector fixes them: the beam clamped by `--fixed-below x=0`
+/// (the nodes of its `clamp` group, at x = 0) gets the same fixed nodes, modes and table as
+/// with `--fixed clamp`. A table built on the free-free object instead reads about a third of
+/// the clamped beam's peaks.
+#[test]
+fn a_table_follows_every_fixed_node_selector() {
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = data("data/meshes/beam.msh");
+    let bake = |name: &str, fixed: &[&str]| {
+        let out = dir.path().join(name);
+        let mut args = vec!["bake", mesh.to_str().unwrap(), "-o", out.to_str().unwrap()];
+        args.extend_from_slice(fixed);
+        args.extend_from_slice(&[
+            "--modes",
+            "8",
+            "--transfer-h",
+            "0.004",
+            "--transfer-modes",
+            "60",
+        ]);
+        let o = run(&args);
+        assert!(o.status.success(), "{}", text(&o));
+        ModesFile::read(&out).unwrap()
+    };
+    let group = bake("group.modes", &["--fixed", "clamp"]);
+    let below = bake("below.modes", &["--fixed-below", "x=0"]);
+    let boxed = bake("box.modes", &["--fixed-box", "-1,-1,-1,0,1,1"]);
+    assert!(!group.fixed_nodes.is_empty());
+    for other in [&below, &boxed] {
+        assert_eq!(other.fixed_nodes, group.fixed_nodes);
+        assert_eq!(other.eigenvalues, group.eigenvalues);
+        let (t, g) = (
+            other.transfer.as_ref().unwrap(),
+            group.transfer.as_ref().unwrap(),
+        );
+        assert_eq!(t.modes, 60);
+        assert!(t == g, "the tables differ");
+    }
+}

@@ -392,8 +392,7 @@ fn attenuation_fits(root: &Path, studies: &[ObjectStudy]) -> Vec<String> {
             continue;
         };
         let fp = AttenuationFitParams {
-            material: s.spec.material,
-            fixed: s.spec.fixed.clone(),
+            system: study::system_params(&s.spec),
             pairs: 200,
             ..Default::default()
         };

@@ -46,7 +46,7 @@ use std::time::Instant;
 
 use dcr_runtime::attenuation::HeatGeodesic;
 use dcr_runtime::rng::SplitMix64;
-use modal_bake::bake::{bake_mesh, BakeError, BakeParams, MaterialSi, ModeRequest};
+use modal_bake::bake::{bake_mesh, BakeError, ModeRequest};
 use modal_bake::full_order::{FullOrderError, FullOrderSystem, ModalAll, SystemParams};
 use modal_bake::mesh::TetMesh;
 use rayon::prelude::*;
@@ -122,14 +122,10 @@ pub const DEFAULT_SPARSE_MODES: usize = 200;
 /// Parameters of [`fit_attenuation_mesh`] (SI units).
 #[derive(Clone, Debug, PartialEq)]
 pub struct AttenuationFitParams {
-    /// Isotropic material (E in Pa, ν, ρ in kg/m³). Default as `bake`: 1.1 GPa, 0.3, 770.
-    pub material: MaterialSi,
-    /// Fixed physical groups (empty: free-free).
-    pub fixed: Vec<String>,
-    /// Rayleigh damping [α0 (1/s), α1 (s)]. Default (10, 1e-7).
-    pub rayleigh: [f64; 2],
-    /// Lumped mass.
-    pub lumped: bool,
+    /// The object: material, fixed-node selectors, Rayleigh damping [α0 (1/s), α1 (s)] and
+    /// mass lumping. Default as `bake`: 1.1 GPa, 0.3, 770 kg/m³, free-free, (10, 1e-7),
+    /// consistent mass.
+    pub system: SystemParams,
     /// Window h (s) of the peaks. Default 0.01.
     pub h: f64,
     /// Sample period (s); `None`: [`SurfaceResponse::default_dt`].
@@ -150,12 +146,8 @@ pub struct AttenuationFitParams {
 
 impl Default for AttenuationFitParams {
     fn default() -> Self {
-        let t = SystemParams::default();
         AttenuationFitParams {
-            material: t.material,
-            fixed: Vec::new(),
-            rayleigh: t.rayleigh,
-            lumped: false,
+            system: SystemParams::default(),
             h: 0.01,
             dt: None,
             modes: None,
@@ -380,7 +372,9 @@ pub fn sample_attenuation(
 /// use dcr_lab::attenuation_fit::*;
 /// use modal_bake::mesh::TetMesh;
 /// let mesh = TetMesh::structured_box([6, 2, 2], [1.0, 0.2, 0.2]);
-/// let p = AttenuationFitParams { fixed: vec!["xmin".into()], h: 2e-3, pairs: 20, ..Default::default() };
+/// /// use modal_bake::full_order::SystemParams;
+/// let system = SystemParams { fixed: vec!["xmin".into()], ..Default::default() };
+/// let p = AttenuationFitParams { system, h: 2e-3, pairs: 20, ..Default::default() };
 /// let rep = fit_attenuation_mesh(mesh, &p, "box", &mut |_| {}).unwrap();
 /// assert!(rep.fit.alpha.is_finite() && rep.fit.beta.is_finite() && rep.fit.r0 > 0.0);
 /// ```
@@ -396,16 +390,11 @@ pub fn fit_attenuation_mesh(
             "the number of modes must be at least 1".into(),
         ));
     }
-    let tp = SystemParams {
-        material: params.material,
-        fixed: params.fixed.clone(),
-        rayleigh: params.rayleigh,
-        lumped: params.lumped,
-    };
+    let tp = &params.system;
     let t = Instant::now();
     let free_dofs;
     let (resp, method) = {
-        let sys = FullOrderSystem::new(mesh.clone(), &tp, file)?;
+        let sys = FullOrderSystem::new(mesh.clone(), tp, file)?;
         free_dofs = sys.n();
         let dense = match params.truth {
             FitTruth::Auto => free_dofs <= params.max_dense_dofs,
@@ -423,14 +412,9 @@ pub fn fit_attenuation_mesh(
             )
         } else {
             drop(sys);
-            let bp = BakeParams {
-                material: params.material,
-                modes: ModeRequest::Count(params.modes.unwrap_or(DEFAULT_SPARSE_MODES)),
-                fixed: params.fixed.clone(),
-                rayleigh: params.rayleigh,
-                lumped: params.lumped,
-                ..Default::default()
-            };
+            let bp = tp.bake_params(ModeRequest::Count(
+                params.modes.unwrap_or(DEFAULT_SPARSE_MODES),
+            ));
             let (base, _) = bake_mesh(mesh, &bp, file, &mut |_| {})?;
             (SurfaceResponse::from_base(&base), "modes")
         }
@@ -439,7 +423,7 @@ pub fn fit_attenuation_mesh(
     let t = Instant::now();
     let (samples, kind, dt, steps) = sample_attenuation(
         &resp,
-        params.rayleigh,
+        params.system.rayleigh,
         params.h,
         params.dt,
         params.pairs,

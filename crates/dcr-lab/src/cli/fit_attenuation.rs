@@ -61,10 +61,7 @@ impl FitAttenuationArgs {
     /// The library parameters these options describe.
     pub fn params(&self) -> AttenuationFitParams {
         AttenuationFitParams {
-            material: self.model.material(),
-            fixed: self.model.fixed.clone(),
-            rayleigh: self.model.rayleigh,
-            lumped: self.model.lumped,
+            system: self.model.system(),
             h: self.h,
             dt: self.dt,
             modes: self.modes,

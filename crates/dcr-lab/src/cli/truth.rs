@@ -6,7 +6,7 @@ use std::process::ExitCode;
 
 use anyhow::Context;
 use clap::{Args, ValueEnum};
-use dcr_lab::truth::{self, CrossCheck, SystemParams, TruthImpact, TruthMethod, TruthParams};
+use dcr_lab::truth::{self, CrossCheck, TruthImpact, TruthMethod, TruthParams};
 use modal_bake::full_order::RefineParams;
 
 use super::progress::Progress;
@@ -98,12 +98,7 @@ impl TruthArgs {
     /// The library parameters these options describe.
     pub fn params(&self) -> TruthParams {
         TruthParams {
-            system: SystemParams {
-                material: self.model.material(),
-                fixed: self.model.fixed.clone(),
-                rayleigh: self.model.rayleigh,
-                lumped: self.model.lumped,
-            },
+            system: self.model.system(),
             h: self.h,
             dt: self.dt,
             method: match self.method {

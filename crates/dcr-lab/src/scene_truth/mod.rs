@@ -468,6 +468,9 @@ pub fn prepare_elastic(
             density: e.material.density,
         },
         fixed: e.fixed.clone(),
+        fixed_below: e.fixed_below(),
+        fixed_boxes: e.fixed_boxes.clone(),
+        fixed_near: Vec::new(),
         rayleigh: e.rayleigh,
         lumped: false,
     };
@@ -507,7 +510,8 @@ pub fn prepare_elastic(
     // drift under a held load.
     if let Some(l) = all.eigenvalues.iter().find(|l| **l <= 0.0) {
         bail!(
-            "elastic object {}: the dense eigensolve returned a non-positive elastic eigenvalue              {l:.3e} rad²/s² (largest {:.3e}); the object is too stiff for a dense solve in              double precision or has a mechanism (lower --youngs-scale or check the fixed groups)",
+            "elastic object {}: the dense eigensolve returned a non-positive elastic eigenvalue \
+             {l:.3e} rad²/s² (largest {:.3e}); the object is too stiff for a dense solve in double precision or has a mechanism (lower --youngs-scale or check the fixed nodes)",
             e.name,
             all.eigenvalues.last().copied().unwrap_or(0.0)
         );

@@ -128,7 +128,7 @@ pub struct SoftRunReport {
 /// Runs `desc` with every elastic object a rapier FEM soft body (see
 /// [`tet_soft_body()`](fn@super::tet_soft_body)): the world `dcr_scenes::scene::build_world` builds, the rigid
 /// bodies of the elastic objects (and their proxy colliders) replaced by their tetrahedral
-/// meshes, pinned at their `fixed` groups, with the scene's material and Rayleigh damping;
+/// meshes, pinned at their fixed nodes (`fixed`, `fixed_below`, `fixed_boxes`), with the scene's material and Rayleigh damping;
 /// the projectiles moved as `params.perturbation` says.
 ///
 /// # Errors
@@ -177,6 +177,8 @@ pub fn run_soft_scene(desc: &SceneDesc, params: &SoftSceneParams) -> Result<Soft
             density: e.material.density,
             rayleigh: e.rayleigh,
             fixed: e.fixed.clone(),
+            fixed_below: e.fixed_below(),
+            fixed_boxes: e.fixed_boxes.clone(),
             pose: pose_from_desc(&e.pose),
             particle_radius: params.particle_radius,
             friction: e.friction,

@@ -1,4 +1,4 @@
-//! A rapier FEM soft body from a tetrahedral mesh: the baker's mesh, material, fixed groups and
+//! A rapier FEM soft body from a tetrahedral mesh: the baker's mesh, material, fixed nodes and
 //! Rayleigh damping carried over to `rapier3d_f64::dynamics::SoftBodyBuilder`.
 
 use anyhow::{bail, Context, Result};
@@ -29,6 +29,12 @@ pub struct TetSoftBodyDesc {
     pub rayleigh: [f64; 2],
     /// Names of the mesh's node groups whose nodes are pinned (the baker's `fixed`).
     pub fixed: Vec<String>,
+    /// Pin every node whose coordinate `axis` is ≤ `value` (m, mesh frame; the baker's
+    /// `fixed_below`). Default none.
+    pub fixed_below: Vec<modal_bake::bake::FixedBelow>,
+    /// Pin every node inside a box `[x0, y0, z0, x1, y1, z1]` (m, mesh frame, bounds included;
+    /// the baker's `fixed_boxes`). Default none.
+    pub fixed_boxes: Vec<[f64; 6]>,
     /// Pose of the mesh frame in the world.
     pub pose: Pose,
     /// The contact skin of the body's surface collider (m). rapier's default (1 cm) would hold
@@ -49,6 +55,8 @@ impl Default for TetSoftBodyDesc {
             density: 1000.0,
             rayleigh: [10.0, 1e-7],
             fixed: Vec::new(),
+            fixed_below: Vec::new(),
+            fixed_boxes: Vec::new(),
             pose: Pose::IDENTITY,
             particle_radius: 1.0e-4,
             friction: 0.6,
@@ -146,8 +154,9 @@ fn cell_mean_omega(x: [[f64; 3]; 4], w: [f64; 4], mu: f64, lambda: f64) -> Optio
 /// collision surface.
 ///
 /// # Errors
-/// An unknown fixed group (the message lists the mesh's groups), a fixed group without a
-/// corner node, non-positive material constants, or a mesh without tetrahedra.
+/// An unknown fixed group (the message lists the mesh's groups), a selector that fixes no
+/// node or fixed nodes none of which is a tetrahedron's corner, non-positive material
+/// constants, or a mesh without tetrahedra.
 ///
 /// ```
 /// use dcr_lab::soft_body::{tet_soft_body, TetSoftBodyDesc};
@@ -205,24 +214,31 @@ pub fn tet_soft_body(mesh: &TetMesh, desc: &TetSoftBodyDesc) -> Result<TetSoftBo
             masses[particle_of[n] as usize] += m / 4.0;
         }
     }
-    let mut pinned = Vec::new();
-    for g in &desc.fixed {
-        let nodes = mesh.group_nodes(g).map_err(|_| {
-            anyhow::anyhow!(
-                "fixed group {g:?}: no such group in the mesh (groups: {})",
-                mesh.groups.keys().cloned().collect::<Vec<_>>().join(", ")
-            )
-        })?;
-        let before = pinned.len();
-        pinned.extend(
-            nodes
+    let selectors = modal_bake::bake::FixedSelectors {
+        groups: &desc.fixed,
+        below: &desc.fixed_below,
+        boxes: &desc.fixed_boxes,
+        near: &[],
+    };
+    let fixed = selectors
+        .resolve(mesh, "the mesh")
+        .map_err(|e| anyhow::anyhow!("fixed nodes: {e}"))?;
+    let mut pinned: Vec<u32> = fixed
+        .nodes
+        .iter()
+        .map(|&n| particle_of[n])
+        .filter(|&p| p != u32::MAX)
+        .collect();
+    if !selectors.is_empty() && pinned.is_empty() {
+        bail!(
+            "fixed nodes ({}): none is a corner node of a tetrahedron",
+            fixed
+                .by
                 .iter()
-                .map(|&n| particle_of[n])
-                .filter(|&p| p != u32::MAX),
+                .map(|(w, _)| w.as_str())
+                .collect::<Vec<_>>()
+                .join(", ")
         );
-        if pinned.len() == before {
-            bail!("fixed group {g:?} holds no corner node of a tetrahedron");
-        }
     }
     pinned.sort_unstable();
     pinned.dedup();

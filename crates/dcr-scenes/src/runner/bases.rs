@@ -15,7 +15,7 @@ use modal_bake::transfer::{TableOrder, TransferModes, TransferParams};
 
 use crate::scene::{ElasticDesc, TableOrderDesc, TransferDesc};
 
-/// The bake parameters of an elastic object (material, modes, fixed groups, Rayleigh).
+/// The bake parameters of an elastic object (material, modes, fixed nodes, Rayleigh).
 pub fn bake_params(e: &ElasticDesc) -> BakeParams {
     BakeParams {
         material: MaterialSi {
@@ -25,8 +25,30 @@ pub fn bake_params(e: &ElasticDesc) -> BakeParams {
         },
         modes: ModeRequest::Count(e.modes),
         fixed: e.fixed.clone(),
+        fixed_below: e.fixed_below(),
+        fixed_boxes: e.fixed_boxes.clone(),
         rayleigh: e.rayleigh,
         ..BakeParams::default()
+    }
+}
+
+/// The fixed-node selectors of `e` in words: `groups ["feet"]`, `y ≤ 0.01 m`, `box [..]`,
+/// joined by `+`; `nothing (free-free)` when none is given.
+fn fixed_summary(e: &ElasticDesc) -> String {
+    let mut parts = Vec::new();
+    if !e.fixed.is_empty() {
+        parts.push(format!("groups {:?}", e.fixed));
+    }
+    parts.extend(
+        e.fixed_below
+            .iter()
+            .map(|b| format!("{} ≤ {} m", ["x", "y", "z"][b.axis as usize], b.value)),
+    );
+    parts.extend(e.fixed_boxes.iter().map(|b| format!("box {b:?} m")));
+    if parts.is_empty() {
+        "nothing (free-free)".into()
+    } else {
+        parts.join(" + ")
     }
 }
 
@@ -166,10 +188,10 @@ fn ensure(
         ),
     };
     eprintln!(
-        "[dcr-scenes] baking {} ({} modes, fixed {:?}){table} -> {}",
+        "[dcr-scenes] baking {} ({} modes, fixed {}){table} -> {}",
         e.name,
         e.modes,
-        e.fixed,
+        fixed_summary(e),
         out.display()
     );
     let t = std::time::Instant::now();

@@ -5,9 +5,9 @@ mod validate;
 mod world_builder;
 
 pub use scene_desc::{
-    name_matches, BodyKind, ColliderDesc, DriverDesc, ElasticDesc, JointDesc, MaterialDesc,
-    MethodDesc, OutcomeDesc, PoseDesc, PropDesc, SceneDesc, ShapeDesc, TableOrderDesc,
-    TransferDesc,
+    name_matches, AxisDesc, BodyKind, ColliderDesc, DriverDesc, ElasticDesc, FixedBelowDesc,
+    JointDesc, MaterialDesc, MethodDesc, OutcomeDesc, PoseDesc, PropDesc, SceneDesc, ShapeDesc,
+    TableOrderDesc, TransferDesc,
 };
 pub use validate::{
     is_plain_name, H_RANGE_S, MASS_RANGE_KG, MAX_BODIES, MAX_GRAVITY, MAX_POSITION_M, MAX_SIZE_M,

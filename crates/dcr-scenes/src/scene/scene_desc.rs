@@ -191,9 +191,19 @@ pub struct ElasticDesc {
     pub mesh: String,
     /// Material (paper Table 2).
     pub material: MaterialDesc,
-    /// Physical groups fixed in the bake (empty: free-free).
+    /// Physical groups of the mesh whose nodes are fixed. The fixed set is the union of
+    /// `fixed`, `fixed_below` and `fixed_boxes`; all empty: free-free. Default empty.
     #[serde(default)]
     pub fixed: Vec<String>,
+    /// Half-spaces of fixed nodes, in the mesh frame: `{"axis": "y", "value": 0.01}` fixes
+    /// every node with y ≤ 0.01 m — an asset without physical groups (an OBJ meshed by
+    /// `modal-bake mesh`) standing on its feet. The bake's `--fixed-below`. Default empty.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub fixed_below: Vec<FixedBelowDesc>,
+    /// Boxes of fixed nodes `[x0, y0, z0, x1, y1, z1]` (m, mesh frame, bounds included). The
+    /// bake's `--fixed-box`. Default empty.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub fixed_boxes: Vec<[f64; 6]>,
     /// Number of modes. Default 20.
     #[serde(default = "default_modes")]
     pub modes: usize,
@@ -231,6 +241,46 @@ pub struct ElasticDesc {
     /// for every object. Default 1.
     #[serde(default = "default_gain")]
     pub gain: f64,
+}
+
+impl ElasticDesc {
+    /// `fixed_below` as the baker's selectors (axis 0 = x, 1 = y, 2 = z).
+    pub fn fixed_below(&self) -> Vec<modal_bake::bake::FixedBelow> {
+        self.fixed_below
+            .iter()
+            .map(|b| modal_bake::bake::FixedBelow {
+                axis: b.axis as usize,
+                value: b.value,
+            })
+            .collect()
+    }
+
+    /// Whether nothing is fixed (a free-free object).
+    pub fn free_free(&self) -> bool {
+        self.fixed.is_empty() && self.fixed_below.is_empty() && self.fixed_boxes.is_empty()
+    }
+}
+
+/// A half-space of fixed nodes: every node whose coordinate `axis` is ≤ `value` (mesh frame).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FixedBelowDesc {
+    /// The coordinate compared: `"x"`, `"y"` or `"z"`.
+    pub axis: AxisDesc,
+    /// The threshold (m); nodes at or below it are fixed.
+    pub value: f64,
+}
+
+/// A coordinate axis of the mesh frame.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum AxisDesc {
+    /// x.
+    X = 0,
+    /// y.
+    Y = 1,
+    /// z.
+    Z = 2,
 }
 
 fn default_modes() -> usize {

@@ -6,7 +6,8 @@
 use std::collections::BTreeSet;
 
 use super::scene_desc::{
-    name_matches, BodyKind, ColliderDesc, MethodDesc, PoseDesc, SceneDesc, ShapeDesc, TransferDesc,
+    name_matches, BodyKind, ColliderDesc, ElasticDesc, MethodDesc, PoseDesc, SceneDesc, ShapeDesc,
+    TransferDesc,
 };
 
 /// Largest |coordinate| of a pose, copy, anchor or point (m).
@@ -212,6 +213,51 @@ fn colliders(field: &str, cs: &[ColliderDesc]) -> Check {
     for (i, c) in cs.iter().enumerate() {
         shape(&format!("{field}[{i}].shape"), &c.shape)?;
         pose(&format!("{field}[{i}].offset"), &c.offset)?;
+    }
+    Ok(())
+}
+
+/// Most fixed-node selectors of one kind (half-spaces or boxes) per elastic object.
+const MAX_FIXED_SELECTORS: usize = 64;
+
+/// The fixed-node selectors of elastic object `e` (field prefix `field`): finite values within
+/// the scene's extent, boxes with each minimum ≤ its maximum, at most
+/// [`MAX_FIXED_SELECTORS`] of each kind. Whether they fix any node is the bake's check (it
+/// reads the mesh).
+fn fixed_selectors(field: &str, e: &ElasticDesc) -> Check {
+    if e.fixed_below.len() > MAX_FIXED_SELECTORS || e.fixed_boxes.len() > MAX_FIXED_SELECTORS {
+        return Err(format!(
+            "{field}: at most {MAX_FIXED_SELECTORS} fixed_below and {MAX_FIXED_SELECTORS} fixed_boxes (got {} and {})",
+            e.fixed_below.len(),
+            e.fixed_boxes.len()
+        ));
+    }
+    for (i, b) in e.fixed_below.iter().enumerate() {
+        if !(b.value.is_finite() && b.value.abs() <= MAX_POSITION_M) {
+            return Err(format!(
+                "{field}.fixed_below[{i}].value must be finite within ±{MAX_POSITION_M} m (got {})",
+                b.value
+            ));
+        }
+    }
+    for (i, b) in e.fixed_boxes.iter().enumerate() {
+        for (k, x) in b.iter().enumerate() {
+            if !(x.is_finite() && x.abs() <= MAX_POSITION_M) {
+                return Err(format!(
+                    "{field}.fixed_boxes[{i}][{k}] must be finite within ±{MAX_POSITION_M} m (got {x})"
+                ));
+            }
+        }
+        for k in 0..3 {
+            if b[k] > b[k + 3] {
+                return Err(format!(
+                    "{field}.fixed_boxes[{i}]: the minimum {} of axis {} is above its maximum {} (expected [x0, y0, z0, x1, y1, z1] m)",
+                    b[k],
+                    ["x", "y", "z"][k],
+                    b[k + 3]
+                ));
+            }
+        }
     }
     Ok(())
 }
@@ -429,6 +475,7 @@ impl SceneDesc {
                 ));
             }
             positive_max(&format!("{f}.material.density"), m.density, 1e6, " kg/m³")?;
+            fixed_selectors(&f, e)?;
             if e.modes == 0 || e.modes > 2000 {
                 return Err(format!("{f}.modes must be in [1, 2000] (got {})", e.modes));
             }

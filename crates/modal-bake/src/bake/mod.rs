@@ -13,6 +13,7 @@
 mod error;
 mod estimate;
 mod fixed_near;
+mod fixed_nodes;
 mod hashing;
 mod mode_set;
 mod params;
@@ -33,6 +34,7 @@ pub use estimate::{
     FTETWILD_ELEMENTS,
 };
 pub use fixed_near::{FixedNear, DEFAULT_DISTANCE_FRACTION};
+pub use fixed_nodes::{FixedNodes, FixedSelectors};
 pub use hashing::{geometry_hash, round_16_digits};
 pub use mode_set::{mode_set_dense, mode_set_from_dense, mode_set_lanczos};
 pub use params::{BakeParams, FixedBelow, ModeRequest};

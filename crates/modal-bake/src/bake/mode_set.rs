@@ -22,12 +22,7 @@ pub fn mode_set_dense(
     modes: TransferModes,
     file: &str,
 ) -> Result<ModesFile, TransferError> {
-    let tp = SystemParams {
-        material: params.material,
-        fixed: params.fixed.clone(),
-        rayleigh: params.rayleigh,
-        lumped: params.lumped,
-    };
+    let tp = SystemParams::of_bake(params);
     let sys = FullOrderSystem::new(mesh.clone(), &tp, file)?;
     let ma = ModalAll::new(&sys, DENSE_MAX_DOFS)?;
     let m = match modes {

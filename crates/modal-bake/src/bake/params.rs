@@ -137,37 +137,18 @@ impl BakeParams {
                 self.rayleigh
             )));
         }
-        for b in &self.fixed_below {
-            if b.axis > 2 || !b.value.is_finite() {
-                return Err(BakeError::Params(format!(
-                    "parameter `fixed_below` needs an axis 0, 1 or 2 (x, y, z) and a finite value in m, got axis {} value {}",
-                    b.axis, b.value
-                )));
-            }
-        }
-        for b in &self.fixed_boxes {
-            if !b.iter().all(|x| x.is_finite()) || (0..3).any(|k| b[k] > b[k + 3]) {
-                return Err(BakeError::Params(format!(
-                    "parameter `fixed_boxes` = {b:?}: expected finite [x0, y0, z0, x1, y1, z1] (m) with each minimum ≤ its maximum"
-                )));
-            }
-        }
-        for f in &self.fixed_near {
-            let n = f.points.len();
-            if n == 0
-                || !f.points.iter().flatten().all(|x| x.is_finite())
-                || f.triangles.iter().flatten().any(|&i| i >= n)
-                || f.distance.is_some_and(|d| !(d.is_finite() && d > 0.0))
-            {
-                return Err(BakeError::Params(format!(
-                    "parameter `fixed_near` ({}): expected at least one point, finite coordinates (m), triangles indexing the points and a positive distance (m), got {n} points, {} triangles, distance {:?}",
-                    f.label,
-                    f.triangles.len(),
-                    f.distance
-                )));
-            }
-        }
+        self.fixed_selectors().check()?;
         Ok(mat)
+    }
+
+    /// The fixed-node selectors (`fixed`, `fixed_below`, `fixed_boxes`, `fixed_near`), borrowed.
+    pub fn fixed_selectors(&self) -> super::FixedSelectors<'_> {
+        super::FixedSelectors {
+            groups: &self.fixed,
+            below: &self.fixed_below,
+            boxes: &self.fixed_boxes,
+            near: &self.fixed_near,
+        }
     }
 
     /// `sha256:<hex>` of everything in these parameters that changes the result, plus a

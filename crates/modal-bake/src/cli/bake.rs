@@ -4,9 +4,7 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::Args;
-use modal_bake::bake::{
-    self, BakeParams, BakeReport, BakeStage, FixedBelow, ModeRequest, ModesPrecision,
-};
+use modal_bake::bake::{self, BakeParams, BakeReport, BakeStage, ModeRequest, ModesPrecision};
 use modal_bake::transfer::{TableOrder, TransferModes, TransferParams};
 
 use super::budget::BudgetOptions;
@@ -31,23 +29,6 @@ pub struct BakeOptions {
     /// Store the surface mode shapes as 32-bit floats (half the file size).
     #[arg(long)]
     pub f32: bool,
-    /// Fix every node at or below a coordinate, e.g. `y=0.01` (m, object frame; repeatable;
-    /// combines with --fixed and --fixed-box). A selector that fixes no node is an error.
-    #[arg(long, value_name = "AXIS=VALUE", value_parser = parse::axis_value, allow_hyphen_values = true)]
-    pub fixed_below: Vec<FixedBelow>,
-    /// Fix every node inside a box X0,Y0,Z0,X1,Y1,Z1 (m, object frame, bounds included;
-    /// repeatable; combines with --fixed and --fixed-below).
-    #[arg(long, value_name = "X0,Y0,Z0,X1,Y1,Z1", value_parser = parse::aabb, allow_hyphen_values = true)]
-    pub fixed_box: Vec<[f64; 6]>,
-    /// Fix every node within --fixed-near-distance of the points and faces in an OBJ file
-    /// (`v x y z` lines in m, object frame; optional `f` faces), e.g. a vertex group's
-    /// vertices and faces: exactly the region they cover (repeatable; combines with the other
-    /// selectors). The mid-edge node of an edge whose two ends are fixed is fixed too.
-    #[arg(long, value_name = "FILE.obj", value_parser = parse::fixed_near)]
-    pub fixed_near: Vec<modal_bake::bake::FixedNear>,
-    /// Distance (m) for --fixed-near [default: 1/200 of the mesh's bounding-box diagonal].
-    #[arg(long, value_name = "M", requires = "fixed_near")]
-    pub fixed_near_distance: Option<f64>,
 }
 
 impl BakeOptions {
@@ -59,16 +40,9 @@ impl BakeOptions {
                 None => ModeRequest::Count(self.modes.unwrap_or(20)),
             },
             fixed: self.model.fixed.clone(),
-            fixed_below: self.fixed_below.clone(),
-            fixed_boxes: self.fixed_box.clone(),
-            fixed_near: self
-                .fixed_near
-                .iter()
-                .map(|f| modal_bake::bake::FixedNear {
-                    distance: self.fixed_near_distance.or(f.distance),
-                    ..f.clone()
-                })
-                .collect(),
+            fixed_below: self.model.fixed_below.clone(),
+            fixed_boxes: self.model.fixed_box.clone(),
+            fixed_near: self.model.fixed_near(),
             rayleigh: self.model.rayleigh,
             lumped: self.model.lumped,
             precision: if self.f32 {

@@ -34,10 +34,12 @@ pub struct FullOrderSystem {
 }
 
 impl FullOrderSystem {
-    /// Orients and checks `mesh`, fixes the groups named in `params.fixed`, assembles K and M.
+    /// Orients and checks `mesh`, fixes the nodes `params`' selectors pick (groups, half-spaces,
+    /// boxes: [`SystemParams::fixed_selectors`]), assembles K and M.
     ///
     /// # Errors
-    /// [`FullOrderError`] on an invalid material, a degenerate or disconnected mesh, unknown groups.
+    /// [`FullOrderError`] on an invalid material, a degenerate or disconnected mesh, an unknown
+    /// group, a selector that fixes no node, collinear fixed nodes or every node fixed.
     pub fn new(
         mut mesh: TetMesh,
         params: &SystemParams,
@@ -79,17 +81,15 @@ impl FullOrderSystem {
                 "{file}: the mesh has {pieces} disconnected pieces"
             )));
         }
-        let mut fixed = Vec::new();
-        for name in &params.fixed {
-            fixed.extend_from_slice(mesh.group_nodes(name).map_err(name_file)?);
-        }
-        fixed.sort_unstable();
-        fixed.dedup();
-        if !fixed.is_empty() && fixed.len() == mesh.nodes.len() {
-            return Err(FullOrderError::Params(format!(
-                "{file}: the fixed groups fix every node; nothing can vibrate"
-            )));
-        }
+        let fixed = params
+            .fixed_selectors()
+            .resolve(&mesh, file)
+            .map_err(|e| match e {
+                crate::bake::BakeError::Mesh(e) => FullOrderError::Mesh(e),
+                crate::bake::BakeError::Params(msg) => FullOrderError::Params(msg),
+                other => FullOrderError::Params(other.to_string()),
+            })?
+            .nodes;
         let (map, k, m) = fem::assemble_clamped(&mesh, &mat, params.lumped, &fixed)
             .map_err(|e| FullOrderError::Params(format!("{file}: {e}")))?;
         let rigid = if fixed.is_empty() {

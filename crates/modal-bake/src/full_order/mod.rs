@@ -40,8 +40,18 @@ use crate::mesh::MeshError;
 pub struct SystemParams {
     /// Isotropic material (E in Pa, ν, ρ in kg/m³). Default: 1.1 GPa, 0.3, 770 (as a bake).
     pub material: MaterialSi,
-    /// Names of physical groups whose nodes are fixed (empty: free-free).
+    /// Names of physical groups whose nodes are fixed (empty, with the other selectors empty:
+    /// free-free).
     pub fixed: Vec<String>,
+    /// Fix every node whose coordinate `axis` is ≤ `value` (m, mesh frame); a bake's
+    /// `fixed_below`. Default none.
+    pub fixed_below: Vec<crate::bake::FixedBelow>,
+    /// Fix every node inside an axis-aligned box `[x0, y0, z0, x1, y1, z1]` (m, mesh frame,
+    /// bounds included); a bake's `fixed_boxes`. Default none.
+    pub fixed_boxes: Vec<[f64; 6]>,
+    /// Fix every node near given points and triangles (m, mesh frame); a bake's `fixed_near`.
+    /// Default none.
+    pub fixed_near: Vec<crate::bake::FixedNear>,
     /// Rayleigh damping [α0 (1/s), α1 (s)]. Default (10, 1e-7), as a bake.
     pub rayleigh: [f64; 2],
     /// Lumped (diagonal) mass instead of consistent mass. Default false.
@@ -57,8 +67,54 @@ impl Default for SystemParams {
                 density: 770.0,
             },
             fixed: Vec::new(),
+            fixed_below: Vec::new(),
+            fixed_boxes: Vec::new(),
+            fixed_near: Vec::new(),
             rayleigh: [10.0, 1e-7],
             lumped: false,
+        }
+    }
+}
+
+impl SystemParams {
+    /// The object a bake with `params` describes: its material, every fixed-node selector,
+    /// Rayleigh damping and mass lumping (the full-order system of that bake's base).
+    pub fn of_bake(params: &crate::bake::BakeParams) -> SystemParams {
+        SystemParams {
+            material: params.material,
+            fixed: params.fixed.clone(),
+            fixed_below: params.fixed_below.clone(),
+            fixed_boxes: params.fixed_boxes.clone(),
+            fixed_near: params.fixed_near.clone(),
+            rayleigh: params.rayleigh,
+            lumped: params.lumped,
+        }
+    }
+
+    /// The bake of this object keeping `modes` (every other bake parameter at its default):
+    /// the inverse of [`SystemParams::of_bake`].
+    pub fn bake_params(&self, modes: crate::bake::ModeRequest) -> crate::bake::BakeParams {
+        crate::bake::BakeParams {
+            material: self.material,
+            modes,
+            fixed: self.fixed.clone(),
+            fixed_below: self.fixed_below.clone(),
+            fixed_boxes: self.fixed_boxes.clone(),
+            fixed_near: self.fixed_near.clone(),
+            rayleigh: self.rayleigh,
+            lumped: self.lumped,
+            ..Default::default()
+        }
+    }
+
+    /// The fixed-node selectors (`fixed`, `fixed_below`, `fixed_boxes`, `fixed_near`),
+    /// borrowed: the same selection as a bake with these parameters.
+    pub fn fixed_selectors(&self) -> crate::bake::FixedSelectors<'_> {
+        crate::bake::FixedSelectors {
+            groups: &self.fixed,
+            below: &self.fixed_below,
+            boxes: &self.fixed_boxes,
+            near: &self.fixed_near,
         }
     }
 }

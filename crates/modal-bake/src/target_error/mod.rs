@@ -144,12 +144,7 @@ pub fn bake_to_target(
     }
     // The many-mode set: every mode (dense) or 640 (Lanczos); modal candidates truncate it.
     progress(BakeStage::TransferModes);
-    let sp = SystemParams {
-        material: params.material,
-        fixed: params.fixed.clone(),
-        rayleigh: params.rayleigh,
-        lumped: params.lumped,
-    };
+    let sp = SystemParams::of_bake(params);
     let sys = FullOrderSystem::new(mesh.clone(), &sp, file).map_err(|e| terr(e.into()))?;
     let dense = dofs <= DENSE_MAX_DOFS;
     let ma = if dense {
