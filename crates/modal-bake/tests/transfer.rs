@@ -475,6 +475,20 @@ fn a_table_follows_every_fixed_node_selector() {
         assert!(o.status.success(), "{}", text(&o));
         ModesFile::read(&out).unwrap()
     };
+    let check = |name: &str, fixed: &[&str]| {
+        let out = dir.path().join(name);
+        let mut args = vec!["check", mesh.to_str().unwrap(), out.to_str().unwrap()];
+        args.extend_from_slice(fixed);
+        args.extend_from_slice(&[
+            "--modes",
+            "8",
+            "--transfer-h",
+            "0.004",
+            "--transfer-modes",
+            "60",
+        ]);
+        run(&args)
+    };
     let group = bake("group.modes", &["--fixed", "clamp"]);
     let below = bake("below.modes", &["--fixed-below", "x=0"]);
     let boxed = bake("box.modes", &["--fixed-box", "-1,-1,-1,0,1,1"]);
@@ -489,4 +503,22 @@ fn a_table_follows_every_fixed_node_selector() {
         assert_eq!(t.modes, 60);
         assert!(t == g, "the tables differ");
     }
+    // A table base fixed by a half-space but baked when its extra modes were solved with the
+    // groups alone (it lacks `modes_fixed_by`) is stale; the fresh one is up to date.
+    let o = check("below.modes", &["--fixed-below", "x=0"]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let mut old = below.clone();
+    let removed = old.meta.bake_params["transfer"]
+        .as_object_mut()
+        .unwrap()
+        .remove("modes_fixed_by");
+    assert_eq!(removed, Some(serde_json::json!("every selector")));
+    old.write_atomic(&dir.path().join("below.modes")).unwrap();
+    let o = check("below.modes", &["--fixed-below", "x=0"]);
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+    assert!(text(&o).contains("transfer"), "{}", text(&o));
+    // A base fixed by groups alone records nothing new.
+    assert!(group.meta.bake_params["transfer"]
+        .get("modes_fixed_by")
+        .is_none());
 }

@@ -430,17 +430,23 @@ fn bake_with_table(
         t.elapsed().as_secs_f64(),
     ));
     if let Some(obj) = base.meta.bake_params.as_object_mut() {
-        obj.insert("transfer".into(), transfer_meta(tp));
+        obj.insert("transfer".into(), transfer_meta(tp, params));
     }
     base.transfer = Some(table);
     Ok((base, report))
 }
 
 /// The record of a transfer table's parameters in `meta.bake_params.transfer` (what
-/// [`base_status`] compares).
-pub(super) fn transfer_meta(tp: &crate::transfer::TransferParams) -> serde_json::Value {
+/// [`base_status`] compares). A base fixed by half-spaces, boxes or `near` sets records
+/// `"modes_fixed_by": "every selector"`: its table's extra modes are solved with those nodes
+/// fixed, where tables baked before that was so were solved with the physical groups alone —
+/// such bases lack the key and are stale.
+pub(super) fn transfer_meta(
+    tp: &crate::transfer::TransferParams,
+    params: &BakeParams,
+) -> serde_json::Value {
     use crate::transfer::TransferModes;
-    serde_json::json!({
+    let mut meta = serde_json::json!({
         "h": tp.h,
         "modes": match tp.modes {
             TransferModes::All => serde_json::json!("all"),
@@ -457,7 +463,12 @@ pub(super) fn transfer_meta(tp: &crate::transfer::TransferParams) -> serde_json:
             crate::transfer::TableOrder::Quadratic => serde_json::json!(2),
             crate::transfer::TableOrder::Cubic => serde_json::json!(3),
         },
-    })
+    });
+    let selectors = params.fixed_selectors();
+    if !(selectors.below.is_empty() && selectors.boxes.is_empty() && selectors.near.is_empty()) {
+        meta["modes_fixed_by"] = "every selector".into();
+    }
+    meta
 }
 
 /// Reads `mesh_path`, bakes it ([`bake_mesh`], with the transfer table when `params` asks for

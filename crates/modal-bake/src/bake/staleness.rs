@@ -156,7 +156,7 @@ pub fn mesh_base_status(
                 ..tp.clone()
             };
             base.transfer.is_some()
-                && base.meta.bake_params.get("transfer") == Some(&transfer_meta(&resolved))
+                && base.meta.bake_params.get("transfer") == Some(&transfer_meta(&resolved, params))
         }
     };
     if !table_matches {
