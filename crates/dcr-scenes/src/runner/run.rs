@@ -16,6 +16,7 @@ use dcr_runtime::{Launch, Method, ModalModel, ResponseParams};
 use ndarray::{Array1, Array2};
 use ndarray_npy::NpzWriter;
 use rapier3d_f64::math::Vector;
+use rapier3d_f64::prelude::RigidBodyHandle;
 use serde::Serialize;
 
 use crate::runner::bases::{ensure_base, ensure_transfer_base};
@@ -283,6 +284,145 @@ pub struct RunReport {
     /// stepped, and the contact reports it was given (not serialised; `timings.npz`).
     #[serde(skip)]
     pub step_times: Vec<StepTime>,
+    /// Launched bodies (the scene's projectiles: dynamic, with a non-zero initial velocity,
+    /// starting more than [`SETTLE_GAP_M`] from the object) that hit an elastic object within
+    /// the world's settle window — its first `settle_steps` steps (3 by default), whose
+    /// contacts are the initial resting set and never impacts — so that the hit had no
+    /// response: one line per body and object, with the step and the fix. Also printed on
+    /// stderr. Empty: none.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub warnings: Vec<String>,
+}
+
+/// A launched body starting within this distance (m) of an elastic object rests on it (a
+/// vehicle on the ground), and its contacts in the settle window are not reported.
+pub const SETTLE_GAP_M: f64 = 1e-3;
+
+/// Watches the world's settle window for the scene's projectiles (see
+/// [`RunReport::warnings`]).
+struct SettleWatch {
+    /// The window: steps 0 … `steps` − 1.
+    steps: usize,
+    /// Launched bodies: (handle, name).
+    launched: Vec<(RigidBodyHandle, String)>,
+    /// Elastic bodies: (handle, object name).
+    elastic: Vec<(RigidBodyHandle, String)>,
+    /// Pairs (launched, object) that start resting on each other (closer than
+    /// [`SETTLE_GAP_M`]).
+    resting: Vec<(usize, usize)>,
+    /// What was seen: (launched, object, step, the pair's impulse in N·s).
+    hits: Vec<(usize, usize, usize, f64)>,
+}
+
+impl SettleWatch {
+    fn new(desc: &SceneDesc, built: &BuiltWorld, settle_steps: u64) -> SettleWatch {
+        let launched: Vec<(RigidBodyHandle, String)> = built
+            .bodies
+            .iter()
+            .filter(|b| b.dynamic && built.world.bodies[b.handle].linvel().length() > 0.0)
+            .map(|b| (b.handle, b.name.clone()))
+            .collect();
+        let elastic: Vec<(RigidBodyHandle, String)> = built
+            .elastic_body
+            .iter()
+            .zip(&desc.elastic)
+            .map(|(&i, e)| (built.bodies[i].handle, e.name.clone()))
+            .collect();
+        let mut resting = Vec::new();
+        for (l, (a, _)) in launched.iter().enumerate() {
+            for (e, (b, _)) in elastic.iter().enumerate() {
+                if gap(built, *a, *b) <= SETTLE_GAP_M {
+                    resting.push((l, e));
+                }
+            }
+        }
+        SettleWatch {
+            steps: settle_steps as usize,
+            launched,
+            elastic,
+            resting,
+            hits: Vec::new(),
+        }
+    }
+
+    /// Records the contacts of step `k` between a launched body and an elastic object that
+    /// carried an impulse (touching, not only predicted).
+    fn look(&mut self, built: &BuiltWorld, k: usize) {
+        if k >= self.steps || self.launched.is_empty() {
+            return;
+        }
+        let world = &built.world;
+        for pair in world.narrow_phase.contact_pairs() {
+            let body = |c| world.colliders.get(c).and_then(|c| c.parent());
+            let (Some(b1), Some(b2)) = (body(pair.collider1), body(pair.collider2)) else {
+                continue;
+            };
+            let impulse: f64 = pair
+                .solver_manifolds()
+                .iter()
+                .flat_map(|m| m.points.iter())
+                .map(|p| p.data.impulse)
+                .sum();
+            if !(impulse > 0.0) {
+                continue;
+            }
+            for (a, b) in [(b1, b2), (b2, b1)] {
+                let l = self.launched.iter().position(|(h, _)| *h == a);
+                let e = self.elastic.iter().position(|(h, _)| *h == b);
+                if let (Some(l), Some(e)) = (l, e) {
+                    if !self.resting.contains(&(l, e))
+                        && !self.hits.iter().any(|h| h.0 == l && h.1 == e)
+                    {
+                        self.hits.push((l, e, k, impulse));
+                    }
+                }
+            }
+        }
+    }
+
+    /// One warning per launched body and object it hit in the window.
+    fn warnings(&self, h: f64) -> Vec<String> {
+        self.hits
+            .iter()
+            .map(|&(l, e, k, impulse)| {
+                format!(
+                    "{} hit elastic object {} in step {} (t = {:.3} s, impulse {impulse:.3e} N·s), \
+                     inside the world's settle window (its first {} steps, whose contacts are the \
+                     initial resting set and never impacts): that hit has no distant response; \
+                     start {} farther from the object so that it arrives after t = {:.3} s",
+                    self.launched[l].1,
+                    self.elastic[e].1,
+                    k + 1,
+                    (k + 1) as f64 * h,
+                    self.steps,
+                    self.launched[l].1,
+                    self.steps as f64 * h
+                )
+            })
+            .collect()
+    }
+}
+
+/// The smallest distance (m) between the colliders of bodies `a` and `b` at their current
+/// poses (0 when they overlap; infinite when no pair of their shapes has a distance query).
+fn gap(built: &BuiltWorld, a: RigidBodyHandle, b: RigidBodyHandle) -> f64 {
+    let bodies = &built.world.bodies;
+    let colliders = &built.world.colliders;
+    let mut best = f64::INFINITY;
+    for &ca in bodies[a].colliders() {
+        for &cb in bodies[b].colliders() {
+            let (ca, cb) = (&colliders[ca], &colliders[cb]);
+            if let Ok(d) = rapier3d_f64::parry::query::distance(
+                ca.position(),
+                ca.shape(),
+                cb.position(),
+                cb.shape(),
+            ) {
+                best = best.min(d.distance);
+            }
+        }
+    }
+    best
 }
 
 /// One step's timing (see [`RunReport::step_times`]).
@@ -551,6 +691,7 @@ pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
     let objects = add_elastic_objects(desc, params, &mut built, &mut dcr)?;
     let drivers = resolve_drivers(desc, &built)?;
     let mut rec = RunRecord::new(desc, &built, steps);
+    let mut settle = SettleWatch::new(desc, &built, dcr.world().params().classify.settle_steps);
     let wall = Instant::now();
     let mut last_progress = Instant::now();
     for k in 0..steps {
@@ -559,6 +700,7 @@ pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
         rec.count_world_step(&dcr, &objects, apply);
         rec.collect_events(&dcr, &objects, &built, apply, k);
         rec.record_poses(&built, (k + 1) as f64 * desc.h);
+        settle.look(&built, k);
         if params.progress && last_progress.elapsed().as_secs_f64() > 5.0 {
             last_progress = Instant::now();
             eprintln!(
@@ -571,8 +713,12 @@ pub fn run_scene(desc: &SceneDesc, params: &RunParams) -> Result<RunReport> {
             );
         }
     }
-    let (report, rapier_us, adapter_us) =
+    let (mut report, rapier_us, adapter_us) =
         rec.into_report(desc, params, (seconds, steps, apply), &built, objects);
+    report.warnings = settle.warnings(desc.h);
+    for w in &report.warnings {
+        eprintln!("[dcr-scenes] warning: scene {}: {w}", desc.name);
+    }
     if let Some(dir) = &params.out_dir {
         write_outputs(dir, &report, &rapier_us, &adapter_us)?;
     }
@@ -962,6 +1108,7 @@ impl RunRecord {
             events: self.events,
             bodies_all: built.bodies.iter().map(|b| b.name.clone()).collect(),
             step_times: self.step_times,
+            warnings: Vec::new(),
         };
         (report, self.rapier_us, self.adapter_us)
     }
