@@ -6,21 +6,20 @@ asset nobody here made (docs/scenes.md, "A packaged asset in a scene").
 Steps, all into out/asset-scene/ (ignored by git):
   1. the bunny from its npm package, scaled to 0.3 m (largest side), faces as shipped
      (scripts/real_assets.py's loader);
-  2. `modal-bake mesh bunny.obj -o bunny.msh --order 1` (4-node tetrahedra: the coupled
-     reference takes linear meshes);
-  3. resting spots: vertical rays on the mesh's boundary, keeping the highest spots whose
-     surface within 1 cm rises or falls less than 3 mm per cm;
+  2. `modal-bake mesh bunny.obj -o bunny.msh --order 1 --size 0.04` (4-node tetrahedra of
+     about 4 cm: the coupled reference takes linear meshes whose every mode fits its dense
+     solve, 6000 free dofs by default);
+  3. resting spots: vertical rays on the mesh's boundary, keeping the highest spots where the
+     surface under a 2 x 2 cm pebble rises or falls by at most 2 mm; a pebble's bottom is
+     placed 0.1 mm above the highest point under it;
   4. the scene bunny.json: the bunny in ABS (E 2.3 GPa, nu 0.35, rho 1050 kg/m^3) standing on
      its feet (`fixed_below` y <= 1 cm above its lowest node, since an OBJ has no physical
-     groups), 10 g pebbles 1 mm above the two highest spots, a 5 kg steel ball thrown down at
+     groups), 10 g pebbles on the two highest spots, a 5 kg steel ball thrown down at
      6 m/s from 0.3 m above the third, a fixed ground;
   5. `dcr-scenes run bunny.json --dcr both`.
 Prints a markdown table of the outcomes and the run's warnings.
 
-The pebbles start 1 mm above the surface they fall onto (the outcome is their rise above that
-start): the coupled reference (`dcr-lab scene-truth out/asset-scene/bunny.json`) runs on the
-scene too, but reads a prop that starts inside the surface as a launch, so compare with it only
-from settled placements.
+The coupled reference runs on the scene too: `dcr-lab scene-truth out/asset-scene/bunny.json`.
 
 Usage: python3 scripts/asset_scene.py [--target DIR]
 Needs node/npm (the package), meshio and numpy, gmsh (modal-bake mesh's default mesher), and
@@ -42,7 +41,9 @@ ROOT = Path(__file__).resolve().parent.parent
 OUT = ROOT / "out/asset-scene"
 
 ABS = {"youngs": 2.3e9, "poisson": 0.35, "density": 1050.0}
-PEBBLE_HALF = [0.01, 0.004, 0.01]
+PEBBLE_HALF = [0.006, 0.003, 0.006]
+# Clearance (m) between a pebble's bottom and the highest surface point under it.
+GAP = 1e-4
 
 
 def boundary(msh):
@@ -73,27 +74,31 @@ def top(nodes, tris, x, z):
     return float((a[ok, 1] + u[ok] * e1[ok, 1] + v[ok] * e2[ok, 1]).max())
 
 
-def resting_spots(nodes, tris, count=3, step=0.01, max_slope=0.3, spacing=0.04):
-    """The `count` highest spots (x, z, surface y) whose neighbours 1 cm away differ by at
-    most `max_slope` cm per cm, at least `spacing` m apart."""
+def footprint(nodes, tris, x, z, half):
+    """(lowest, highest) boundary point (m) under a (2 half[0]) x (2 half[2]) footprint
+    centred at (x, z), sampled on a 5 x 5 grid, or None where a sample misses the mesh."""
+    ys = [top(nodes, tris, x + dx, z + dz)
+          for dx in np.linspace(-half[0], half[0], 5) for dz in np.linspace(-half[2], half[2], 5)]
+    return None if any(y is None for y in ys) else (min(ys), max(ys))
+
+
+def resting_spots(nodes, tris, count=3, step=0.005, max_rise=0.002, spacing=0.03):
+    """The `count` highest spots (x, z, y), at least `spacing` m apart, where the surface
+    under a pebble's footprint rises or falls by at most `max_rise` (m); y is the highest
+    boundary point under the footprint, so a pebble whose bottom is at y touches the surface
+    without entering it (and tips by at most `max_rise` as it settles)."""
     lo, hi = nodes.min(0), nodes.max(0)
-    ring = [(step, 0), (-step, 0), (0, step), (0, -step)]
     spots = []
     for x in np.arange(lo[0] + step, hi[0] - step, step):
         for z in np.arange(lo[2] + step, hi[2] - step, step):
-            y = top(nodes, tris, x, z)
-            if y is None:
-                continue
-            around = [top(nodes, tris, x + dx, z + dz) for dx, dz in ring]
-            if any(t is None for t in around):
-                continue
-            if max(abs(t - y) for t in around) / step <= max_slope:
-                spots.append((float(x), float(z), max([y] + around)))
+            f = footprint(nodes, tris, x, z, PEBBLE_HALF)
+            if f is not None and f[1] - f[0] <= max_rise:
+                spots.append((float(x), float(z), f[1]))
     spots.sort(key=lambda s: -s[2])
     chosen = []
-    for s in spots:
-        if all(np.hypot(s[0] - c[0], s[1] - c[1]) > spacing for c in chosen):
-            chosen.append(s)
+    for x, z, y in spots:
+        if all(np.hypot(x - c[0], z - c[1]) > spacing for c in chosen):
+            chosen.append((x, z, y))
         if len(chosen) == count:
             break
     if len(chosen) < count:
@@ -104,7 +109,7 @@ def resting_spots(nodes, tris, count=3, step=0.01, max_slope=0.3, spacing=0.04):
 def scene(mesh, nodes, spots):
     lowest = float(nodes[:, 1].min())
     (x0, z0, y0), (x1, z1, y1), (xb, zb, yb) = spots
-    lift = PEBBLE_HALF[1] + 0.001
+    lift = PEBBLE_HALF[1] + GAP
     return {
         "name": "bunny",
         "description": "A 0.3 m ABS Stanford bunny (npm bunny@1.0.1) standing on its feet; a 5 kg "
@@ -159,7 +164,8 @@ def main():
     obj = OUT / "bunny.obj"
     real_assets.write_obj(obj, v, f, size)
     msh = OUT / "bunny.msh"
-    p = run([rel / "modal-bake", "mesh", obj, "-o", msh, "--order", "1", "--json"],
+    p = run([rel / "modal-bake", "mesh", obj, "-o", msh, "--order", "1", "--size", "0.04",
+             "--json"],
             OUT / "mesh.log")
     if p.returncode != 0:
         sys.exit(f"asset_scene: modal-bake mesh failed (see {OUT / 'mesh.log'})")
