@@ -370,9 +370,9 @@ pub fn sample_attenuation(
 ///
 /// ```
 /// use dcr_lab::attenuation_fit::*;
+/// use modal_bake::full_order::SystemParams;
 /// use modal_bake::mesh::TetMesh;
 /// let mesh = TetMesh::structured_box([6, 2, 2], [1.0, 0.2, 0.2]);
-/// /// use modal_bake::full_order::SystemParams;
 /// let system = SystemParams { fixed: vec!["xmin".into()], ..Default::default() };
 /// let p = AttenuationFitParams { system, h: 2e-3, pairs: 20, ..Default::default() };
 /// let rep = fit_attenuation_mesh(mesh, &p, "box", &mut |_| {}).unwrap();

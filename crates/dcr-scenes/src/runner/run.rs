@@ -285,7 +285,7 @@ pub struct RunReport {
     #[serde(skip)]
     pub step_times: Vec<StepTime>,
     /// Launched bodies (the scene's projectiles: dynamic, with a non-zero initial velocity,
-    /// starting more than [`SETTLE_GAP_M`] from the object) that hit an elastic object within
+    /// starting more than 1 mm from the object) that hit an elastic object within
     /// the world's settle window — its first `settle_steps` steps (3 by default), whose
     /// contacts are the initial resting set and never impacts — so that the hit had no
     /// response: one line per body and object, with the step and the fix. Also printed on
@@ -296,7 +296,7 @@ pub struct RunReport {
 
 /// A launched body starting within this distance (m) of an elastic object rests on it (a
 /// vehicle on the ground), and its contacts in the settle window are not reported.
-pub const SETTLE_GAP_M: f64 = 1e-3;
+const SETTLE_GAP_M: f64 = 1e-3;
 
 /// Watches the world's settle window for the scene's projectiles (see
 /// [`RunReport::warnings`]).
