@@ -10,8 +10,8 @@ Steps, all into out/asset-scene/ (ignored by git):
      about 4 cm: the coupled reference takes linear meshes whose every mode fits its dense
      solve, 6000 free dofs by default);
   3. resting spots: vertical rays on the mesh's boundary, keeping the highest spots where the
-     surface under a 2 x 2 cm pebble rises or falls by at most 2 mm; a pebble's bottom is
-     placed 0.1 mm above the highest point under it;
+     surface under a 1.2 x 1.2 cm pebble rises or falls by at most 2 mm (the ball's, 6 mm,
+     7 cm from the pebbles'); a pebble's bottom is placed 0.1 mm above the highest point under it;
   4. the scene bunny.json: the bunny in ABS (E 2.3 GPa, nu 0.35, rho 1050 kg/m^3) standing on
      its feet (`fixed_below` y <= 1 cm above its lowest node, since an OBJ has no physical
      groups), 10 g pebbles on the two highest spots, a 5 kg steel ball thrown down at
@@ -74,33 +74,59 @@ def top(nodes, tris, x, z):
     return float((a[ok, 1] + u[ok] * e1[ok, 1] + v[ok] * e2[ok, 1]).max())
 
 
-def footprint(nodes, tris, x, z, half):
+def footprint(nodes, tris, x, z, half, exact=True):
     """(lowest, highest) boundary point (m) under a (2 half[0]) x (2 half[2]) footprint
-    centred at (x, z), sampled on a 5 x 5 grid, or None where a sample misses the mesh."""
-    ys = [top(nodes, tris, x + dx, z + dz)
-          for dx in np.linspace(-half[0], half[0], 5) for dz in np.linspace(-half[2], half[2], 5)]
+    centred at (x, z), or None where a sample misses the mesh. The surface is flat on each
+    triangle, so its highest point under the footprint is at a mesh vertex inside it or on the
+    footprint's rim: both are taken (the rim every 0.5 mm, the inside on a 5 x 5 grid).
+    `exact=False`: the 5 x 5 grid alone (a quick first pass)."""
+    xs = np.linspace(-half[0], half[0], 5)
+    zs = np.linspace(-half[2], half[2], 5)
+    pts = [(x + dx, z + dz) for dx in xs for dz in zs]
+    if not exact:
+        ys = [top(nodes, tris, px, pz) for px, pz in pts]
+        return None if any(y is None for y in ys) else (min(ys), max(ys))
+    n = max(2, int(2 * max(half[0], half[2]) / 5e-4) + 1)
+    for t in np.linspace(-1.0, 1.0, n):
+        pts += [(x + t * half[0], z - half[2]), (x + t * half[0], z + half[2]),
+                (x - half[0], z + t * half[2]), (x + half[0], z + t * half[2])]
+    used = np.unique(tris.ravel())
+    inside = used[(np.abs(nodes[used, 0] - x) <= half[0]) & (np.abs(nodes[used, 2] - z) <= half[2])]
+    pts += [(nodes[v, 0], nodes[v, 2]) for v in inside]
+    ys = [top(nodes, tris, px, pz) for px, pz in pts]
     return None if any(y is None for y in ys) else (min(ys), max(ys))
 
 
-def resting_spots(nodes, tris, count=3, step=0.005, max_rise=0.002, spacing=0.03):
-    """The `count` highest spots (x, z, y), at least `spacing` m apart, where the surface
-    under a pebble's footprint rises or falls by at most `max_rise` (m); y is the highest
-    boundary point under the footprint, so a pebble whose bottom is at y touches the surface
-    without entering it (and tips by at most `max_rise` as it settles)."""
+def resting_spots(nodes, tris, count=3, step=0.005, max_rise=0.002, spacing=0.03,
+                  ball_spacing=0.07):
+    """`count` spots (x, z, y): the `count` − 1 highest where the surface under a pebble's
+    footprint rises or falls by at most `max_rise` (m), at least `spacing` m apart, for the
+    pebbles — y the highest boundary point under the footprint, so a pebble whose bottom is at
+    y touches the surface without entering it (and tips by at most `max_rise` as it settles) —
+    and for the ball the highest spot at least `ball_spacing` m from them where the surface
+    under the footprint rises or falls by at most 3 `max_rise`."""
     lo, hi = nodes.min(0), nodes.max(0)
-    spots = []
+    spots, targets = [], []
     for x in np.arange(lo[0] + step, hi[0] - step, step):
         for z in np.arange(lo[2] + step, hi[2] - step, step):
-            f = footprint(nodes, tris, x, z, PEBBLE_HALF)
+            f = footprint(nodes, tris, x, z, PEBBLE_HALF, exact=False)
             if f is not None and f[1] - f[0] <= max_rise:
                 spots.append((float(x), float(z), f[1]))
+            if f is not None and f[1] - f[0] <= 3 * max_rise:
+                targets.append((float(x), float(z), f[1]))
     spots.sort(key=lambda s: -s[2])
+    targets.sort(key=lambda s: -s[2])
     chosen = []
     for x, z, y in spots:
-        if all(np.hypot(x - c[0], z - c[1]) > spacing for c in chosen):
+        if len(chosen) < count - 1:
+            if all(np.hypot(x - c[0], z - c[1]) > spacing for c in chosen):
+                f = footprint(nodes, tris, x, z, PEBBLE_HALF)
+                if f is not None and f[1] - f[0] <= max_rise:
+                    chosen.append((x, z, f[1]))
+    for x, z, y in targets:
+        if len(chosen) == count - 1 and all(
+                np.hypot(x - c[0], z - c[1]) > ball_spacing for c in chosen):
             chosen.append((x, z, y))
-        if len(chosen) == count:
-            break
     if len(chosen) < count:
         sys.exit(f"asset_scene: found {len(chosen)} resting spots on the mesh, need {count}")
     return chosen

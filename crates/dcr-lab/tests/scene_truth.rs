@@ -411,3 +411,36 @@ fn a_half_space_clamps_the_beam_as_its_group_does() {
         "{err}"
     );
 }
+
+/// A prop placed inside the object's surface is refused before its contact springs throw it:
+/// the 0.5 kg ball resting 0.1 mm deep in the clamped beam's top (y = 0.1 m) would hold
+/// ½·k·d² = 5 J under a 1e9 N/m spring, enough to lift it a metre. Resting on the surface it
+/// runs, as do the repository's scenes (their props start about 1e-9 m deep).
+#[test]
+fn a_prop_starting_inside_the_surface_is_refused() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let p = CoupledParams {
+        contact_stiffness: 1e9,
+        ..params(2e-5, 0.01, [10.0, 1e-7], 0.15)
+    };
+    let inside = scene(
+        false,
+        -9.81,
+        0.15,
+        0.5,
+        [0.8, 0.1299, 0.05],
+        [0.0, 0.0, 0.0],
+    );
+    let prep = prepare_elastic(&inside, &root, 1.0, 6000, None).expect("beam modes");
+    let err = run_coupled(&inside, &root, &prep, &p)
+        .err()
+        .expect("a ball 0.1 mm deep is refused")
+        .to_string();
+    assert!(
+        err.contains("ball starts 0.1000 mm inside elastic object beam's surface")
+            && err.contains("place it on the surface"),
+        "{err}"
+    );
+    let on = scene(false, -9.81, 0.15, 0.5, [0.8, 0.13, 0.05], [0.0, 0.0, 0.0]);
+    run_coupled(&on, &root, &prep, &p).expect("a ball on the surface runs");
+}

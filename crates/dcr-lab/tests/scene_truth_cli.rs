@@ -1,8 +1,7 @@
 //! `dcr-lab scene-truth`'s per-scene settings: `--scene-seconds SCENE=S` and `--scene-dt
 //! SCENE=S` reach that scene's run over `--seconds` and `--dt`, and malformed or foreign values
 //! of either are refused before any run; `--no-prop-feedback` is refused with `--page`;
-//! every scene is planned before any runs; an object colliding through its mesh boundary is
-//! warned about.
+//! every scene is planned before any runs.
 
 use std::process::{Command, Output};
 
@@ -103,23 +102,4 @@ fn a_scene_that_cannot_run_stops_the_others_before_they_start() {
     );
     assert!(e.contains("above the dense limit 6000"), "{e}");
     assert!(!e.contains("dinner dt"), "dinner started a run: {e}");
-}
-
-/// An elastic object colliding through its mesh boundary (the rockfall's cliff) is warned
-/// about before anything is planned; one with primitive colliders (dinner's table) is not.
-/// Both stop at a dense limit of 10 dofs, so nothing runs.
-#[test]
-fn a_mesh_boundary_collider_is_warned_about() {
-    let o = scene_truth(&["rockfall", "--max-dense-dofs", "10"]);
-    let e = stderr(&o);
-    assert!(!o.status.success(), "{e}");
-    assert!(
-        e.contains("warning: rockfall: elastic object cliff collides through its mesh boundary"),
-        "{e}"
-    );
-    let o = scene_truth(&["dinner", "--max-dense-dofs", "10"]);
-    let e = stderr(&o);
-    assert!(!o.status.success(), "{e}");
-    assert!(e.contains("above the dense limit 10"), "{e}");
-    assert!(!e.contains("warning"), "{e}");
 }

@@ -88,7 +88,10 @@ mod elastic_body;
 mod outcomes_page;
 
 pub use contact_solve::{solve_penalty_block, BlockSolveInfo};
-pub use coupled_run::{run_coupled, CoupledParams, CoupledRun, CouplingScheme, ElasticPrep};
+pub use coupled_run::{
+    run_coupled, CoupledParams, CoupledRun, CouplingScheme, ElasticPrep, START_OVERLAP_FLOOR_M,
+    START_OVERLAP_RISE_M,
+};
 pub use eigen_cache::{eigen_key, eigen_path, read_eigen, write_eigen};
 pub use elastic_body::ElasticBody;
 pub use outcomes_page::{
@@ -562,18 +565,6 @@ pub struct TruthPlan {
 /// As [`prepare_elastic`]; a projectile that cannot be advanced; a first contact after the
 /// simulated time; a run over the work budget.
 pub fn plan_truth(desc: &SceneDesc, root: &Path, params: &SceneTruthParams) -> Result<TruthPlan> {
-    // The repository's scenes rest their props on primitive colliders; on the npm bunny's
-    // mesh boundary a resting pebble was thrown with no impact (57 solver fallbacks in the
-    // run), for a cause not yet established.
-    for e in desc.elastic.iter().filter(|e| e.colliders.is_none()) {
-        eprintln!(
-            "[scene-truth] warning: {}: elastic object {} collides through its mesh boundary (a \
-             triangle mesh); the reference's contacts on triangle meshes are not validated — a \
-             10 g pebble resting on a meshed bunny was thrown 0.68 m with no impact — so give it \
-             primitive `colliders` where its props rest",
-            desc.name, e.name
-        );
-    }
     let t0 = Instant::now();
     let prep = prepare_elastic(
         desc,
