@@ -433,8 +433,7 @@ fn a_prop_starting_inside_the_surface_is_refused() {
     );
     let prep = prepare_elastic(&inside, &root, 1.0, 6000, None).expect("beam modes");
     let err = run_coupled(&inside, &root, &prep, &p)
-        .err()
-        .expect("a ball 0.1 mm deep is refused")
+        .expect_err("a ball 0.1 mm deep is refused")
         .to_string();
     assert!(
         err.contains("ball starts 0.1000 mm inside elastic object beam's surface")
