@@ -192,7 +192,7 @@ fn every_field_out_of_range_is_refused_naming_the_field() {
             "roof",
             vec!["elastic", "0", "fixed_boxes"],
             json!([[0, 1, 0, 1, 0, 1]]),
-            "elastic[0].fixed_boxes[0]: the minimum 1 of axis y is above its maximum 0",
+            "elastic[0].fixed_boxes[0] must be [xmin, ymin, zmin, xmax, ymax, zmax] with each min ≤ max (got 1 > 0)",
         ),
         (
             "roof",

@@ -459,36 +459,32 @@ fn check_is_fresh_after_a_default_table_bake() {
 fn a_table_follows_every_fixed_node_selector() {
     let dir = tempfile::tempdir().unwrap();
     let mesh = data("data/meshes/beam.msh");
-    let bake = |name: &str, fixed: &[&str]| {
+    let table = [
+        "--modes",
+        "8",
+        "--transfer-h",
+        "0.004",
+        "--transfer-modes",
+        "60",
+    ];
+    // `modal-bake COMMAND MESH OUT --FIXED... --table options` for `bake` and `check`.
+    let run_on = |command: &str, name: &str, fixed: &[&str]| {
         let out = dir.path().join(name);
-        let mut args = vec!["bake", mesh.to_str().unwrap(), "-o", out.to_str().unwrap()];
+        let mut args = vec![command, mesh.to_str().unwrap()];
+        if command == "bake" {
+            args.push("-o");
+        }
+        args.push(out.to_str().unwrap());
         args.extend_from_slice(fixed);
-        args.extend_from_slice(&[
-            "--modes",
-            "8",
-            "--transfer-h",
-            "0.004",
-            "--transfer-modes",
-            "60",
-        ]);
-        let o = run(&args);
-        assert!(o.status.success(), "{}", text(&o));
-        ModesFile::read(&out).unwrap()
-    };
-    let check = |name: &str, fixed: &[&str]| {
-        let out = dir.path().join(name);
-        let mut args = vec!["check", mesh.to_str().unwrap(), out.to_str().unwrap()];
-        args.extend_from_slice(fixed);
-        args.extend_from_slice(&[
-            "--modes",
-            "8",
-            "--transfer-h",
-            "0.004",
-            "--transfer-modes",
-            "60",
-        ]);
+        args.extend_from_slice(&table);
         run(&args)
     };
+    let bake = |name: &str, fixed: &[&str]| {
+        let o = run_on("bake", name, fixed);
+        assert!(o.status.success(), "{}", text(&o));
+        ModesFile::read(&dir.path().join(name)).unwrap()
+    };
+    let check = |name: &str, fixed: &[&str]| run_on("check", name, fixed);
     let group = bake("group.modes", &["--fixed", "clamp"]);
     let below = bake("below.modes", &["--fixed-below", "x=0"]);
     let boxed = bake("box.modes", &["--fixed-box", "-1,-1,-1,0,1,1"]);

@@ -240,20 +240,26 @@ fn fixed_selectors(field: &str, e: &ElasticDesc) -> Check {
             ));
         }
     }
-    for (i, b) in e.fixed_boxes.iter().enumerate() {
+    aabbs(&format!("{field}.fixed_boxes"), &e.fixed_boxes)?;
+    Ok(())
+}
+
+/// Axis-aligned boxes `[xmin, ymin, zmin, xmax, ymax, zmax]` (m) at `field`: finite within
+/// ±[`MAX_POSITION_M`], each minimum ≤ its maximum.
+fn aabbs(field: &str, boxes: &[[f64; 6]]) -> Check {
+    for (i, b) in boxes.iter().enumerate() {
         for (k, x) in b.iter().enumerate() {
             if !(x.is_finite() && x.abs() <= MAX_POSITION_M) {
                 return Err(format!(
-                    "{field}.fixed_boxes[{i}][{k}] must be finite within ±{MAX_POSITION_M} m (got {x})"
+                    "{field}[{i}][{k}] must be finite within ±{MAX_POSITION_M} m (got {x})"
                 ));
             }
         }
         for k in 0..3 {
             if b[k] > b[k + 3] {
                 return Err(format!(
-                    "{field}.fixed_boxes[{i}]: the minimum {} of axis {} is above its maximum {} (expected [x0, y0, z0, x1, y1, z1] m)",
+                    "{field}[{i}] must be [xmin, ymin, zmin, xmax, ymax, zmax] with each min ≤ max (got {} > {})",
                     b[k],
-                    ["x", "y", "z"][k],
                     b[k + 3]
                 ));
             }
@@ -266,24 +272,7 @@ fn transfer(field: &str, t: &TransferDesc) -> Check {
     if let Some(up) = t.up {
         nonzero_axis(&format!("{field}.up"), up)?;
     }
-    for (i, b) in t.boxes.iter().enumerate() {
-        for (k, x) in b.iter().enumerate() {
-            if !(x.is_finite() && x.abs() <= MAX_POSITION_M) {
-                return Err(format!(
-                    "{field}.boxes[{i}][{k}] must be finite within ±{MAX_POSITION_M} m (got {x})"
-                ));
-            }
-        }
-        for k in 0..3 {
-            if b[k] > b[k + 3] {
-                return Err(format!(
-                    "{field}.boxes[{i}] must be [xmin, ymin, zmin, xmax, ymax, zmax] with each min ≤ max (got {} > {})",
-                    b[k],
-                    b[k + 3]
-                ));
-            }
-        }
-    }
+    aabbs(&format!("{field}.boxes"), &t.boxes)?;
     if t.modes == Some(0) {
         return Err(format!("{field}.modes must be ≥ 1 (got 0)"));
     }
