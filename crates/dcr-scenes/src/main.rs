@@ -67,6 +67,41 @@ impl From<ApplyArg> for ApplyMode {
     }
 }
 
+/// How long and how large a missing or stale base may be to bake on demand (`run`, `table1`,
+/// `bench-stress`): each bake is sized before it starts (the mesh's modes and a transfer
+/// table's mode set, then the table once its modes are known) and refused over the budget,
+/// as `modal-bake bake --max-memory / --max-time` does.
+#[derive(clap::Args, Clone)]
+struct BakeBudgetArgs {
+    /// Refuse a base whose estimated bake (or transfer table) needs more memory than this
+    /// (GB, 1e9 bytes).
+    #[arg(long, value_name = "GB", default_value_t = 2.0)]
+    max_bake_memory: f64,
+    /// Refuse a base whose estimated bake (or transfer table) takes longer than this (s).
+    #[arg(long, value_name = "SECONDS", default_value_t = 300.0)]
+    max_bake_time: f64,
+    /// Bake whatever the estimate says.
+    #[arg(long)]
+    force_bake: bool,
+}
+
+impl BakeBudgetArgs {
+    fn budget(&self) -> Result<Option<modal_bake::bake::Budget>> {
+        for (name, v) in [
+            ("--max-bake-memory", self.max_bake_memory),
+            ("--max-bake-time", self.max_bake_time),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                bail!("{name} {v} must be a positive number");
+            }
+        }
+        Ok((!self.force_bake).then_some(modal_bake::bake::Budget {
+            max_bytes: self.max_bake_memory * 1e9,
+            max_seconds: self.max_bake_time,
+        }))
+    }
+}
+
 /// Options shared by `run` and `table1`: how the response is applied and bounded.
 #[derive(clap::Args, Clone)]
 struct ResponseArgs {
@@ -203,6 +238,8 @@ enum Cmd {
         gltf: Option<PathBuf>,
         #[command(flatten)]
         response: ResponseArgs,
+        #[command(flatten)]
+        budget: BakeBudgetArgs,
     },
     /// Bake missing/stale bases, run every scene on and off, print Table 1.
     Table1 {
@@ -227,6 +264,8 @@ enum Cmd {
         /// e.g. 1,0.5,0.1) and report which outcomes move by more than 5 %.
         #[arg(long, value_delimiter = ',', value_name = "ETAS")]
         energy_sweep: Vec<f64>,
+        #[command(flatten)]
+        budget: BakeBudgetArgs,
     },
     /// The adapter's per-step cost against the number of resting contacts: scenes/stress.json
     /// cut to its first N boxes, one JSON object on stdout (wall-clock medians).
@@ -240,6 +279,8 @@ enum Cmd {
         /// Bases directory (default out/bases).
         #[arg(long)]
         bases: Option<PathBuf>,
+        #[command(flatten)]
+        budget: BakeBudgetArgs,
     },
 }
 
@@ -314,7 +355,9 @@ fn real_main() -> Result<()> {
             bases,
             gltf,
             response,
+            budget,
         } => {
+            let bake_budget = budget.budget()?;
             let path = scene_path(&root, &scene);
             if std::fs::symlink_metadata(&path).is_err() {
                 bail!(
@@ -411,6 +454,7 @@ fn real_main() -> Result<()> {
                         launch: response.launch.into(),
                         contact_recycling: !response.no_contact_recycling,
                         gate: response.gate.into(),
+                        bake_budget,
                         ..RunParams::new(root.clone(), on)
                     },
                 )?;
@@ -459,7 +503,9 @@ fn real_main() -> Result<()> {
             gltf,
             response,
             energy_sweep,
+            budget,
         } => {
+            let bake_budget = budget.budget()?;
             for &e in &energy_sweep {
                 if !(0.0..=1.0).contains(&e) {
                     bail!("--energy-sweep: {e} is outside [0, 1]");
@@ -492,6 +538,7 @@ fn real_main() -> Result<()> {
                 gate: response.gate.into(),
                 eta_sweep: energy_sweep,
                 gltf_dir: gltf,
+                bake_budget,
             })
             .context("table1")?;
             if json {
@@ -504,7 +551,9 @@ fn real_main() -> Result<()> {
             props,
             seconds,
             bases,
+            budget,
         } => {
+            let bake_budget = budget.budget()?;
             if let Some(s) = seconds {
                 if !(s.is_finite() && s > 0.0) {
                     bail!("--seconds must be positive, got {s}");
@@ -516,6 +565,7 @@ fn real_main() -> Result<()> {
                 root: root.clone(),
                 bases_dir: bases.unwrap_or_else(|| root.join("out").join("bases")),
                 progress: true,
+                bake_budget,
             })
             .context("bench-stress")?;
             println!("{}", serde_json::to_string_pretty(&value)?);

@@ -22,7 +22,7 @@ fn bases() -> &'static PathBuf {
         let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("bases");
         for s in SCENES {
             for e in &scene(s).elastic {
-                ensure_base(&repo_root(), &dir, e).expect("base bakes");
+                ensure_base(&repo_root(), &dir, e, None).expect("base bakes");
             }
         }
         dir

@@ -23,7 +23,7 @@ fn bases() -> &'static PathBuf {
             let desc = SceneDesc::read(&root.join("scenes").join(format!("{s}.json")))
                 .expect("scene reads");
             for e in &desc.elastic {
-                ensure_base(&root, &dir, e).expect("base bakes");
+                ensure_base(&root, &dir, e, None).expect("base bakes");
             }
         }
         dir
@@ -220,12 +220,12 @@ fn a_half_space_fixes_the_table_as_its_feet_group_does() {
     boxed.elastic[0].fixed.clear();
     boxed.elastic[0].fixed_boxes = vec![[-1.0, -0.01, -1.0, 1.0, 0.0, 1.0]];
     let read = |p: PathBuf| dcr_runtime::format::ModesFile::read(&p).unwrap();
-    let (g, _) = ensure_base(&repo_root(), bases(), &grouped.elastic[0]).unwrap();
+    let (g, _) = ensure_base(&repo_root(), bases(), &grouped.elastic[0], None).unwrap();
     let g = read(g);
     let reference = run(&grouped, true, MethodChoice::Scene);
     for (what, desc) in [("fixed_below", below), ("fixed_boxes", boxed)] {
         let sub = dir.path().join(what);
-        let (b, baked) = ensure_base(&repo_root(), &sub, &desc.elastic[0]).unwrap();
+        let (b, baked) = ensure_base(&repo_root(), &sub, &desc.elastic[0], None).unwrap();
         assert!(baked);
         let b = read(b);
         assert_eq!(b.fixed_nodes, g.fixed_nodes, "{what}");
@@ -244,7 +244,13 @@ fn a_half_space_fixes_the_table_as_its_feet_group_does() {
     }
     let mut free = grouped.clone();
     free.elastic[0].fixed.clear();
-    let (f, _) = ensure_base(&repo_root(), &dir.path().join("free"), &free.elastic[0]).unwrap();
+    let (f, _) = ensure_base(
+        &repo_root(),
+        &dir.path().join("free"),
+        &free.elastic[0],
+        None,
+    )
+    .unwrap();
     assert!(read(f).fixed_nodes.is_empty());
 }
 

@@ -130,7 +130,7 @@ fn transfer_scene_bakes_a_table_and_serves_from_it() {
     let bases = bases_dir("serves");
     let desc = floor_scene(json!({"transfer": transfer_settings()}), None);
     let e = &desc.elastic[0];
-    let (modal_path, _) = ensure_base(&repo_root(), &bases, e).expect("modal base bakes");
+    let (modal_path, _) = ensure_base(&repo_root(), &bases, e, None).expect("modal base bakes");
     let modal_bytes = std::fs::read(&modal_path).expect("modal base reads");
 
     let r = run(&desc, &bases, MethodChoice::Scene, None);
@@ -206,11 +206,11 @@ fn transfer_settings_leave_the_modal_base_alone() {
     let bases = bases_dir("separate");
     let root = repo_root();
     let plain = floor_scene(json!("modal"), None);
-    let (p0, _) = ensure_base(&root, &bases, &plain.elastic[0]).expect("modal base bakes");
+    let (p0, _) = ensure_base(&root, &bases, &plain.elastic[0], None).expect("modal base bakes");
     let bytes = std::fs::read(&p0).expect("reads");
     let with = floor_scene(json!("modal"), Some(transfer_settings()));
     let e = &with.elastic[0];
-    let (p1, baked) = ensure_base(&root, &bases, e).expect("modal base checks");
+    let (p1, baked) = ensure_base(&root, &bases, e, None).expect("modal base checks");
     assert_eq!(p0, p1);
     assert!(!baked, "transfer settings made the modal base stale");
     assert_eq!(std::fs::read(&p1).expect("reads"), bytes);
@@ -220,15 +220,15 @@ fn transfer_settings_leave_the_modal_base_alone() {
     );
 
     let t = e.transfer.clone().expect("settings");
-    let (tp, _) = ensure_transfer_base(&root, &bases, e, &t, 0.01).expect("table bakes");
+    let (tp, _) = ensure_transfer_base(&root, &bases, e, &t, 0.01, None).expect("table bakes");
     assert_ne!(tp, p0);
-    let (_, again) = ensure_transfer_base(&root, &bases, e, &t, 0.01).expect("checks");
+    let (_, again) = ensure_transfer_base(&root, &bases, e, &t, 0.01, None).expect("checks");
     assert!(!again, "an unchanged table was rebaked");
     let moved = TransferDesc {
         boxes: vec![[-2.6, -0.5, -2.1, 0.0, 0.5, 2.1]],
         ..t
     };
-    let (_, rebaked) = ensure_transfer_base(&root, &bases, e, &moved, 0.01).expect("rebakes");
+    let (_, rebaked) = ensure_transfer_base(&root, &bases, e, &moved, 0.01, None).expect("rebakes");
     assert!(rebaked, "a changed region did not rebake the table");
     assert_eq!(std::fs::read(&p0).expect("reads"), bytes);
 }
@@ -352,6 +352,67 @@ fn cli_refuses_transfer_without_settings_a_negative_gain_and_a_sustained_attenua
         "{err}"
     );
     assert!(!bases.join("run-launch").exists());
+}
+
+/// An on-demand table over `--max-bake-time` is refused once its modes are known, before a row
+/// is built: the error names the object, the estimate and the scene settings that lower it,
+/// and no base is written; the mode count it suggests bakes within the same budget. (The
+/// floor's every-mode cubic table: 753 modes, ~50 s on one thread, against a 1 s budget.)
+#[test]
+fn cli_refuses_an_on_demand_table_over_the_budget() {
+    let exe = env!("CARGO_BIN_EXE_dcr-scenes");
+    let bases = bases_dir("budget");
+    let _ = std::fs::remove_dir_all(&bases);
+    let desc = floor_scene(json!({"transfer": {}}), None);
+    let scene = bases.join("scene.json");
+    std::fs::create_dir_all(&bases).unwrap();
+    std::fs::write(&scene, serde_json::to_vec(&desc).unwrap()).unwrap();
+    let dcr = |extra: &[&str]| {
+        std::process::Command::new(exe)
+            .arg("run")
+            .arg(&scene)
+            .args(["--seconds", "0.02", "--dcr", "on", "--max-bake-time", "1"])
+            .args(extra)
+            .arg("--bases")
+            .arg(bases.join("bases"))
+            .arg("--out")
+            .arg(bases.join("run"))
+            .env("RAYON_NUM_THREADS", "1")
+            .current_dir(repo_root())
+            .output()
+            .expect("dcr-scenes runs")
+    };
+    let out = dcr(&[]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "exit 0; stderr {err}");
+    for needle in [
+        "elastic object floor: ",
+        "transfer table: refused before building",
+        "753 modes",
+        "`transfer.modes` ",
+        "`transfer.up`",
+        "--force-bake",
+    ] {
+        assert!(err.contains(needle), "{needle:?} missing: {err}");
+    }
+    assert!(!err.contains("panicked"), "{err}");
+    assert!(!bases.join("bases/floor.transfer.modes").exists());
+    // The suggested count bakes within the same budget.
+    let k: usize = err
+        .split("`transfer.modes` ")
+        .nth(1)
+        .and_then(|r| r.split_whitespace().next())
+        .and_then(|n| n.parse().ok())
+        .expect("a suggested mode count");
+    let fitted = floor_scene(json!({"transfer": {"modes": k}}), None);
+    std::fs::write(&scene, serde_json::to_vec(&fitted).unwrap()).unwrap();
+    let out = dcr(&[]);
+    assert!(
+        out.status.success(),
+        "{k} modes: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(bases.join("bases/floor.transfer.modes").exists());
 }
 
 /// The support of lifted bodies in the scene runner, in both application modes: a box the

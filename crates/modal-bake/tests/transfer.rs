@@ -425,6 +425,73 @@ fn bad_transfer_options_are_clear_errors() {
     assert!(!o.status.success());
 }
 
+/// A table whose estimate is over `--max-time` is refused once its modes are known, before a
+/// row is built, naming the estimate and the fixes; nothing is written; the mode count it
+/// suggests then builds within the same budget; `--force` builds the refused table.
+#[test]
+fn a_table_over_the_budget_is_refused_before_it_is_built() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("t.modes");
+    // Every mode, one thread: an estimate of ~16 s against a 1 s budget on any machine.
+    let bake = |modes: &str, extra: &[&str]| {
+        let mesh = data("data/meshes/beam.msh");
+        let mut args = vec![
+            "bake",
+            mesh.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "--fixed",
+            "clamp",
+            "--modes",
+            "8",
+            "--transfer-h",
+            "0.004",
+            "--transfer-modes",
+            modes,
+            "--max-time",
+            "1",
+            "--json",
+        ];
+        args.extend_from_slice(extra);
+        bin()
+            .args(&args)
+            .env("RAYON_NUM_THREADS", "1")
+            .output()
+            .expect("run modal-bake")
+    };
+    let o = bake("all", &[]);
+    let msg = text(&o);
+    assert!(!o.status.success(), "{msg}");
+    for needle in [
+        "transfer table: refused before building",
+        "534 modes",
+        "samples per step come from the highest mode",
+        "`transfer.modes` ",
+        "--force",
+    ] {
+        assert!(msg.contains(needle), "{needle:?} missing: {msg}");
+    }
+    assert!(!msg.contains("transfer table: 1"), "rows were built: {msg}");
+    assert!(!out.exists(), "a base was written");
+    let left: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
+    assert!(left.is_empty(), "left behind: {left:?}");
+    let k = msg
+        .split("`transfer.modes` ")
+        .nth(1)
+        .and_then(|r| r.split_whitespace().next())
+        .expect("a suggested mode count")
+        .to_string();
+    let o = bake(&k, &[]);
+    assert!(o.status.success(), "{k} modes: {}", text(&o));
+    let report: serde_json::Value = serde_json::from_slice(&o.stdout).expect("json report");
+    let t = &report["transfer"];
+    assert_eq!(t["modes"].as_u64(), k.parse().ok());
+    assert!(t["estimated_s"].as_f64().unwrap() <= 1.0, "{t}");
+    let o = bake("all", &["--force", "--transfer-order", "2"]);
+    assert!(o.status.success(), "--force: {}", text(&o));
+    assert!(out.exists());
+}
+
 /// `check` with the bake's own options says fresh for a table baked at its default mode count
 /// (`auto`, recorded resolved for the mesh), and stale when a table option changes.
 #[test]

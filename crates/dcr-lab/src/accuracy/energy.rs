@@ -35,6 +35,7 @@ pub fn energy_section(root: &Path) -> anyhow::Result<String> {
         gate: Default::default(),
         eta_sweep: ETAS.to_vec(),
         gltf_dir: None,
+        bake_budget: Some(modal_bake::bake::Budget::default()),
     })?;
     Ok(render(&value))
 }

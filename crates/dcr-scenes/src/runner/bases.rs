@@ -6,11 +6,20 @@
 //! table reads) and `NAME.transfer.modes` (the same modes plus the bake-time peak-transfer
 //! table, baked only when a run asks for `transfer`). The two never share a file, so baking a
 //! table leaves the modal base and the runs that read it untouched.
+//!
+//! An on-demand bake is sized first, as `modal-bake bake` sizes it: the mesh's modes and a
+//! table's mode set before anything is solved ([`SizeEstimate::of_bake`]), the table itself
+//! once its modes are known (`modal_bake::transfer::TablePlan`); over the run's budget
+//! ([`RunParams::bake_budget`](super::RunParams::bake_budget)) the bake is refused with the
+//! estimate and the scene settings that lower it. Progress goes to stderr.
 
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
-use modal_bake::bake::{BakeParams, MaterialSi, ModeRequest};
+use modal_bake::bake::{
+    format_bytes, format_seconds, BakeError, BakeParams, BakeStage, Budget, MaterialSi,
+    ModeRequest, SizeEstimate,
+};
 use modal_bake::transfer::{TableOrder, TransferModes, TransferParams};
 
 use crate::scene::{ElasticDesc, TableOrderDesc, TransferDesc};
@@ -127,35 +136,49 @@ pub fn surface_base_path(bases_dir: &Path, e: &ElasticDesc) -> PathBuf {
     }
 }
 
-/// Bakes `e`'s modal base into `bases_dir` unless an up-to-date one is there. Returns the path
-/// and whether it baked. Progress on stderr.
+/// Bakes `e`'s modal base into `bases_dir` unless an up-to-date one is there, refusing a bake
+/// whose estimate is over `budget` (`None`: no limit). Returns the path and whether it baked.
+/// Progress on stderr.
 ///
 /// # Errors
-/// Mesh or bake failures, with the mesh path.
-pub fn ensure_base(root: &Path, bases_dir: &Path, e: &ElasticDesc) -> Result<(PathBuf, bool)> {
-    ensure(root, &base_path(bases_dir, e), e, &bake_params(e))
+/// Mesh or bake failures, with the mesh path; a bake over the budget.
+pub fn ensure_base(
+    root: &Path,
+    bases_dir: &Path,
+    e: &ElasticDesc,
+    budget: Option<Budget>,
+) -> Result<(PathBuf, bool)> {
+    ensure(root, &base_path(bases_dir, e), e, &bake_params(e), budget)
 }
 
 /// Bakes `e`'s base with the peak-transfer table `t` for step `h` (s) into `bases_dir`
 /// (`NAME.transfer.modes`) unless an up-to-date one is there (same mesh, bake and table
-/// parameters). Returns the path and whether it baked. Progress on stderr.
+/// parameters), refusing a bake or a table whose estimate is over `budget` (`None`: no limit).
+/// Returns the path and whether it baked. Progress on stderr.
 ///
 /// # Errors
 /// As [`transfer_params`]; mesh, bake or table failures (an empty region among them), with the
-/// object and the mesh path.
+/// object and the mesh path; a bake or a table over the budget.
 pub fn ensure_transfer_base(
     root: &Path,
     bases_dir: &Path,
     e: &ElasticDesc,
     t: &TransferDesc,
     h: f64,
+    budget: Option<Budget>,
 ) -> Result<(PathBuf, bool)> {
     let params = BakeParams {
-        transfer: Some(transfer_params(e, t, h)?),
+        transfer: Some(TransferParams {
+            budget,
+            ..transfer_params(e, t, h)?
+        }),
         ..bake_params(e)
     };
-    ensure(root, &transfer_base_path(bases_dir, e), e, &params)
+    ensure(root, &transfer_base_path(bases_dir, e), e, &params, budget)
 }
+
+/// How to run a refused bake anyway (the `dcr-scenes` options).
+const BUDGET_HINT: &str = "or raise --max-bake-memory / --max-bake-time, or pass --force-bake";
 
 /// Bakes `e`'s mesh with `params` to `out` unless `out` is up to date.
 fn ensure(
@@ -163,6 +186,7 @@ fn ensure(
     out: &Path,
     e: &ElasticDesc,
     params: &BakeParams,
+    budget: Option<Budget>,
 ) -> Result<(PathBuf, bool)> {
     if let Some(dir) = out.parent() {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
@@ -181,22 +205,64 @@ fn ensure(
     let table = match &params.transfer {
         None => String::new(),
         Some(t) => format!(
-            " with a transfer table (h {} s, up {:?}, {} boxes)",
+            " with a transfer table (h {} s, {}, {} region boxes)",
             t.h,
-            t.up,
+            t.up.map_or("every direction".into(), |u| format!(
+                "faces within {:.0}° of ({}, {}, {})",
+                t.up_min_cos.acos().to_degrees(),
+                u[0],
+                u[1],
+                u[2]
+            )),
             t.boxes.len()
         ),
     };
+    let tet_mesh = modal_bake::mesh::read_mesh(&mesh)
+        .with_context(|| format!("elastic object {}: reading {}", e.name, mesh.display()))?;
+    let estimate = SizeEstimate::of_bake(&tet_mesh, params);
+    drop(tet_mesh);
     eprintln!(
-        "[dcr-scenes] baking {} ({} modes, fixed {}){table} -> {}",
+        "[dcr-scenes] baking {} ({} modes, fixed {}){table} -> {}: {}",
         e.name,
         e.modes,
         fixed_summary(e),
-        out.display()
+        out.display(),
+        estimate.describe()
     );
+    if let Some(b) = budget.filter(|b| !estimate.fits(b)) {
+        let mut how = vec![
+            "a coarser mesh".to_string(),
+            format!("fewer `modes` (now {})", e.modes),
+        ];
+        if estimate.table_modes_s > 0.0 {
+            how.push("a `transfer.modes` count of at most `modes` (no second solve)".into());
+        }
+        bail!(
+            "elastic object {}: refused before baking {}: estimated {} is over the budget of {} and {}; to lower it: {}; {BUDGET_HINT}",
+            e.name,
+            mesh.display(),
+            estimate.describe(),
+            format_seconds(b.max_seconds),
+            format_bytes(b.max_bytes),
+            how.join(", or ")
+        );
+    }
     let t = std::time::Instant::now();
-    let report = modal_bake::bake::bake_file(&mesh, params, out, &mut |_| {})
-        .with_context(|| format!("elastic object {}: baking {}", e.name, mesh.display()))?;
+    let mut reporter = StageReporter::new(&e.name);
+    let report = match modal_bake::bake::bake_file(&mesh, params, out, &mut |s| reporter.update(s))
+    {
+        Ok(r) => r,
+        Err(err @ BakeError::Transfer { .. }) if is_over_budget(&err) => {
+            bail!("elastic object {}: {err}; {BUDGET_HINT}", e.name)
+        }
+        Err(err) => {
+            return Err(anyhow::Error::new(err).context(format!(
+                "elastic object {}: baking {}",
+                e.name,
+                mesh.display()
+            )))
+        }
+    };
     let table = match &report.transfer {
         None => String::new(),
         Some(r) => format!(
@@ -212,4 +278,71 @@ fn ensure(
         report.tets
     );
     Ok((out.to_path_buf(), true))
+}
+
+/// Whether `err` is a transfer table refused over its budget.
+fn is_over_budget(err: &BakeError) -> bool {
+    matches!(err, BakeError::Transfer { error, .. }
+        if matches!(**error, modal_bake::transfer::TransferError::OverBudget(_)))
+}
+
+/// Progress lines of an on-demand bake on stderr: each stage once, the table's plan when its
+/// build starts and its rows at most every 5 s.
+struct StageReporter<'a> {
+    name: &'a str,
+    stage: &'static str,
+    last_rows: Option<std::time::Instant>,
+}
+
+impl<'a> StageReporter<'a> {
+    fn new(name: &'a str) -> Self {
+        StageReporter {
+            name,
+            stage: "",
+            last_rows: None,
+        }
+    }
+
+    fn update(&mut self, s: BakeStage) {
+        let (stage, what) = match s {
+            BakeStage::Read | BakeStage::Write => return,
+            BakeStage::Assemble => ("assemble", "assembling K and M".to_string()),
+            BakeStage::Factor => ("factor", "factoring K − σM".to_string()),
+            BakeStage::Eigensolve(_) => ("eigensolve", "solving for the modes".to_string()),
+            BakeStage::TransferModes => (
+                "transfer modes",
+                "solving for the transfer table's modes".to_string(),
+            ),
+            BakeStage::Transfer(p) => {
+                let now = std::time::Instant::now();
+                let first = self.stage != "transfer";
+                if first {
+                    eprintln!(
+                        "[dcr-scenes] {}: building the transfer table: {}",
+                        self.name,
+                        p.plan.describe()
+                    );
+                } else if p.done < p.total
+                    && self
+                        .last_rows
+                        .is_some_and(|t| now.duration_since(t).as_secs_f64() < 5.0)
+                {
+                    return;
+                }
+                self.stage = "transfer";
+                self.last_rows = Some(now);
+                if !first {
+                    eprintln!(
+                        "[dcr-scenes] {}: transfer table {}/{} rows",
+                        self.name, p.done, p.total
+                    );
+                }
+                return;
+            }
+        };
+        if stage != self.stage {
+            self.stage = stage;
+            eprintln!("[dcr-scenes] {}: {what}", self.name);
+        }
+    }
 }

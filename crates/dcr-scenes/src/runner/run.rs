@@ -81,6 +81,11 @@ pub struct RunParams {
     /// Ensemble member and placement distance (m): the launched bodies start moved as
     /// [`crate::scene::BuiltWorld::perturb_placement`] says. Default `(0, 0.0)`: the scene as written.
     pub perturbation: (usize, f64),
+    /// The work a missing or stale base may take to bake (the mesh's modes, a table's mode set
+    /// and the table itself, each estimated before it starts); over it the run is refused with
+    /// the estimate. `None`: no limit. Default `modal_bake::bake::Budget::default()` (5
+    /// minutes, 2 GB), as `modal-bake bake`.
+    pub bake_budget: Option<modal_bake::bake::Budget>,
 }
 
 impl RunParams {
@@ -104,6 +109,7 @@ impl RunParams {
             contact_recycling: true,
             gate: StepGate::ImpactSteps,
             perturbation: (0, 0.0),
+            bake_budget: Some(modal_bake::bake::Budget::default()),
         }
     }
 }
@@ -770,8 +776,15 @@ fn add_elastic_objects(
     for (i, e) in desc.elastic.iter().enumerate() {
         let transfer = transfer_of(e, &params.method)?;
         let (path, _) = match transfer {
-            Some(t) => ensure_transfer_base(&params.root, &params.bases_dir, e, t, desc.h)?,
-            None => ensure_base(&params.root, &params.bases_dir, e)?,
+            Some(t) => ensure_transfer_base(
+                &params.root,
+                &params.bases_dir,
+                e,
+                t,
+                desc.h,
+                params.bake_budget,
+            )?,
+            None => ensure_base(&params.root, &params.bases_dir, e, params.bake_budget)?,
         };
         let base =
             ModesFile::read(&path).with_context(|| format!("reading base {}", path.display()))?;

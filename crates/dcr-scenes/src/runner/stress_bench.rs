@@ -28,6 +28,8 @@ pub struct StressBenchParams {
     pub bases_dir: PathBuf,
     /// Progress on stderr.
     pub progress: bool,
+    /// The work a missing or stale base may take to bake ([`RunParams::bake_budget`]).
+    pub bake_budget: Option<modal_bake::bake::Budget>,
 }
 
 fn median(mut v: Vec<f64>) -> Option<f64> {
@@ -66,6 +68,7 @@ pub fn stress_bench(p: &StressBenchParams) -> Result<Value> {
                 seconds: p.seconds,
                 bases_dir: p.bases_dir.clone(),
                 progress: p.progress,
+                bake_budget: p.bake_budget,
                 ..RunParams::new(p.root.clone(), true)
             },
         )?;

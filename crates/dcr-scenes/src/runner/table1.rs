@@ -88,6 +88,8 @@ pub struct Table1Params {
     pub eta_sweep: Vec<f64>,
     /// If set, write each scene's on and off runs side by side as `DIR/SCENE.glb`.
     pub gltf_dir: Option<PathBuf>,
+    /// The work a missing or stale base may take to bake ([`RunParams::bake_budget`]).
+    pub bake_budget: Option<modal_bake::bake::Budget>,
 }
 
 /// An outcome "changes" when it moves by more than this fraction of the reference value (or of
@@ -241,6 +243,7 @@ fn run_one(
             launch: p.launch,
             contact_recycling: p.contact_recycling,
             gate: p.gate,
+            bake_budget: p.bake_budget,
             ..RunParams::new(p.root.clone(), dcr)
         },
     )

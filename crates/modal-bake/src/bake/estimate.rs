@@ -56,6 +56,13 @@ pub struct SizeEstimate {
     pub bake_s: f64,
     /// Peak memory of the bake (bytes).
     pub bake_bytes: f64,
+    /// Wall time of solving a transfer table's modes (s): the dense all-mode eigensolve or a
+    /// Lanczos bake with the table's modes; 0 without a table, or when the base's own modes
+    /// suffice. The table's own build is estimated once its modes are known
+    /// ([`TablePlan`](crate::transfer::TablePlan)): its sampling depends on its highest mode.
+    pub table_modes_s: f64,
+    /// Peak memory of solving a transfer table's modes (bytes); 0 as `table_modes_s`.
+    pub table_modes_bytes: f64,
 }
 
 /// The work a bake may take before it is refused (unless forced).
@@ -108,6 +115,12 @@ const R_THIN: f64 = 1.6;
 const R_SOLID: f64 = 6.0;
 /// Modes (20 elastic + 6 rigid) the bake coefficients were measured at.
 const CALIBRATED_MODES: f64 = 26.0;
+/// The dense all-mode eigensolve of n free dofs (a transfer table's modes on a small mesh):
+/// CPU seconds per n³ and peak bytes per n² (dense K and M, the Cholesky factor, the reduced
+/// matrix, its eigenvectors and the workspace; the dinner table's 2,988 free dofs peaked at
+/// 628 MB, the npm bunny's 4,785 took 36 s of CPU).
+const DENSE_S_PER_N3: f64 = 3.3e-10;
+const DENSE_B_PER_N2: f64 = 70.0;
 
 /// A surface asset's measures that the estimate needs (SI).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -255,6 +268,62 @@ impl SizeEstimate {
         e
     }
 
+    /// With a transfer table's mode set, for a mesh of `free_dofs` free degrees of freedom:
+    /// `modes` resolved as the bake resolves them (`Auto`: every mode up to
+    /// [`DENSE_MAX_DOFS`](crate::transfer::DENSE_MAX_DOFS) free dofs, else
+    /// [`AUTO_LANCZOS_MODES`](crate::transfer::AUTO_LANCZOS_MODES)); nothing when the base's
+    /// own `self.modes` suffice, the dense eigensolve up to `DENSE_MAX_DOFS` free dofs, else a
+    /// Lanczos bake of that many modes.
+    pub fn with_table_modes(
+        mut self,
+        modes: crate::transfer::TransferModes,
+        free_dofs: usize,
+    ) -> SizeEstimate {
+        use crate::transfer::{TransferModes, DENSE_MAX_DOFS};
+        self.table_modes_s = 0.0;
+        self.table_modes_bytes = 0.0;
+        match modes.resolve(free_dofs) {
+            TransferModes::Count(k) if k <= self.modes => {}
+            TransferModes::Count(k) if free_dofs > DENSE_MAX_DOFS => {
+                let mut lanczos = SizeEstimate { modes: k, ..self };
+                lanczos.bake();
+                self.table_modes_s = lanczos.bake_s;
+                self.table_modes_bytes = lanczos.bake_bytes;
+            }
+            _ => {
+                let n = free_dofs as f64;
+                self.table_modes_s = DENSE_S_PER_N3 * n.powi(3);
+                self.table_modes_bytes = DENSE_B_PER_N2 * n * n;
+            }
+        }
+        self
+    }
+
+    /// The estimate for baking the tetrahedral `mesh` with `params`: its modes (a count, plus
+    /// six — the rigid-body modes of a free-free object; 20 for a frequency limit, as the CLI
+    /// counts) and, when `params.transfer` asks for a table, the table's mode set
+    /// ([`SizeEstimate::with_table_modes`], over the dofs its fixed-node selectors leave free;
+    /// all of them when the selectors do not resolve — the bake then says why).
+    pub fn of_bake(mesh: &crate::mesh::TetMesh, params: &super::BakeParams) -> SizeEstimate {
+        let order = if mesh.is_quadratic() { 2 } else { 1 };
+        let boundary = crate::mesh::extract_surface(mesh).1.len();
+        let modes = match params.modes {
+            super::ModeRequest::Count(n) => n,
+            super::ModeRequest::MaxFreqHz(_) => 20,
+        } + 6;
+        let e = SizeEstimate::of_mesh(mesh.nodes.len(), mesh.tets.len(), boundary, order, modes);
+        match &params.transfer {
+            Some(t) => {
+                let fixed = params
+                    .fixed_selectors()
+                    .resolve(mesh, "")
+                    .map_or(0, |f| f.nodes.len());
+                e.with_table_modes(t.modes, 3 * mesh.nodes.len().saturating_sub(fixed))
+            }
+            None => e,
+        }
+    }
+
     /// The factor's bytes per n^(4/3) (b_o in the module doc): at order 2 from 170 (thin-walled,
     /// T/F ≤ 1.6) to 300 (compact, T/F ≥ 6, or the boundary unknown).
     fn fill_per_n43(&self) -> f64 {
@@ -280,14 +349,16 @@ impl SizeEstimate {
             + 24.0 * n * (m - CALIBRATED_MODES).max(0.0);
     }
 
-    /// Total wall time (s): meshing and baking.
+    /// Total wall time (s): meshing, baking and a transfer table's modes.
     pub fn total_s(&self) -> f64 {
-        self.mesh_s + self.bake_s
+        self.mesh_s + self.bake_s + self.table_modes_s
     }
 
-    /// Peak memory (bytes): the larger of meshing's and baking's.
+    /// Peak memory (bytes): the largest of meshing's, baking's and a transfer table's modes'.
     pub fn peak_bytes(&self) -> f64 {
-        self.mesh_bytes.max(self.bake_bytes)
+        self.mesh_bytes
+            .max(self.bake_bytes)
+            .max(self.table_modes_bytes)
     }
 
     /// Whether the estimate (meshing and baking) is within `budget`.
@@ -316,6 +387,13 @@ impl SizeEstimate {
             format_seconds(self.bake_s),
             format_bytes(self.bake_bytes)
         ));
+        if self.table_modes_s > 0.0 {
+            s.push_str(&format!(
+                ", the transfer table's modes about {} and {}",
+                format_seconds(self.table_modes_s),
+                format_bytes(self.table_modes_bytes)
+            ));
+        }
         s
     }
 }

@@ -416,19 +416,20 @@ fn bake_with_table(
     };
     let modes_s = t.elapsed().as_secs_f64();
     let t = Instant::now();
+    let mut plan = None;
     let table = tr::build_transfer_table(
         set.as_ref().unwrap_or(&base),
         tp,
         params.rayleigh,
-        &mut |p| progress(BakeStage::Transfer(p)),
+        &mut |p| {
+            plan = Some(p.plan);
+            progress(BakeStage::Transfer(p))
+        },
     )
     .map_err(terr)?;
-    report.transfer = Some(TransferReport::of(
-        &table,
-        mode_source,
-        modes_s,
-        t.elapsed().as_secs_f64(),
-    ));
+    report.transfer = Some(
+        TransferReport::of(&table, mode_source, modes_s, t.elapsed().as_secs_f64()).with_plan(plan),
+    );
     if let Some(obj) = base.meta.bake_params.as_object_mut() {
         obj.insert("transfer".into(), transfer_meta(tp, params));
     }

@@ -89,6 +89,13 @@ pub struct TransferReport {
     pub samples: usize,
     /// Where its modes came from (`base`, `dense`, `lanczos`).
     pub mode_source: String,
+    /// Points computed from their own normal rows (vertices' normals differ).
+    pub bent: usize,
+    /// The build's estimated wall time (s) and peak memory (bytes) before it started
+    /// ([`TablePlan`](crate::transfer::TablePlan)); 0 when not planned.
+    pub estimated_s: f64,
+    /// See `estimated_s`.
+    pub estimated_bytes: f64,
 }
 
 impl TransferReport {
@@ -109,6 +116,20 @@ impl TransferReport {
             modes: table.modes as usize,
             samples: table.samples as usize,
             mode_source: mode_source.to_string(),
+            ..TransferReport::default()
+        }
+    }
+
+    /// With the build's plan: its bent points and estimate.
+    pub fn with_plan(self, plan: Option<crate::transfer::TablePlan>) -> Self {
+        match plan {
+            None => self,
+            Some(p) => TransferReport {
+                bent: p.bent,
+                estimated_s: p.seconds(),
+                estimated_bytes: p.bytes(),
+                ..self
+            },
         }
     }
 }

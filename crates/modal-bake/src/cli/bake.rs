@@ -91,6 +91,13 @@ pub struct BakeArgs {
     pub target_error: Option<f64>,
 }
 
+impl BakeArgs {
+    /// The modes of the transfer table this bake builds (`None` without `--transfer-h`).
+    pub fn table_modes(&self) -> Option<TransferModes> {
+        self.transfer.params().map(|t| t.modes)
+    }
+}
+
 /// The tetrahedral mesh of `path`: read, or (a surface asset) meshed by the meshing chain; with the
 /// seconds it took. Meshing options given with a volume mesh are an error.
 pub fn load_mesh(
@@ -238,6 +245,8 @@ impl BakeOptions {
 /// What a bake does before the factorization, once the mesh is in memory: the size estimate
 /// against the budget (a refusal unless `--force`), and warnings about an implausible size
 /// (unless `surface`: meshing already said it) or mass, naming the likely unit mistake.
+/// `params`: what the bake makes (a transfer table's mode set is in the estimate; the table
+/// itself is checked once its modes are known).
 ///
 /// # Errors
 /// The estimate over the budget.
@@ -245,11 +254,12 @@ pub fn before_factorization(
     file: &str,
     mesh: &modal_bake::mesh::TetMesh,
     options: &BakeOptions,
+    params: &BakeParams,
     budget: &super::budget::BudgetOptions,
     units: super::mesh::Units,
     surface: bool,
 ) -> anyhow::Result<()> {
-    budget.check_mesh(file, mesh, options.modes_for_estimate())?;
+    budget.check_mesh(file, mesh, params)?;
     let extent = mesh.extent();
     let material = options.model.material();
     let mass = material.density * mesh.volume();
@@ -304,8 +314,12 @@ pub fn run(args: &BakeArgs, asset: &AssetOptions) -> anyhow::Result<()> {
         ..args.options.params()
     };
     if is_surface_asset(&args.mesh) {
-        args.budget
-            .check_surface(&args.mesh, asset, args.options.modes_for_estimate())?;
+        args.budget.check_surface(
+            &args.mesh,
+            asset,
+            args.options.modes_for_estimate(),
+            args.table_modes(),
+        )?;
     }
     let (mesh, read_s) = load_mesh_with_progress(&args.mesh, asset)?;
     bake_loaded(args, &params, mesh, read_s)
@@ -342,12 +356,17 @@ pub fn bake_and_write(
         &file,
         &mesh,
         &args.options,
+        params,
         &args.budget,
         args.asset.units,
         surface,
     )?;
-    bake::bake_mesh(mesh, params, &file, &mut |s| on_stage(s))
-        .map_err(anyhow::Error::new)
+    let mut params = params.clone();
+    if let Some(t) = &mut params.transfer {
+        t.budget = args.budget.table_budget()?;
+    }
+    bake::bake_mesh(mesh, &params, &file, &mut |s| on_stage(s))
+        .map_err(|e| args.budget.explain_table_refusal(e))
         .and_then(|(mut base, mut report)| {
             report.read_s = read_s;
             report.material_name = args.options.model.material_choice().describe();

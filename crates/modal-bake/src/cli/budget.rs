@@ -6,6 +6,7 @@ use std::path::Path;
 
 use clap::Args;
 use modal_bake::bake::{self as mb, Budget, SizeEstimate, SurfaceMeasures};
+use modal_bake::transfer::TransferModes;
 
 use super::mesh::AssetOptions;
 
@@ -45,6 +46,32 @@ impl BudgetOptions {
         })
     }
 
+    /// The budget a transfer table's build is held to ([`TransferParams::budget`]): `None`
+    /// with `--force`.
+    ///
+    /// [`TransferParams::budget`]: modal_bake::transfer::TransferParams::budget
+    ///
+    /// # Errors
+    /// As [`BudgetOptions::budget`].
+    pub fn table_budget(&self) -> anyhow::Result<Option<Budget>> {
+        let b = self.budget()?;
+        Ok((!self.force).then_some(b))
+    }
+
+    /// `error` with the way round a refused table build (`--max-memory`, `--max-time`,
+    /// `--force`) when it is one; unchanged otherwise.
+    pub fn explain_table_refusal(&self, error: mb::BakeError) -> anyhow::Error {
+        let over = matches!(&error, mb::BakeError::Transfer { error: e, .. }
+            if matches!(**e, modal_bake::transfer::TransferError::OverBudget(_)));
+        if over {
+            anyhow::anyhow!(
+                "{error}; or raise --max-memory / --max-time, or pass --force to build it anyway"
+            )
+        } else {
+            anyhow::Error::new(error)
+        }
+    }
+
     fn describe(&self) -> String {
         format!(
             "the budget of {} GB and {} (--max-memory, --max-time)",
@@ -54,8 +81,8 @@ impl BudgetOptions {
     }
 
     /// Estimates meshing the surface asset `path` with `asset` and baking `modes` modes of the
-    /// mesh (`mesh` too: the mesh is made to be baked), prints the estimate (stderr) and
-    /// refuses it over the budget unless `--force`.
+    /// mesh (`mesh` too: the mesh is made to be baked) and a transfer table's mode set `table`,
+    /// prints the estimate (stderr) and refuses it over the budget unless `--force`.
     /// The refusal names the estimate, the budget and the smallest coarsening of `--size` that
     /// fits.
     ///
@@ -66,6 +93,7 @@ impl BudgetOptions {
         path: &Path,
         asset: &AssetOptions,
         modes: usize,
+        table: Option<TransferModes>,
     ) -> anyhow::Result<SizeEstimate> {
         let budget = self.budget()?;
         let mut s = modal_bake::mesh::surface::read_surface(path)
@@ -99,7 +127,12 @@ impl BudgetOptions {
         };
         let est = |size: f64, order: u8| {
             let h = modal_bake::mesh::sizing::equivalent_size(&s, size, curvature, thickness);
-            SizeEstimate::of_surface(&measures, h, asset.keep_surface, order, modes).scaled(k)
+            let e =
+                SizeEstimate::of_surface(&measures, h, asset.keep_surface, order, modes).scaled(k);
+            match table {
+                Some(t) => e.with_table_modes(t, e.dofs as usize),
+                None => e,
+            }
         };
         let fits = |e: &SizeEstimate| e.fits(&budget);
         let e = est(size, order);
@@ -180,8 +213,9 @@ impl BudgetOptions {
         self.refuse(&path.display().to_string(), &e, &how, measures.extent_m)
     }
 
-    /// Estimates baking `modes` modes of `mesh`, prints it when it is long (stderr) and refuses
-    /// it over the budget unless `--force`.
+    /// Estimates baking `mesh` with `params` ([`SizeEstimate::of_bake`]: its modes and a
+    /// transfer table's mode set), prints it when it is long (stderr) and refuses it over the
+    /// budget unless `--force`.
     ///
     /// # Errors
     /// The estimate over the budget.
@@ -189,22 +223,26 @@ impl BudgetOptions {
         &self,
         file: &str,
         mesh: &modal_bake::mesh::TetMesh,
-        modes: usize,
+        params: &mb::BakeParams,
     ) -> anyhow::Result<SizeEstimate> {
         let budget = self.budget()?;
-        let order = if mesh.is_quadratic() { 2 } else { 1 };
-        let boundary = modal_bake::mesh::extract_surface(mesh).1.len();
-        let e = SizeEstimate::of_mesh(mesh.nodes.len(), mesh.tets.len(), boundary, order, modes);
-        if e.bake_s >= 10.0 || !e.fits(&budget) {
+        let e = SizeEstimate::of_bake(mesh, params);
+        if e.total_s() >= 10.0 || !e.fits(&budget) {
             eprintln!("size estimate for baking {file}: {}", e.describe());
         }
         if e.fits(&budget) {
             return Ok(e);
         }
-        let how = vec![
+        let mut how = vec![
             "a coarser mesh (a larger --size when meshing; halving the tetrahedra more than halves the time)".to_string(),
             "fewer --modes".to_string(),
         ];
+        if e.table_modes_s > 0.0 {
+            how.push(
+                "fewer --transfer-modes (a count the base's --modes cover needs no second solve)"
+                    .into(),
+            );
+        }
         self.refuse(file, &e, &how, mesh.extent())
     }
 

@@ -276,7 +276,7 @@ pub fn mesh_asset(asset: &Path, options: &AssetOptions) -> anyhow::Result<Meshed
 pub fn run(args: &MeshArgs) -> anyhow::Result<()> {
     super::check_output(&args.out, "-o", &[&args.asset])?;
     args.budget
-        .check_surface(&args.asset, &args.asset_options, 26)?;
+        .check_surface(&args.asset, &args.asset_options, 26, None)?;
     let out = mesh_asset(&args.asset, &args.asset_options)?;
     dcr_files::write_atomic(&args.out, &out.msh)
         .with_context(|| format!("writing {}", args.out.display()))?;

@@ -201,7 +201,12 @@ impl Progress {
                 "solving for the transfer table's modes".into()
             }),
             BakeStage::Transfer(p) => plain.report("transfer", || {
-                format!("transfer table: {}/{} rows", p.done, p.total)
+                format!(
+                    "transfer table: {}/{} rows ({})",
+                    p.done,
+                    p.total,
+                    p.plan.describe()
+                )
             }),
             BakeStage::Write => plain.report("write", || "writing".into()),
         });
@@ -242,6 +247,8 @@ impl Progress {
                         .progress_chars("=> "),
                     );
                     self.bar.set_length(p.total as u64);
+                    self.bar
+                        .println(format!("transfer table: {}", p.plan.describe()));
                 }
                 self.bar.set_position(p.done as u64);
             }

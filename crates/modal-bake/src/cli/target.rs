@@ -30,7 +30,7 @@ pub fn run(args: &BakeArgs, asset: &AssetOptions, target: f64) -> anyhow::Result
     };
     if surface {
         args.budget
-            .check_surface(&args.mesh, asset, args.options.modes_for_estimate())?;
+            .check_surface(&args.mesh, asset, args.options.modes_for_estimate(), None)?;
     }
     let (mesh, _) = super::bake::load_mesh_with_progress(&args.mesh, asset)?;
     let file = args.mesh.display().to_string();
@@ -38,6 +38,7 @@ pub fn run(args: &BakeArgs, asset: &AssetOptions, target: f64) -> anyhow::Result
         &file,
         &mesh,
         &args.options,
+        &params,
         &args.budget,
         asset.units,
         surface,

@@ -18,10 +18,12 @@
 
 mod region;
 mod table_builder;
+mod table_plan;
 mod transfer_params;
 
 pub use region::{select_region, RegionBox};
-pub use table_builder::{build_transfer_table, CLUSTER_BYTES};
+pub use table_builder::{build_transfer_table, plan_transfer_table, CLUSTER_BYTES};
+pub use table_plan::{OverBudget, TablePlan};
 pub use transfer_params::{
     TableOrder, TransferError, TransferModes, TransferParams, TransferProgress,
     AUTO_CUBIC_MAX_POINTS, AUTO_LANCZOS_MODES, DEFAULT_OVERSAMPLE, DENSE_MAX_DOFS, UP_MIN_COS,

@@ -35,7 +35,10 @@ use faer::linalg::matmul::matmul;
 use faer::{Accum, Mat, Par};
 use rayon::prelude::*;
 
-use super::{TransferError, TransferModes, TransferParams, TransferProgress};
+use super::{
+    OverBudget, TablePlan, TransferError, TransferModes, TransferParams, TransferProgress,
+};
+use crate::bake::Budget;
 
 /// Budget of one cluster's vertex series (bytes).
 pub const CLUSTER_BYTES: usize = 384 << 20;
@@ -43,18 +46,23 @@ pub const CLUSTER_BYTES: usize = 384 << 20;
 /// Scalar of the series (the GEMMs and blends); the table stores f32.
 type Real = f32;
 
-/// Builds the table over the region selected by `params` from the mode set `modes` (a base
-/// with many modes; its own Rayleigh damping is ignored in favour of `rayleigh`).
-///
-/// # Errors
-/// [`TransferError::Params`] for invalid parameters, an empty region, or one whose points
-/// exceed [`MAX_TRANSFER_POINTS`].
-pub fn build_transfer_table(
+/// A table's skeleton (region, order, points; no peaks), the model and the sampling, before any
+/// series is computed.
+struct Prepared {
+    model: ModalModel,
+    table: TransferTable,
+    /// Modes summed.
+    m: usize,
+    /// Sampling period (s).
+    period: f64,
+    plan: TablePlan,
+}
+
+fn prepare(
     modes: &ModesFile,
     params: &TransferParams,
     rayleigh: [f64; 2],
-    progress: &mut dyn FnMut(TransferProgress),
-) -> Result<TransferTable, TransferError> {
+) -> Result<Prepared, TransferError> {
     params.check()?;
     let m = match params.modes {
         TransferModes::All | TransferModes::Auto => modes.num_modes(),
@@ -83,18 +91,9 @@ pub fn build_transfer_table(
             faces.len()
         )));
     }
-    let mm = model.num_modes();
     let omega = &model.omega()[..m];
-    let t_req = Sampling::Oversample(params.oversample).period(omega[m - 1]);
-    if params.h / t_req > 1e7 {
-        return Err(TransferError::Params(format!(
-            "{:.0} samples per step (h/T) exceed the limit of 1e7; use fewer table modes or a shorter step",
-            params.h / t_req
-        )));
-    }
-    let s = samples_per_step(params.h, t_req);
-    let period = params.h / s as f64;
-    let mut table = TransferTable {
+    let s = samples_for(params, omega[m - 1])?;
+    let table = TransferTable {
         h: params.h,
         rayleigh,
         modes: m as u32,
@@ -105,6 +104,159 @@ pub fn build_transfer_table(
         faces: if order == 3 { faces } else { Vec::new() },
         peaks: Vec::new(),
     };
+    let normals = model.vertex_normals();
+    let bent = (table.len()..table.num_points())
+        .filter(|&p| bent_normal(&table, normals, p).is_some())
+        .count();
+    let plan = TablePlan {
+        order,
+        vertices: nr,
+        points: np,
+        bent,
+        modes: m,
+        samples: s,
+        omega_max: omega[m - 1],
+        h: params.h,
+        surface_vertices: modes.num_surface_vertices(),
+        set_modes: modes.num_modes(),
+        threads: rayon::current_num_threads(),
+    };
+    Ok(Prepared {
+        period: params.h / s as f64,
+        model,
+        table,
+        m,
+        plan,
+    })
+}
+
+/// Samples per step S for a table whose highest mode is `omega_max` (rad/s).
+fn samples_for(params: &TransferParams, omega_max: f64) -> Result<usize, TransferError> {
+    let t_req = Sampling::Oversample(params.oversample).period(omega_max);
+    if params.h / t_req > 1e7 {
+        return Err(TransferError::Params(format!(
+            "{:.0} samples per step (h/T) exceed the limit of 1e7; use fewer table modes or a shorter step",
+            params.h / t_req
+        )));
+    }
+    Ok(samples_per_step(params.h, t_req))
+}
+
+/// What building the table over the region selected by `params` from the mode set `modes`
+/// would compute and cost ([`TablePlan`]), without building it.
+///
+/// # Errors
+/// As [`build_transfer_table`], but never [`TransferError::OverBudget`].
+pub fn plan_transfer_table(
+    modes: &ModesFile,
+    params: &TransferParams,
+) -> Result<TablePlan, TransferError> {
+    prepare(modes, params, [0.0; 2]).map(|p| p.plan)
+}
+
+/// The changes of `params` whose tables fit `budget`, each with its estimate: the most modes
+/// that fit (when fewer than the plan's), and the lower orders.
+fn fixes(prep: &Prepared, params: &TransferParams, budget: &Budget) -> Vec<String> {
+    let plan = &prep.plan;
+    let omega = prep.model.omega();
+    let with_modes = |m: usize| -> Option<TablePlan> {
+        let s = samples_for(params, omega[m - 1]).ok()?;
+        Some(TablePlan {
+            modes: m,
+            samples: s,
+            omega_max: omega[m - 1],
+            ..*plan
+        })
+    };
+    let mut out = Vec::new();
+    // The plan's cost grows with m (m and ω_m both grow): bisect for the most modes that fit.
+    let fits = |m: usize| with_modes(m).is_some_and(|p| p.fits(budget));
+    if fits(1) {
+        let (mut lo, mut hi) = (1, plan.modes);
+        while hi - lo > 1 {
+            let mid = lo + (hi - lo) / 2;
+            if fits(mid) {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        if let Some(p) = with_modes(lo) {
+            out.push(format!(
+                "`transfer.modes` {lo} (the lowest {lo} modes, up to {:.3e} rad/s: {})",
+                p.omega_max,
+                p.describe()
+            ));
+        }
+    }
+    let tris = &prep.model.base().surface_triangles;
+    let t = &prep.table;
+    let (ne, nf) = (
+        TransferTable::region_edges(tris, &t.vertices).len(),
+        TransferTable::region_faces(tris, &t.vertices).len(),
+    );
+    for order in (1..plan.order).rev() {
+        let np = TransferTable::points_for(order, t.len(), ne, nf);
+        // Bent points among the edge and face points, in proportion.
+        let extra = plan.points - plan.vertices;
+        let bent = (plan.bent * (np - plan.vertices))
+            .checked_div(extra)
+            .unwrap_or(0);
+        let p = TablePlan {
+            order,
+            points: np,
+            bent,
+            ..*plan
+        };
+        if p.fits(budget) {
+            out.push(format!("`transfer.order` {order} ({})", p.describe()));
+            break;
+        }
+    }
+    if params.up.is_none() && params.boxes.is_empty() {
+        out.push(
+            "a smaller region (`transfer.up`: the faces a prop can rest on; `transfer.boxes`)"
+                .into(),
+        );
+    }
+    out
+}
+
+/// Builds the table over the region selected by `params` from the mode set `modes` (a base
+/// with many modes; its own Rayleigh damping is ignored in favour of `rayleigh`). With
+/// `params.budget` set, the build is refused before it starts when its [`TablePlan`]'s estimate
+/// is over the budget.
+///
+/// # Errors
+/// [`TransferError::Params`] for invalid parameters, an empty region, or one whose points
+/// exceed [`MAX_TRANSFER_POINTS`]; [`TransferError::OverBudget`] for a plan over
+/// `params.budget`.
+pub fn build_transfer_table(
+    modes: &ModesFile,
+    params: &TransferParams,
+    rayleigh: [f64; 2],
+    progress: &mut dyn FnMut(TransferProgress),
+) -> Result<TransferTable, TransferError> {
+    let prep = prepare(modes, params, rayleigh)?;
+    if let Some(budget) = params.budget {
+        if !prep.plan.fits(&budget) {
+            return Err(TransferError::OverBudget(Box::new(OverBudget {
+                plan: prep.plan,
+                budget,
+                fixes: fixes(&prep, params, &budget),
+            })));
+        }
+    }
+    let Prepared {
+        model,
+        mut table,
+        m,
+        period,
+        plan,
+    } = prep;
+    let mm = model.num_modes();
+    let omega = &model.omega()[..m];
+    let s = table.samples as usize;
     // G (S × m): g_l(kT), the exact impulse response the runtime uses.
     let filters: Vec<ModeFilter> = omega
         .iter()
@@ -115,12 +267,16 @@ pub fn build_transfer_table(
     });
     // W (m × nr): normal rows of the region vertices, one column per vertex.
     let rows = model.normal_mode_rows();
+    let nr = table.len();
     let w = Mat::from_fn(m, nr, |l, c| rows[table.vertices[c] as usize * mm + l]);
+    let tris = &model.base().surface_triangles;
     let adjacency = TransferTable::region_edges(tris, &table.vertices);
     let g = Mat::<Real>::from_fn(s, m, |k, l| g[(k, l)] as Real);
     let w = Mat::<Real>::from_fn(m, nr, |l, c| w[(l, c)] as Real);
     let bent = bent_point_rows(&table, &model, m);
-    table.peaks = tabulate(&table, &adjacency, &g, &w, &bent, progress);
+    table.peaks = tabulate(&table, &adjacency, &g, &w, &bent, &mut |done, total| {
+        progress(TransferProgress { done, total, plan })
+    });
     table
         .check(modes.num_surface_vertices())
         .map_err(TransferError::Params)?;
@@ -145,26 +301,14 @@ fn bent_point_rows(table: &TransferTable, model: &ModalModel, m: usize) -> BentR
     let mut points = Vec::new();
     let mut cols: Vec<Vec<f64>> = Vec::new();
     for p in table.len()..table.num_points() {
+        let Some(n) = bent_normal(table, normals, p) else {
+            continue;
+        };
         let (vs, ws) = table.point_support(p);
         let used: Vec<(usize, f64)> = (0..3)
             .filter(|&k| ws[k] != 0.0)
             .map(|k| (table.vertices[vs[k] as usize] as usize, ws[k]))
             .collect();
-        let n0 = normals[used[0].0];
-        if used
-            .iter()
-            .all(|&(v, _)| (0..3).all(|c| (normals[v][c] - n0[c]).abs() <= 1e-12))
-        {
-            continue;
-        }
-        let mut n = [0.0; 3];
-        for &(v, l) in &used {
-            for c in 0..3 {
-                n[c] += l * normals[v][c];
-            }
-        }
-        let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
-        let n = if len > 0.0 { n.map(|x| x / len) } else { n0 };
         let mut row = vec![0.0f64; m];
         for &(v, l) in &used {
             for c in 0..3 {
@@ -179,6 +323,32 @@ fn bent_point_rows(table: &TransferTable, model: &ModalModel, m: usize) -> BentR
     }
     let rows = Mat::<Real>::from_fn(m, points.len(), |l, k| cols[k][l] as Real);
     BentRows { points, rows }
+}
+
+/// The normal of table point `p` when its vertices' normals differ (a bent point: the normalised
+/// blend of the vertices' normals, or the first vertex's when the blend vanishes); `None` when
+/// every vertex of its support has the same normal.
+fn bent_normal(table: &TransferTable, normals: &[[f64; 3]], p: usize) -> Option<[f64; 3]> {
+    let (vs, ws) = table.point_support(p);
+    let used: Vec<(usize, f64)> = (0..3)
+        .filter(|&k| ws[k] != 0.0)
+        .map(|k| (table.vertices[vs[k] as usize] as usize, ws[k]))
+        .collect();
+    let n0 = normals[used[0].0];
+    if used
+        .iter()
+        .all(|&(v, _)| (0..3).all(|c| (normals[v][c] - n0[c]).abs() <= 1e-12))
+    {
+        return None;
+    }
+    let mut n = [0.0; 3];
+    for &(v, l) in &used {
+        for c in 0..3 {
+            n[c] += l * normals[v][c];
+        }
+    }
+    let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+    Some(if len > 0.0 { n.map(|x| x / len) } else { n0 })
 }
 
 /// A table point's support: region vertices and barycentric weights (1 to 3 of them).
@@ -245,14 +415,15 @@ fn processing_order(nr: usize, edges: &[[u32; 2]], sup: &[Support]) -> Vec<u32> 
 }
 
 /// The packed upper triangle of peaks (see the module docs); `edges`: the region's edges (for
-/// the processing order); `bent`: the rows of the points whose vertices' normals differ.
+/// the processing order); `bent`: the rows of the points whose vertices' normals differ;
+/// `progress(done, total)` after each cluster of rows.
 fn tabulate(
     table: &TransferTable,
     edges: &[[u32; 2]],
     g: &Mat<Real>,
     w: &Mat<Real>,
     bent: &BentRows,
-    progress: &mut dyn FnMut(TransferProgress),
+    progress: &mut dyn FnMut(usize, usize),
 ) -> Vec<f32> {
     let np = table.num_points();
     let nr = table.len();
@@ -286,7 +457,7 @@ fn tabulate(
     // keys: vertex v is v, bent point q is nr + q (ascending: vertices first).
     let mut kept: HashMap<u32, (Vec<u32>, Mat<Real>)> = HashMap::new();
     let mut start = 0;
-    progress(TransferProgress { done: 0, total: np });
+    progress(0, np);
     while start < np {
         let end = cluster_end(&order, &sup, &bent_of, start, max_vertices);
         let mut verts: Vec<u32> = order[start..end]
@@ -418,10 +589,7 @@ fn tabulate(
             .map(|(v, y)| (v, (keys.clone(), y)))
             .collect();
         start = end;
-        progress(TransferProgress {
-            done: start,
-            total: np,
-        });
+        progress(start, np);
     }
     peaks
 }

@@ -98,6 +98,10 @@ pub struct TransferParams {
     pub oversample: f64,
     /// Interpolation order. Default [`TableOrder::Auto`].
     pub order: TableOrder,
+    /// Refuse the build before it starts when its estimated wall time or peak memory
+    /// ([`TablePlan`](super::TablePlan)) is over this budget; `None` (the default): no limit.
+    /// Not a table parameter: it changes no peak and is not recorded in the base.
+    pub budget: Option<crate::bake::Budget>,
 }
 
 impl Default for TransferParams {
@@ -110,6 +114,7 @@ impl Default for TransferParams {
             up_min_cos: UP_MIN_COS,
             oversample: DEFAULT_OVERSAMPLE,
             order: TableOrder::Auto,
+            budget: None,
         }
     }
 }
@@ -161,13 +166,15 @@ impl TransferParams {
     }
 }
 
-/// Progress of a table build: source rows done of total.
+/// Progress of a table build: source rows done of total, and the build's plan and estimate.
 #[derive(Clone, Copy, Debug)]
 pub struct TransferProgress {
     /// Rows done.
     pub done: usize,
     /// Rows in all.
     pub total: usize,
+    /// What the build computes and its estimated cost.
+    pub plan: super::TablePlan,
 }
 
 /// Why a table could not be built.
@@ -180,4 +187,7 @@ pub enum TransferError {
     /// The dense eigensolve for the table's modes failed.
     #[error("transfer table modes: {0}")]
     FullOrder(#[from] FullOrderError),
+    /// The build's estimate is over [`TransferParams::budget`]: refused before it started.
+    #[error("transfer table: {0}")]
+    OverBudget(Box<super::OverBudget>),
 }

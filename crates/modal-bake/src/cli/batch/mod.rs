@@ -303,8 +303,12 @@ fn run_entry(entry: &Entry, tag: &str, start: Instant) -> EntryRecord {
             ..args.options.params()
         };
         if is_surface_asset(&args.mesh) {
-            args.budget
-                .check_surface(&args.mesh, &asset, args.options.modes_for_estimate())?;
+            args.budget.check_surface(
+                &args.mesh,
+                &asset,
+                args.options.modes_for_estimate(),
+                args.table_modes(),
+            )?;
         }
         let (mesh, read_s) = super::bake::load_mesh(&args.mesh, &asset)?;
         let file = args.mesh.display().to_string();
