@@ -1,6 +1,7 @@
 //! Size before work (`--max-memory`, `--max-time`, `--force`): the estimate of
 //! [`modal_bake::bake::SizeEstimate`] printed before meshing and baking, and a refusal with the
-//! estimate and how to lower it when it is over the budget.
+//! estimate and how to lower it when it is over the budget; a transfer table's build is held to
+//! the same budget once its modes are known ([`modal_bake::transfer::TablePlan`]).
 
 use std::path::Path;
 
@@ -14,14 +15,16 @@ use super::mesh::AssetOptions;
 #[derive(Args, Clone, Debug)]
 pub struct BudgetOptions {
     /// Refuse (before any long work) when the estimated peak memory of meshing or baking is
-    /// above this (GB, 1e9 bytes).
+    /// above this (GB, 1e9 bytes); a transfer table's build (--transfer-h) is held to it too,
+    /// checked once the table's modes are known.
     #[arg(long, value_name = "GB", default_value_t = 2.0)]
     pub max_memory: f64,
     /// Refuse (before any long work) when the estimated wall time of meshing plus baking is
-    /// above this (seconds).
+    /// above this (seconds); a transfer table's build (--transfer-h) is held to it too,
+    /// checked once the table's modes are known.
     #[arg(long, value_name = "SECONDS", default_value_t = 300.0)]
     pub max_time: f64,
-    /// Run even when the estimate is over --max-memory or --max-time.
+    /// Run even when an estimate is over --max-memory or --max-time.
     #[arg(long)]
     pub force: bool,
 }

@@ -73,11 +73,14 @@ impl Plain {
                 self.line(&self.label);
                 self.announced = true;
             }
-        } else if now.duration_since(self.last) >= self.every {
+        } else {
+            // Always the latest label: the heartbeat repeats it between reports.
             self.label = label();
-            self.line(&self.label);
-            self.last = now;
-            self.announced = true;
+            if now.duration_since(self.last) >= self.every {
+                self.line(&self.label);
+                self.last = now;
+                self.announced = true;
+            }
         }
     }
 
@@ -263,5 +266,32 @@ impl Progress {
 impl Drop for Progress {
     fn drop(&mut self) {
         self.finish();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    // The heartbeat repeats the latest count, not the stage's first: a report between two
+    // heartbeat lines (too soon for a line of its own) still updates the label.
+    #[test]
+    fn the_heartbeat_repeats_the_latest_report() {
+        let now = Instant::now();
+        let mut p = Plain {
+            tool: "test",
+            every: Duration::from_secs(3600),
+            start: now,
+            stage: "",
+            label: String::new(),
+            stage_start: now,
+            last: now,
+            announced: false,
+        };
+        p.report("transfer", || "transfer table: 0/10 rows".into());
+        p.report("transfer", || "transfer table: 4/10 rows".into());
+        assert_eq!(p.label, "transfer table: 4/10 rows");
+        p.report("write", || "writing".into());
+        assert_eq!((p.stage, p.label.as_str()), ("write", "writing"));
     }
 }

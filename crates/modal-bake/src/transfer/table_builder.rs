@@ -209,7 +209,11 @@ fn fixes(prep: &Prepared, params: &TransferParams, budget: &Budget) -> Vec<Strin
             ..*plan
         };
         if p.fits(budget) {
-            out.push(format!("`transfer.order` {order} ({})", p.describe()));
+            let name = ["linear", "quadratic"][usize::from(order) - 1];
+            out.push(format!(
+                "`transfer.order` {order} ({name}: {})",
+                p.describe()
+            ));
             break;
         }
     }

@@ -27,12 +27,13 @@
 use super::CLUSTER_BYTES;
 use crate::bake::{format_bytes, format_seconds, Budget};
 
-/// Seconds per flop of the vertex-series GEMMs (f32, one thread).
-const GEMM_S_PER_FLOP: f64 = 2.5e-11;
+/// Seconds per modelled flop of the vertex-series GEMMs (f32, one thread; the count S m n_c²
+/// overstates the flops run, as series are reused between clusters).
+const GEMM_S_PER_FLOP: f64 = 9.3e-12;
 /// Seconds per sample of one point pair's peak search (one thread).
-const PEAK_S_PER_SAMPLE: f64 = 1.0e-9;
+const PEAK_S_PER_SAMPLE: f64 = 7.7e-10;
 /// Seconds per sample and column of one point's blended series (one thread).
-const BLEND_S_PER_SAMPLE: f64 = 1.0e-9;
+const BLEND_S_PER_SAMPLE: f64 = 4.7e-9;
 /// Clusters of vertex series alive at once: the one being computed and the part of the last
 /// one it still needs (measured: the beam's 1,676-point table peaks at 487 MB, one cluster
 /// 402 MB of it).
