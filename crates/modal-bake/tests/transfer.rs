@@ -37,8 +37,16 @@ fn text(o: &Output) -> String {
 /// Bakes the beam (clamped) with 8 runtime modes and a table with `modes` table modes over
 /// every surface vertex (or the region `extra` options select).
 fn bake_beam_with(out: &Path, modes: &str, extra: &[&str]) -> Output {
+    bin()
+        .args(beam_args(out, modes, extra))
+        .output()
+        .expect("run modal-bake")
+}
+
+/// The arguments of [`bake_beam_with`].
+fn beam_args(out: &Path, modes: &str, extra: &[&str]) -> Vec<String> {
     let mesh = data("data/meshes/beam.msh");
-    let mut args = vec![
+    let mut args: Vec<String> = [
         "bake",
         mesh.to_str().unwrap(),
         "-o",
@@ -51,9 +59,11 @@ fn bake_beam_with(out: &Path, modes: &str, extra: &[&str]) -> Output {
         "0.004",
         "--transfer-modes",
         modes,
-    ];
-    args.extend_from_slice(extra);
-    run(&args)
+    ]
+    .map(String::from)
+    .into();
+    args.extend(extra.iter().map(|s| s.to_string()));
+    args
 }
 
 fn bake_beam(out: &Path, modes: &str) -> Output {
@@ -434,27 +444,9 @@ fn a_table_over_the_budget_is_refused_before_it_is_built() {
     let out = dir.path().join("t.modes");
     // Every mode, one thread: an estimate of ~16 s against a 1 s budget on any machine.
     let bake = |modes: &str, extra: &[&str]| {
-        let mesh = data("data/meshes/beam.msh");
-        let mut args = vec![
-            "bake",
-            mesh.to_str().unwrap(),
-            "-o",
-            out.to_str().unwrap(),
-            "--fixed",
-            "clamp",
-            "--modes",
-            "8",
-            "--transfer-h",
-            "0.004",
-            "--transfer-modes",
-            modes,
-            "--max-time",
-            "1",
-            "--json",
-        ];
-        args.extend_from_slice(extra);
+        let budget = ["--max-time", "1", "--json"];
         bin()
-            .args(&args)
+            .args(beam_args(&out, modes, &[&budget[..], extra].concat()))
             .env("RAYON_NUM_THREADS", "1")
             .output()
             .expect("run modal-bake")

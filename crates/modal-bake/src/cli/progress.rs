@@ -38,6 +38,20 @@ struct Plain {
 }
 
 impl Plain {
+    /// No stage yet; lines every `every`, times from `now`.
+    fn new(tool: &'static str, every: Duration, now: Instant) -> Plain {
+        Plain {
+            tool,
+            every,
+            start: now,
+            stage: "",
+            label: String::new(),
+            stage_start: now,
+            last: now,
+            announced: false,
+        }
+    }
+
     fn line(&self, text: &str) {
         eprintln!(
             "{} [{:7.1} s] {text}",
@@ -121,16 +135,7 @@ impl Progress {
             .and_then(|s| s.parse::<f64>().ok())
             .filter(|s| s.is_finite() && *s >= 0.0)
             .map_or(PLAIN_EVERY, Duration::from_secs_f64);
-        let plain = Arc::new(Mutex::new(Plain {
-            tool,
-            every,
-            start: now,
-            stage: "",
-            label: String::new(),
-            stage_start: now,
-            last: now,
-            announced: false,
-        }));
+        let plain = Arc::new(Mutex::new(Plain::new(tool, every, now)));
         let heartbeat = (!every.is_zero()).then(|| {
             let (plain, stop) = (plain.clone(), stop.clone());
             let nap = every.min(Duration::from_millis(500));
@@ -277,17 +282,7 @@ mod tests {
     // heartbeat lines (too soon for a line of its own) still updates the label.
     #[test]
     fn the_heartbeat_repeats_the_latest_report() {
-        let now = Instant::now();
-        let mut p = Plain {
-            tool: "test",
-            every: Duration::from_secs(3600),
-            start: now,
-            stage: "",
-            label: String::new(),
-            stage_start: now,
-            last: now,
-            announced: false,
-        };
+        let mut p = Plain::new("test", Duration::from_secs(3600), Instant::now());
         p.report("transfer", || "transfer table: 0/10 rows".into());
         p.report("transfer", || "transfer table: 4/10 rows".into());
         assert_eq!(p.label, "transfer table: 4/10 rows");

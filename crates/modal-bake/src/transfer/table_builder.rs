@@ -58,6 +58,9 @@ struct Prepared {
     plan: TablePlan,
 }
 
+/// The skeleton and plan of the table `params` select from the mode set `modes`: checks, region,
+/// order, points, samples per step, bent points (errors as [`build_transfer_table`]'s, never
+/// over a budget).
 fn prepare(
     modes: &ModesFile,
     params: &TransferParams,
