@@ -484,6 +484,32 @@ fn a_table_over_the_budget_is_refused_before_it_is_built() {
     assert!(out.exists());
 }
 
+/// A region that selects nothing is refused before the table's modes are solved: the region
+/// depends on the surface only.
+#[test]
+fn an_empty_region_is_refused_before_the_tables_modes_are_solved() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("t.modes");
+    let o = bin()
+        .args(beam_args(
+            &out,
+            "all",
+            &["--transfer-region", "100,100,100,101,101,101"],
+        ))
+        .env("MODAL_BAKE_PROGRESS_EVERY", "0")
+        .output()
+        .expect("run modal-bake");
+    let msg = text(&o);
+    assert!(!o.status.success(), "{msg}");
+    assert!(msg.contains("selects no surface vertex"), "{msg}");
+    assert!(msg.contains("eigensolve"), "no progress lines: {msg}");
+    assert!(
+        !msg.contains("solving for the transfer table's modes"),
+        "the table's modes were solved first: {msg}"
+    );
+    assert!(!out.exists());
+}
+
 /// `check` with the bake's own options says fresh for a table baked at its default mode count
 /// (`auto`, recorded resolved for the mesh), and stale when a table option changes.
 #[test]

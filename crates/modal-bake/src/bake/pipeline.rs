@@ -390,6 +390,17 @@ fn bake_with_table(
         )));
     }
     let (mut base, mut report) = bake_modes(mesh.clone(), params, file, progress)?;
+    // The region and its points depend on the surface only: an empty or oversized region is
+    // refused before the table's modes are solved (the plan over the base's own modes).
+    tr::plan_transfer_table(
+        &base,
+        &tr::TransferParams {
+            modes: TransferModes::Count(base.num_modes()),
+            budget: None,
+            ..tp.clone()
+        },
+    )
+    .map_err(terr)?;
     let t = Instant::now();
     let tp = &tr::TransferParams {
         modes: tp.modes.resolve(report.free_dofs),
