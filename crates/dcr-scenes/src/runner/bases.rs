@@ -17,8 +17,8 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
 use modal_bake::bake::{
-    format_bytes, format_seconds, BakeError, BakeParams, BakeStage, Budget, MaterialSi,
-    ModeRequest, SizeEstimate,
+    format_bytes, format_seconds, BakeParams, BakeStage, Budget, MaterialSi, ModeRequest,
+    SizeEstimate,
 };
 use modal_bake::transfer::{TableOrder, TransferModes, TransferParams};
 
@@ -252,7 +252,7 @@ fn ensure(
     let report = match modal_bake::bake::bake_file(&mesh, params, out, &mut |s| reporter.update(s))
     {
         Ok(r) => r,
-        Err(err @ BakeError::Transfer { .. }) if is_over_budget(&err) => {
+        Err(err) if err.is_table_over_budget() => {
             bail!("elastic object {}: {err}; {BUDGET_HINT}", e.name)
         }
         Err(err) => {
@@ -278,12 +278,6 @@ fn ensure(
         report.tets
     );
     Ok((out.to_path_buf(), true))
-}
-
-/// Whether `err` is a transfer table refused over its budget.
-fn is_over_budget(err: &BakeError) -> bool {
-    matches!(err, BakeError::Transfer { error, .. }
-        if matches!(**error, modal_bake::transfer::TransferError::OverBudget(_)))
 }
 
 /// Progress lines of an on-demand bake on stderr: each stage once, the table's plan when its

@@ -77,3 +77,12 @@ pub enum BakeError {
         error: Box<BakeError>,
     },
 }
+
+impl BakeError {
+    /// Whether this is a transfer table refused before its build for an estimate over its
+    /// budget ([`TransferError::OverBudget`](crate::transfer::TransferError::OverBudget)).
+    pub fn is_table_over_budget(&self) -> bool {
+        matches!(self, BakeError::Transfer { error, .. }
+            if matches!(**error, crate::transfer::TransferError::OverBudget(_)))
+    }
+}

@@ -64,9 +64,7 @@ impl BudgetOptions {
     /// `error` with the way round a refused table build (`--max-memory`, `--max-time`,
     /// `--force`) when it is one; unchanged otherwise.
     pub fn explain_table_refusal(&self, error: mb::BakeError) -> anyhow::Error {
-        let over = matches!(&error, mb::BakeError::Transfer { error: e, .. }
-            if matches!(**e, modal_bake::transfer::TransferError::OverBudget(_)));
-        if over {
+        if error.is_table_over_budget() {
             anyhow::anyhow!(
                 "{error}; or raise --max-memory / --max-time, or pass --force to build it anyway"
             )
