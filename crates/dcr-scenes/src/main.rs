@@ -87,18 +87,13 @@ struct BakeBudgetArgs {
 
 impl BakeBudgetArgs {
     fn budget(&self) -> Result<Option<modal_bake::bake::Budget>> {
-        for (name, v) in [
-            ("--max-bake-memory", self.max_bake_memory),
-            ("--max-bake-time", self.max_bake_time),
-        ] {
-            if !(v.is_finite() && v > 0.0) {
-                bail!("{name} {v} must be a positive number");
-            }
-        }
-        Ok((!self.force_bake).then_some(modal_bake::bake::Budget {
-            max_bytes: self.max_bake_memory * 1e9,
-            max_seconds: self.max_bake_time,
-        }))
+        let budget = modal_bake::bake::Budget::from_gb(
+            self.max_bake_memory,
+            self.max_bake_time,
+            ["--max-bake-memory", "--max-bake-time"],
+        )
+        .map_err(anyhow::Error::msg)?;
+        Ok((!self.force_bake).then_some(budget))
     }
 }
 

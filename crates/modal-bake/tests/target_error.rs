@@ -18,6 +18,10 @@ fn beam() -> PathBuf {
 }
 
 fn bake(out: &Path, target: &str) -> Output {
+    bake_with(out, target, &[])
+}
+
+fn bake_with(out: &Path, target: &str, extra: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_modal-bake"))
         .args([
             "bake",
@@ -33,6 +37,9 @@ fn bake(out: &Path, target: &str) -> Output {
             "--target-error",
             target,
         ])
+        .args(extra)
+        // Table plans count per-thread memory: the budgets below assume two threads.
+        .env("RAYON_NUM_THREADS", "2")
         .output()
         .unwrap()
 }
@@ -134,4 +141,85 @@ fn a_target_needs_the_step_and_a_positive_percentage() {
         text(&o)
     );
     assert!(!text(&o).contains("panicked") && !out.exists());
+}
+
+// Every candidate table is held to the bake's budget: one over it is not built (reported as
+// skipped, with its estimate), except that the every-mode candidate first becomes the most
+// modes that fit when those are more than any table tried before it has. An unmeetable target
+// (1e-6 %) makes the choice try every candidate. By their plans on two threads the beam's
+// tables need 0.10 GB (160 modes, quadratic) to 0.43 GB (every mode, cubic); 0.05 GB is under
+// any table (a plan counts 50 MB before its first row).
+#[test]
+fn candidate_tables_are_held_to_the_budget() {
+    let dir = tempfile::tempdir().unwrap();
+    let json = |o: &Output| -> serde_json::Value {
+        assert!(o.status.success(), "{}", text(o));
+        serde_json::from_slice(&o.stdout).expect("--json output")
+    };
+    let names = |v: &serde_json::Value, key: &str| -> Vec<String> {
+        v[key]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|c| c["representation"].as_str().unwrap().to_string())
+            .collect()
+    };
+    let count = |t: &str| -> Option<usize> {
+        t.strip_prefix("20 modes + table of ")
+            .and_then(|r| r.split_whitespace().next())
+            .and_then(|n| n.parse().ok())
+    };
+    // 0.2 GB: the 160-mode tables fit; the every-mode quadratic one becomes the most modes that
+    // fit (more than 160); the cubic one's most modes are fewer than that, so it is skipped.
+    let out = dir.path().join("mid.modes");
+    let v = json(&bake_with(&out, "1e-6", &["--max-memory", "0.2", "--json"]));
+    let tried = names(&v, "tried");
+    let counts: Vec<usize> = tried.iter().filter_map(|t| count(t)).collect();
+    assert_eq!(counts.len(), 3, "{tried:?}");
+    assert!(counts[..2] == [160, 160] && counts[2] > 160, "{tried:?}");
+    assert!(tried[5].ends_with("order 2"), "{tried:?}");
+    assert_eq!(
+        names(&v, "skipped"),
+        ["20 modes + table of every mode, order 3"],
+        "{v}"
+    );
+    let b = ModesFile::read(&out).unwrap();
+    let a = b.meta.accuracy.clone().unwrap();
+    assert!(!a.met && a.table_modes == Some(counts[2]), "{a:?}");
+    // 0.05 GB: no table fits; the four are skipped with their estimates and the choice is the
+    // most accurate modal candidate, no table, nothing over the budget built.
+    let out = dir.path().join("low.modes");
+    let v = json(&bake_with(
+        &out,
+        "1e-6",
+        &["--max-memory", "0.05", "--json"],
+    ));
+    assert_eq!(names(&v, "tried").len(), 3, "{v}");
+    let skipped = v["skipped"].as_array().unwrap();
+    assert_eq!(skipped.len(), 4, "{v}");
+    for k in skipped {
+        assert!(k["estimated_bytes"].as_f64().unwrap() > 5e7, "{k}");
+        assert!(
+            k["reason"]
+                .as_str()
+                .unwrap()
+                .contains("refused before building"),
+            "{k}"
+        );
+    }
+    let b = ModesFile::read(&out).unwrap();
+    assert!(
+        b.transfer.is_none() && b.num_modes() == 20,
+        "{:?}",
+        b.meta.accuracy
+    );
+    // The text output names what was skipped and how to build it.
+    let o = bake_with(&out, "1e-6", &["--max-memory", "0.05"]);
+    assert!(o.status.success(), "{}", text(&o));
+    let t = text(&o);
+    assert!(
+        t.contains("skipped 20 modes + table of every mode, order 3"),
+        "{t}"
+    );
+    assert!(t.contains("--force builds it"), "{t}");
 }

@@ -299,14 +299,11 @@ impl<'a> StageReporter<'a> {
 
     fn update(&mut self, s: BakeStage) {
         let (stage, what) = match s {
-            BakeStage::Read | BakeStage::Write => return,
-            BakeStage::Assemble => ("assemble", "assembling K and M".to_string()),
-            BakeStage::Factor => ("factor", "factoring K − σM".to_string()),
-            BakeStage::Eigensolve(_) => ("eigensolve", "solving for the modes".to_string()),
-            BakeStage::TransferModes => (
-                "transfer modes",
-                "solving for the transfer table's modes".to_string(),
-            ),
+            BakeStage::Read | BakeStage::Write | BakeStage::Truth(_) => return,
+            BakeStage::Assemble => ("assemble", s.label()),
+            BakeStage::Factor => ("factor", s.label()),
+            BakeStage::Eigensolve(_) => ("eigensolve", s.label()),
+            BakeStage::TransferModes => ("transfer modes", s.label()),
             BakeStage::Transfer(p) => {
                 let now = std::time::Instant::now();
                 let first = self.stage != "transfer";

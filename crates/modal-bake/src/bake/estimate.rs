@@ -63,6 +63,9 @@ pub struct SizeEstimate {
     pub table_modes_s: f64,
     /// Peak memory of solving a transfer table's modes (bytes); 0 as `table_modes_s`.
     pub table_modes_bytes: f64,
+    /// The counts (tetrahedra, nodes, dofs) are a tetrahedral mesh's own, not estimated from a
+    /// surface ([`SizeEstimate::of_mesh`]); the times and memory are estimates either way.
+    pub counted: bool,
 }
 
 /// The work a bake may take before it is refused (unless forced).
@@ -72,6 +75,25 @@ pub struct Budget {
     pub max_bytes: f64,
     /// Longest wall time of meshing plus baking (s). Default 300 (5 minutes).
     pub max_seconds: f64,
+}
+
+impl Budget {
+    /// A budget of `max_gb` GB (1e9 bytes) and `max_seconds` s; `names`: how the two limits are
+    /// given (command-line options), for the error.
+    ///
+    /// # Errors
+    /// A limit that is not a positive finite number, naming it.
+    pub fn from_gb(max_gb: f64, max_seconds: f64, names: [&str; 2]) -> Result<Budget, String> {
+        for (name, v) in names.into_iter().zip([max_gb, max_seconds]) {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(format!("{name} {v} must be a positive number"));
+            }
+        }
+        Ok(Budget {
+            max_bytes: max_gb * 1e9,
+            max_seconds,
+        })
+    }
 }
 
 impl Default for Budget {
@@ -262,6 +284,7 @@ impl SizeEstimate {
             dofs: 3.0 * nodes as f64,
             boundary: boundary as f64,
             modes,
+            counted: true,
             ..Default::default()
         };
         e.bake();
@@ -366,14 +389,22 @@ impl SizeEstimate {
         self.peak_bytes() <= budget.max_bytes && self.total_s() <= budget.max_seconds
     }
 
-    /// One line: `~12,300 tetrahedra (order 2), ~56,000 dofs; about 14 s and 0.5 GB`.
+    /// One line: `~12,300 tetrahedra (order 2), ~3,100 nodes, ~9,300 dofs; baking about 14 s and
+    /// 0.5 GB` (counts without `~` when [`SizeEstimate::counted`]).
     pub fn describe(&self) -> String {
+        let count = |x: f64| {
+            if self.counted {
+                group_digits(x as usize)
+            } else {
+                format!("~{}", format_count(x))
+            }
+        };
         let mut s = format!(
-            "~{} tetrahedra (order {}), ~{} nodes, ~{} dofs; ",
-            format_count(self.tets),
+            "{} tetrahedra (order {}), {} nodes, {} dofs; ",
+            count(self.tets),
             self.order,
-            format_count(self.nodes),
-            format_count(self.dofs)
+            count(self.nodes),
+            count(self.dofs)
         );
         if self.mesh_s > 0.0 {
             s.push_str(&format!(
@@ -406,11 +437,15 @@ pub fn format_count(x: f64) -> String {
     let x = x.max(0.0);
     let mag = if x >= 1.0 { x.log10().floor() } else { 0.0 };
     let unit = 10f64.powf((mag - 2.0).max(0.0));
-    let r = ((x / unit).round() * unit) as u128;
-    let digits = r.to_string();
-    let mut out = String::new();
-    for (i, c) in digits.chars().enumerate() {
-        if i > 0 && (digits.len() - i).is_multiple_of(3) {
+    group_digits(((x / unit).round() * unit) as usize)
+}
+
+/// `5742` → `5,742` (exact, digits grouped by thousands).
+pub fn group_digits(n: usize) -> String {
+    let d = n.to_string();
+    let mut out = String::with_capacity(d.len() + d.len() / 3);
+    for (i, c) in d.chars().enumerate() {
+        if i > 0 && (d.len() - i).is_multiple_of(3) {
             out.push(',');
         }
         out.push(c);
@@ -441,6 +476,23 @@ pub fn format_bytes(b: f64) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    // A budget's limits are positive and finite; the refusal names the limit as it was given.
+    #[test]
+    fn a_budget_refuses_non_positive_limits_by_name() {
+        let names = ["--max-memory", "--max-time"];
+        let b = Budget::from_gb(2.0, 300.0, names).unwrap();
+        assert_eq!(b, Budget::default());
+        for (gb, s, bad) in [
+            (0.0, 300.0, "--max-memory 0"),
+            (f64::NAN, 300.0, "--max-memory NaN"),
+            (2.0, -1.0, "--max-time -1"),
+            (2.0, f64::INFINITY, "--max-time inf"),
+        ] {
+            let e = Budget::from_gb(gb, s, names).unwrap_err();
+            assert!(e.starts_with(bad), "{e}");
+        }
+    }
 
     // Halving the size multiplies the tetrahedra by 8 and raises every cost; order 2 has more
     // dofs than order 1 on the same tetrahedra; keeping a fine surface refines the estimate.

@@ -30,8 +30,8 @@ pub use dcr_runtime::format::{MaterialSi, ModesFile, ModesPrecision};
 pub use crate::mesh::extract_surface;
 pub use error::BakeError;
 pub use estimate::{
-    format_bytes, format_count, format_seconds, Budget, SizeEstimate, SurfaceMeasures,
-    FTETWILD_ELEMENTS,
+    format_bytes, format_count, format_seconds, group_digits, Budget, SizeEstimate,
+    SurfaceMeasures, FTETWILD_ELEMENTS,
 };
 pub use fixed_near::{FixedNear, DEFAULT_DISTANCE_FRACTION};
 pub use fixed_nodes::{FixedNodes, FixedSelectors};

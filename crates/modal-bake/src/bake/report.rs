@@ -149,6 +149,26 @@ pub enum BakeStage {
     TransferModes,
     /// Building the transfer table; carries rows done / total.
     Transfer(crate::transfer::TransferProgress),
+    /// Computing the converged full-order truth a choice by accuracy scores candidates
+    /// against (`--target-error`); carries the refinement's level and samples.
+    Truth(crate::full_order::RefineProgress),
     /// Writing the file.
     Write,
+}
+
+impl BakeStage {
+    /// The stage in words, for progress lines and logs ("assembling K and M", …; the
+    /// eigensolve's and the table's counts are in their progress values, not here).
+    pub fn label(&self) -> &'static str {
+        match self {
+            BakeStage::Read => "reading mesh",
+            BakeStage::Assemble => "assembling K and M",
+            BakeStage::Factor => "factoring K − σM",
+            BakeStage::Eigensolve(_) => "solving for the modes",
+            BakeStage::TransferModes => "solving for the transfer table's modes",
+            BakeStage::Transfer(_) => "building the transfer table",
+            BakeStage::Truth(_) => "computing the full-order truth",
+            BakeStage::Write => "writing",
+        }
+    }
 }

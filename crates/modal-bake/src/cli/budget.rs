@@ -35,18 +35,12 @@ impl BudgetOptions {
     /// # Errors
     /// A non-positive or non-finite `--max-memory` or `--max-time`.
     pub fn budget(&self) -> anyhow::Result<Budget> {
-        for (name, v) in [
-            ("--max-memory", self.max_memory),
-            ("--max-time", self.max_time),
-        ] {
-            if !(v.is_finite() && v > 0.0) {
-                anyhow::bail!("{name} {v} must be a positive number");
-            }
-        }
-        Ok(Budget {
-            max_bytes: self.max_memory * 1e9,
-            max_seconds: self.max_time,
-        })
+        Budget::from_gb(
+            self.max_memory,
+            self.max_time,
+            ["--max-memory", "--max-time"],
+        )
+        .map_err(anyhow::Error::msg)
     }
 
     /// The budget a transfer table's build is held to ([`TransferParams::budget`]): `None`

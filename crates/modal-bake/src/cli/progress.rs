@@ -194,9 +194,9 @@ impl Progress {
     /// Reports a bake stage.
     pub fn update(&mut self, stage: BakeStage) {
         let plain = self.plain(|plain| match stage {
-            BakeStage::Read => plain.report("read", || "reading mesh".into()),
-            BakeStage::Assemble => plain.report("assemble", || "assembling K and M".into()),
-            BakeStage::Factor => plain.report("factor", || "factoring K − σM".into()),
+            BakeStage::Read => plain.report("read", || stage.label().into()),
+            BakeStage::Assemble => plain.report("assemble", || stage.label().into()),
+            BakeStage::Factor => plain.report("factor", || stage.label().into()),
             BakeStage::Eigensolve(p) => plain.report("eigensolve", || {
                 format!(
                     "eigensolve: {}/{} modes converged, Lanczos step {}",
@@ -205,9 +205,7 @@ impl Progress {
                     p.iteration
                 )
             }),
-            BakeStage::TransferModes => plain.report("transfer modes", || {
-                "solving for the transfer table's modes".into()
-            }),
+            BakeStage::TransferModes => plain.report("transfer modes", || stage.label().into()),
             BakeStage::Transfer(p) => plain.report("transfer", || {
                 format!(
                     "transfer table: {}/{} rows ({})",
@@ -216,15 +214,16 @@ impl Progress {
                     p.plan.describe()
                 )
             }),
-            BakeStage::Write => plain.report("write", || "writing".into()),
+            BakeStage::Truth(_) => plain.report("truth", || detailed(stage)),
+            BakeStage::Write => plain.report("write", || stage.label().into()),
         });
         if plain {
             return;
         }
         match stage {
-            BakeStage::Read => self.bar.set_message("reading mesh"),
-            BakeStage::Assemble => self.bar.set_message("assembling K and M"),
-            BakeStage::Factor => self.bar.set_message("factoring K − σM"),
+            BakeStage::Read | BakeStage::Assemble | BakeStage::Factor => {
+                self.bar.set_message(stage.label())
+            }
             BakeStage::Eigensolve(p) => {
                 if self.bar.length().is_none() {
                     self.bar.set_style(
@@ -240,10 +239,9 @@ impl Progress {
                 self.bar
                     .set_message(format!("Lanczos step {}", p.iteration));
             }
-            BakeStage::TransferModes => {
+            BakeStage::TransferModes | BakeStage::Truth(_) | BakeStage::Write => {
                 self.bar.set_style(ProgressStyle::default_spinner());
-                self.bar
-                    .set_message("solving for the transfer table's modes");
+                self.bar.set_message(detailed(stage));
             }
             BakeStage::Transfer(p) => {
                 if self.bar.length() != Some(p.total as u64) {
@@ -260,11 +258,22 @@ impl Progress {
                 }
                 self.bar.set_position(p.done as u64);
             }
-            BakeStage::Write => {
-                self.bar.set_style(ProgressStyle::default_spinner());
-                self.bar.set_message("writing");
-            }
         }
+    }
+}
+
+/// A stage's label with its counts where a spinner shows them (the truth's level and samples).
+fn detailed(stage: BakeStage) -> String {
+    match stage {
+        BakeStage::Truth(p) => format!(
+            "{}: level {} (dt {:.2e} s), {}/{} samples",
+            stage.label(),
+            p.level,
+            p.dt,
+            p.done,
+            p.total
+        ),
+        _ => stage.label().into(),
     }
 }
 

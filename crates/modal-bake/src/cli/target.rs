@@ -2,7 +2,10 @@
 //! [`modal_bake::target_error`]).
 
 use anyhow::Context;
-use modal_bake::target_error::{bake_to_target, Candidate, PairsParams, Representation};
+use modal_bake::target_error::{
+    bake_to_target, Candidate, PairsParams, Representation, Skipped, TargetBake,
+};
+use modal_bake::transfer::{TransferModes, TransferParams};
 
 use super::bake::{annotate, before_factorization, print_report, BakeArgs, Progress};
 use super::mesh::AssetOptions;
@@ -19,7 +22,7 @@ fn describe(r: Representation) -> String {
 pub fn run(args: &BakeArgs, asset: &AssetOptions, target: f64) -> anyhow::Result<()> {
     let params = args.options.params();
     let surface = is_surface_asset(&args.mesh);
-    let Some(transfer) = args.transfer.params() else {
+    let Some(mut transfer) = args.transfer.params() else {
         if !surface {
             anyhow::bail!(
                 "--target-error without --transfer-h chooses the mesh of a surface asset (.obj, .stl, .ply); {} is a volume mesh: give --transfer-h (the scene's step) to choose its representation",
@@ -34,15 +37,25 @@ pub fn run(args: &BakeArgs, asset: &AssetOptions, target: f64) -> anyhow::Result
     }
     let (mesh, _) = super::bake::load_mesh_with_progress(&args.mesh, asset)?;
     let file = args.mesh.display().to_string();
+    // The choice solves for the table's every-mode set (dense where it fits, else Lanczos) and
+    // holds each candidate table to the budget.
+    let estimated = modal_bake::bake::BakeParams {
+        transfer: Some(TransferParams {
+            modes: TransferModes::All,
+            ..transfer.clone()
+        }),
+        ..params.clone()
+    };
     before_factorization(
         &file,
         &mesh,
         &args.options,
-        &params,
+        &estimated,
         &args.budget,
         asset.units,
         surface,
     )?;
+    transfer.budget = args.budget.table_budget()?;
     let mut progress = Progress::new("bake");
     let res = bake_to_target(
         mesh,
@@ -54,7 +67,12 @@ pub fn run(args: &BakeArgs, asset: &AssetOptions, target: f64) -> anyhow::Result
         &mut |s| progress.update(s),
     );
     progress.finish();
-    let (mut base, mut report, tried) =
+    let TargetBake {
+        mut base,
+        mut report,
+        tried,
+        skipped,
+    } =
         res.with_context(|| format!("baking {} failed; nothing was written", args.mesh.display()))?;
     report.material_name = args.options.model.material_choice().describe();
     annotate(&mut base, &args.options, &report);
@@ -77,6 +95,13 @@ pub fn run(args: &BakeArgs, asset: &AssetOptions, target: f64) -> anyhow::Result
                     "worst_pct": c.worst_pct,
                     "query_cost": c.query_cost,
                     "payload_bytes": c.payload_bytes,
+                    "build_s": c.build_s,
+                })).collect::<Vec<_>>(),
+                "skipped": skipped.iter().map(|k: &Skipped| serde_json::json!({
+                    "representation": describe(k.representation),
+                    "estimated_s": k.over_budget.plan.seconds(),
+                    "estimated_bytes": k.over_budget.plan.bytes(),
+                    "reason": k.over_budget.to_string(),
                 })).collect::<Vec<_>>(),
             }))?
         );
@@ -111,6 +136,13 @@ pub fn run(args: &BakeArgs, asset: &AssetOptions, target: f64) -> anyhow::Result
             c.worst_pct,
             c.query_cost,
             c.payload_bytes as f64 / 1024.0
+        );
+    }
+    for k in &skipped {
+        outln!(
+            "    skipped {:<40} {} (over the budget: --max-memory, --max-time; --force builds it)",
+            describe(k.representation),
+            k.over_budget.plan.describe()
         );
     }
     Ok(())

@@ -173,10 +173,20 @@ pub fn converged_peaks(
             total: steps,
         });
         let peaks = match (solver, &projected) {
-            (PeakSolver::ModalAll(ma, modes), Some((r, w))) => r
-                .iter()
-                .map(|ri| ma.peaks_projected(ri, w, sys.rayleigh, dt, steps, modes))
-                .collect(),
+            (PeakSolver::ModalAll(ma, modes), Some((r, w))) => {
+                let mut out = Vec::with_capacity(r.len());
+                for (i, ri) in r.iter().enumerate() {
+                    out.push(ma.peaks_projected(ri, w, sys.rayleigh, dt, steps, modes));
+                    // Loads done, in samples.
+                    progress(RefineProgress {
+                        level,
+                        dt,
+                        done: steps * (i + 1) / r.len(),
+                        total: steps,
+                    });
+                }
+                out
+            }
             _ => newmark_level(sys, loads, rows, dt, steps, level, progress)?,
         };
         let change = prev.as_ref().map_or(f64::NAN, |p| max_change(p, &peaks));

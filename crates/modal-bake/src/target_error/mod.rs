@@ -9,7 +9,11 @@
 //! modes without a table, as long as their query costs at most twice the paper's 20 modes
 //! (cost model: m·S multiply-adds per impact–contact pair, S = h/T samples at the paper's
 //! T = π/(2ω_m)); then 20 modes with a table of 160 modes, then of every mode (dense solve) or
-//! 640 (Lanczos), each quadratic then cubic (k² lookups per pair, k = 6 or 10 nodes). The first
+//! 640 (Lanczos), each quadratic then cubic (k² lookups per pair, k = 6 or 10 nodes). With a
+//! budget ([`TransferParams::budget`]) a table candidate is planned first
+//! ([`crate::transfer::TablePlan`]): over the budget, the every-mode candidate becomes the most
+//! modes that fit (when more than any table tried before it) and any other is skipped
+//! ([`Skipped`]), so a choice never starts a table its bake's budget refuses. The first
 //! whose worst |error| over the pairs is at most the target is chosen; if none is, the one with
 //! the smallest worst error, marked as not meeting it. The choice and its figures are stored
 //! in the base ([`dcr_runtime::format::AccuracyRecord`]); they are deterministic, so the file is
@@ -37,8 +41,8 @@ use crate::bake::{
 use crate::full_order::{FullOrderSystem, ModalAll, SystemParams};
 use crate::mesh::TetMesh;
 use crate::transfer::{
-    build_transfer_table, select_region, TableOrder, TransferError, TransferModes, TransferParams,
-    AUTO_LANCZOS_MODES, DENSE_MAX_DOFS, UP_MIN_COS,
+    build_transfer_table, most_modes_within, select_region, OverBudget, TableOrder, TransferError,
+    TransferModes, TransferParams, AUTO_LANCZOS_MODES, DENSE_MAX_DOFS, UP_MIN_COS,
 };
 
 /// Modal candidates (modes), cheapest first.
@@ -70,6 +74,54 @@ pub struct Candidate {
     pub query_cost: f64,
     /// Payload bytes (mode rows and table entries).
     pub payload_bytes: u64,
+    /// Wall time of building its table (s); 0 without one.
+    pub build_s: f64,
+}
+
+/// A table candidate not built: its [`crate::transfer::TablePlan`] is over the bake's budget
+/// ([`TransferParams::budget`]) and no smaller table of its order has more modes than the
+/// tables tried before it.
+#[derive(Clone, Debug)]
+pub struct Skipped {
+    /// What it would have been.
+    pub representation: Representation,
+    /// Its plan, the budget and what would fit.
+    pub over_budget: Box<OverBudget>,
+}
+
+/// What [`bake_to_target`] made.
+#[derive(Clone, Debug)]
+pub struct TargetBake {
+    /// The chosen base (its `meta.accuracy` records the choice).
+    pub base: ModesFile,
+    /// The bake's report (the chosen base's modes and table).
+    pub report: BakeReport,
+    /// Every candidate scored, in the order tried.
+    pub tried: Vec<Candidate>,
+    /// Table candidates over the budget, not built.
+    pub skipped: Vec<Skipped>,
+}
+
+/// The candidates scored so far, and the most accurate one's base (kept, so a choice that
+/// meets no target writes it without building it again).
+#[derive(Default)]
+struct Tried {
+    all: Vec<Candidate>,
+    best: Option<(ModesFile, Candidate)>,
+}
+
+impl Tried {
+    /// Records `c`, scored on base `b`.
+    fn push(&mut self, b: &ModesFile, c: &Candidate) {
+        let better = self
+            .best
+            .as_ref()
+            .is_none_or(|(_, x)| c.worst_pct.total_cmp(&x.worst_pct).is_lt());
+        if better {
+            self.best = Some((b.clone(), c.clone()));
+        }
+        self.all.push(c.clone());
+    }
 }
 
 fn median(v: &mut [f64]) -> f64 {
@@ -104,7 +156,9 @@ fn score(pairs: &ReferencePairs, base: ModesFile) -> (f64, f64) {
 /// Bakes `mesh` into the cheapest representation whose worst error at the seeded pairs of the
 /// table region (`transfer`: h, boxes, up direction; its modes and order are chosen here) is at
 /// most `target_pct` (see the module docs). `pairs`: sampling and truth settings (its h is
-/// taken from `transfer`).
+/// taken from `transfer`). With `transfer.budget` set, a table candidate whose plan is over it
+/// is not built: the every-mode candidate becomes the most modes that fit (when more than any
+/// table tried before it), any other is [`Skipped`].
 ///
 /// # Errors
 /// [`BakeError`] from the bakes; [`BakeError::Transfer`] for a bad target or region, a truth or
@@ -117,7 +171,7 @@ pub fn bake_to_target(
     pairs_params: &PairsParams,
     file: &str,
     progress: &mut dyn FnMut(BakeStage),
-) -> Result<(ModesFile, BakeReport, Vec<Candidate>), BakeError> {
+) -> Result<TargetBake, BakeError> {
     let terr = |error| BakeError::Transfer {
         file: file.to_string(),
         error: Box::new(error),
@@ -144,6 +198,7 @@ pub fn bake_to_target(
     }
     // The many-mode set: every mode (dense) or 640 (Lanczos); modal candidates truncate it.
     progress(BakeStage::TransferModes);
+    let set_start = std::time::Instant::now();
     let sp = SystemParams::of_bake(params);
     let sys = FullOrderSystem::new(mesh.clone(), &sp, file).map_err(|e| terr(e.into()))?;
     let dense = dofs <= DENSE_MAX_DOFS;
@@ -156,16 +211,20 @@ pub fn bake_to_target(
         Some(m) => mode_set_from_dense(&base20, &sys, m, m.eigenvalues.len()),
         None => mode_set_lanczos(&mesh, &base_params, AUTO_LANCZOS_MODES, file)?,
     };
+    let modes_s = set_start.elapsed().as_secs_f64();
     let pp = PairsParams {
         h: transfer.h,
         ..pairs_params.clone()
     };
-    let pairs = ReferencePairs::new(&sys, ma.as_ref(), &base20, &region, &pp, &mut |_| {})
-        .map_err(|e| terr(e.into()))?;
+    let pairs = ReferencePairs::new(&sys, ma.as_ref(), &base20, &region, &pp, &mut |p| {
+        progress(BakeStage::Truth(p))
+    })
+    .map_err(|e| terr(e.into()))?;
     drop(ma);
     let h = transfer.h;
     let cost20 = modal_cost(&set, TABLE_BASE_MODES.min(set.num_modes()), h);
-    let mut tried: Vec<Candidate> = Vec::new();
+    let mut tried = Tried::default();
+    let mut skipped: Vec<Skipped> = Vec::new();
     let mut chosen = try_modal(&set, &base20, &pairs, h, cost20, target_pct, &mut tried);
     if chosen.is_none() {
         chosen = try_tables(
@@ -176,6 +235,7 @@ pub fn bake_to_target(
             params.rayleigh,
             target_pct,
             &mut tried,
+            &mut skipped,
             progress,
         )
         .map_err(terr)?;
@@ -183,18 +243,8 @@ pub fn bake_to_target(
     let met = chosen.is_some();
     let (mut base, c) = match chosen {
         Some(x) => x,
-        None => {
-            // The most accurate tried.
-            let best = tried
-                .iter()
-                .min_by(|a, b| a.worst_pct.total_cmp(&b.worst_pct))
-                .expect("a candidate at least")
-                .clone();
-            (
-                rebuild(&best, &set, &base20, transfer, params.rayleigh).map_err(terr)?,
-                best,
-            )
-        }
+        // The most accurate tried.
+        None => tried.best.take().expect("a candidate at least"),
     };
     record_accuracy(&mut base, &c, met, &pairs, h, target_pct, cost20);
     let mut report = report20;
@@ -203,9 +253,14 @@ pub fn bake_to_target(
     report.residuals = base.residuals.clone();
     report.transfer = base.transfer.as_ref().map(|t| {
         let source = if dense { "dense" } else { "lanczos" };
-        crate::bake::TransferReport::of(t, source, 0.0, 0.0)
+        crate::bake::TransferReport::of(t, source, modes_s, c.build_s)
     });
-    Ok((base, report, tried))
+    Ok(TargetBake {
+        base,
+        report,
+        tried: tried.all,
+        skipped,
+    })
 }
 
 /// The first modal candidate (the lowest m of [`MODAL_CANDIDATES`] costing at most twice the
@@ -218,7 +273,7 @@ fn try_modal(
     h: f64,
     cost20: f64,
     target_pct: f64,
-    tried: &mut Vec<Candidate>,
+    tried: &mut Tried,
 ) -> Option<(ModesFile, Candidate)> {
     for &m in MODAL_CANDIDATES.iter().filter(|&&m| m <= set.num_modes()) {
         let cost = modal_cost(set, m, h);
@@ -232,9 +287,10 @@ fn try_modal(
             median_pct,
             worst_pct,
             query_cost: cost,
+            build_s: 0.0,
             payload_bytes: modal_bytes(set, m),
         };
-        tried.push(c.clone());
+        tried.push(&b, &c);
         if worst_pct <= target_pct {
             return Some((b, c));
         }
@@ -243,7 +299,9 @@ fn try_modal(
 }
 
 /// The first table candidate (160 modes or every mode, quadratic then cubic, over the 20-mode
-/// base) whose worst error is within `target_pct`; every one scored is pushed to `tried`.
+/// base) whose worst error is within `target_pct`; every one scored is pushed to `tried`, every
+/// one over `transfer.budget` to `skipped` (the every-mode one first tries the most modes that
+/// fit, when more than any table tried before it).
 ///
 /// # Errors
 /// A table that cannot be built (a cubic table too large for the format is skipped).
@@ -255,7 +313,8 @@ fn try_tables(
     transfer: &TransferParams,
     rayleigh: [f64; 2],
     target_pct: f64,
-    tried: &mut Vec<Candidate>,
+    tried: &mut Tried,
+    skipped: &mut Vec<Skipped>,
     progress: &mut dyn FnMut(BakeStage),
 ) -> Result<Option<(ModesFile, Candidate)>, TransferError> {
     let mut variants: Vec<(TransferModes, TableOrder)> = Vec::new();
@@ -264,21 +323,48 @@ fn try_tables(
             variants.push((modes, order));
         }
     }
+    // The most modes of a table tried so far: a table cut to fit the budget is only tried with
+    // more (fewer modes lose more than a higher order gains: on the npm bunny at h = 10 ms, a
+    // cubic table of 265 modes is 51 % worst where a quadratic one of 1,053 is 15 %).
+    let mut most_tried = 0;
     for (modes, order) in variants {
         if matches!(modes, TransferModes::Count(n) if n >= set.num_modes()) {
             continue;
         }
-        let tp = TransferParams {
+        let mut tp = TransferParams {
             modes,
             order,
             ..transfer.clone()
         };
-        let table = match build_transfer_table(set, &tp, rayleigh, &mut |p| {
-            progress(BakeStage::Transfer(p))
-        }) {
+        let mut build = |tp: &TransferParams| {
+            build_transfer_table(set, tp, rayleigh, &mut |p| progress(BakeStage::Transfer(p)))
+        };
+        let start = std::time::Instant::now();
+        let table = match build(&tp) {
             Ok(t) => t,
             // A cubic table too large for the format: the quadratic one stands.
             Err(TransferError::Params(_)) if order == TableOrder::Cubic => continue,
+            Err(TransferError::OverBudget(over)) => {
+                let budget = over.budget;
+                let most = match modes {
+                    TransferModes::All => most_modes_within(set, &tp, &budget)?
+                        .map(|p| p.modes)
+                        .filter(|&m| m > most_tried),
+                    _ => None,
+                };
+                let Some(m) = most else {
+                    skipped.push(Skipped {
+                        representation: Representation::Table(
+                            matches!(modes, TransferModes::Count(_)).then_some(over.plan.modes),
+                            over.plan.order,
+                        ),
+                        over_budget: over,
+                    });
+                    continue;
+                };
+                tp.modes = TransferModes::Count(m);
+                build(&tp)?
+            }
             Err(e) => return Err(e),
         };
         let k = match table.order {
@@ -288,9 +374,11 @@ fn try_tables(
         };
         let payload = modal_bytes(base20, TABLE_BASE_MODES) + 4 * table.peaks.len() as u64;
         let representation = Representation::Table(
-            matches!(modes, TransferModes::Count(_)).then_some(table.modes as usize),
+            matches!(tp.modes, TransferModes::Count(_)).then_some(table.modes as usize),
             table.order,
         );
+        let build_s = start.elapsed().as_secs_f64();
+        most_tried = most_tried.max(table.modes as usize);
         let mut b = base20.clone();
         b.transfer = Some(table);
         let (median_pct, worst_pct) = score(pairs, b.clone());
@@ -299,9 +387,10 @@ fn try_tables(
             median_pct,
             worst_pct,
             query_cost: k * k,
+            build_s,
             payload_bytes: payload,
         };
-        tried.push(c.clone());
+        tried.push(&b, &c);
         if worst_pct <= target_pct {
             return Ok(Some((b, c)));
         }
@@ -348,34 +437,6 @@ fn record_accuracy(
     if let Some(obj) = base.meta.bake_params.as_object_mut() {
         obj.insert("target_error_pct".into(), serde_json::json!(target_pct));
     }
-}
-
-/// The candidate `c` built again (when no candidate met the target and the most accurate one
-/// was not the last built).
-fn rebuild(
-    c: &Candidate,
-    set: &ModesFile,
-    base20: &ModesFile,
-    transfer: &TransferParams,
-    rayleigh: [f64; 2],
-) -> Result<ModesFile, TransferError> {
-    Ok(match c.representation {
-        Representation::Modal(m) => truncate(set, base20, m),
-        Representation::Table(modes, order) => {
-            let tp = TransferParams {
-                modes: modes.map_or(TransferModes::All, TransferModes::Count),
-                order: if order == 3 {
-                    TableOrder::Cubic
-                } else {
-                    TableOrder::Quadratic
-                },
-                ..transfer.clone()
-            };
-            let mut b = base20.clone();
-            b.transfer = Some(build_transfer_table(set, &tp, rayleigh, &mut |_| {})?);
-            b
-        }
-    })
 }
 
 /// The lowest `m` modes of the mode set `set` in the layout and metadata of `base20` (same

@@ -157,10 +157,31 @@ pub fn plan_transfer_table(
     prepare(modes, params, [0.0; 2]).map(|p| p.plan)
 }
 
-/// The changes of `params` whose tables fit `budget`, each with its estimate: the most modes
-/// that fit (when fewer than the plan's), and the lower orders.
-fn fixes(prep: &Prepared, params: &TransferParams, budget: &Budget) -> Vec<String> {
+/// The largest table of `params`' region and order within `budget`: the most of the set's
+/// lowest modes (at most those `params` select) whose [`TablePlan`] fits, and that plan; `None`
+/// when not even one mode fits.
+///
+/// # Errors
+/// As [`plan_transfer_table`].
+pub fn most_modes_within(
+    modes: &ModesFile,
+    params: &TransferParams,
+    budget: &Budget,
+) -> Result<Option<TablePlan>, TransferError> {
+    let prep = prepare(modes, params, [0.0; 2])?;
+    Ok(most_modes_fitting(&prep, params, budget))
+}
+
+/// [`most_modes_within`] on a prepared table.
+fn most_modes_fitting(
+    prep: &Prepared,
+    params: &TransferParams,
+    budget: &Budget,
+) -> Option<TablePlan> {
     let plan = &prep.plan;
+    if plan.fits(budget) {
+        return Some(*plan);
+    }
     let omega = prep.model.omega();
     let with_modes = |m: usize| -> Option<TablePlan> {
         let s = samples_for(params, omega[m - 1]).ok()?;
@@ -171,26 +192,36 @@ fn fixes(prep: &Prepared, params: &TransferParams, budget: &Budget) -> Vec<Strin
             ..*plan
         })
     };
-    let mut out = Vec::new();
     // The plan's cost grows with m (m and ω_m both grow): bisect for the most modes that fit.
     let fits = |m: usize| with_modes(m).is_some_and(|p| p.fits(budget));
-    if fits(1) {
-        let (mut lo, mut hi) = (1, plan.modes);
-        while hi - lo > 1 {
-            let mid = lo + (hi - lo) / 2;
-            if fits(mid) {
-                lo = mid;
-            } else {
-                hi = mid;
-            }
+    if !fits(1) {
+        return None;
+    }
+    let (mut lo, mut hi) = (1, plan.modes);
+    while hi - lo > 1 {
+        let mid = lo + (hi - lo) / 2;
+        if fits(mid) {
+            lo = mid;
+        } else {
+            hi = mid;
         }
-        if let Some(p) = with_modes(lo) {
-            out.push(format!(
-                "`transfer.modes` {lo} (the lowest {lo} modes, up to {:.3e} rad/s: {})",
-                p.omega_max,
-                p.describe()
-            ));
-        }
+    }
+    with_modes(lo)
+}
+
+/// The changes of `params` whose tables fit `budget` (the plan does not), each with its
+/// estimate: the most modes that fit, and the lower orders.
+fn fixes(prep: &Prepared, params: &TransferParams, budget: &Budget) -> Vec<String> {
+    let plan = &prep.plan;
+    let mut out = Vec::new();
+    if let Some(p) = most_modes_fitting(prep, params, budget) {
+        out.push(format!(
+            "`transfer.modes` {} (the lowest {} modes, up to {:.3e} rad/s: {})",
+            p.modes,
+            p.modes,
+            p.omega_max,
+            p.describe()
+        ));
     }
     let tris = &prep.model.base().surface_triangles;
     let t = &prep.table;

@@ -25,7 +25,7 @@
 //! at the order of magnitude a budget needs; it is not a benchmark.
 
 use super::CLUSTER_BYTES;
-use crate::bake::{format_bytes, format_seconds, Budget};
+use crate::bake::{format_bytes, format_seconds, group_digits, Budget};
 
 /// Seconds per modelled flop of the vertex-series GEMMs (f32, one thread; the count S m n_c²
 /// overstates the flops run, as series are reused between clusters).
@@ -157,17 +157,4 @@ impl std::fmt::Display for OverBudget {
             write!(f, "; to lower it: {}", self.fixes.join(", or "))
         }
     }
-}
-
-/// `5742` → `5,742` (exact, digits grouped by thousands).
-fn group_digits(n: usize) -> String {
-    let d = n.to_string();
-    let mut out = String::with_capacity(d.len() + d.len() / 3);
-    for (i, c) in d.chars().enumerate() {
-        if i > 0 && (d.len() - i).is_multiple_of(3) {
-            out.push(',');
-        }
-        out.push(c);
-    }
-    out
 }

@@ -268,20 +268,6 @@ fn record_of(entry: &Entry, action: &'static str, reason: Option<&'static str>) 
     }
 }
 
-/// A bake stage in words, for progress lines.
-fn stage_label(s: bake::BakeStage) -> &'static str {
-    use bake::BakeStage as S;
-    match s {
-        S::Read => "reading the mesh",
-        S::Assemble => "assembling K and M",
-        S::Factor => "factoring",
-        S::Eigensolve(_) => "eigensolve",
-        S::TransferModes => "transfer-table modes",
-        S::Transfer(_) => "transfer table",
-        S::Write => "writing",
-    }
-}
-
 /// Checks one entry's base and bakes it unless it is up to date.
 fn run_entry(entry: &Entry, tag: &str, start: Instant) -> EntryRecord {
     let args = &entry.args;
@@ -331,7 +317,7 @@ fn run_entry(entry: &Entry, tag: &str, start: Instant) -> EntryRecord {
         let mut stage_name = "";
         super::bake::bake_and_write(args, &params, mesh, read_s, &mut |s| {
             // Long bakes say which stage they are in.
-            let name = stage_label(s);
+            let name = s.label();
             if name != stage_name && t.elapsed().as_secs_f64() >= 5.0 {
                 line(start, &format!("{tag} {}: {name}", args.out.display()));
             }
