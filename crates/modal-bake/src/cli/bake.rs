@@ -84,7 +84,10 @@ pub struct BakeArgs {
     /// converged full-order truth, at seeded pairs of the table region (--transfer-up /
     /// --transfer-region), is at most PCT percent; the estimate, query cost and size are stored
     /// in the base (`info` shows them); overrides --modes and --transfer-modes /
-    /// --transfer-order. Without --transfer-h, for a surface asset: choose the mesh, refining
+    /// --transfer-order. Each candidate table is held to --max-memory / --max-time (one over
+    /// them is cut to the most modes that fit, or skipped and listed; --force builds it); the
+    /// truth the candidates are scored against is not estimated (minutes on a mesh of a few
+    /// thousand dofs). Without --transfer-h, for a surface asset: choose the mesh, refining
     /// --size (from its default) until the lowest five modes move by less than PCT percent
     /// between successive meshes, within the budget.
     #[arg(long, value_name = "PCT", conflicts_with = "max_freq")]
