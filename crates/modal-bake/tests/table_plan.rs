@@ -4,8 +4,8 @@
 //! Expectations: the plan counts what the build then computes (points, region vertices, modes,
 //! samples per step, bent points); its sampling is the coarsest that resolves the highest mode
 //! summed (T = π/(2ω)); a build over its budget is refused before any row is computed, and the
-//! mode count it suggests is the largest that fits (`most_modes_within`); a budget the plan
-//! fits changes no bit.
+//! mode count it suggests is the largest that fits (`OverBudget::most_modes`); a budget the
+//! plan fits changes no bit.
 
 use std::path::Path;
 
@@ -13,8 +13,8 @@ use dcr_runtime::format::ModesFile;
 use dcr_runtime::ModalModel;
 use modal_bake::bake::{bake_mesh, BakeParams, Budget, ModeRequest};
 use modal_bake::transfer::{
-    build_transfer_table, most_modes_within, plan_transfer_table, TableOrder, TransferError,
-    TransferModes, TransferParams,
+    build_transfer_table, plan_transfer_table, TableOrder, TransferError, TransferModes,
+    TransferParams,
 };
 
 /// The beam (clamped) with its lowest `n` modes, as a table's mode set.
@@ -135,20 +135,32 @@ fn a_build_over_its_budget_is_refused_with_the_most_modes_that_fit() {
     assert!(k < 120);
     assert!(plan_k(k).fits(&budget), "{k} modes do not fit");
     assert!(!plan_k(k + 1).fits(&budget), "{} modes fit too", k + 1);
-    // The library's answer is the suggestion's; a plan that fits is its own answer, and a
-    // budget below one mode's table has none.
-    let most = most_modes_within(&set, &all, &budget).expect("plan");
-    assert_eq!(most, Some(plan_k(k)));
-    let roomy = Budget {
-        max_seconds: 1e9,
-        max_bytes: 1e15,
-    };
-    assert_eq!(most_modes_within(&set, &all, &roomy).unwrap(), Some(full));
+    // The refusal's largest table is the suggestion's; a budget below one mode's table has
+    // none, and no mode-count fix.
+    assert_eq!(o.most_modes, Some(plan_k(k)));
     let tiny = Budget {
         max_seconds: 1e-12,
         max_bytes: 1e15,
     };
-    assert_eq!(most_modes_within(&set, &all, &tiny).unwrap(), None);
+    let err = build_transfer_table(
+        &set,
+        &TransferParams {
+            budget: Some(tiny),
+            ..all.clone()
+        },
+        [10.0, 1e-7],
+        &mut |_| {},
+    )
+    .expect_err("over the budget");
+    let TransferError::OverBudget(o) = &err else {
+        panic!("expected OverBudget, got {err}");
+    };
+    assert_eq!(o.most_modes, None);
+    assert!(
+        !o.fixes.iter().any(|f| f.contains("`transfer.modes`")),
+        "{:?}",
+        o.fixes
+    );
     // ... and that many modes build within the same budget.
     build_transfer_table(
         &set,

@@ -41,8 +41,8 @@ use crate::bake::{
 use crate::full_order::{FullOrderSystem, ModalAll, SystemParams};
 use crate::mesh::TetMesh;
 use crate::transfer::{
-    build_transfer_table, most_modes_within, select_region, OverBudget, TableOrder, TransferError,
-    TransferModes, TransferParams, AUTO_LANCZOS_MODES, DENSE_MAX_DOFS, UP_MIN_COS,
+    build_transfer_table, select_region, OverBudget, TableOrder, TransferError, TransferModes,
+    TransferParams, AUTO_LANCZOS_MODES, DENSE_MAX_DOFS, UP_MIN_COS,
 };
 
 /// Modal candidates (modes), cheapest first.
@@ -345,11 +345,10 @@ fn try_tables(
             // A cubic table too large for the format: the quadratic one stands.
             Err(TransferError::Params(_)) if order == TableOrder::Cubic => continue,
             Err(TransferError::OverBudget(over)) => {
-                let budget = over.budget;
                 let most = match modes {
-                    TransferModes::All => most_modes_within(set, &tp, &budget)?
-                        .map(|p| p.modes)
-                        .filter(|&m| m > most_tried),
+                    TransferModes::All => {
+                        over.most_modes.map(|p| p.modes).filter(|&m| m > most_tried)
+                    }
                     _ => None,
                 };
                 let Some(m) = most else {

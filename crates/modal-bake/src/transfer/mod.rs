@@ -22,9 +22,7 @@ mod table_plan;
 mod transfer_params;
 
 pub use region::{select_region, RegionBox};
-pub use table_builder::{
-    build_transfer_table, most_modes_within, plan_transfer_table, CLUSTER_BYTES,
-};
+pub use table_builder::{build_transfer_table, plan_transfer_table, CLUSTER_BYTES};
 pub use table_plan::{OverBudget, TablePlan};
 pub use transfer_params::{
     TableOrder, TransferError, TransferModes, TransferParams, TransferProgress,

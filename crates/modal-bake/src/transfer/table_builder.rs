@@ -157,22 +157,8 @@ pub fn plan_transfer_table(
     prepare(modes, params, [0.0; 2]).map(|p| p.plan)
 }
 
-/// The largest table of `params`' region and order within `budget`: the most of the set's
-/// lowest modes (at most those `params` select) whose [`TablePlan`] fits, and that plan; `None`
-/// when not even one mode fits.
-///
-/// # Errors
-/// As [`plan_transfer_table`].
-pub fn most_modes_within(
-    modes: &ModesFile,
-    params: &TransferParams,
-    budget: &Budget,
-) -> Result<Option<TablePlan>, TransferError> {
-    let prep = prepare(modes, params, [0.0; 2])?;
-    Ok(most_modes_fitting(&prep, params, budget))
-}
-
-/// [`most_modes_within`] on a prepared table.
+/// The most of the set's lowest modes (at most the plan's) whose table fits `budget`, with its
+/// plan ([`OverBudget::most_modes`]).
 fn most_modes_fitting(
     prep: &Prepared,
     params: &TransferParams,
@@ -210,11 +196,16 @@ fn most_modes_fitting(
 }
 
 /// The changes of `params` whose tables fit `budget` (the plan does not), each with its
-/// estimate: the most modes that fit, and the lower orders.
-fn fixes(prep: &Prepared, params: &TransferParams, budget: &Budget) -> Vec<String> {
+/// estimate: the most modes that fit (`most`), and the lower orders.
+fn fixes(
+    prep: &Prepared,
+    params: &TransferParams,
+    budget: &Budget,
+    most: Option<TablePlan>,
+) -> Vec<String> {
     let plan = &prep.plan;
     let mut out = Vec::new();
-    if let Some(p) = most_modes_fitting(prep, params, budget) {
+    if let Some(p) = most {
         out.push(format!(
             "`transfer.modes` {} (the lowest {} modes, up to {:.3e} rad/s: {})",
             p.modes,
@@ -278,10 +269,12 @@ pub fn build_transfer_table(
     let prep = prepare(modes, params, rayleigh)?;
     if let Some(budget) = params.budget {
         if !prep.plan.fits(&budget) {
+            let most = most_modes_fitting(&prep, params, &budget);
             return Err(TransferError::OverBudget(Box::new(OverBudget {
                 plan: prep.plan,
                 budget,
-                fixes: fixes(&prep, params, &budget),
+                most_modes: most,
+                fixes: fixes(&prep, params, &budget, most),
             })));
         }
     }

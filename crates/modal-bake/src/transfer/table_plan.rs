@@ -135,6 +135,9 @@ pub struct OverBudget {
     pub plan: TablePlan,
     /// The budget it is over.
     pub budget: Budget,
+    /// The largest table of the same region and order within the budget: the most of the
+    /// set's lowest modes that fit, with its plan; `None` when not even one mode fits.
+    pub most_modes: Option<TablePlan>,
     /// Changes of the parameters that fit the budget, each with its estimate (may be empty).
     pub fixes: Vec<String>,
 }
