@@ -13,8 +13,8 @@ use dcr_runtime::format::ModesFile;
 use dcr_runtime::ModalModel;
 use modal_bake::bake::{bake_mesh, BakeParams, Budget, ModeRequest};
 use modal_bake::transfer::{
-    build_transfer_table, plan_transfer_table, TableOrder, TransferError, TransferModes,
-    TransferParams,
+    build_transfer_table, plan_transfer_table, OverBudget, TableOrder, TransferError,
+    TransferModes, TransferParams,
 };
 
 /// The beam (clamped) with its lowest `n` modes, as a table's mode set.
@@ -92,6 +92,28 @@ fn the_sampling_is_the_coarsest_that_resolves_the_highest_mode() {
     }
 }
 
+/// Builds `params`' table from `set` under `budget`, expecting the refusal: its reason, and how
+/// many rows were computed before it.
+fn refusal(set: &ModesFile, params: &TransferParams, budget: Budget) -> (Box<OverBudget>, usize) {
+    let mut rows = 0;
+    let err = build_transfer_table(
+        set,
+        &TransferParams {
+            budget: Some(budget),
+            ..params.clone()
+        },
+        [10.0, 1e-7],
+        &mut |_| rows += 1,
+    )
+    .expect_err("over the budget");
+    let text = err.to_string();
+    assert!(text.contains("refused before building"), "{text}");
+    match err {
+        TransferError::OverBudget(o) => (o, rows),
+        e => panic!("expected OverBudget, got {e}"),
+    }
+}
+
 #[test]
 fn a_build_over_its_budget_is_refused_with_the_most_modes_that_fit() {
     let set = beam_modes(120);
@@ -101,24 +123,9 @@ fn a_build_over_its_budget_is_refused_with_the_most_modes_that_fit() {
         max_seconds: full.seconds() / 8.0,
         max_bytes: 1e12,
     };
-    let mut rows = 0;
-    let err = build_transfer_table(
-        &set,
-        &TransferParams {
-            budget: Some(budget),
-            ..all.clone()
-        },
-        [10.0, 1e-7],
-        &mut |_| rows += 1,
-    )
-    .expect_err("over the budget");
+    let (o, rows) = refusal(&set, &all, budget);
     assert_eq!(rows, 0, "a refused build computed rows");
-    let TransferError::OverBudget(o) = &err else {
-        panic!("expected OverBudget, got {err}");
-    };
     assert_eq!(o.plan, full);
-    let text = err.to_string();
-    assert!(text.contains("refused before building"), "{text}");
     // The first fix: the most modes that fit.
     let k: usize = o.fixes[0]
         .strip_prefix("`transfer.modes` ")
@@ -135,32 +142,8 @@ fn a_build_over_its_budget_is_refused_with_the_most_modes_that_fit() {
     assert!(k < 120);
     assert!(plan_k(k).fits(&budget), "{k} modes do not fit");
     assert!(!plan_k(k + 1).fits(&budget), "{} modes fit too", k + 1);
-    // The refusal's largest table is the suggestion's; a budget below one mode's table has
-    // none, and no mode-count fix.
+    // The refusal's largest table is the suggestion's ...
     assert_eq!(o.most_modes, Some(plan_k(k)));
-    let tiny = Budget {
-        max_seconds: 1e-12,
-        max_bytes: 1e15,
-    };
-    let err = build_transfer_table(
-        &set,
-        &TransferParams {
-            budget: Some(tiny),
-            ..all.clone()
-        },
-        [10.0, 1e-7],
-        &mut |_| {},
-    )
-    .expect_err("over the budget");
-    let TransferError::OverBudget(o) = &err else {
-        panic!("expected OverBudget, got {err}");
-    };
-    assert_eq!(o.most_modes, None);
-    assert!(
-        !o.fixes.iter().any(|f| f.contains("`transfer.modes`")),
-        "{:?}",
-        o.fixes
-    );
     // ... and that many modes build within the same budget.
     build_transfer_table(
         &set,
@@ -172,6 +155,18 @@ fn a_build_over_its_budget_is_refused_with_the_most_modes_that_fit() {
         &mut |_| {},
     )
     .expect("the suggested mode count builds");
+    // A budget below one mode's table has no largest table and no mode-count fix.
+    let tiny = Budget {
+        max_seconds: 1e-12,
+        max_bytes: 1e15,
+    };
+    let (o, _) = refusal(&set, &all, tiny);
+    assert_eq!(o.most_modes, None);
+    assert!(
+        !o.fixes.iter().any(|f| f.contains("`transfer.modes`")),
+        "{:?}",
+        o.fixes
+    );
 }
 
 #[test]
