@@ -453,9 +453,12 @@ pub fn group_digits(n: usize) -> String {
     out
 }
 
-/// `14 s`, `3.2 min`, `2.1 h`.
+/// `0.05 s`, `1.5 s`, `14 s`, `3.2 min`, `2.1 h`: two significant digits under 10 s, so a
+/// sub-second budget does not print as `0 s`.
 pub fn format_seconds(s: f64) -> String {
-    if s < 90.0 {
+    if s > 0.0 && s < 10.0 {
+        format!("{s:.*} s", significant_decimals(s))
+    } else if s < 90.0 {
         format!("{s:.0} s")
     } else if s < 5400.0 {
         format!("{:.1} min", s / 60.0)
@@ -464,18 +467,48 @@ pub fn format_seconds(s: f64) -> String {
     }
 }
 
-/// `120 MB`, `2.4 GB`.
+/// `512 B`, `40 kB`, `120 MB`, `2.4 GB`.
 pub fn format_bytes(b: f64) -> String {
-    if b < 1e9 {
+    if b < 1e3 {
+        format!("{b:.0} B")
+    } else if b < 1e6 {
+        format!("{:.0} kB", b / 1e3)
+    } else if b < 1e9 {
         format!("{:.0} MB", b / 1e6)
     } else {
         format!("{:.1} GB", b / 1e9)
     }
 }
 
+/// Decimals that print `x` (> 0, < 10) with two significant digits, at most six.
+fn significant_decimals(x: f64) -> usize {
+    (1.0 - x.log10().floor()).clamp(0.0, 6.0) as usize
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    // Limits below a unit print with their digits, not as zero.
+    #[test]
+    fn small_seconds_and_bytes_keep_their_digits() {
+        let secs = [
+            (0.05, "0.050 s"),
+            (0.5, "0.50 s"),
+            (1.5, "1.5 s"),
+            (14.0, "14 s"),
+        ];
+        for (s, text) in secs {
+            assert_eq!(format_seconds(s), text);
+        }
+        assert_eq!(format_seconds(0.0), "0 s");
+        assert_eq!(format_seconds(300.0), "5.0 min");
+        assert_eq!(format_seconds(7200.0), "2.0 h");
+        assert_eq!(format_bytes(512.0), "512 B");
+        assert_eq!(format_bytes(4.0e4), "40 kB");
+        assert_eq!(format_bytes(1.2e8), "120 MB");
+        assert_eq!(format_bytes(2.4e9), "2.4 GB");
+    }
 
     // A budget's limits are positive and finite; the refusal names the limit as it was given.
     #[test]
