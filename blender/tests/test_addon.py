@@ -16,7 +16,9 @@ user folder, enables it, points its preference at the modal-bake binary, and:
 - bakes Suzanne fixed by a vertex group on its ears (`--fixed-near`, the group's vertices and
   faces): the ears' vertices stay still, the head between them moves, and a box around both
   ears (which spans the head) would fix over twice as many nodes;
-- checks that a missing binary is a clear error, not a crash.
+- checks that a missing binary is a clear error, not a crash;
+- meshes Blender's glTF exports (GLB, and .gltf with its .bin) of a placed, rotated and mirrored
+  torus with `modal-bake mesh`: the same closed solid as Blender's OBJ export of it.
 
 Prints one line per check and "N passed, N failed, N skipped"; exits 1 on a failure. Without
 bpy it skips, except with DCR_REQUIRE_BPY=1 (CI), where that is a failure.
@@ -295,6 +297,46 @@ def main():
             prefs.binary = exe
 
     check("missing binary: a clear error naming where it looked", missing_binary)
+
+    def gltf_export():
+        # Blender's own glTF exporter (GLB, and .gltf with a .bin beside it) and its OBJ
+        # exporter, on a torus placed, rotated and mirrored (scale y < 0) in the scene: the
+        # glTF reader applies the node's transform and keeps the mirrored surface outward, so
+        # all three describe the same solid (the exporters split the quads along different
+        # diagonals: volumes within 0.5 %).
+        for o in bpy.context.view_layer.objects:
+            o.select_set(False)
+        bpy.ops.mesh.primitive_torus_add(major_radius=0.2, minor_radius=0.05,
+                                         location=(0.1, 0.3, 0.0), rotation=(0.3, 0.2, 0.0))
+        bpy.context.active_object.scale = (1.0, -0.8, 1.2)
+        paths = {fmt: os.path.join(work, "torus" + ext) for fmt, ext in
+                 [("GLB", ".glb"), ("GLTF_SEPARATE", ".gltf"), ("OBJ", ".obj")]}
+        for fmt in ("GLB", "GLTF_SEPARATE"):
+            bpy.ops.export_scene.gltf(filepath=paths[fmt], export_format=fmt,
+                                      use_selection=True)
+        bpy.ops.wm.obj_export(filepath=paths["OBJ"], export_materials=False,
+                              export_selected_objects=True)
+        got = {}
+        for fmt, path in paths.items():
+            report = json.loads(cli("mesh", path, "-o", path + ".msh", "--json"))["report"]
+            got[fmt] = report
+            i = report["inspection"]
+            assert report["backend"] == "gmsh", (fmt, report["backend"])
+            assert (i["vertices"], i["triangles"], i["shells"]) == (576, 1152, 1), (fmt, i)
+            assert i["open_edges"] == i["inconsistent_edges"] == 0, (fmt, i)
+            # Outward as exported: not turned inside out by the mirror (`flipped`).
+            assert report["volume_m3"] > 0 and not report["flipped"], (fmt, report["flipped"])
+        assert got["GLB"]["volume_m3"] == got["GLTF_SEPARATE"]["volume_m3"]
+        a, b = got["GLB"], got["OBJ"]
+        for lo_hi in range(2):
+            for k in range(3):
+                x, y = a["inspection"]["bbox"][lo_hi][k], b["inspection"]["bbox"][lo_hi][k]
+                assert abs(x - y) <= 2e-6, f"bbox {lo_hi} {k}: glb {x}, obj {y}"
+        assert abs(a["volume_m3"] / b["volume_m3"] - 1) < 5e-3, (a["volume_m3"], b["volume_m3"])
+        print(f"  torus: glb/gltf volume {a['volume_m3']:.6e} m³, obj {b['volume_m3']:.6e} m³, "
+              f"bbox {a['inspection']['bbox']}", flush=True)
+
+    check("Blender's glTF export (GLB and .gltf + .bin) meshes as its OBJ export", gltf_export)
 
     print(f"{results['passed']} passed, {results['failed']} failed, "
           f"{results['skipped']} skipped", flush=True)

@@ -31,6 +31,9 @@ use dcr_runtime::testing::SplitMix64;
 use modal_bake::mesh::surface::read_surface_bytes;
 use modal_bake::mesh::{read_mesh_bytes, Location, MeshErrorKind};
 
+#[path = "common/gltf_cube.rs"]
+mod gltf_cube;
+
 struct Counting;
 
 static CURRENT: AtomicUsize = AtomicUsize::new(0);
@@ -98,9 +101,9 @@ enum Kind {
     MshBinary,
     Json,
     Modes,
-    /// OBJ, ASCII STL, ASCII PLY.
+    /// OBJ, ASCII STL, ASCII PLY, `.gltf`.
     SurfaceAscii,
-    /// Binary STL and PLY.
+    /// Binary STL, PLY and glTF.
     SurfaceBinary,
 }
 
@@ -462,7 +465,7 @@ fn modes_seeds() -> Vec<(String, Vec<u8>)> {
 
 /// The surface seeds: a unit cube as OBJ (quads), ASCII STL (two solids, the second a shifted
 /// cube: refused as two shells unless a mutation breaks one), binary STL whose header starts
-/// with `solid`, ASCII PLY and binary PLY.
+/// with `solid`, ASCII PLY, binary PLY, GLB and `.gltf` with a base64 data URI.
 fn surface_seeds() -> Vec<(String, Vec<u8>, Kind)> {
     const V: [[f64; 3]; 8] = [
         [0.0, 0.0, 0.0],
@@ -549,6 +552,16 @@ fn surface_seeds() -> Vec<(String, Vec<u8>, Kind)> {
         ("cube_bin.stl".into(), stlb, Kind::SurfaceBinary),
         ("cube.ply".into(), ply.into_bytes(), Kind::SurfaceAscii),
         ("cube_bin.ply".into(), plyb, Kind::SurfaceBinary),
+        (
+            "cube.glb".into(),
+            gltf_cube::cube_glb(),
+            Kind::SurfaceBinary,
+        ),
+        (
+            "cube.gltf".into(),
+            gltf_cube::cube_gltf_embedded(),
+            Kind::SurfaceAscii,
+        ),
     ]
 }
 

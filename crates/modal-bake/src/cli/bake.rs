@@ -58,9 +58,9 @@ impl BakeOptions {
 #[derive(Args)]
 pub struct BakeArgs {
     /// Tetrahedral mesh: gmsh .msh (2.2 or 4.1, ASCII or binary, 4- or 10-node tetrahedra) or
-    /// meshio-style .json; or a surface asset .obj / .stl / .ply, meshed first as `modal-bake
-    /// mesh` does (--mesher, --size, --order, ...). Coordinates in metres unless --units says
-    /// otherwise.
+    /// meshio-style .json; or a surface asset .obj / .stl / .ply / .glb / .gltf, meshed first
+    /// as `modal-bake mesh` does (--mesher, --size, --order, ...). Coordinates in metres unless
+    /// --units says otherwise.
     pub mesh: PathBuf,
     /// Output base (written atomically: nothing is left behind on failure).
     #[arg(short = 'o', long = "out", value_name = "OUT.modes")]
@@ -114,7 +114,7 @@ pub fn load_mesh(
     }
     if asset.any_set() {
         anyhow::bail!(
-            "--mesher, --size, --order, --envelope, --gmsh, --ftetwild, --keep-surface, --uniform-size and --mesher-timeout apply to surface assets (.obj, .stl, .ply), not to the volume mesh {}",
+            "--mesher, --size, --order, --envelope, --gmsh, --ftetwild, --keep-surface, --uniform-size and --mesher-timeout apply to surface assets (.obj, .stl, .ply, .glb, .gltf), not to the volume mesh {}",
             path.display()
         );
     }

@@ -91,8 +91,8 @@ impl BudgetOptions {
         table: Option<TransferModes>,
     ) -> anyhow::Result<SizeEstimate> {
         let budget = self.budget()?;
-        let mut s = modal_bake::mesh::surface::read_surface(path)
-            .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+        // The reader's errors name the file.
+        let mut s = modal_bake::mesh::surface::read_surface(path)?;
         let to_m = asset.units.to_metres();
         if to_m != 1.0 {
             s.scale(to_m);

@@ -44,7 +44,7 @@ pub struct ExportArgs {
     #[arg(long, value_name = "OUT.glb")]
     pub gltf: Option<PathBuf>,
     /// With --gltf: put the morph targets on this surface asset's own vertices (.obj, .stl,
-    /// .ply; the file the base was baked from) instead of the base's surface.
+    /// .ply, .glb, .gltf; the file the base was baked from) instead of the base's surface.
     #[arg(long, value_name = "ASSET", requires = "gltf")]
     pub onto: Option<PathBuf>,
     /// Unit of the --onto asset's coordinates (as given to `mesh`/`bake` --units).

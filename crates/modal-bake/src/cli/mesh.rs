@@ -1,4 +1,4 @@
-//! `modal-bake mesh`: a surface asset (OBJ, STL, PLY) to a tetrahedral gmsh mesh.
+//! `modal-bake mesh`: a surface asset (OBJ, STL, PLY, glTF) to a tetrahedral gmsh mesh.
 
 use std::path::{Path, PathBuf};
 
@@ -217,7 +217,9 @@ impl AssetOptions {
     `pip install pytetwild==0.4.2`."
 )]
 pub struct MeshArgs {
-    /// Surface asset: .obj, .stl (ASCII or binary) or .ply (ASCII or binary).
+    /// Surface asset: .obj, .stl (ASCII or binary), .ply (ASCII or binary), or glTF 2.0 (.glb,
+    /// or .gltf with its buffers embedded or beside it): every triangle mesh its scene places,
+    /// in the scene's frame (glTF's metres, +Y up).
     pub asset: PathBuf,
     /// Output tetrahedral mesh (gmsh MSH 4.1 binary; written atomically).
     #[arg(short = 'o', long = "out", value_name = "OUT.msh")]

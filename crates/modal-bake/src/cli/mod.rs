@@ -40,14 +40,14 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Bake MESH (gmsh MSH 2.2/4.1 ASCII or binary, meshio JSON, or a surface asset .obj /
-    /// .stl / .ply meshed with gmsh or fTetWild) into OUT.modes.
+    /// .stl / .ply / .glb / .gltf meshed with gmsh or fTetWild) into OUT.modes.
     #[command(allow_negative_numbers = true)]
     Bake(bake::BakeArgs),
     /// Bake the bases a manifest (JSON or TOML) lists, skipping those up to date; one shard
     /// of it (--shard I/N) on a farm, --jobs J at once. See docs/farm.md.
     #[command(allow_negative_numbers = true)]
     Batch(batch::BatchArgs),
-    /// Tetrahedralize a surface asset (OBJ, STL, PLY) into a .msh mesh: inspected, then gmsh
+    /// Tetrahedralize a surface asset (OBJ, STL, PLY, glTF) into a .msh mesh: inspected, then gmsh
     /// or fTetWild (--mesher auto).
     Mesh(mesh::MeshArgs),
     /// Print a readable summary of a .modes file (or one JSON object with --json).

@@ -25,7 +25,7 @@ pub fn run(args: &BakeArgs, asset: &AssetOptions, target: f64) -> anyhow::Result
     let Some(mut transfer) = args.transfer.params() else {
         if !surface {
             anyhow::bail!(
-                "--target-error without --transfer-h chooses the mesh of a surface asset (.obj, .stl, .ply); {} is a volume mesh: give --transfer-h (the scene's step) to choose its representation",
+                "--target-error without --transfer-h chooses the mesh of a surface asset (.obj, .stl, .ply, .glb, .gltf); {} is a volume mesh: give --transfer-h (the scene's step) to choose its representation",
                 args.mesh.display()
             );
         }
@@ -158,8 +158,8 @@ fn choose_mesh_and_bake(args: &BakeArgs, asset: &AssetOptions, target: f64) -> a
     use modal_bake::bake::{BakeError, SizeEstimate, SurfaceMeasures};
     use modal_bake::target_error::choose_mesh;
     let budget = args.budget.budget()?;
-    let mut s = modal_bake::mesh::surface::read_surface(&args.mesh)
-        .map_err(|e| anyhow::anyhow!("{}: {e}", args.mesh.display()))?;
+    // The reader's errors name the file.
+    let mut s = modal_bake::mesh::surface::read_surface(&args.mesh)?;
     if asset.units.to_metres() != 1.0 {
         s.scale(asset.units.to_metres());
     }

@@ -34,7 +34,7 @@ pub struct AssetMesh {
 }
 
 impl AssetMesh {
-    /// Reads an OBJ, STL or PLY asset keeping its vertex list and order, and multiplies its
+    /// Reads an OBJ, STL, PLY or glTF asset keeping its vertex list and order, and multiplies its
     /// coordinates by `to_metres` (the factor `modal-bake mesh --units` applies).
     ///
     /// # Errors

@@ -136,28 +136,48 @@ impl SurfaceInspection {
     /// The defects as a list (`"64 open edges, 1 non-manifold vertex, 2 shells"`), or
     /// `"closed, manifold, consistently oriented, no self-intersection, one shell"`.
     pub fn summary(&self) -> String {
-        let plural = |n: usize, what: &str| {
+        let plural = |n: usize, one: &str, many: &str| {
             if n == 1 {
-                format!("1 {what}")
+                format!("1 {one}")
             } else {
-                format!("{n} {what}s")
+                format!("{n} {many}")
             }
         };
         let mut parts = Vec::new();
-        for (n, what) in [
-            (self.degenerate_triangles, "degenerate triangle"),
-            (self.open_edges, "open edge"),
-            (self.non_manifold_edges, "non-manifold edge"),
-            (self.non_manifold_vertices, "non-manifold vertex"),
-            (self.inconsistent_edges, "inconsistently oriented edge"),
-            (self.self_intersections, "self-intersecting triangle pair"),
+        for (n, one, many) in [
+            (
+                self.degenerate_triangles,
+                "degenerate triangle",
+                "degenerate triangles",
+            ),
+            (self.open_edges, "open edge", "open edges"),
+            (
+                self.non_manifold_edges,
+                "non-manifold edge",
+                "non-manifold edges",
+            ),
+            (
+                self.non_manifold_vertices,
+                "non-manifold vertex",
+                "non-manifold vertices",
+            ),
+            (
+                self.inconsistent_edges,
+                "inconsistently oriented edge",
+                "inconsistently oriented edges",
+            ),
+            (
+                self.self_intersections,
+                "self-intersecting triangle pair",
+                "self-intersecting triangle pairs",
+            ),
         ] {
             if n > 0 {
-                parts.push(plural(n, what));
+                parts.push(plural(n, one, many));
             }
         }
         if self.shells != 1 {
-            parts.push(plural(self.shells, "shell"));
+            parts.push(plural(self.shells, "shell", "shells"));
         }
         if parts.is_empty() {
             "closed, manifold, consistently oriented, no self-intersection, one shell".into()

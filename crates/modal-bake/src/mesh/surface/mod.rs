@@ -1,4 +1,5 @@
-//! Surface assets in: OBJ, STL (ASCII and binary) and PLY (ASCII and binary) read into a
+//! Surface assets in: OBJ, STL (ASCII and binary), PLY (ASCII and binary) and glTF 2.0
+//! (`.glb`, `.gltf`; [`gltf_asset`](self) has what is read) read into a
 //! [`SurfaceMesh`] and checked to bound a solid ([`SurfaceMesh::check_closed`]) before
 //! [`crate::mesh::gmsh`] fills it with tetrahedra.
 //!
@@ -9,6 +10,7 @@
 //! Unsupported: non-triangle primitives other than planar polygons, textures and materials
 //! (ignored).
 
+mod gltf_asset;
 mod inspect;
 mod surface_error;
 mod surface_mesh;
@@ -20,7 +22,8 @@ pub use inspect::{inspect_surface, Defect, DefectKind, SurfaceInspection, MAX_EX
 pub use surface_error::SurfaceError;
 pub use surface_mesh::{SurfaceInfo, SurfaceMesh};
 
-/// Whether `path` has a surface-asset extension (`.obj`, `.stl`, `.ply`, any case).
+/// Whether `path` has a surface-asset extension (`.obj`, `.stl`, `.ply`, `.glb`, `.gltf`, any
+/// case).
 pub fn is_surface_asset(path: &Path) -> bool {
     format_of(path).is_some()
 }
@@ -30,6 +33,7 @@ enum Format {
     Obj,
     Stl,
     Ply,
+    Gltf,
 }
 
 fn format_of(path: &Path) -> Option<Format> {
@@ -38,6 +42,7 @@ fn format_of(path: &Path) -> Option<Format> {
         "obj" => Some(Format::Obj),
         "stl" => Some(Format::Stl),
         "ply" => Some(Format::Ply),
+        "glb" | "gltf" => Some(Format::Gltf),
         _ => None,
     }
 }
@@ -89,17 +94,13 @@ pub fn read_surface_unwelded(data: &[u8], name: &str) -> Result<Soup3, SurfaceEr
         Some(Format::Obj) => read_obj(data, name)?,
         Some(Format::Stl) => read_stl(data, name)?,
         Some(Format::Ply) => read_ply(data, name)?,
+        // Triangles already, their indices checked against each primitive's vertices.
+        Some(Format::Gltf) => {
+            let (positions, triangles) = gltf_asset::read_gltf(data, name)?;
+            return finite_and_nonempty(positions, triangles, name);
+        }
         None => return Err(SurfaceError::UnknownFormat { file: file() }),
     };
-    if let Some(v) = positions
-        .iter()
-        .position(|p| !p.iter().all(|x| x.is_finite()))
-    {
-        return Err(SurfaceError::NonFinite {
-            file: file(),
-            vertex: v,
-        });
-    }
     let mut triangles = Vec::with_capacity(faces.len());
     for (f, face) in faces.iter().enumerate() {
         if let Some(&bad) = face
@@ -117,6 +118,25 @@ pub fn read_surface_unwelded(data: &[u8], name: &str) -> Result<Soup3, SurfaceEr
         for k in 1..face.len().saturating_sub(1) {
             triangles.push([face[0] as usize, face[k] as usize, face[k + 1] as usize]);
         }
+    }
+    finite_and_nonempty(positions, triangles, name)
+}
+
+/// The soup, refused when a coordinate is not finite or there is no triangle.
+fn finite_and_nonempty(
+    positions: Vec<[f64; 3]>,
+    triangles: Vec<[usize; 3]>,
+    name: &str,
+) -> Result<Soup3, SurfaceError> {
+    let file = || name.to_string();
+    if let Some(v) = positions
+        .iter()
+        .position(|p| !p.iter().all(|x| x.is_finite()))
+    {
+        return Err(SurfaceError::NonFinite {
+            file: file(),
+            vertex: v,
+        });
     }
     if triangles.is_empty() {
         return Err(SurfaceError::Empty { file: file() });

@@ -1,6 +1,6 @@
 //! [`SurfaceError`]: why a surface asset cannot be meshed.
 
-/// Why a surface asset (OBJ, STL, PLY) was refused. Every variant names the file; defects of
+/// Why a surface asset (OBJ, STL, PLY, glTF) was refused. Every variant names the file; defects of
 /// the surface give a position in metres (after the unit scaling) so it can be found in a
 /// modelling tool.
 #[derive(Debug, thiserror::Error)]
@@ -14,8 +14,8 @@ pub enum SurfaceError {
         /// What the operating system said.
         detail: String,
     },
-    /// The extension is not one of `.obj`, `.stl`, `.ply`.
-    #[error("{file}: unrecognised surface format (expected .obj, .stl or .ply)")]
+    /// The extension is not one of `.obj`, `.stl`, `.ply`, `.glb`, `.gltf`.
+    #[error("{file}: unrecognised surface format (expected .obj, .stl, .ply, .glb or .gltf)")]
     UnknownFormat {
         /// The file.
         file: String,
@@ -25,7 +25,7 @@ pub enum SurfaceError {
     Parse {
         /// The file.
         file: String,
-        /// `OBJ`, `STL` or `PLY`.
+        /// `OBJ`, `STL`, `PLY` or `glTF`.
         format: &'static str,
         /// What the parser said.
         detail: String,
