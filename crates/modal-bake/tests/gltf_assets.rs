@@ -199,6 +199,9 @@ fn a_document_without_scenes_reads_every_mesh() {
     assert_eq!((p.len(), t.len()), (8, 12));
 }
 
+/// A change to the cube's glTF document.
+type Edit = Box<dyn FnOnce(&mut Value)>;
+
 /// The error of reading the cube GLB after `edit` changed its document.
 fn refusal(edit: impl FnOnce(&mut Value), name: &str) -> String {
     let (mut doc, bin) = cube_document(&cube_triangles(), 4, json!({}));
@@ -213,7 +216,7 @@ fn refusal(edit: impl FnOnce(&mut Value), name: &str) -> String {
 // panic or an allocation beyond what the file holds.
 #[test]
 fn hostile_documents_are_refused_with_the_file_and_the_reason() {
-    let cases: Vec<(&str, Box<dyn FnOnce(&mut Value)>, &str)> = vec![
+    let cases: Vec<(&str, Edit, &str)> = vec![
         (
             "count0.glb",
             Box::new(|d| d["accessors"][0]["count"] = json!(0)),

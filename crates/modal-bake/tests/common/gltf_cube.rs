@@ -35,7 +35,7 @@ pub fn cube_triangles() -> Vec<u16> {
 pub fn cube_document(indices: &[u16], mode: u32, buffer: Value) -> (Value, Vec<u8>) {
     let mut bin: Vec<u8> = V.iter().flatten().flat_map(|x| x.to_le_bytes()).collect();
     bin.extend(indices.iter().flat_map(|i| i.to_le_bytes()));
-    while bin.len() % 4 != 0 {
+    while !bin.len().is_multiple_of(4) {
         bin.push(0);
     }
     let mut buffer = buffer;
@@ -63,11 +63,11 @@ pub fn cube_document(indices: &[u16], mode: u32, buffer: Value) -> (Value, Vec<u
 /// A binary glTF: 12-byte header, the JSON chunk (space-padded), the BIN chunk (zero-padded).
 pub fn glb(doc: &Value, bin: &[u8]) -> Vec<u8> {
     let mut j = serde_json::to_vec(doc).unwrap();
-    while j.len() % 4 != 0 {
+    while !j.len().is_multiple_of(4) {
         j.push(b' ');
     }
     let mut b = bin.to_vec();
-    while b.len() % 4 != 0 {
+    while !b.len().is_multiple_of(4) {
         b.push(0);
     }
     let total = 12 + 8 + j.len() + 8 + b.len();

@@ -15,10 +15,10 @@
 //! winding back to outward), primitives of mode `TRIANGLES`, `TRIANGLE_STRIP` and
 //! `TRIANGLE_FAN` with `POSITION` as `VEC3` `FLOAT` (or, with `KHR_mesh_quantization`, 8- or
 //! 16-bit integers, normalized or not, as gltfpack writes by default) and optional
-//! `u8`/`u16`/`u32` indices.
-//! Points and lines are ignored, as materials, textures, normals, skins and morph targets are
-//! (a skinned mesh is read in its bind pose). Refused with what to do: Draco or meshopt
-//! compression (`KHR_draco_mesh_compression`, `EXT_meshopt_compression`), sparse positions,
+//! `u8`/`u16`/`u32` indices. Points and lines are ignored, as materials, textures, normals,
+//! skins and morph targets are (a skinned mesh is read as its node places it, without its
+//! joints). Refused with what to do: Draco or meshopt compression
+//! (`KHR_draco_mesh_compression`, `EXT_meshopt_compression`), sparse positions,
 //! nodes placed twice (glTF's nodes form trees), buffers behind a URL.
 
 use std::borrow::Cow;
@@ -362,7 +362,7 @@ impl Collect<'_, '_> {
                 }
                 None => (0..count).collect(),
             };
-            if prim.mode() == Mode::Triangles && indices.len() % 3 != 0 {
+            if prim.mode() == Mode::Triangles && !indices.len().is_multiple_of(3) {
                 return Err(err(
                     name,
                     format!(

@@ -72,7 +72,8 @@ pub fn read_surface(path: &Path) -> Result<SurfaceMesh, SurfaceError> {
 }
 
 /// [`read_surface`] on bytes in memory; `name` (a file name) chooses the format by its
-/// extension and names the file in errors.
+/// extension and names the file in errors. A `.gltf`'s buffer files are read from `name`'s
+/// folder.
 ///
 /// # Errors
 /// As [`read_surface`].
