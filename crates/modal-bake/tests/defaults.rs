@@ -483,6 +483,60 @@ fn an_over_budget_surface_is_refused_with_the_estimate() {
     );
 }
 
+/// An estimate over the budget by less than its element count's uncertainty does not refuse a
+/// surface before meshing: the 0.1 m box at --size 6 mm is estimated at 1.6 GB to bake and
+/// meshes to 1.5 GB (gmsh has made as few as 1/2.5 of the estimate's elements). Under 1.4 GB
+/// it is meshed with a note, `mesh` warns that the mesh's bake is over, and `bake` refuses it
+/// on the mesh's exact counts; under 0.4 GB even the fewest elements are over and it is refused
+/// before meshing, as before.
+#[test]
+fn an_estimate_within_its_uncertainty_meshes_first_and_the_exact_counts_decide() {
+    if !have_gmsh("an_estimate_within_its_uncertainty_meshes_first_and_the_exact_counts_decide") {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let asset = dir.path().join("box.obj");
+    std::fs::write(&asset, box_obj(0.1, 2)).unwrap();
+    let msh = dir.path().join("box.msh");
+    let common = ["--size", "0.006", "--max-memory", "1.4"];
+    let mut a = vec!["mesh", asset.to_str().unwrap(), "-o", msh.to_str().unwrap()];
+    a.extend(common);
+    let o = run(&a);
+    let e = stderr(&o);
+    assert!(o.status.success() && msh.exists(), "{e}");
+    assert!(
+        e.contains("its element count is uncertain before meshing")
+            && e.contains("gmsh has made as few as 0.40 times it"),
+        "{e}"
+    );
+    assert!(
+        e.contains("baking it (20 modes) is estimated on its counts")
+            && e.contains("`modal-bake bake` will refuse it"),
+        "{e}"
+    );
+    // `bake` of the asset: meshed, then refused on the exact counts (no `~`).
+    let out = dir.path().join("box.modes");
+    let mut a = vec!["--material", "steel"];
+    a.extend(common);
+    let o = bake(&asset, &out, &a);
+    let e = stderr(&o);
+    assert!(!o.status.success() && !out.exists(), "{e}");
+    assert!(
+        e.contains("box.obj (order 2, --mesher auto) ...")
+            && e.contains("refused before baking: estimated 22,"),
+        "{e}"
+    );
+    // Far over: refused before meshing.
+    let o = bake(&asset, &out, &["--size", "0.006", "--max-memory", "0.4"]);
+    let e = stderr(&o);
+    assert!(
+        !o.status.success()
+            && e.contains("refused before meshing or baking")
+            && !e.contains("(order 2, --mesher auto) ..."),
+        "{e}"
+    );
+}
+
 /// `--target-error` without a transfer table picks a surface asset's mesh: it refines --size
 /// until the lowest modes move by less than the target, reports each mesh, bakes the last;
 /// a target the budget cannot reach is baked at the finest mesh that fits, with a warning.

@@ -31,7 +31,7 @@ pub use crate::mesh::extract_surface;
 pub use error::BakeError;
 pub use estimate::{
     format_bytes, format_count, format_seconds, group_digits, Budget, SizeEstimate,
-    SurfaceMeasures, FTETWILD_ELEMENTS,
+    SurfaceMeasures, FEWEST_ELEMENTS, FTETWILD_ELEMENTS, FTETWILD_S_PER_TET,
 };
 pub use fixed_near::{FixedNear, DEFAULT_DISTANCE_FRACTION};
 pub use fixed_nodes::{FixedNodes, FixedSelectors};

@@ -115,20 +115,18 @@ impl BudgetOptions {
                 !modal_bake::mesh::surface::inspect_surface(&s).is_solid()
             }
         };
-        let k = if ftetwild {
-            modal_bake::bake::FTETWILD_ELEMENTS
-        } else {
-            1.0
-        };
-        let est = |size: f64, order: u8| {
+        // `k`: the fraction of the estimate's elements the mesh is taken to have (1: the
+        // estimate; below 1: the fewest the mesher has made against it).
+        let est_k = |size: f64, order: u8, k: f64| {
             let h = modal_bake::mesh::sizing::equivalent_size(&s, size, curvature, thickness);
-            let e =
-                SizeEstimate::of_surface(&measures, h, asset.keep_surface, order, modes).scaled(k);
+            let e = SizeEstimate::of_surface(&measures, h, asset.keep_surface, order, modes);
+            let e = if ftetwild { e.for_ftetwild() } else { e }.with_elements(k);
             match table {
                 Some(t) => e.with_table_modes(t, e.dofs as usize),
                 None => e,
             }
         };
+        let est = |size: f64, order: u8| est_k(size, order, 1.0);
         let fits = |e: &SizeEstimate| e.fits(&budget);
         let e = est(size, order);
         eprintln!(
@@ -163,6 +161,28 @@ impl BudgetOptions {
             e.describe()
         );
         if fits(&e) {
+            return Ok(e);
+        }
+        // The element count is known only once meshed: when the fewest elements the mesher has
+        // made against this estimate would fit (and meshing itself does), mesh first and let
+        // the bake be decided on the mesh's exact counts (`check_mesh`, or `mesh`'s warning).
+        let fewest = modal_bake::bake::FEWEST_ELEMENTS[usize::from(ftetwild)];
+        let meshing = SizeEstimate {
+            bake_s: 0.0,
+            bake_bytes: 0.0,
+            table_modes_s: 0.0,
+            table_modes_bytes: 0.0,
+            ..e
+        };
+        if !self.force && !asset.keep_surface && fits(&meshing) && fits(&est_k(size, order, fewest))
+        {
+            eprintln!(
+                "note: {}: the estimate is over {}, but its element count is uncertain before meshing ({} has made as few as {:.2} times it, which would fit): meshing first; the bake is checked on the mesh's exact counts",
+                path.display(),
+                self.describe(),
+                if ftetwild { "fTetWild" } else { "gmsh" },
+                fewest
+            );
             return Ok(e);
         }
         let mut how = Vec::new();
@@ -205,7 +225,8 @@ impl BudgetOptions {
             ));
         }
         how.push("fewer --modes".into());
-        self.refuse(&path.display().to_string(), &e, &how, measures.extent_m)
+        let file = path.display().to_string();
+        self.refuse(&file, "meshing or baking", &e, &how, measures.extent_m)
     }
 
     /// Estimates baking `mesh` with `params` ([`SizeEstimate::of_bake`]: its modes and a
@@ -238,12 +259,33 @@ impl BudgetOptions {
                     .into(),
             );
         }
-        self.refuse(file, &e, &how, mesh.extent())
+        self.refuse(file, "baking", &e, &how, mesh.extent())
     }
 
+    /// After `mesh`: the bake of `mesh` (20 modes, `bake`'s default) estimated on its exact
+    /// counts, printed with a warning when it is over the budget (`bake` would refuse it).
+    ///
+    /// # Errors
+    /// A malformed budget.
+    pub fn warn_bake(&self, file: &str, mesh: &modal_bake::mesh::TetMesh) -> anyhow::Result<()> {
+        let budget = self.budget()?;
+        let e = SizeEstimate::of_bake(mesh, &mb::BakeParams::default());
+        if !e.fits(&budget) {
+            eprintln!(
+                "warning: {file}: baking it (20 modes) is estimated on its counts at {}: over {}; `modal-bake bake` will refuse it: mesh again with a coarser --size (or --order 1), or give bake a larger --max-memory / --max-time",
+                e.describe(),
+                self.describe()
+            );
+        }
+        Ok(())
+    }
+
+    /// Refuses `e` (unless `--force`) before the work `before` names ("meshing or baking",
+    /// "baking").
     fn refuse(
         &self,
         file: &str,
+        before: &str,
         e: &SizeEstimate,
         how: &[String],
         extent_m: f64,
@@ -257,7 +299,7 @@ impl BudgetOptions {
         }
         let scale = mb::unit_hint(extent_m).map_or_else(String::new, |h| format!("; note: {h}"));
         anyhow::bail!(
-            "{file}: refused before meshing or baking: estimated {} is over {}; to lower it: {}; or pass --force to run anyway{scale}",
+            "{file}: refused before {before}: estimated {} is over {}; to lower it: {}; or pass --force to run anyway{scale}",
             e.describe(),
             self.describe(),
             how.join(", or ")

@@ -282,6 +282,8 @@ pub fn run(args: &MeshArgs) -> anyhow::Result<()> {
     let out = mesh_asset(&args.asset, &args.asset_options)?;
     dcr_files::write_atomic(&args.out, &out.msh)
         .with_context(|| format!("writing {}", args.out.display()))?;
+    args.budget
+        .warn_bake(&args.out.display().to_string(), &out.mesh)?;
     let m = &out.mesh;
     let r = &out.report;
     if args.json {
