@@ -261,6 +261,11 @@ fn hostile_documents_are_refused_with_the_file_and_the_reason() {
             "without compression",
         ),
         (
+            "instancing.glb",
+            Box::new(|d| d["extensionsUsed"] = json!(["EXT_mesh_gpu_instancing"])),
+            "without GPU instancing",
+        ),
+        (
             "sparse.glb",
             Box::new(|d| {
                 d["accessors"][0]["sparse"] = json!({"count": 1,

@@ -18,7 +18,8 @@
 //! `u8`/`u16`/`u32` indices. Points and lines are ignored, as materials, textures, normals,
 //! skins and morph targets are (a skinned mesh is read as its node places it, without its
 //! joints). Refused with what to do: Draco or meshopt compression
-//! (`KHR_draco_mesh_compression`, `EXT_meshopt_compression`), sparse positions,
+//! (`KHR_draco_mesh_compression`, `EXT_meshopt_compression`), GPU instancing
+//! (`EXT_mesh_gpu_instancing`), sparse positions,
 //! nodes placed twice (glTF's nodes form trees), buffers behind a URL.
 
 use std::borrow::Cow;
@@ -34,6 +35,9 @@ use super::{Soup3, SurfaceError};
 /// required extensions concern materials, textures and lights, ignored, except
 /// `KHR_mesh_quantization`, which is read).
 const COMPRESSION_EXTENSIONS: [&str; 2] = ["KHR_draco_mesh_compression", "EXT_meshopt_compression"];
+
+/// Copies of a mesh placed by per-instance attributes: refused when used.
+const GPU_INSTANCING: &str = "EXT_mesh_gpu_instancing";
 
 /// Integer positions (`KHR_mesh_quantization`): the node transform dequantizes them.
 const QUANTIZATION: &str = "KHR_mesh_quantization";
@@ -65,6 +69,16 @@ pub(super) fn read_gltf(data: &[u8], name: &str) -> Result<Soup3, SurfaceError> 
                 "the file requires {ext} (compressed geometry), which is not read; export it \
                  without compression (Blender: File → Export → glTF 2.0, Data → Compression \
                  off; gltfpack: without -c/-cc) or as OBJ/STL/PLY"
+            ),
+        ));
+    }
+    // Copies placed by per-instance attributes: read without them, the solid would be one copy.
+    if root.extensions_used.iter().any(|e| e == GPU_INSTANCING) {
+        return Err(err(
+            name,
+            format!(
+                "the file uses {GPU_INSTANCING} (copies of a mesh placed by per-instance \
+                 attributes), which is not read; export the one object without GPU instancing"
             ),
         ));
     }
