@@ -427,3 +427,94 @@ fn the_cli_bakes_a_glb_as_the_same_obj_and_exports_onto_it() {
     assert!(!o.status.success() && e.matches(&named).count() == 1, "{e}");
     assert!(e.contains("invalid glTF file: GLB"), "{e}");
 }
+
+// `--object`: one node of the scene (its name, or the name of the mesh it places) with its
+// children, where the scene places it; a name the file lacks is refused with the names it has,
+// and a mesh name placed by two nodes asks for a node name.
+#[test]
+fn one_named_object_is_read_where_the_scene_places_it() {
+    use modal_bake::mesh::surface::read_surface_unwelded_object;
+    let (mut doc, bin) = cube_document(&cube_triangles(), 4, json!({}));
+    doc["meshes"][0]["name"] = json!("box");
+    doc["scenes"] = json!([{"nodes": [0, 1]}]);
+    doc["nodes"] = json!([
+        {"name": "A", "mesh": 0},
+        {"name": "B", "translation": [5.0, 0.0, 0.0], "children": [2]},
+        {"name": "B-child", "mesh": 0, "translation": [0.0, 1.0, 0.0]}
+    ]);
+    let bytes = glb(&doc, &bin);
+    let read = |o: &str| read_surface_unwelded_object(&bytes, "two.glb", Some(o));
+    let (p, t) = read("B").unwrap();
+    assert_eq!((p.len(), t.len()), (8, 12));
+    for (q, v) in p.iter().zip(V) {
+        assert_eq!(*q, [5.0 + v[0] as f64, 1.0 + v[1] as f64, v[2] as f64]);
+    }
+    let (p, _) = read("A").unwrap();
+    assert_eq!(p[6], [1.0, 1.0, 1.0]);
+    let e = read("C").unwrap_err().to_string();
+    assert!(
+        e.starts_with("two.glb: no node or mesh named `C`")
+            && e.contains("`A`, `B`, `B-child`, `box`"),
+        "{e}"
+    );
+    let e = read("box").unwrap_err().to_string();
+    assert!(
+        e.contains("2 nodes are named `box` or place a mesh of that name"),
+        "{e}"
+    );
+    // The whole scene without --object: both copies.
+    let (p, _) = read_surface_unwelded(&bytes, "two.glb").unwrap();
+    assert_eq!(p.len(), 16);
+}
+
+// OBJ objects and groups by name (`o`/`g`); STL and PLY name no objects.
+#[test]
+fn obj_objects_are_selected_by_name_and_stl_has_none() {
+    use modal_bake::export::AssetMesh;
+    use modal_bake::mesh::surface::read_surface_unwelded_object;
+    let mut obj = String::new();
+    for (name, dx) in [("left", 0.0), ("right", 3.0)] {
+        obj += &format!("o {name}\n");
+        for v in V {
+            obj += &format!("v {} {} {}\n", v[0] as f64 + dx, v[1], v[2]);
+        }
+    }
+    for (name, base) in [("left", 1), ("right", 9)] {
+        obj += &format!("g {name}\n");
+        for q in Q {
+            obj += &format!(
+                "f {} {} {} {}\n",
+                q[0] as usize + base,
+                q[1] as usize + base,
+                q[2] as usize + base,
+                q[3] as usize + base
+            );
+        }
+    }
+    // Faces grouped after every vertex: `g` names the faces' groups.
+    let (p, t) = read_surface_unwelded_object(obj.as_bytes(), "two.obj", Some("right")).unwrap();
+    assert_eq!(t.len(), 12);
+    let used: std::collections::BTreeSet<usize> = t.iter().flatten().copied().collect();
+    assert!(used.iter().all(|&v| p[v][0] >= 3.0), "{:?}", used);
+    let e = read_surface_unwelded_object(obj.as_bytes(), "two.obj", Some("middle"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.starts_with("two.obj: no object or group named `middle`"),
+        "{e}"
+    );
+    // `export --onto --object`: the object's vertices, in file order.
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("two.obj");
+    std::fs::write(&path, &obj).unwrap();
+    let a = AssetMesh::read(&path, 1.0, Some("right")).unwrap();
+    let want: Vec<[f64; 3]> = V
+        .iter()
+        .map(|v| [v[0] as f64 + 3.0, v[1] as f64, v[2] as f64])
+        .collect();
+    assert_eq!((a.positions, a.triangles.len()), (want, 12));
+    let e = read_surface_unwelded_object(b"solid x\nendsolid x\n", "x.stl", Some("x"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("STL and PLY files name no objects"), "{e}");
+}

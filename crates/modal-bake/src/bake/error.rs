@@ -21,7 +21,7 @@ pub enum BakeError {
     Params(String),
     /// The mesh has several disconnected pieces.
     #[error(
-        "{file}: the mesh has {pieces} disconnected pieces; bake each piece as its own object"
+        "{file}: the mesh has {pieces} disconnected pieces; bake each piece as its own object (a glTF or OBJ asset's named objects one at a time: --object NAME)"
     )]
     Disconnected {
         /// Mesh file.

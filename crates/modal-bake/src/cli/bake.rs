@@ -114,7 +114,7 @@ pub fn load_mesh(
     }
     if asset.any_set() {
         anyhow::bail!(
-            "--mesher, --size, --order, --envelope, --gmsh, --ftetwild, --keep-surface, --uniform-size and --mesher-timeout apply to surface assets (.obj, .stl, .ply, .glb, .gltf), not to the volume mesh {}",
+            "--mesher, --size, --order, --envelope, --gmsh, --ftetwild, --keep-surface, --uniform-size, --mesher-timeout and --object apply to surface assets (.obj, .stl, .ply, .glb, .gltf), not to the volume mesh {}",
             path.display()
         );
     }

@@ -92,7 +92,7 @@ impl BudgetOptions {
     ) -> anyhow::Result<SizeEstimate> {
         let budget = self.budget()?;
         // The reader's errors name the file.
-        let mut s = modal_bake::mesh::surface::read_surface(path)?;
+        let mut s = modal_bake::mesh::surface::read_surface_object(path, asset.object.as_deref())?;
         let to_m = asset.units.to_metres();
         if to_m != 1.0 {
             s.scale(to_m);

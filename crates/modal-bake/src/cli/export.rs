@@ -50,6 +50,10 @@ pub struct ExportArgs {
     /// Unit of the --onto asset's coordinates (as given to `mesh`/`bake` --units).
     #[arg(long, value_enum, default_value_t = Units::M, requires = "onto")]
     pub units: Units,
+    /// The named object of the --onto asset the base was baked from (as given to
+    /// `mesh`/`bake` --object): a glTF node or mesh, an OBJ object or group.
+    #[arg(long, value_name = "NAME", requires = "onto")]
+    pub object: Option<String>,
     /// Write a contact sheet of the modes here (.png).
     #[arg(long, value_name = "OUT.png")]
     pub png: Option<PathBuf>,
@@ -109,7 +113,7 @@ pub fn run(args: &ExportArgs) -> anyhow::Result<()> {
     if let Some(p) = &args.gltf {
         let t = std::time::Instant::now();
         if let Some(asset_path) = &args.onto {
-            let asset = AssetMesh::read(asset_path, args.units.to_metres())
+            let asset = AssetMesh::read(asset_path, args.units.to_metres(), args.object.as_deref())
                 .with_context(|| format!("reading --onto {}", asset_path.display()))?;
             let params = OntoParams {
                 modes,

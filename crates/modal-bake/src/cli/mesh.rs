@@ -156,6 +156,11 @@ pub struct AssetOptions {
     /// Surface assets: time limit of one mesher run (s); the mesher is stopped past it.
     #[arg(long, value_name = "S", default_value_t = modal_bake::mesh::work::DEFAULT_TIMEOUT_S)]
     pub mesher_timeout: f64,
+    /// Surface assets: mesh only this named object of the file: a glTF node (with its children,
+    /// where the scene places it) or mesh, or an OBJ object or group (`o`/`g`) [default: the
+    /// whole file]. A name the file does not have is refused with the names it has.
+    #[arg(long, value_name = "NAME")]
+    pub object: Option<String>,
 }
 
 impl AssetOptions {
@@ -185,6 +190,7 @@ impl AssetOptions {
                 .map_err(anyhow::Error::msg)?,
             curvature: !self.uniform_size,
             thickness: !self.no_thickness_sizing,
+            object: self.object.clone(),
         })
     }
 
@@ -201,6 +207,7 @@ impl AssetOptions {
             || self.envelope.is_some()
             || self.ftetwild.is_some()
             || self.mesher_timeout != modal_bake::mesh::work::DEFAULT_TIMEOUT_S
+            || self.object.is_some()
     }
 }
 

@@ -159,7 +159,8 @@ fn choose_mesh_and_bake(args: &BakeArgs, asset: &AssetOptions, target: f64) -> a
     use modal_bake::target_error::choose_mesh;
     let budget = args.budget.budget()?;
     // The reader's errors name the file.
-    let mut s = modal_bake::mesh::surface::read_surface(&args.mesh)?;
+    let mut s =
+        modal_bake::mesh::surface::read_surface_object(&args.mesh, asset.object.as_deref())?;
     if asset.units.to_metres() != 1.0 {
         s.scale(asset.units.to_metres());
     }

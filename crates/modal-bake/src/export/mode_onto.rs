@@ -22,7 +22,7 @@ use dcr_runtime::ModalModel;
 use super::gltf_builder::extras_of;
 use super::mode_gltf::morph_scene;
 use super::{diagonal, write_file_atomic, ExportError, GltfBuilder};
-use crate::mesh::surface::read_surface_unwelded;
+use crate::mesh::surface::read_surface_unwelded_object;
 
 /// A surface asset's own vertices and triangles (positions in m after unit scaling).
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -35,12 +35,18 @@ pub struct AssetMesh {
 
 impl AssetMesh {
     /// Reads an OBJ, STL, PLY or glTF asset keeping its vertex list and order, and multiplies its
-    /// coordinates by `to_metres` (the factor `modal-bake mesh --units` applies).
+    /// coordinates by `to_metres` (the factor `modal-bake mesh --units` applies). `object`: only
+    /// that named object ([`read_surface_object`](crate::mesh::surface::read_surface_object)),
+    /// for an OBJ the vertices its faces use, in file order.
     ///
     /// # Errors
     /// [`ExportError::Invalid`] naming the file (and line for OBJ): unreadable, unknown
     /// extension, parse errors, indices out of range, non-finite coordinates, no triangles.
-    pub fn read(path: &Path, to_metres: f64) -> Result<AssetMesh, ExportError> {
+    pub fn read(
+        path: &Path,
+        to_metres: f64,
+        object: Option<&str>,
+    ) -> Result<AssetMesh, ExportError> {
         let name = path.display().to_string();
         let data = std::fs::read(path).map_err(|e| ExportError::Io {
             path: path.to_path_buf(),
@@ -50,10 +56,10 @@ impl AssetMesh {
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("obj"));
         let (mut positions, triangles) = if is_obj {
-            let a = read_obj_ordered(&data, &name)?;
+            let a = read_obj_ordered(&data, &name, object)?;
             (a.positions, a.triangles)
         } else {
-            let (p, t) = read_surface_unwelded(&data, &name)
+            let (p, t) = read_surface_unwelded_object(&data, &name, object)
                 .map_err(|e| ExportError::Invalid(e.to_string()))?;
             (p, t.into_iter().map(|t| t.map(|i| i as u32)).collect())
         };
@@ -79,16 +85,30 @@ impl AssetMesh {
 
 /// OBJ `v` records in file order and `f` records fan-triangulated (`i`, `i/t`, `i//n`,
 /// `i/t/n`; negative indices count back from the last vertex read).
-fn read_obj_ordered(data: &[u8], name: &str) -> Result<AssetMesh, ExportError> {
+fn read_obj_ordered(
+    data: &[u8],
+    name: &str,
+    object: Option<&str>,
+) -> Result<AssetMesh, ExportError> {
     let bad = |line: usize, what: String| ExportError::Invalid(format!("{name}:{line}: {what}"));
     let text = std::str::from_utf8(data)
         .map_err(|e| ExportError::Invalid(format!("{name}: not a text OBJ file: {e}")))?;
     let mut positions: Vec<[f64; 3]> = Vec::new();
     let mut triangles = Vec::new();
+    // The current `o`/`g` name, and the names seen (for the error when `object` is not there).
+    let mut current = String::new();
+    let mut names: Vec<String> = Vec::new();
     for (k, raw) in text.lines().enumerate() {
         let line = k + 1;
         let mut tok = raw.split_whitespace();
         match tok.next() {
+            Some("o" | "g") => {
+                current = tok.collect::<Vec<_>>().join(" ");
+                if !names.contains(&current) {
+                    names.push(current.clone());
+                }
+            }
+            Some("f") if object.is_some_and(|o| o != current) => {}
             Some("v") => {
                 let mut p = [0.0; 3];
                 for (a, x) in p.iter_mut().enumerate() {
@@ -131,6 +151,32 @@ fn read_obj_ordered(data: &[u8], name: &str) -> Result<AssetMesh, ExportError> {
                 }
             }
             _ => {}
+        }
+    }
+    if let Some(o) = object {
+        if !names.iter().any(|n| n == o) {
+            return Err(ExportError::Invalid(format!(
+                "{name}: no object or group named `{o}`; the file's objects: {}",
+                names.join(", ")
+            )));
+        }
+        // The vertices the object's faces use, in file order.
+        let mut keep = vec![u32::MAX; positions.len()];
+        for t in &triangles {
+            for &v in t {
+                keep[v as usize] = 0;
+            }
+        }
+        let mut kept = Vec::new();
+        for (v, k) in keep.iter_mut().enumerate() {
+            if *k == 0 {
+                *k = kept.len() as u32;
+                kept.push(positions[v]);
+            }
+        }
+        positions = kept;
+        for t in &mut triangles {
+            *t = t.map(|v| keep[v as usize]);
         }
     }
     if triangles.is_empty() {
@@ -323,7 +369,7 @@ pub struct OntoInfo {
 /// ```no_run
 /// use modal_bake::export::{write_modes_glb_onto, AssetMesh, OntoParams};
 /// let base = dcr_runtime::format::ModesFile::read("cube.modes".as_ref()).unwrap();
-/// let asset = AssetMesh::read("cube.obj".as_ref(), 1.0).unwrap();
+/// let asset = AssetMesh::read("cube.obj".as_ref(), 1.0, None).unwrap();
 /// write_modes_glb_onto(&base, &asset, &OntoParams::default(), "cube.glb".as_ref()).unwrap();
 /// ```
 pub fn write_modes_glb_onto(

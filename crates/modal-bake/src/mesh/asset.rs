@@ -6,7 +6,7 @@ use std::path::Path;
 use super::mesher::{mesh_surface, AssetError, MeshParams, MeshedAsset};
 use super::surface;
 
-/// Reads the surface asset `path`, multiplies its coordinates by `to_metres` (1 for an asset
+/// Reads the surface asset `path` (its object `params.object`, or all of it), multiplies its coordinates by `to_metres` (1 for an asset
 /// in m, 0.001 for mm, ...) and meshes it ([`mesh_surface`]); `progress` receives a line per
 /// stage.
 ///
@@ -20,7 +20,7 @@ pub fn mesh_asset(
     progress: &dyn Fn(&str),
 ) -> Result<MeshedAsset, AssetError> {
     let file = path.display().to_string();
-    let mut s = surface::read_surface(path)?;
+    let mut s = surface::read_surface_object(path, params.object.as_deref())?;
     if to_metres != 1.0 {
         s.scale(to_metres);
     }

@@ -96,6 +96,10 @@ pub struct MeshParams {
     /// local wall thickness where the asset is thin ([`super::sizing::thickness_grid`]).
     /// Default true.
     pub thickness: bool,
+    /// The named object of the asset to mesh ([`super::surface::read_surface_object`]: a glTF
+    /// node or mesh, an OBJ object or group); `None` (the default): the whole asset. Read by
+    /// [`super::mesh_asset`].
+    pub object: Option<String>,
 }
 
 impl Default for MeshParams {
@@ -111,6 +115,7 @@ impl Default for MeshParams {
             timeout: Duration::from_secs_f64(DEFAULT_TIMEOUT_S),
             curvature: true,
             thickness: true,
+            object: None,
         }
     }
 }

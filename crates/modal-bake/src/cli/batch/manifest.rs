@@ -519,7 +519,7 @@ fn check_entry(args: &BakeArgs) -> anyhow::Result<()> {
         args.asset.params()?;
     } else if args.asset.any_set() {
         bail!(
-            "mesher, size, order, envelope, gmsh, ftetwild, keep-surface and mesher-timeout apply to surface assets (.obj, .stl, .ply, .glb, .gltf), not to the volume mesh {}",
+            "mesher, size, order, envelope, gmsh, ftetwild, keep-surface, mesher-timeout and object apply to surface assets (.obj, .stl, .ply, .glb, .gltf), not to the volume mesh {}",
             args.mesh.display()
         );
     }

@@ -49,7 +49,13 @@ fn err(name: &str, detail: impl ToString) -> SurfaceError {
 /// Reads a `.glb` or `.gltf` (`name` is its path: external buffers are found beside it).
 /// Positions are the scene's world positions (m); triangles index them, each primitive's
 /// vertices appended in file order.
-pub(super) fn read_gltf(data: &[u8], name: &str) -> Result<Soup3, SurfaceError> {
+/// `object`: only the node of that name (or the one node placing the mesh of that name) with
+/// its children, where the scene places it; `None`: the whole scene.
+pub(super) fn read_gltf(
+    data: &[u8],
+    name: &str,
+    object: Option<&str>,
+) -> Result<Soup3, SurfaceError> {
     let (json, bin): (Cow<[u8]>, Option<Cow<[u8]>>) = if data.starts_with(b"glTF") {
         let glb = gltf::Glb::from_slice(data).map_err(|e| err(name, format!("GLB: {e}")))?;
         (glb.json, glb.bin)
@@ -116,13 +122,23 @@ pub(super) fn read_gltf(data: &[u8], name: &str) -> Result<Soup3, SurfaceError> 
         budget,
     };
     let scene = doc.default_scene().or_else(|| doc.scenes().next());
+    // Whether a node is the selected object: its name, or its mesh's.
+    let selected = |node: &gltf::Node| {
+        object.is_some_and(|o| {
+            node.name() == Some(o) || node.mesh().is_some_and(|m| m.name() == Some(o))
+        })
+    };
+    let mut matches = 0;
     match scene {
         Some(scene) => {
             let mut placed = vec![false; doc.nodes().len()];
-            // Depth-first over the scene's trees, each node with its world matrix.
-            let mut stack: Vec<(gltf::Node, [[f64; 4]; 4])> =
-                scene.nodes().map(|n| (n, IDENTITY)).collect();
-            while let Some((node, parent)) = stack.pop() {
+            // Depth-first over the scene's trees, each node with its world matrix and whether
+            // it is (inside) the object read.
+            let mut stack: Vec<(gltf::Node, [[f64; 4]; 4], bool)> = scene
+                .nodes()
+                .map(|n| (n, IDENTITY, object.is_none()))
+                .collect();
+            while let Some((node, parent, inside)) = stack.pop() {
                 if std::mem::replace(&mut placed[node.index()], true) {
                     return Err(err(
                         name,
@@ -138,16 +154,45 @@ pub(super) fn read_gltf(data: &[u8], name: &str) -> Result<Soup3, SurfaceError> 
                     &parent,
                     &node.transform().matrix().map(|c| c.map(f64::from)),
                 );
-                if let Some(mesh) = node.mesh() {
+                let this = selected(&node);
+                matches += usize::from(this);
+                let inside = inside || this;
+                if let (Some(mesh), true) = (node.mesh(), inside) {
                     out.mesh(&mesh, &world)?;
                 }
-                stack.extend(node.children().map(|c| (c, world)));
+                stack.extend(node.children().map(|c| (c, world, inside)));
             }
         }
         None => {
             for mesh in doc.meshes() {
-                out.mesh(&mesh, &IDENTITY)?;
+                if object.is_none_or(|o| mesh.name() == Some(o)) {
+                    matches += 1;
+                    out.mesh(&mesh, &IDENTITY)?;
+                }
             }
+        }
+    }
+    if let Some(o) = object {
+        if matches != 1 {
+            let nodes: Vec<&str> = doc.nodes().filter_map(|n| n.name()).collect();
+            let detail = if matches == 0 {
+                let mut names = nodes.clone();
+                names.extend(doc.meshes().filter_map(|m| m.name()));
+                format!(
+                    "no node or mesh named `{o}` in the scene; {}",
+                    super::list_names(&names)
+                )
+            } else {
+                format!(
+                    "{matches} nodes are named `{o}` or place a mesh of that name; name one node \
+                     ({})",
+                    super::list_names(&nodes)
+                )
+            };
+            return Err(SurfaceError::Object {
+                file: name.to_string(),
+                detail,
+            });
         }
     }
     Ok((out.positions, out.triangles))

@@ -54,6 +54,16 @@ fn format_of(path: &Path) -> Option<Format> {
 /// [`SurfaceError`] naming the file: unreadable, unknown extension, parse errors, indices out of
 /// range, non-finite coordinates, no triangles.
 pub fn read_surface(path: &Path) -> Result<SurfaceMesh, SurfaceError> {
+    read_surface_object(path, None)
+}
+
+/// [`read_surface`] of one named object of the asset: a glTF node (with its children) or
+/// mesh, or an OBJ object or group (`o`/`g`); `None`: the whole asset.
+///
+/// # Errors
+/// As [`read_surface`], and [`SurfaceError::Object`] when no object or several nodes have that
+/// name (listing the names the file has), or for STL and PLY, which name no objects.
+pub fn read_surface_object(path: &Path, object: Option<&str>) -> Result<SurfaceMesh, SurfaceError> {
     use dcr_runtime::format::open_regular_file;
     use std::io::Read;
     let file = path.display().to_string();
@@ -68,7 +78,8 @@ pub fn read_surface(path: &Path) -> Result<SurfaceMesh, SurfaceError> {
     f.take(len)
         .read_to_end(&mut data)
         .map_err(|e| io(e.to_string()))?;
-    read_surface_bytes(&data, &file)
+    let (positions, triangles) = read_surface_unwelded_object(&data, &file, object)?;
+    Ok(SurfaceMesh::welded(positions, triangles))
 }
 
 /// [`read_surface`] on bytes in memory; `name` (a file name) chooses the format by its
@@ -90,14 +101,33 @@ pub fn read_surface_bytes(data: &[u8], name: &str) -> Result<SurfaceMesh, Surfac
 /// # Errors
 /// As [`read_surface`].
 pub fn read_surface_unwelded(data: &[u8], name: &str) -> Result<Soup3, SurfaceError> {
+    read_surface_unwelded_object(data, name, None)
+}
+
+/// [`read_surface_unwelded`] of one named object ([`read_surface_object`]); `None`: all.
+///
+/// # Errors
+/// As [`read_surface_object`].
+pub fn read_surface_unwelded_object(
+    data: &[u8],
+    name: &str,
+    object: Option<&str>,
+) -> Result<Soup3, SurfaceError> {
     let file = || name.to_string();
-    let (positions, faces) = match format_of(Path::new(name)) {
-        Some(Format::Obj) => read_obj(data, name)?,
+    let format = format_of(Path::new(name));
+    if object.is_some() && matches!(format, Some(Format::Stl | Format::Ply)) {
+        return Err(SurfaceError::Object {
+            file: file(),
+            detail: "--object names an object of a glTF or OBJ asset; STL and PLY files name no objects (export the one object)".into(),
+        });
+    }
+    let (positions, faces) = match format {
+        Some(Format::Obj) => read_obj(data, name, object)?,
         Some(Format::Stl) => read_stl(data, name)?,
         Some(Format::Ply) => read_ply(data, name)?,
         // Triangles already, their indices checked against each primitive's vertices.
         Some(Format::Gltf) => {
-            let (positions, triangles) = gltf_asset::read_gltf(data, name)?;
+            let (positions, triangles) = gltf_asset::read_gltf(data, name, object)?;
             return finite_and_nonempty(positions, triangles, name);
         }
         None => return Err(SurfaceError::UnknownFormat { file: file() }),
@@ -121,6 +151,22 @@ pub fn read_surface_unwelded(data: &[u8], name: &str) -> Result<Soup3, SurfaceEr
         }
     }
     finite_and_nonempty(positions, triangles, name)
+}
+
+/// `the file's objects: `a`, `b`, … (N in all)`: the distinct names, the first 20.
+fn list_names(names: &[&str]) -> String {
+    let mut seen: Vec<&str> = Vec::new();
+    for n in names {
+        if !seen.contains(n) {
+            seen.push(n);
+        }
+    }
+    let shown: Vec<String> = seen.iter().take(20).map(|n| format!("`{n}`")).collect();
+    match seen.len() {
+        0 => "the file names no objects".into(),
+        k if k > 20 => format!("the file's objects: {}, … ({k} in all)", shown.join(", ")),
+        _ => format!("the file's objects: {}", shown.join(", ")),
+    }
 }
 
 /// The soup, refused when a coordinate is not finite or there is no triangle.
@@ -232,7 +278,7 @@ fn obj_error_line(data: &[u8]) -> Option<usize> {
         .map(|i| i + 1)
 }
 
-fn read_obj(data: &[u8], name: &str) -> Result<Soup, SurfaceError> {
+fn read_obj(data: &[u8], name: &str, object: Option<&str>) -> Result<Soup, SurfaceError> {
     let opts = tobj::LoadOptions {
         triangulate: false,
         single_index: false,
@@ -248,7 +294,16 @@ fn read_obj(data: &[u8], name: &str) -> Result<Soup, SurfaceError> {
     })?;
     let mut positions = Vec::new();
     let mut faces = Vec::new();
-    for model in &models {
+    if let Some(o) = object {
+        if !models.iter().any(|m| m.name == o) {
+            let names: Vec<&str> = models.iter().map(|m| m.name.as_str()).collect();
+            return Err(SurfaceError::Object {
+                file: name.to_string(),
+                detail: format!("no object or group named `{o}`; {}", list_names(&names)),
+            });
+        }
+    }
+    for model in models.iter().filter(|m| object.is_none_or(|o| m.name == o)) {
         let mesh = &model.mesh;
         let base = positions.len() as i64;
         positions.extend(mesh.positions.chunks_exact(3).map(|c| [c[0], c[1], c[2]]));

@@ -30,6 +30,15 @@ pub enum SurfaceError {
         /// What the parser said.
         detail: String,
     },
+    /// The named object (`--object`) is not in the file, is ambiguous, or the format has no
+    /// named objects.
+    #[error("{file}: {detail}")]
+    Object {
+        /// The file.
+        file: String,
+        /// What is wrong, with the names the file has.
+        detail: String,
+    },
     /// No triangle in the file.
     #[error("{file}: the file holds no triangles")]
     Empty {
