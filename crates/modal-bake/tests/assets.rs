@@ -11,9 +11,13 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use modal_bake::mesh::gmsh::{gmsh_version, tetrahedralize, GmshParams};
+use modal_bake::mesh::gmsh::{tetrahedralize, GmshParams};
 use modal_bake::mesh::surface::{read_surface_bytes, SurfaceError, SurfaceMesh};
 use modal_bake::mesh::DEFAULT_STRAIGHT_REL_TOL;
+
+#[path = "common/gmsh_gate.rs"]
+mod gmsh_gate;
+use gmsh_gate::have_gmsh;
 
 const CUBE_V: [[f64; 3]; 8] = [
     [0.0, 0.0, 0.0],
@@ -262,20 +266,6 @@ fn surface_defects_are_refused_with_positions() {
     assert!(err.to_string().contains("huge.ply"), "{err}");
     let err = read_surface_bytes(b"v 0 0 0\nf 1 2 3\n", "bad.obj").unwrap_err();
     assert!(err.to_string().contains("bad.obj"), "{err}");
-}
-
-/// Whether gmsh can run; `false` (skip) only when `DCR_REQUIRE_GMSH` is not `1`.
-fn have_gmsh(test: &str) -> bool {
-    match gmsh_version(None) {
-        Ok(_) => true,
-        Err(e) => {
-            if std::env::var("DCR_REQUIRE_GMSH").as_deref() == Ok("1") {
-                panic!("{test}: DCR_REQUIRE_GMSH=1 but {e}");
-            }
-            eprintln!("SKIPPED {test}: {e}");
-            false
-        }
-    }
 }
 
 /// gmsh's tutorial STL (a real asset from the PyPI `gmsh` package, coordinates in mm),

@@ -11,6 +11,10 @@ use std::process::{Command, Output};
 use dcr_runtime::format::ModesFile;
 use modal_bake::fem::MaterialPreset;
 
+#[path = "common/gmsh_gate.rs"]
+mod gmsh_gate;
+use gmsh_gate::have_gmsh;
+
 fn bin() -> Command {
     Command::new(env!("CARGO_BIN_EXE_modal-bake"))
 }
@@ -38,20 +42,6 @@ fn ok(o: &Output) -> String {
 
 fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-/// Whether gmsh can run; `false` (skip) only when `DCR_REQUIRE_GMSH` is not `1`.
-fn have_gmsh(test: &str) -> bool {
-    match modal_bake::mesh::gmsh::gmsh_version(None) {
-        Ok(_) => true,
-        Err(e) => {
-            if std::env::var("DCR_REQUIRE_GMSH").as_deref() == Ok("1") {
-                panic!("{test}: DCR_REQUIRE_GMSH=1 but {e}");
-            }
-            eprintln!("SKIPPED {test}: {e}");
-            false
-        }
-    }
 }
 
 /// An OBJ of the axis-aligned box [0, a]³ (m) whose faces are each an n × n grid of quads

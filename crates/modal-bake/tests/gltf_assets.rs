@@ -14,6 +14,10 @@ use serde_json::{json, Value};
 mod gltf_cube;
 use gltf_cube::{cube_document, cube_glb, cube_triangles, glb, Q, V};
 
+#[path = "common/gmsh_gate.rs"]
+mod gmsh_gate;
+use gmsh_gate::have_gmsh;
+
 /// Signed volume of a triangle soup (m³): positive when the triangles face outward.
 fn signed_volume(p: &[[f64; 3]], t: &[[usize; 3]]) -> f64 {
     t.iter()
@@ -333,19 +337,6 @@ fn hostile_documents_are_refused_with_the_file_and_the_reason() {
     assert!(modal_bake::mesh::surface::is_surface_asset(Path::new(
         "x.GLB"
     )));
-}
-
-fn have_gmsh(test: &str) -> bool {
-    match modal_bake::mesh::gmsh::gmsh_version(None) {
-        Ok(_) => true,
-        Err(e) => {
-            if std::env::var("DCR_REQUIRE_GMSH").as_deref() == Ok("1") {
-                panic!("{test}: DCR_REQUIRE_GMSH=1 but {e}");
-            }
-            eprintln!("SKIPPED {test}: {e}");
-            false
-        }
-    }
 }
 
 fn modal_bake(args: &[&std::ffi::OsStr]) -> std::process::Output {

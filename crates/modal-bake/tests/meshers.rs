@@ -14,6 +14,10 @@ use std::process::{Command, Output};
 
 use modal_bake::mesh::surface::{inspect_surface, DefectKind, SurfaceMesh};
 
+#[path = "common/gmsh_gate.rs"]
+mod gmsh_gate;
+use gmsh_gate::have_gmsh;
+
 /// Positions and triangles of one part.
 type Part = (Vec<[f64; 3]>, Vec<[usize; 3]>);
 
@@ -200,19 +204,6 @@ fn have_ftetwild(test: &str) -> bool {
         Err(e) => {
             if std::env::var("DCR_REQUIRE_FTETWILD").as_deref() == Ok("1") {
                 panic!("{test}: DCR_REQUIRE_FTETWILD=1 but {e}");
-            }
-            eprintln!("SKIPPED {test}: {e}");
-            false
-        }
-    }
-}
-
-fn have_gmsh(test: &str) -> bool {
-    match modal_bake::mesh::gmsh::gmsh_version(None) {
-        Ok(_) => true,
-        Err(e) => {
-            if std::env::var("DCR_REQUIRE_GMSH").as_deref() == Ok("1") {
-                panic!("{test}: DCR_REQUIRE_GMSH=1 but {e}");
             }
             eprintln!("SKIPPED {test}: {e}");
             false
