@@ -166,6 +166,7 @@ impl BudgetOptions {
         // The element count is known only once meshed: when the fewest elements the mesher has
         // made against this estimate would fit (and meshing itself does), mesh first and let
         // the bake be decided on the mesh's exact counts (`check_mesh`, or `mesh`'s warning).
+        // With --keep-surface the asset's own triangles set the count: no such uncertainty.
         let fewest = modal_bake::bake::FEWEST_ELEMENTS[usize::from(ftetwild)];
         let meshing = SizeEstimate {
             bake_s: 0.0,

@@ -49,6 +49,7 @@ fn err(name: &str, detail: impl ToString) -> SurfaceError {
 /// Reads a `.glb` or `.gltf` (`name` is its path: external buffers are found beside it).
 /// Positions are the scene's world positions (m); triangles index them, each primitive's
 /// vertices appended in file order.
+///
 /// `object`: only the node of that name (or the one node placing the mesh of that name) with
 /// its children, where the scene places it; `None`: the whole scene.
 pub(super) fn read_gltf(
@@ -56,61 +57,7 @@ pub(super) fn read_gltf(
     name: &str,
     object: Option<&str>,
 ) -> Result<Soup3, SurfaceError> {
-    let (json, bin): (Cow<[u8]>, Option<Cow<[u8]>>) = if data.starts_with(b"glTF") {
-        let glb = gltf::Glb::from_slice(data).map_err(|e| err(name, format!("GLB: {e}")))?;
-        (glb.json, glb.bin)
-    } else {
-        (Cow::Borrowed(data), None)
-    };
-    let mut root: gltf::json::Root =
-        gltf::json::deserialize::from_slice(&json).map_err(|e| err(name, e))?;
-    if let Some(ext) = root
-        .extensions_required
-        .iter()
-        .find(|e| COMPRESSION_EXTENSIONS.contains(&e.as_str()))
-    {
-        return Err(err(
-            name,
-            format!(
-                "the file requires {ext} (compressed geometry), which is not read; export it \
-                 without compression (Blender: File → Export → glTF 2.0, Data → Compression \
-                 off; gltfpack: without -c/-cc) or as OBJ/STL/PLY"
-            ),
-        ));
-    }
-    // Copies placed by per-instance attributes: read without them, the solid would be one copy.
-    if root.extensions_used.iter().any(|e| e == GPU_INSTANCING) {
-        return Err(err(
-            name,
-            format!(
-                "the file uses {GPU_INSTANCING} (copies of a mesh placed by per-instance \
-                 attributes), which is not read; export the one object without GPU instancing"
-            ),
-        ));
-    }
-    let quantized = root.extensions_used.iter().any(|e| e == QUANTIZATION);
-    // Material, texture and light extensions do not change the geometry.
-    root.extensions_required.clear();
-    // gltf-json 1.4.1's validation indexes the accessor a POSITION names before checking it
-    // (a panic on a hostile index): checked here first.
-    for (m, mesh) in root.meshes.iter().enumerate() {
-        for (p, prim) in mesh.primitives.iter().enumerate() {
-            let pos = gltf::json::validation::Checked::Valid(gltf::Semantic::Positions);
-            if let Some(a) = prim.attributes.get(&pos) {
-                if a.value() >= root.accessors.len() {
-                    return Err(err(
-                        name,
-                        format!(
-                            "mesh {m} primitive {p}: POSITION names accessor {}, but the file has {}",
-                            a.value(),
-                            root.accessors.len()
-                        ),
-                    ));
-                }
-            }
-        }
-    }
-    let doc = gltf::Document::from_json(root).map_err(|e| err(name, e))?;
+    let (doc, bin, quantized) = document(data, name)?;
     let buffers = load_buffers(&doc, bin.as_deref(), name)?;
     let budget = data.len() + buffers.iter().map(|b| b.len()).sum::<usize>();
     let mut out = Collect {
@@ -196,6 +143,71 @@ pub(super) fn read_gltf(
         }
     }
     Ok((out.positions, out.triangles))
+}
+
+/// The validated document of a `.glb` or `.gltf`, its GLB binary chunk, and whether it uses
+/// `KHR_mesh_quantization`; refused when it needs what is not read (compression, GPU
+/// instancing).
+fn document<'d>(
+    data: &'d [u8],
+    name: &str,
+) -> Result<(gltf::Document, Option<Cow<'d, [u8]>>, bool), SurfaceError> {
+    let (json, bin): (Cow<[u8]>, Option<Cow<[u8]>>) = if data.starts_with(b"glTF") {
+        let glb = gltf::Glb::from_slice(data).map_err(|e| err(name, format!("GLB: {e}")))?;
+        (glb.json, glb.bin)
+    } else {
+        (Cow::Borrowed(data), None)
+    };
+    let mut root: gltf::json::Root =
+        gltf::json::deserialize::from_slice(&json).map_err(|e| err(name, e))?;
+    if let Some(ext) = root
+        .extensions_required
+        .iter()
+        .find(|e| COMPRESSION_EXTENSIONS.contains(&e.as_str()))
+    {
+        return Err(err(
+            name,
+            format!(
+                "the file requires {ext} (compressed geometry), which is not read; export it \
+                 without compression (Blender: File → Export → glTF 2.0, Data → Compression \
+                 off; gltfpack: without -c/-cc) or as OBJ/STL/PLY"
+            ),
+        ));
+    }
+    // Copies placed by per-instance attributes: read without them, the solid would be one copy.
+    if root.extensions_used.iter().any(|e| e == GPU_INSTANCING) {
+        return Err(err(
+            name,
+            format!(
+                "the file uses {GPU_INSTANCING} (copies of a mesh placed by per-instance \
+                 attributes), which is not read; export the one object without GPU instancing"
+            ),
+        ));
+    }
+    let quantized = root.extensions_used.iter().any(|e| e == QUANTIZATION);
+    // Material, texture and light extensions do not change the geometry.
+    root.extensions_required.clear();
+    // gltf-json 1.4.1's validation indexes the accessor a POSITION names before checking it
+    // (a panic on a hostile index): checked here first.
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, prim) in mesh.primitives.iter().enumerate() {
+            let pos = gltf::json::validation::Checked::Valid(gltf::Semantic::Positions);
+            if let Some(a) = prim.attributes.get(&pos) {
+                if a.value() >= root.accessors.len() {
+                    return Err(err(
+                        name,
+                        format!(
+                            "mesh {m} primitive {p}: POSITION names accessor {}, but the file has {}",
+                            a.value(),
+                            root.accessors.len()
+                        ),
+                    ));
+                }
+            }
+        }
+    }
+    let doc = gltf::Document::from_json(root).map_err(|e| err(name, e))?;
+    Ok((doc, bin, quantized))
 }
 
 const IDENTITY: [[f64; 4]; 4] = [
