@@ -57,7 +57,11 @@ pub(super) fn read_gltf(
     name: &str,
     object: Option<&str>,
 ) -> Result<Soup3, SurfaceError> {
-    let (doc, bin, quantized) = document(data, name)?;
+    let Parsed {
+        doc,
+        bin,
+        quantized,
+    } = document(data, name)?;
     let buffers = load_buffers(&doc, bin.as_deref(), name)?;
     let budget = data.len() + buffers.iter().map(|b| b.len()).sum::<usize>();
     let mut out = Collect {
@@ -145,13 +149,18 @@ pub(super) fn read_gltf(
     Ok((out.positions, out.triangles))
 }
 
-/// The validated document of a `.glb` or `.gltf`, its GLB binary chunk, and whether it uses
-/// `KHR_mesh_quantization`; refused when it needs what is not read (compression, GPU
-/// instancing).
-fn document<'d>(
-    data: &'d [u8],
-    name: &str,
-) -> Result<(gltf::Document, Option<Cow<'d, [u8]>>, bool), SurfaceError> {
+/// A `.glb` or `.gltf` parsed and validated.
+struct Parsed<'d> {
+    doc: gltf::Document,
+    /// The GLB's binary chunk.
+    bin: Option<Cow<'d, [u8]>>,
+    /// The file uses `KHR_mesh_quantization`.
+    quantized: bool,
+}
+
+/// Parses and validates a `.glb` or `.gltf`; refused when it needs what is not read
+/// (compression, GPU instancing).
+fn document<'d>(data: &'d [u8], name: &str) -> Result<Parsed<'d>, SurfaceError> {
     let (json, bin): (Cow<[u8]>, Option<Cow<[u8]>>) = if data.starts_with(b"glTF") {
         let glb = gltf::Glb::from_slice(data).map_err(|e| err(name, format!("GLB: {e}")))?;
         (glb.json, glb.bin)
@@ -207,7 +216,11 @@ fn document<'d>(
         }
     }
     let doc = gltf::Document::from_json(root).map_err(|e| err(name, e))?;
-    Ok((doc, bin, quantized))
+    Ok(Parsed {
+        doc,
+        bin,
+        quantized,
+    })
 }
 
 const IDENTITY: [[f64; 4]; 4] = [
