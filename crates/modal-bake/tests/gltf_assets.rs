@@ -453,9 +453,10 @@ fn one_named_object_is_read_where_the_scene_places_it() {
         e.contains("2 nodes are named `box` or place a mesh of that name"),
         "{e}"
     );
-    // The whole scene without --object: both copies.
+    // The whole scene without --object: both copies, in the file's node order (A, then B's).
     let (p, _) = read_surface_unwelded(&bytes, "two.glb").unwrap();
     assert_eq!(p.len(), 16);
+    assert_eq!((p[6], p[14]), ([1.0, 1.0, 1.0], [6.0, 2.0, 1.0]));
 }
 
 // OBJ objects and groups by name (`o`/`g`); STL and PLY name no objects.

@@ -83,12 +83,14 @@ pub(super) fn read_gltf(
     match scene {
         Some(scene) => {
             let mut placed = vec![false; doc.nodes().len()];
-            // Depth-first over the scene's trees, each node with its world matrix and whether
-            // it is (inside) the object read.
+            // Depth-first over the scene's trees in the file's order (pushed reversed, popped
+            // first to last), each node with its world matrix and whether it is (inside) the
+            // object read.
             let mut stack: Vec<(gltf::Node, [[f64; 4]; 4], bool)> = scene
                 .nodes()
                 .map(|n| (n, IDENTITY, object.is_none()))
                 .collect();
+            stack.reverse();
             while let Some((node, parent, inside)) = stack.pop() {
                 if std::mem::replace(&mut placed[node.index()], true) {
                     return Err(err(
@@ -111,7 +113,9 @@ pub(super) fn read_gltf(
                 if let (Some(mesh), true) = (node.mesh(), inside) {
                     out.mesh(&mesh, &world)?;
                 }
+                let at = stack.len();
                 stack.extend(node.children().map(|c| (c, world, inside)));
+                stack[at..].reverse();
             }
         }
         None => {
