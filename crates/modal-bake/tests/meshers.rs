@@ -280,6 +280,35 @@ fn auto_meshes_an_open_surface_with_ftetwild_and_reports_the_distance() {
     assert!((vol - 0.008).abs() < 0.0015, "volume {vol} m³");
 }
 
+/// Two separate clean cubes: auto sends them to fTetWild as one object and says how to mesh one
+/// named object instead; with no located defect there is no "(first: …)".
+#[test]
+fn auto_says_separate_shells_are_meshed_as_one_object() {
+    if !have_ftetwild("auto_says_separate_shells_are_meshed_as_one_object") {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let two = surface(&[cube([0.0; 3], 0.1), cube([0.5, 0.0, 0.0], 0.1)]);
+    let asset = write_obj(dir.path(), "two.obj", &two);
+    let out = bin()
+        .arg("mesh")
+        .arg(&asset)
+        .arg("-o")
+        .arg(dir.path().join("two.msh"))
+        .args(["--order", "1", "--json"])
+        .output()
+        .unwrap();
+    let r = json_of(&out);
+    assert_eq!(r["backend"], "ftetwild");
+    let reason = r["reason"].as_str().unwrap();
+    assert!(
+        reason.starts_with("auto: the surface has 2 shells; gmsh needs")
+            && reason.contains("meshed together as one object")
+            && reason.contains("--object NAME"),
+        "{reason}"
+    );
+}
+
 /// `--mesher ftetwild` twice, at order 2: the same bytes; the mesh is straight-sided
 /// second order; the default `auto` on a clean cube picks gmsh and says why.
 #[test]

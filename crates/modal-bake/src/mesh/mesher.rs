@@ -358,13 +358,24 @@ pub fn mesh_surface(
             Backend::Gmsh,
             "auto: the surface bounds one solid as it is (closed, manifold, consistently oriented, no self-intersection, one shell), so gmsh remeshes it".to_string(),
         ),
-        MesherChoice::Auto => (
-            Backend::Ftetwild,
-            format!(
-                "auto: the surface has {} (first: {first}); gmsh needs a surface that bounds a solid, fTetWild does not",
-                inspection.summary()
-            ),
-        ),
+        MesherChoice::Auto => {
+            // A located defect is named; separate shells are meshed as one object.
+            let located = inspection
+                .first_defect()
+                .map_or_else(String::new, |d| format!(" (first: {d})"));
+            let shells = if inspection.shells > 1 {
+                "; its shells are meshed together as one object (one named object of a glTF or OBJ: --object NAME)"
+            } else {
+                ""
+            };
+            (
+                Backend::Ftetwild,
+                format!(
+                    "auto: the surface has {}{located}; gmsh needs a surface that bounds a solid, fTetWild does not{shells}",
+                    inspection.summary()
+                ),
+            )
+        }
         MesherChoice::Gmsh if !solid => {
             // The existing closed-surface check words open edges, orientation and shells with
             // both positions; self-intersections only the inspection sees.
