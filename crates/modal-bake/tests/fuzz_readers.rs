@@ -467,16 +467,7 @@ fn modes_seeds() -> Vec<(String, Vec<u8>)> {
 /// cube: refused as two shells unless a mutation breaks one), binary STL whose header starts
 /// with `solid`, ASCII PLY, binary PLY, GLB and `.gltf` with a base64 data URI.
 fn surface_seeds() -> Vec<(String, Vec<u8>, Kind)> {
-    const V: [[f64; 3]; 8] = [
-        [0.0, 0.0, 0.0],
-        [1.0, 0.0, 0.0],
-        [1.0, 1.0, 0.0],
-        [0.0, 1.0, 0.0],
-        [0.0, 0.0, 1.0],
-        [1.0, 0.0, 1.0],
-        [1.0, 1.0, 1.0],
-        [0.0, 1.0, 1.0],
-    ];
+    use gltf_cube::V;
     const Q: [[usize; 4]; 6] = [
         [0, 3, 2, 1],
         [4, 5, 6, 7],

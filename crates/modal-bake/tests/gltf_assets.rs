@@ -54,11 +54,7 @@ fn node_transforms_place_the_mesh_and_a_mirror_keeps_it_outward() {
     let bytes = glb(&doc, &bin);
     let (p, t) = read_surface_unwelded(&bytes, "placed.glb").unwrap();
     for (q, v) in p.iter().zip(V) {
-        let want = [
-            1.0 - 2.0 * v[0] as f64,
-            2.0 + 2.0 * v[1] as f64,
-            3.0 + 2.0 * v[2] as f64,
-        ];
+        let want = [1.0 - 2.0 * v[0], 2.0 + 2.0 * v[1], 3.0 + 2.0 * v[2]];
         assert_eq!(*q, want);
     }
     assert!(
@@ -171,11 +167,7 @@ fn quantized_positions_are_dequantized_by_the_node() {
     doc["extensionsRequired"] = json!(["KHR_mesh_quantization"]);
     let (p, t) = read_surface_unwelded(&glb(&doc, &bin), "quantized.glb").unwrap();
     for (q, v) in p.iter().zip(V) {
-        let want = [
-            0.5 * v[0] as f64 - 0.25,
-            0.5 * v[1] as f64,
-            0.5 * v[2] as f64,
-        ];
+        let want = [0.5 * v[0] - 0.25, 0.5 * v[1], 0.5 * v[2]];
         assert_eq!(*q, want);
     }
     assert!((signed_volume(&p, &t) - 0.125).abs() < 1e-12);
@@ -438,7 +430,7 @@ fn one_named_object_is_read_where_the_scene_places_it() {
     let (p, t) = read("B").unwrap();
     assert_eq!((p.len(), t.len()), (8, 12));
     for (q, v) in p.iter().zip(V) {
-        assert_eq!(*q, [5.0 + v[0] as f64, 1.0 + v[1] as f64, v[2] as f64]);
+        assert_eq!(*q, [5.0 + v[0], 1.0 + v[1], v[2]]);
     }
     let (p, _) = read("A").unwrap();
     assert_eq!(p[6], [1.0, 1.0, 1.0]);
@@ -468,7 +460,7 @@ fn obj_objects_are_selected_by_name_and_stl_has_none() {
     for (name, dx) in [("left", 0.0), ("right", 3.0)] {
         obj += &format!("o {name}\n");
         for v in V {
-            obj += &format!("v {} {} {}\n", v[0] as f64 + dx, v[1], v[2]);
+            obj += &format!("v {} {} {}\n", v[0] + dx, v[1], v[2]);
         }
     }
     for (name, base) in [("left", 1), ("right", 9)] {
@@ -500,10 +492,7 @@ fn obj_objects_are_selected_by_name_and_stl_has_none() {
     let path = dir.path().join("two.obj");
     std::fs::write(&path, &obj).unwrap();
     let a = AssetMesh::read(&path, 1.0, Some("right")).unwrap();
-    let want: Vec<[f64; 3]> = V
-        .iter()
-        .map(|v| [v[0] as f64 + 3.0, v[1] as f64, v[2] as f64])
-        .collect();
+    let want: Vec<[f64; 3]> = V.iter().map(|v| [v[0] + 3.0, v[1], v[2]]).collect();
     assert_eq!((a.positions, a.triangles.len()), (want, 12));
     let e = read_surface_unwelded_object(b"solid x\nendsolid x\n", "x.stl", Some("x"))
         .unwrap_err()

@@ -4,7 +4,7 @@
 
 use serde_json::{json, Value};
 
-pub const V: [[f32; 3]; 8] = [
+pub const V: [[f64; 3]; 8] = [
     [0.0, 0.0, 0.0],
     [1.0, 0.0, 0.0],
     [1.0, 1.0, 0.0],
@@ -33,7 +33,11 @@ pub fn cube_triangles() -> Vec<u16> {
 
 /// Positions (8 × 12 bytes) then u16 indices; the accessors and views of a one-mesh document.
 pub fn cube_document(indices: &[u16], mode: u32, buffer: Value) -> (Value, Vec<u8>) {
-    let mut bin: Vec<u8> = V.iter().flatten().flat_map(|x| x.to_le_bytes()).collect();
+    let mut bin: Vec<u8> = V
+        .iter()
+        .flatten()
+        .flat_map(|&x| (x as f32).to_le_bytes())
+        .collect();
     bin.extend(indices.iter().flat_map(|i| i.to_le_bytes()));
     while !bin.len().is_multiple_of(4) {
         bin.push(0);
