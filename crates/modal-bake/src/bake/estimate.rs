@@ -110,10 +110,10 @@ impl Default for Budget {
 /// 3.1, 1.9 and 2.9 times; docs/artist-guide.md § 7).
 pub const FTETWILD_ELEMENTS: f64 = 2.5;
 
-/// fTetWild's wall time per tetrahedron it makes (s): `modal-bake mesh` on five real assets at
-/// load ≈ 1 took 0.58–1.04 ms per output tetrahedron (the teapot, Suzanne and three XR
-/// controllers, docs/benchmarks.md § Meshing real assets and § glTF assets as shipped); gmsh's
-/// per-tetrahedron time is 30 times less.
+/// fTetWild's wall time per tetrahedron it makes (s): `modal-bake mesh` on six real assets at
+/// load ≈ 1 took 0.58–1.25 ms per output tetrahedron (the teapot, the dragon, Suzanne and three
+/// XR controllers, docs/benchmarks.md § Meshing real assets and § glTF assets as shipped);
+/// gmsh's per-tetrahedron time is 30 times less.
 pub const FTETWILD_S_PER_TET: f64 = 1.0e-3;
 
 /// The fewest tetrahedra a mesher has made against this estimate's count, as a fraction of it
