@@ -19,32 +19,9 @@ use modal_bake::mesh::DEFAULT_STRAIGHT_REL_TOL;
 mod gmsh_gate;
 use gmsh_gate::have_gmsh;
 
-const CUBE_V: [[f64; 3]; 8] = [
-    [0.0, 0.0, 0.0],
-    [1.0, 0.0, 0.0],
-    [1.0, 1.0, 0.0],
-    [0.0, 1.0, 0.0],
-    [0.0, 0.0, 1.0],
-    [1.0, 0.0, 1.0],
-    [1.0, 1.0, 1.0],
-    [0.0, 1.0, 1.0],
-];
-/// Outward quads of the unit cube.
-const CUBE_Q: [[usize; 4]; 6] = [
-    [0, 3, 2, 1],
-    [4, 5, 6, 7],
-    [0, 1, 5, 4],
-    [2, 3, 7, 6],
-    [1, 2, 6, 5],
-    [0, 4, 7, 3],
-];
-
-fn cube_tris() -> Vec<[usize; 3]> {
-    CUBE_Q
-        .iter()
-        .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
-        .collect()
-}
+#[path = "common/unit_cube.rs"]
+mod unit_cube;
+use unit_cube::{cube_tris, CUBE_Q, CUBE_V};
 
 fn obj(v: &[[f64; 3]], quads: bool) -> Vec<u8> {
     let mut s = String::from("# cube\no cube\n");

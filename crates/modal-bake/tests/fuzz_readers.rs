@@ -467,15 +467,7 @@ fn modes_seeds() -> Vec<(String, Vec<u8>)> {
 /// cube: refused as two shells unless a mutation breaks one), binary STL whose header starts
 /// with `solid`, ASCII PLY, binary PLY, GLB and `.gltf` with a base64 data URI.
 fn surface_seeds() -> Vec<(String, Vec<u8>, Kind)> {
-    use gltf_cube::V;
-    const Q: [[usize; 4]; 6] = [
-        [0, 3, 2, 1],
-        [4, 5, 6, 7],
-        [0, 1, 5, 4],
-        [2, 3, 7, 6],
-        [1, 2, 6, 5],
-        [0, 4, 7, 3],
-    ];
+    use gltf_cube::{Q, V};
     let tris: Vec<[usize; 3]> = Q
         .iter()
         .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])

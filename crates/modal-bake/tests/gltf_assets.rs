@@ -111,7 +111,7 @@ fn glb_data_uri_and_buffer_file_read_the_same_cube() {
 #[test]
 fn strips_and_fans_triangulate_with_one_winding() {
     for (mode, order) in [(5u32, [0usize, 1, 3, 2]), (6, [0, 1, 2, 3])] {
-        let idx: Vec<u16> = Q.iter().flat_map(|q| order.map(|k| q[k])).collect();
+        let idx: Vec<u16> = Q.iter().flat_map(|q| order.map(|k| q[k] as u16)).collect();
         let (mut doc, bin) = cube_document(&idx, mode, json!({}));
         doc["bufferViews"] = json!([{"buffer": 0, "byteLength": 96},
             {"buffer": 0, "byteOffset": 96, "byteLength": 48}]);
@@ -468,10 +468,10 @@ fn obj_objects_are_selected_by_name_and_stl_has_none() {
         for q in Q {
             obj += &format!(
                 "f {} {} {} {}\n",
-                q[0] as usize + base,
-                q[1] as usize + base,
-                q[2] as usize + base,
-                q[3] as usize + base
+                q[0] + base,
+                q[1] + base,
+                q[2] + base,
+                q[3] + base
             );
         }
     }

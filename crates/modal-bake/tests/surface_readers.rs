@@ -7,31 +7,9 @@
 
 use modal_bake::mesh::surface::{read_surface, read_surface_bytes, SurfaceError};
 
-const CUBE_V: [[f64; 3]; 8] = [
-    [0.0, 0.0, 0.0],
-    [1.0, 0.0, 0.0],
-    [1.0, 1.0, 0.0],
-    [0.0, 1.0, 0.0],
-    [0.0, 0.0, 1.0],
-    [1.0, 0.0, 1.0],
-    [1.0, 1.0, 1.0],
-    [0.0, 1.0, 1.0],
-];
-const CUBE_Q: [[usize; 4]; 6] = [
-    [0, 3, 2, 1],
-    [4, 5, 6, 7],
-    [0, 1, 5, 4],
-    [2, 3, 7, 6],
-    [1, 2, 6, 5],
-    [0, 4, 7, 3],
-];
-
-fn cube_tris() -> Vec<[usize; 3]> {
-    CUBE_Q
-        .iter()
-        .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
-        .collect()
-}
+#[path = "common/unit_cube.rs"]
+mod unit_cube;
+use unit_cube::{cube_tris, CUBE_Q, CUBE_V};
 
 /// One ASCII `solid` block of the cube scaled by `k` and shifted by `dx`, keywords through
 /// `case`.

@@ -4,30 +4,16 @@
 
 use serde_json::{json, Value};
 
-pub const V: [[f64; 3]; 8] = [
-    [0.0, 0.0, 0.0],
-    [1.0, 0.0, 0.0],
-    [1.0, 1.0, 0.0],
-    [0.0, 1.0, 0.0],
-    [0.0, 0.0, 1.0],
-    [1.0, 0.0, 1.0],
-    [1.0, 1.0, 1.0],
-    [0.0, 1.0, 1.0],
-];
+#[path = "unit_cube.rs"]
+mod unit_cube;
+pub use unit_cube::{CUBE_Q as Q, CUBE_V as V};
 
-/// The cube's faces as outward counter-clockwise quads.
-pub const Q: [[u16; 4]; 6] = [
-    [0, 3, 2, 1],
-    [4, 5, 6, 7],
-    [0, 1, 5, 4],
-    [1, 2, 6, 5],
-    [2, 3, 7, 6],
-    [3, 0, 4, 7],
-];
-
+/// The cube's triangles as glTF `u16` indices.
 pub fn cube_triangles() -> Vec<u16> {
-    Q.iter()
-        .flat_map(|q| [q[0], q[1], q[2], q[0], q[2], q[3]])
+    unit_cube::cube_tris()
+        .into_iter()
+        .flatten()
+        .map(|i| i as u16)
         .collect()
 }
 
