@@ -155,9 +155,10 @@ fn read_obj_ordered(
     }
     if let Some(o) = object {
         if !names.iter().any(|n| n == o) {
+            let names: Vec<&str> = names.iter().map(String::as_str).collect();
             return Err(ExportError::Invalid(format!(
-                "{name}: no object or group named `{o}`; the file's objects: {}",
-                names.join(", ")
+                "{name}: no object or group named `{o}`; {}",
+                crate::mesh::surface::list_names(&names)
             )));
         }
         // The vertices the object's faces use, in file order.

@@ -154,7 +154,7 @@ pub fn read_surface_unwelded_object(
 }
 
 /// `the file's objects: `a`, `b`, … (N in all)`: the distinct names, the first 20.
-fn list_names(names: &[&str]) -> String {
+pub(crate) fn list_names(names: &[&str]) -> String {
     let mut seen: Vec<&str> = Vec::new();
     for n in names {
         if !seen.contains(n) {
