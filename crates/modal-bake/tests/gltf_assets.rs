@@ -40,6 +40,22 @@ fn a_glb_cube_reads_closed_with_its_eight_corners() {
     assert!((signed_volume(&p, &t) - 1.0).abs() < 1e-12);
 }
 
+// An accessor without a buffer view is zeros in glTF 2.0 (gltf-json 1.4.1's validation calls
+// it missing data): a morph target written so does not stop the read.
+#[test]
+fn a_morph_target_of_zeros_without_a_buffer_view_is_read_past() {
+    let (mut doc, bin) = cube_document(&cube_triangles(), 4, json!({}));
+    doc["accessors"]
+        .as_array_mut()
+        .unwrap()
+        .push(json!({"componentType": 5126, "count": 8,
+        "type": "VEC3", "min": [0.0, 0.0, 0.0], "max": [0.0, 0.0, 0.0]}));
+    doc["meshes"][0]["primitives"][0]["targets"] = json!([{"POSITION": 2}]);
+    let (p, t) = read_surface_unwelded(&glb(&doc, &bin), "zeros.glb").unwrap();
+    assert_eq!((p.len(), t.len()), (8, 12));
+    assert!((signed_volume(&p, &t) - 1.0).abs() < 1e-12);
+}
+
 // The scene's transforms place the mesh: a parent translation, a child mirrored in x and
 // scaled. A mirroring placement turns the triangles inside out unless their winding is
 // reversed: the volume stays positive and the surface closed and oriented.
@@ -274,6 +290,17 @@ fn hostile_documents_are_refused_with_the_file_and_the_reason() {
             "url.glb",
             Box::new(|d| d["buffers"][0]["uri"] = json!("https://example.com/cube.bin")),
             "download it beside the asset",
+        ),
+        (
+            // glTF allows an accessor without a view (zeros), but not as positions.
+            "zeros.glb",
+            Box::new(|d| {
+                d["accessors"][0]
+                    .as_object_mut()
+                    .unwrap()
+                    .remove("bufferView");
+            }),
+            "accessor 0 has no bufferView",
         ),
         (
             "vec2.glb",

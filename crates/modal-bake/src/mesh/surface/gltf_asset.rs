@@ -57,12 +57,62 @@ pub(super) fn read_gltf(
     name: &str,
     object: Option<&str>,
 ) -> Result<Soup3, SurfaceError> {
+    let scene = read_gltf_scene(data, name, object)?;
+    Ok((scene.positions, scene.triangles))
+}
+
+/// One triangle primitive the scene places: which node places which mesh's primitive, its
+/// world matrix, and the range of its vertices in [`GltfScene::positions`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct GltfPlacement {
+    /// The placing node (`None` in a document without scenes: the mesh as it is).
+    pub node: Option<usize>,
+    /// The mesh placed.
+    pub mesh: usize,
+    /// The primitive of the mesh.
+    pub primitive: usize,
+    /// The node's world matrix (column-major `m[column][row]`, the file's units).
+    pub world: [[f64; 4]; 4],
+    /// Index of the primitive's first vertex in [`GltfScene::positions`]; its `POSITION`
+    /// accessor's vertices follow in order.
+    pub first_vertex: usize,
+    /// Number of vertices (the `POSITION` accessor's count).
+    pub vertices: usize,
+}
+
+/// A glTF asset as read: the placed triangles (as [`read_gltf`]), where each came from, and
+/// the document's JSON and buffers (what a writer that keeps the asset starts from).
+#[derive(Clone, Debug)]
+pub struct GltfScene<'d> {
+    /// The JSON document as in the file (a GLB's JSON chunk).
+    pub json: Cow<'d, [u8]>,
+    /// Each buffer's bytes (exactly its `byteLength`).
+    pub buffers: Vec<Cow<'d, [u8]>>,
+    /// World positions of the placed primitives' vertices (the file's units).
+    pub positions: Vec<[f64; 3]>,
+    /// Outward triangles indexing `positions`.
+    pub triangles: Vec<[usize; 3]>,
+    /// The placed triangle primitives, in the order their vertices were appended.
+    pub placements: Vec<GltfPlacement>,
+}
+
+/// Reads a `.glb` or `.gltf` as [`read_gltf`] does, keeping the document, its buffers and each
+/// primitive's placement.
+///
+/// # Errors
+/// As [`read_gltf`].
+pub fn read_gltf_scene<'d>(
+    data: &'d [u8],
+    name: &str,
+    object: Option<&str>,
+) -> Result<GltfScene<'d>, SurfaceError> {
     let Parsed {
         doc,
+        json,
         bin,
         quantized,
     } = document(data, name)?;
-    let buffers = load_buffers(&doc, bin.as_deref(), name)?;
+    let buffers = load_buffers(&doc, bin, name)?;
     let budget = data.len() + buffers.iter().map(|b| b.len()).sum::<usize>();
     let mut out = Collect {
         name,
@@ -70,6 +120,7 @@ pub(super) fn read_gltf(
         buffers: &buffers,
         positions: Vec::new(),
         triangles: Vec::new(),
+        placements: Vec::new(),
         budget,
     };
     let scene = doc.default_scene().or_else(|| doc.scenes().next());
@@ -111,7 +162,7 @@ pub(super) fn read_gltf(
                 matches += usize::from(this);
                 let inside = inside || this;
                 if let (Some(mesh), true) = (node.mesh(), inside) {
-                    out.mesh(&mesh, &world)?;
+                    out.mesh(&mesh, Some(node.index()), &world)?;
                 }
                 let at = stack.len();
                 stack.extend(node.children().map(|c| (c, world, inside)));
@@ -122,7 +173,7 @@ pub(super) fn read_gltf(
             for mesh in doc.meshes() {
                 if object.is_none_or(|o| mesh.name() == Some(o)) {
                     matches += 1;
-                    out.mesh(&mesh, &IDENTITY)?;
+                    out.mesh(&mesh, None, &IDENTITY)?;
                 }
             }
         }
@@ -150,12 +201,21 @@ pub(super) fn read_gltf(
             });
         }
     }
-    Ok((out.positions, out.triangles))
+    let (positions, triangles, placements) = (out.positions, out.triangles, out.placements);
+    Ok(GltfScene {
+        json,
+        buffers,
+        positions,
+        triangles,
+        placements,
+    })
 }
 
 /// A `.glb` or `.gltf` parsed and validated.
 struct Parsed<'d> {
     doc: gltf::Document,
+    /// The JSON document's bytes.
+    json: Cow<'d, [u8]>,
     /// The GLB's binary chunk.
     bin: Option<Cow<'d, [u8]>>,
     /// The file uses `KHR_mesh_quantization`.
@@ -219,12 +279,42 @@ fn document<'d>(data: &'d [u8], name: &str) -> Result<Parsed<'d>, SurfaceError> 
             }
         }
     }
-    let doc = gltf::Document::from_json(root).map_err(|e| err(name, e))?;
+    validate_document(&root).map_err(|e| err(name, e))?;
+    let doc = gltf::Document::from_json_without_validation(root);
     Ok(Parsed {
         doc,
+        json,
         bin,
         quantized,
     })
+}
+
+/// Validates a glTF document as `gltf::Document::from_json` does (indices in range, required
+/// members present, enumerations known), except for one finding: `gltf-json` 1.4.1 reports an
+/// accessor without a buffer view and without sparse values as missing data, where glTF 2.0
+/// defines its elements as zeros (a morph target that leaves a primitive in place is written
+/// so). Such an accessor is refused only where it is read (`POSITION`, indices).
+///
+/// # Errors
+/// The findings, `invalid glTF: PATH: WHAT; …`.
+pub fn validate_document(root: &gltf::json::Root) -> Result<(), String> {
+    use gltf::json::validation::{Error, Validate};
+    let mut findings = Vec::new();
+    root.validate(root, gltf::json::Path::new, &mut |path, error| {
+        let path = path();
+        let zeros = matches!(error, Error::Missing)
+            && path.as_str().starts_with("accessors[")
+            && path.as_str().ends_with("].bufferView")
+            && path.as_str().matches('.').count() == 1;
+        if !zeros {
+            findings.push(format!("{path}: {error}"));
+        }
+    });
+    if findings.is_empty() {
+        Ok(())
+    } else {
+        Err(format!("invalid glTF: {}", findings.join("; ")))
+    }
 }
 
 const IDENTITY: [[f64; 4]; 4] = [
@@ -249,7 +339,7 @@ fn mul(a: &[[f64; 4]; 4], b: &[[f64; 4]; 4]) -> [[f64; 4]; 4] {
 /// a file beside the asset.
 fn load_buffers<'a>(
     doc: &gltf::Document,
-    bin: Option<&'a [u8]>,
+    bin: Option<Cow<'a, [u8]>>,
     name: &str,
 ) -> Result<Vec<Cow<'a, [u8]>>, SurfaceError> {
     let mut out = Vec::with_capacity(doc.buffers().len());
@@ -263,16 +353,19 @@ fn load_buffers<'a>(
         };
         let bytes: Cow<[u8]> = match buffer.source() {
             gltf::buffer::Source::Bin => {
-                let Some(bin) = bin else {
+                let Some(bin) = &bin else {
                     return Err(err(
                         name,
                         format!("buffer {i} is the GLB's binary chunk, which the file lacks"),
                     ));
                 };
-                let b = bin
-                    .get(..need)
-                    .ok_or_else(|| short("the BIN chunk", bin.len()))?;
-                Cow::Borrowed(b)
+                if bin.len() < need {
+                    return Err(short("the BIN chunk", bin.len()));
+                }
+                match bin {
+                    Cow::Borrowed(b) => Cow::Borrowed(&b[..need]),
+                    Cow::Owned(b) => Cow::Owned(b[..need].to_vec()),
+                }
             }
             gltf::buffer::Source::Uri(uri) if uri.starts_with("data:") => {
                 let Some((_, payload)) = uri.split_once(";base64,") else {
@@ -298,25 +391,53 @@ fn load_buffers<'a>(
     Ok(out)
 }
 
-/// The first `need` bytes of the file a relative `uri` names beside the asset `name`.
-fn external_buffer(uri: &str, need: usize, i: usize, name: &str) -> Result<Vec<u8>, SurfaceError> {
-    use std::io::Read;
+/// The file a relative `uri` names beside the asset `name` (URI escapes decoded); a URL
+/// (`scheme://`) is refused naming `what` refers to it.
+fn beside(uri: &str, what: &str, name: &str) -> Result<std::path::PathBuf, SurfaceError> {
     if uri.contains("://") {
         return Err(err(
             name,
-            format!("buffer {i} is at {uri}; download it beside the asset and name it by a relative path"),
+            format!(
+                "{what} is at {uri}; download it beside the asset and name it by a relative path"
+            ),
         ));
     }
-    let rel = percent_decode(uri);
-    let path = Path::new(name).parent().unwrap_or(Path::new("")).join(&rel);
-    let cannot = |detail: String| err(name, format!("buffer {i} ({}): {detail}", path.display()));
+    Ok(Path::new(name)
+        .parent()
+        .unwrap_or(Path::new(""))
+        .join(percent_decode(uri)))
+}
+
+/// The first `need` bytes of the file a relative `uri` names beside the asset `name`.
+fn external_buffer(uri: &str, need: usize, i: usize, name: &str) -> Result<Vec<u8>, SurfaceError> {
+    read_beside(uri, Some(need), &format!("buffer {i}"), name)
+}
+
+/// The bytes of the file a relative `uri` names beside the asset `name` (a buffer's or an
+/// image's, `what` in errors): the first `need`, or all of it. Only regular files are read.
+///
+/// # Errors
+/// A URL, a missing or irregular file, or one shorter than `need`, naming the file.
+pub fn read_beside(
+    uri: &str,
+    need: Option<usize>,
+    what: &str,
+    name: &str,
+) -> Result<Vec<u8>, SurfaceError> {
+    use std::io::Read;
+    let path = beside(uri, what, name)?;
+    let cannot = |detail: String| err(name, format!("{what} ({}): {detail}", path.display()));
     let (f, len) =
         dcr_runtime::format::open_regular_file(&path).map_err(|e| cannot(e.to_string()))?;
-    if len < need as u64 {
-        return Err(cannot(format!(
-            "the file holds {len} bytes, but byteLength is {need}"
-        )));
-    }
+    let need = match need {
+        Some(need) if len < need as u64 => {
+            return Err(cannot(format!(
+                "the file holds {len} bytes, but byteLength is {need}"
+            )))
+        }
+        Some(need) => need,
+        None => usize::try_from(len).map_err(|_| cannot(format!("{len} bytes")))?,
+    };
     let mut b = Vec::with_capacity(need);
     f.take(need as u64)
         .read_to_end(&mut b)
@@ -355,13 +476,19 @@ struct Collect<'a, 'b> {
     buffers: &'a [Cow<'b, [u8]>],
     positions: Vec<[f64; 3]>,
     triangles: Vec<[usize; 3]>,
+    placements: Vec<GltfPlacement>,
     /// Bytes the asset holds (file and buffers): the positions and triangles gathered over every
     /// placement may not outnumber them.
     budget: usize,
 }
 
 impl Collect<'_, '_> {
-    fn mesh(&mut self, mesh: &gltf::Mesh, world: &[[f64; 4]; 4]) -> Result<(), SurfaceError> {
+    fn mesh(
+        &mut self,
+        mesh: &gltf::Mesh,
+        node: Option<usize>,
+        world: &[[f64; 4]; 4],
+    ) -> Result<(), SurfaceError> {
         let name = self.name;
         // Upper 3 × 3 determinant: a mirroring placement turns the winding inside out.
         let m = world;
@@ -474,6 +601,14 @@ impl Collect<'_, '_> {
                 ));
             }
             let base = self.positions.len();
+            self.placements.push(GltfPlacement {
+                node,
+                mesh: mesh.index(),
+                primitive: prim.index(),
+                world: *world,
+                first_vertex: base,
+                vertices: count,
+            });
             for e in raw {
                 let p: [f64; 3] = std::array::from_fn(|k| component(e, k, ty, normalized));
                 self.positions.push(std::array::from_fn(|r| {
