@@ -6,8 +6,8 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context};
 use dcr_runtime::format::ModesFile;
 use modal_bake::export::{
-    select_modes, write_modes_glb, write_modes_glb_onto, write_modes_png, write_modes_vtu,
-    AssetMesh, ModeGltfParams, OntoParams, SheetParams,
+    select_modes, write_modes_glb, write_modes_glb_onto, write_modes_onto_gltf, write_modes_png,
+    write_modes_vtu, AssetMesh, ModeGltfParams, OntoParams, SheetParams,
 };
 
 use super::mesh::Units;
@@ -29,9 +29,13 @@ const ONTO_WARN_FRACTION: f64 = 0.02;
     PNG: the lowest modes side by side, coloured by displacement magnitude normalised per mode \
     (viridis, legend below), over a grey ghost of the rest shape, each seen side-on to its own \
     motion; the title names the base, its material and mesh.\n\
-    GLB with --onto ASSET: the asset's own mesh (its vertex count and order, positions in m) \
-    with the modes as morph targets named \"mode N — F Hz\"; each asset vertex takes the mode at \
-    its closest point on the base's surface (the largest such distance is printed).\n\
+    GLB with --onto ASSET: the modes as morph targets named \"mode N — F Hz\" on the asset's own \
+    vertices (their count and order); each asset vertex takes the mode at its closest point on the \
+    base's surface (the largest such distance is printed). An OBJ, STL or PLY asset is written as \
+    one new mesh (positions in m). A glTF asset (.glb, .gltf) is kept, with the targets added to \
+    the primitives of the scene or --object in each mesh's own frame: its nodes, materials, \
+    textures, UVs, skins and animations stay, images beside a .gltf are embedded, and one preview \
+    animation per mode follows its own.\n\
     Second-order bases: each 6-node surface triangle is written as four linear ones through \
     its mid-edge nodes, which follow the corner vertices with their own mode rows.")]
 pub struct ExportArgs {
@@ -113,19 +117,43 @@ pub fn run(args: &ExportArgs) -> anyhow::Result<()> {
     if let Some(p) = &args.gltf {
         let t = std::time::Instant::now();
         if let Some(asset_path) = &args.onto {
-            let asset = AssetMesh::read(asset_path, args.units.to_metres(), args.object.as_deref())
-                .with_context(|| format!("reading --onto {}", asset_path.display()))?;
             let params = OntoParams {
                 modes,
                 scale: args.scale,
                 ..Default::default()
             };
-            let info = write_modes_glb_onto(&base, &asset, &params, p)
-                .with_context(|| format!("writing {}", p.display()))?;
+            let to_metres = args.units.to_metres();
+            let object = args.object.as_deref();
+            let is_gltf = asset_path
+                .extension()
+                .is_some_and(|e| e.eq_ignore_ascii_case("glb") || e.eq_ignore_ascii_case("gltf"));
+            let info = if is_gltf {
+                write_modes_onto_gltf(&base, asset_path, to_metres, object, &params, p)
+                    .with_context(|| format!("writing {}", p.display()))?
+            } else {
+                let asset = AssetMesh::read(asset_path, to_metres, object)
+                    .with_context(|| format!("reading --onto {}", asset_path.display()))?;
+                write_modes_glb_onto(&base, &asset, &params, p).with_context(|| {
+                    format!(
+                        "writing {} (modes onto {})",
+                        p.display(),
+                        asset_path.display()
+                    )
+                })?
+            };
+            let kept = if is_gltf {
+                format!(
+                    " ({} primitive{}; the asset's nodes, materials and animations kept)",
+                    info.primitives,
+                    if info.primitives == 1 { "" } else { "s" }
+                )
+            } else {
+                String::new()
+            };
             report(
                 p,
                 &format!(
-                    "GLB, {modes} morph targets on {} vertices of {}",
+                    "GLB, {modes} morph targets on {} vertices of {}{kept}",
                     info.vertices,
                     asset_path.display()
                 ),

@@ -6,6 +6,8 @@
 //!   morph target and one animation per mode;
 //! - [`write_modes_glb_onto`]: the same morph targets on the artist's own mesh (its vertex
 //!   count and order), each vertex mapped to the closest point of the base's surface;
+//! - [`write_modes_onto_gltf`]: the same morph targets added to a glTF asset, which is kept
+//!   otherwise (nodes, materials, textures, animations);
 //! - [`render_contact_sheet`] / [`write_modes_png`]: a PNG contact sheet of the lowest modes
 //!   (displacement magnitude as colour over the rest shape, each mode seen side-on to its
 //!   motion, a title and a colour legend; the paper's Fig. 2), rendered on the CPU.
@@ -25,6 +27,7 @@ mod gltf_builder;
 mod mode_gltf;
 mod mode_onto;
 mod mode_vtu;
+mod onto_gltf;
 mod raster;
 
 use std::path::{Path, PathBuf};
@@ -40,6 +43,7 @@ pub use mode_onto::{
     map_modes_onto, mode_title, write_modes_glb_onto, AssetMesh, OntoInfo, OntoMapping, OntoParams,
 };
 pub use mode_vtu::write_modes_vtu;
+pub use onto_gltf::write_modes_onto_gltf;
 
 /// Largest visual amplitude `scale` of the GLB morph targets and the PNG sheet: the largest
 /// displacement as a fraction of the bounding-box diagonal.

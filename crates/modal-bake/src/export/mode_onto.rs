@@ -341,10 +341,12 @@ impl Default for OntoParams {
 /// What [`write_modes_glb_onto`] did.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct OntoInfo {
-    /// Vertices of the asset (= of the glTF mesh).
+    /// Vertices of the asset given targets (= of the glTF mesh written for OBJ, STL, PLY).
     pub vertices: usize,
     /// Triangles of the glTF mesh.
     pub triangles: usize,
+    /// Primitives given the targets (1 for OBJ, STL and PLY assets: one new mesh).
+    pub primitives: usize,
     /// Largest distance from an asset vertex to the base's surface (m).
     pub max_distance_m: f64,
     /// Index of the vertex with the largest distance.
@@ -384,11 +386,8 @@ pub fn write_modes_glb_onto(
     Ok(info)
 }
 
-fn onto_glb_bytes(
-    base: &ModesFile,
-    asset: &AssetMesh,
-    params: &OntoParams,
-) -> Result<(Vec<u8>, OntoInfo), ExportError> {
+/// Refuses a non-positive scale or period and fewer than 4 keyframes.
+pub(super) fn check_onto_params(params: &OntoParams) -> Result<(), ExportError> {
     if !(params.scale.is_finite() && params.scale > 0.0) {
         return Err(ExportError::Invalid(format!(
             "parameter `scale` must be positive, got {}",
@@ -400,6 +399,61 @@ fn onto_glb_bytes(
             "animation period must be positive with at least 4 keyframes".into(),
         ));
     }
+    Ok(())
+}
+
+/// Each mapped mode's modal coordinate `a_j` (kg^½·m) that makes its largest displacement over
+/// the asset's vertices `scale × diag` (m), its display name, and its entry of
+/// `extras.dcr.modes`.
+///
+/// # Errors
+/// [`ExportError::Invalid`] for a mode that is zero at every asset vertex.
+pub(super) fn mode_amplitudes(
+    base: &ModesFile,
+    map: &OntoMapping,
+    diag: f64,
+    scale: f64,
+) -> Result<Vec<(f64, String, serde_json::Value)>, ExportError> {
+    let n = map.modes;
+    let nv = map.distance.len();
+    let freqs = base.frequencies_hz();
+    (0..n)
+        .map(|j| {
+            let peak = (0..nv)
+                .map(|v| {
+                    (0..3)
+                        .map(|a| map.u[(v * 3 + a) * n + j].powi(2))
+                        .sum::<f64>()
+                        .sqrt()
+                })
+                .fold(0.0, f64::max);
+            if !(peak > 0.0) {
+                return Err(ExportError::Invalid(format!(
+                    "mode {} is zero at every asset vertex",
+                    j + 1
+                )));
+            }
+            let a = scale * diag / peak;
+            let name = mode_title(j, freqs[j]);
+            let info = serde_json::json!({
+                "mode": j + 1,
+                "name": name,
+                "frequency_hz": freqs[j],
+                "eigenvalue": base.eigenvalues[j],
+                "modal_coordinate": a,
+                "max_displacement_m": scale * diag,
+            });
+            Ok((a, name, info))
+        })
+        .collect()
+}
+
+fn onto_glb_bytes(
+    base: &ModesFile,
+    asset: &AssetMesh,
+    params: &OntoParams,
+) -> Result<(Vec<u8>, OntoInfo), ExportError> {
+    check_onto_params(params)?;
     let nv = asset.positions.len();
     if let Some(t) = asset
         .triangles
@@ -413,7 +467,6 @@ fn onto_glb_bytes(
     let n = params.modes;
     let map = map_modes_onto(base, &asset.positions, n)?;
     let diag = diagonal(&asset.positions);
-    let freqs = base.frequencies_hz();
     let positions: Vec<[f32; 3]> = asset
         .positions
         .iter()
@@ -421,28 +474,14 @@ fn onto_glb_bytes(
         .collect();
     let mut targets = Vec::with_capacity(n);
     let mut modes_info = Vec::with_capacity(n);
-    for j in 0..n {
-        let at = |v: usize| -> [f64; 3] { std::array::from_fn(|a| map.u[(v * 3 + a) * n + j]) };
-        let peak = (0..nv)
-            .map(|v| at(v).iter().map(|x| x * x).sum::<f64>().sqrt())
-            .fold(0.0, f64::max);
-        if !(peak > 0.0) {
-            return Err(ExportError::Invalid(format!(
-                "mode {} is zero at every asset vertex",
-                j + 1
-            )));
-        }
-        let a = params.scale * diag / peak;
-        let d: Vec<[f32; 3]> = (0..nv).map(|v| at(v).map(|x| (a * x) as f32)).collect();
-        let name = mode_title(j, freqs[j]);
-        modes_info.push(serde_json::json!({
-            "mode": j + 1,
-            "name": name,
-            "frequency_hz": freqs[j],
-            "eigenvalue": base.eigenvalues[j],
-            "modal_coordinate": a,
-            "max_displacement_m": params.scale * diag,
-        }));
+    for (j, (a, name, info)) in mode_amplitudes(base, &map, diag, params.scale)?
+        .into_iter()
+        .enumerate()
+    {
+        let d: Vec<[f32; 3]> = (0..nv)
+            .map(|v| std::array::from_fn(|x| (a * map.u[(v * 3 + x) * n + j]) as f32))
+            .collect();
+        modes_info.push(info);
         targets.push((name, d));
     }
     let (max_d, worst) = map.max_distance();
@@ -472,6 +511,7 @@ fn onto_glb_bytes(
     let info = OntoInfo {
         vertices: nv,
         triangles: asset.triangles.len(),
+        primitives: 1,
         max_distance_m: max_d,
         max_distance_vertex: worst,
         diagonal_m: diag,
