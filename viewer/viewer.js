@@ -140,34 +140,64 @@ function modeTitle(i, hz) {
 }
 
 // The fixed vertices (extras.dcr.fixed_vertices) as dark points on the surface mesh.
-function showFixed(root, fixed) {
-  let mesh = null;
-  root.traverse((o) => { if (!mesh && o.isMesh) mesh = o; });
-  if (!mesh || !fixed?.length) return 0;
-  const pos = mesh.geometry.getAttribute('position');
-  const xyz = new Float32Array(3 * fixed.length);
-  fixed.forEach((v, k) => xyz.set([pos.getX(v), pos.getY(v), pos.getZ(v)], 3 * k));
-  const g = new BufferGeometry();
-  g.setAttribute('position', new BufferAttribute(xyz, 3));
-  const pts = new Points(g, new PointsMaterial({ color: 0xcc2200, size: 7, sizeAttenuation: false, depthTest: true }));
-  pts.name = 'fixed vertices';
-  mesh.add(pts);
-  return fixed.length;
+// The asset vertices a bake held fixed (extras.dcr.fixed_vertices: indices into the vertex list
+// the reader appended, placement after placement) as red points on their meshes. With
+// extras.dcr.placements (a glTF asset kept by `export --onto`) each index is found in its
+// primitive through the loader's object ↔ glTF associations; else in the first mesh.
+function showFixed(gltf, dcr) {
+  const fixed = dcr.fixed_vertices;
+  if (!fixed?.length) return 0;
+  const meshes = [];
+  gltf.scene.traverse((o) => { if (o.isMesh) meshes.push(o); });
+  const locate = (v) => {
+    if (!dcr.placements) return [meshes[0], v];
+    const p = dcr.placements.find((q) => v >= q.first_vertex && v < q.first_vertex + q.vertices);
+    if (!p) return [null, v];
+    const o = meshes.find((m) => {
+      const a = gltf.parser.associations.get(m);
+      return a && a.meshes === p.mesh && a.primitives === p.primitive;
+    });
+    return [o, v - p.first_vertex];
+  };
+  const byMesh = new Map();
+  for (const v of fixed) {
+    const [o, k] = locate(v);
+    if (!o) continue;
+    if (!byMesh.has(o)) byMesh.set(o, []);
+    byMesh.get(o).push(k);
+  }
+  let shown = 0;
+  for (const [mesh, list] of byMesh) {
+    const pos = mesh.geometry.getAttribute('position');
+    const xyz = new Float32Array(3 * list.length);
+    list.forEach((v, k) => xyz.set([pos.getX(v), pos.getY(v), pos.getZ(v)], 3 * k));
+    const g = new BufferGeometry();
+    g.setAttribute('position', new BufferAttribute(xyz, 3));
+    const pts = new Points(g, new PointsMaterial({ color: 0xcc2200, size: 7, sizeAttenuation: false, depthTest: true }));
+    pts.name = 'fixed vertices';
+    mesh.add(pts);
+    shown += list.length;
+  }
+  return shown;
 }
 
+// Mode shapes: one animation per mode. In a kept asset (`export --onto ASSET.glb`) the asset's
+// own animations come first; extras.dcr.modes[i].animation names each mode's, and its morph
+// target is found by its name (mesh.extras.targetNames) after the asset's own targets.
 function setupModes(gltf, dcr) {
   state.kind = 'modes';
-  state.modes = gltf.animations;
-  state.modeInfo = gltf.animations.map((a, i) => {
+  const indexed = dcr.modes?.length && dcr.modes.every((m) => Number.isInteger(m.animation));
+  state.modes = indexed ? dcr.modes.map((m) => gltf.animations[m.animation]) : gltf.animations;
+  state.modeInfo = state.modes.map((a, i) => {
     const m = dcr.modes?.[i] || {};
-    return { name: m.frequency_hz ? modeTitle(i, m.frequency_hz) : a.name, hz: m.frequency_hz || 0 };
+    return { name: m.frequency_hz ? modeTitle(i, m.frequency_hz) : a.name, hz: m.frequency_hz || 0, target: m.name };
   });
   state.period = dcr.period_s || 1;
   state.mixer = new AnimationMixer(gltf.scene);
   $('mode').innerHTML = state.modeInfo.map((m, i) => `<option value="${i}">${m.name}</option>`).join('');
-  state.fixedCount = showFixed(gltf.scene, dcr.fixed_vertices);
+  state.fixedCount = showFixed(gltf, dcr);
   const want = Number(params.get('mode') || 1) - 1;
-  selectMode(Math.max(0, Math.min(want, gltf.animations.length - 1)));
+  selectMode(Math.max(0, Math.min(want, state.modes.length - 1)));
   frame(gltf.scene, null);
   const fixed = state.fixedCount ? `; ${state.fixedCount} fixed vertices (red points)` : '; free-free';
   $('info').textContent = `${dcr.modes.length} modes, largest displacement ${dcr.scale} × diagonal (${(dcr.scale * dcr.diagonal_m).toPrecision(3)} m)${fixed}`;
@@ -185,8 +215,11 @@ function viridis(t) {
 function colourByMode(i) {
   state.root.traverse((o) => {
     const targets = o.isMesh && o.geometry.morphAttributes.position;
-    if (!targets || !targets[i]) return;
-    const d = targets[i];
+    const name = state.modeInfo[i]?.target;
+    const k = name !== undefined && o.morphTargetDictionary && name in o.morphTargetDictionary
+      ? o.morphTargetDictionary[name] : i;
+    if (!targets || !targets[k]) return;
+    const d = targets[k];
     const mag = new Float32Array(d.count);
     let peak = 0;
     for (let v = 0; v < d.count; v++) { mag[v] = Math.hypot(d.getX(v), d.getY(v), d.getZ(v)); peak = Math.max(peak, mag[v]); }

@@ -18,7 +18,10 @@ user folder, enables it, points its preference at the modal-bake binary, and:
   ears (which spans the head) would fix over twice as many nodes;
 - checks that a missing binary is a clear error, not a crash;
 - meshes Blender's glTF exports (GLB, and .gltf with its .bin) of a placed, rotated and mirrored
-  torus with `modal-bake mesh`: the same closed solid as Blender's OBJ export of it.
+  torus with `modal-bake mesh`: the same closed solid as Blender's OBJ export of it;
+- bakes a textured sphere with a shape key and its animation under a scaled, rotated empty from
+  Blender's .gltf, and `export --onto`s it: imported back, the object tree, image, key and
+  action are there and each mode key's world displacement peaks at scale × diagonal.
 
 Prints one line per check and "N passed, N failed, N skipped"; exits 1 on a failure. Without
 bpy it skips, except with DCR_REQUIRE_BPY=1 (CI), where that is a failure.
@@ -337,6 +340,75 @@ def main():
               f"bbox {a['inspection']['bbox']}", flush=True)
 
     check("Blender's glTF export (GLB and .gltf + .bin) meshes as its OBJ export", gltf_export)
+
+    def gltf_onto():
+        # A sphere under a rotated, non-uniformly scaled empty, with an image texture, a shape
+        # key and an animation of it, exported as .gltf (.bin and .png beside it); baked and
+        # `export --onto` it: imported back, Blender finds the same object tree, the material's
+        # image, the Smile key and its action, and one key per mode after it whose world
+        # displacement peaks at scale × diagonal.
+        bpy.ops.wm.read_factory_settings(use_empty=True)
+        bpy.ops.object.empty_add(location=(0.2, 0.0, 0.1), rotation=(0.0, 0.0, 0.7))
+        rig = bpy.context.active_object
+        rig.name, rig.scale = "Rig", (1.0, 1.5, 0.8)
+        bpy.ops.mesh.primitive_uv_sphere_add(radius=0.1, segments=24, ring_count=12)
+        ball = bpy.context.active_object
+        ball.name, ball.parent = "Ball", rig
+        image = bpy.data.images.new("Checker", 8, 8)
+        image.generated_type = "COLOR_GRID"
+        image.filepath_raw = os.path.join(work, "checker.png")
+        image.file_format = "PNG"
+        image.save()
+        mat = bpy.data.materials.new("Painted")
+        mat.use_nodes = True
+        tex = mat.node_tree.nodes.new("ShaderNodeTexImage")
+        tex.image = image
+        bsdf = mat.node_tree.nodes["Principled BSDF"]
+        mat.node_tree.links.new(tex.outputs["Color"], bsdf.inputs["Base Color"])
+        ball.data.materials.append(mat)
+        ball.shape_key_add(name="Basis")
+        smile = ball.shape_key_add(name="Smile")
+        for v in smile.data:
+            v.co.z *= 1.1
+        smile.value = 0.0
+        smile.keyframe_insert("value", frame=1)
+        smile.value = 1.0
+        smile.keyframe_insert("value", frame=24)
+        asset = os.path.join(work, "ball.gltf")
+        bpy.ops.export_scene.gltf(filepath=asset, export_format="GLTF_SEPARATE")
+        assert os.path.exists(os.path.join(work, "ball.bin"))
+        modes = os.path.join(work, "ball.modes")
+        cli("bake", asset, "-o", modes, "--object", "Ball", "--order", "1", "--modes", "6",
+            "--material", "steel")
+        out = os.path.join(work, "ball_modes.glb")
+        cli("export", modes, "--gltf", out, "--onto", asset, "--object", "Ball")
+        bpy.ops.wm.read_factory_settings(use_empty=True)
+        bpy.ops.import_scene.gltf(filepath=out)
+        ball = bpy.data.objects["Ball"]
+        assert ball.parent is not None and ball.parent.name == "Rig", ball.parent
+        images = [n.image for n in ball.active_material.node_tree.nodes
+                  if n.type == "TEX_IMAGE" and n.image is not None]
+        assert images and images[0].size[0] == 8, images
+        keys = ball.data.shape_keys.key_blocks
+        names = [k.name for k in keys]
+        assert names[:2] == ["Basis", "Smile"] and len(names) == 8, names
+        assert all(re.match(r"^mode \d+ — [0-9.]+ Hz$", n) for n in names[2:]), names
+        assert ball.data.shape_keys.animation_data is not None, "the Smile action is lost"
+        with open(out, "rb") as f:
+            data = f.read()
+        n = int.from_bytes(data[12:16], "little")
+        dcr = json.loads(data[20:20 + n])["extras"]["dcr"]
+        want = dcr["scale"] * dcr["diagonal_m"]
+        lin = ball.matrix_world.to_3x3()
+        basis = [v.co.copy() for v in keys["Basis"].data]
+        for k in keys[2:]:
+            peak = max((lin @ (v.co - b)).length for v, b in zip(k.data, basis))
+            assert abs(peak / want - 1) < 1e-4, (k.name, peak, want)
+        print(f"  ball: {len(names) - 2} mode keys after Smile, peak {want:.4e} m; "
+              f"{len(bpy.data.actions)} actions", flush=True)
+
+    check("export --onto Blender's .gltf keeps its object tree, texture, shape key and animation",
+          gltf_onto)
 
     print(f"{results['passed']} passed, {results['failed']} failed, "
           f"{results['skipped']} skipped", flush=True)

@@ -6,7 +6,9 @@
 //   with the response off on both sides (the controls);
 // - a mode-shape GLB plays: the surface moves between two times of its animation;
 // - a mode's label reads "mode N — F Hz", the clock the physical time of the mode's own
-//   period, and a clamped base's fixed vertices are drawn.
+//   period, and a clamped base's fixed vertices are drawn;
+// - in an asset kept by `export --onto ASSET.glb` the modes are dcr's animations after the
+//   asset's own, the selected one moves the surface, and the fixed vertices are drawn.
 // Needs target/release/dcr-scenes and modal-bake (cargo build --release) and `npm ci` here.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
@@ -38,6 +40,11 @@ before(async () => {
   files['beam_modes.glb'] = join(OUT, 'beam_modes.glb');
   execFileSync(bin('modal-bake'), ['export', beam, '--gltf', files['beam_modes.glb']],
     { cwd: ROOT, stdio: ['ignore', 'ignore', 'inherit'] });
+  // The plain export as an asset of its own (a mesh with 4 animations and 4 morph targets):
+  // `--onto` keeps them and adds 2 modes after them.
+  files['beam_kept.glb'] = join(OUT, 'beam_kept.glb');
+  execFileSync(bin('modal-bake'), ['export', beam, '--modes', '2', '--gltf', files['beam_kept.glb'],
+    '--onto', files['beam_modes.glb']], { cwd: ROOT, stdio: ['ignore', 'ignore', 'inherit'] });
   server = await serve(files);
   browser = await launch({ width: 1280, height: 600 });
 });
@@ -183,6 +190,31 @@ test('mode labels: "mode N — F Hz", physical time of the mode, fixed vertices 
   assert.ok(dcr.fixed_vertices.length > 0);
   assert.equal(info.fixed, dcr.fixed_vertices.length);
   await page.screenshot({ path: join(OUT, 'beam_mode2.png') });
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
+test('a kept glTF asset: the modes after its own animations, moving, fixed vertices shown', async () => {
+  const { page, errors } = await openViewer(browser.ctx, server.url, 'file=/files/beam_kept.glb&paused=1&mode=1');
+  const doc = JSON.parse(execFileSync('node', ['-e', `
+    const b = require('fs').readFileSync(process.argv[1]);
+    const n = b.readUInt32LE(12);
+    process.stdout.write(b.subarray(20, 20 + n).toString());`, files['beam_kept.glb']]).toString());
+  const dcr = doc.extras.dcr;
+  assert.equal(doc.animations.length, 6);
+  assert.deepEqual(dcr.modes.map((m) => m.animation), [4, 5]);
+  const info = await page.evaluate(() => window.dcrViewer.info());
+  assert.equal(info.kind, 'modes');
+  assert.deepEqual(info.modes, [doc.animations[4].name, doc.animations[5].name]);
+  assert.equal(info.modeNames[0], `mode 1 — ${dcr.modes[0].frequency_hz.toFixed(1)} Hz`);
+  await page.evaluate(() => window.dcrViewer.setTime(0));
+  await pixelStats(page, { key: 'rest', save: true });
+  await page.evaluate(() => window.dcrViewer.setTime(0.25));
+  const moved = await pixelStats(page, { against: 'rest' });
+  assert.ok(moved > 200, `mode 1 moves only ${moved} pixels`);
+  assert.ok(dcr.fixed_vertices.length > 0);
+  assert.equal(info.fixed, dcr.fixed_vertices.length);
+  await page.screenshot({ path: join(OUT, 'beam_kept_mode1.png') });
   assert.deepEqual(errors, []);
   await page.close();
 });
