@@ -374,7 +374,8 @@ fn assets_that_cannot_carry_the_targets_are_refused_and_nothing_is_written() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let base = ModesFile::read(&base_path).unwrap();
     let (doc, _) = write_asset(dir.path(), &base);
-    let cases: [(&str, fn(&mut Value), &str); 4] = [
+    type Case = (&'static str, fn(&mut Value), &'static str);
+    let cases: [Case; 4] = [
         (
             "text.gltf",
             |d| d["images"][0]["uri"] = json!("beam.gltf"),

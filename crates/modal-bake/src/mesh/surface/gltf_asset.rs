@@ -80,8 +80,9 @@ pub struct GltfPlacement {
     pub vertices: usize,
 }
 
-/// A glTF asset as read: the placed triangles (as [`read_gltf`]), where each came from, and
-/// the document's JSON and buffers (what a writer that keeps the asset starts from).
+/// A glTF asset as read: the placed triangles (as `mesh` and `bake` read them), where each
+/// came from, and the document's JSON and buffers (what a writer that keeps the asset starts
+/// from).
 #[derive(Clone, Debug)]
 pub struct GltfScene<'d> {
     /// The JSON document as in the file (a GLB's JSON chunk).
@@ -96,11 +97,12 @@ pub struct GltfScene<'d> {
     pub placements: Vec<GltfPlacement>,
 }
 
-/// Reads a `.glb` or `.gltf` as [`read_gltf`] does, keeping the document, its buffers and each
-/// primitive's placement.
+/// Reads a `.glb` or `.gltf` as [`read_surface`](super::read_surface) does, keeping the
+/// document, its buffers and each primitive's placement.
 ///
 /// # Errors
-/// As [`read_gltf`].
+/// [`SurfaceError`] naming the file: what the glTF reader refuses (compression, GPU
+/// instancing, sparse or out-of-range accessors, URL buffers, nodes placed twice, …).
 pub fn read_gltf_scene<'d>(
     data: &'d [u8],
     name: &str,
