@@ -102,6 +102,13 @@ fn t13() -> Option<SurfaceMesh> {
     Some(s)
 }
 
+/// The body of an XR controller as shipped (data/assets/hp_body.obj, m): closed and faceted.
+fn hp_body() -> SurfaceMesh {
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/assets/hp_body.obj");
+    modal_bake::mesh::surface::read_surface(&path).unwrap()
+}
+
 /// (estimated dofs, meshed dofs) at the defaults, order 2 (`curvature` false: one size
 /// apart from thin walls, `--uniform-size`).
 fn estimate_and_mesh(name: &str, s: &SurfaceMesh, curvature: bool) -> (f64, usize) {
@@ -159,6 +166,14 @@ fn estimated_dofs_are_within_the_stated_factor_of_the_mesh() {
             FACTOR,
         ),
     ];
+    // A low-poly game asset: at one size, gmsh's sizes must not spread from its short
+    // feature curves (`Mesh.MeshSizeExtendFromBoundary` off; else 36 times the estimate).
+    corpus.push((
+        "HP controller body (npm, faceted), --uniform-size",
+        hp_body(),
+        false,
+        FACTOR,
+    ));
     match t13() {
         Some(s) => corpus.push(("gmsh tutorial t13 (mm)", s, true, FACTOR)),
         None => {
@@ -183,4 +198,66 @@ fn estimated_dofs_are_within_the_stated_factor_of_the_mesh() {
         failures.is_empty(),
         "outside the allowed factor: {failures:?}"
     );
+}
+
+/// A 24-sided prism, radius 0.05 m and 0.1 m tall, its rims chamfered by `c` (m): faceted,
+/// with narrow faces between sharp edges; outward.
+fn chamfered_prism(c: f64) -> SurfaceMesh {
+    use std::f64::consts::TAU;
+    let (n, r, h) = (24, 0.05, 0.1);
+    let rings = [(r - c, 0.0), (r, c), (r, h - c), (r - c, h)];
+    let mut vertices: Vec<[f64; 3]> = rings
+        .iter()
+        .flat_map(|&(rr, z)| {
+            (0..n).map(move |i| {
+                let a = TAU * i as f64 / n as f64;
+                [rr * a.cos(), rr * a.sin(), z]
+            })
+        })
+        .collect();
+    vertices.extend([[0.0, 0.0, 0.0], [0.0, 0.0, h]]);
+    let (bottom, top) = (4 * n, 4 * n + 1);
+    let mut triangles = Vec::new();
+    for i in 0..n {
+        let j = (i + 1) % n;
+        for k in 0..3 {
+            let (p, q, u, w) = (k * n + i, k * n + j, (k + 1) * n + j, (k + 1) * n + i);
+            triangles.extend([[p, q, u], [p, u, w]]);
+        }
+        triangles.extend([[bottom, j, i], [top, 3 * n + i, 3 * n + j]]);
+    }
+    SurfaceMesh {
+        vertices,
+        triangles,
+    }
+}
+
+/// Where gmsh's curvature sizing makes far more elements than the estimate (a faceted prism
+/// with 1 mm chamfers: about five times), the mesh report says so and names `--uniform-size`
+/// with its estimate; a sphere's mesh, within the estimate's spread, says nothing.
+#[test]
+fn a_mesh_far_past_its_estimate_says_so_and_names_the_uniform_size() {
+    if let Err(e) = modal_bake::mesh::gmsh::gmsh_version(None) {
+        if std::env::var("DCR_REQUIRE_GMSH").as_deref() == Ok("1") {
+            panic!("DCR_REQUIRE_GMSH=1 but {e}");
+        }
+        eprintln!("SKIPPED a_mesh_far_past_its_estimate_says_so_and_names_the_uniform_size: {e}");
+        return;
+    }
+    let p = MeshParams {
+        order: 1,
+        ..Default::default()
+    };
+    let m = mesh_surface(&chamfered_prism(0.001), &p, "prism", &|_| {}).unwrap();
+    let note = m
+        .report
+        .excess
+        .unwrap_or_else(|| panic!("prism: {} tetrahedra, no excess", m.mesh.tets.len()));
+    eprintln!("{note}");
+    assert!(
+        note.contains("--uniform-size") && note.contains("times the tetrahedra"),
+        "{note}"
+    );
+    let sphere = mesh_surface(&uv_sphere(0.05, 24, 48), &p, "sphere", &|_| {}).unwrap();
+    assert_eq!(sphere.report.excess, None);
 }

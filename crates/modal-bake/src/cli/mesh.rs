@@ -124,7 +124,7 @@ pub struct AssetOptions {
     #[arg(long, value_name = "M")]
     pub size: Option<f64>,
     /// Surface assets, gmsh remeshing: one size everywhere (no finer elements where the
-    /// surface curves).
+    /// surface curves, nor around short feature curves of a faceted surface).
     #[arg(long)]
     pub uniform_size: bool,
     /// Surface assets, gmsh remeshing: no thickness-aware sizing. By default the elements in a
@@ -267,6 +267,9 @@ pub fn mesh_asset(asset: &Path, options: &AssetOptions) -> anyhow::Result<Meshed
         eprintln!("  fallback: {f}");
     }
     eprintln!("  sizing: {}", r.sizing);
+    if let Some(e) = &r.excess {
+        eprintln!("note: {}: {e}", asset.display());
+    }
     let finest = r.wall_size_m.unwrap_or(r.size_m);
     if let Some(t) = r.thin_parts_m.filter(|t| finest > 2.0 * t) {
         eprintln!(

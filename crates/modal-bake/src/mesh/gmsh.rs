@@ -50,8 +50,10 @@ pub struct GmshParams {
     pub timeout: Duration,
     /// Curvature-driven sizes when remeshing: at most 2π/`curvature_elements` times the local
     /// radius of curvature (gmsh's `Mesh.MeshSizeFromCurvature`, elements per full turn),
-    /// never above `size`; 0 (the default here) for a uniform `size`. Ignored with
-    /// `keep_surface`.
+    /// never above `size`; 0 (the default here) for a uniform `size`: then gmsh's extension
+    /// of boundary sizes into the surfaces and the volume is off too
+    /// (`Mesh.MeshSizeExtendFromBoundary = 0`), so short feature curves of a faceted asset
+    /// do not set finer sizes around them. Ignored with `keep_surface`.
     pub curvature_elements: u32,
     /// Thickness-aware sizes when remeshing ([`super::sizing::thickness_grid`]): gmsh's
     /// `Structured` background field, combined with the size and the curvature sizes by
@@ -304,6 +306,10 @@ fn geo_script(
         String::new()
     };
     let curvature = if keep_surface { 0 } else { curvature_elements };
+    // A uniform remesh is one size everywhere: without this, gmsh carries the sizes of short
+    // feature curves (at least 3 nodes each) into the surfaces and the volume, and a faceted
+    // asset comes out tens of times finer than `size` (docs/benchmarks.md).
+    let extend = if keep_surface || curvature > 0 { 1 } else { 0 };
     format!(
         "General.NumThreads = 1;\n\
          General.Terminal = 1;\n\
@@ -312,6 +318,7 @@ fn geo_script(
          Mesh.Algorithm3D = 1;\n\
          Mesh.MeshSizeMax = {size:?};\n\
          Mesh.MeshSizeFromCurvature = {curvature};\n\
+         Mesh.MeshSizeExtendFromBoundary = {extend};\n\
          Mesh.ElementOrder = {order};\n\
          Mesh.SecondOrderLinear = 1;\n\
          Mesh.MshFileVersion = 4.1;\n\

@@ -165,7 +165,16 @@ pub struct MeshReport {
     pub flipped: bool,
     /// Asset ↔ mesh-boundary distances (m).
     pub distance: SurfaceDistance,
+    /// Set when gmsh's curvature sizing made more than [`GMSH_EXCESS`] times the tetrahedra the
+    /// size estimate expected: the counts, the likely cause (a faceted surface) and the
+    /// uniform size's estimate, for the user to choose.
+    pub excess: Option<String>,
 }
+
+/// The factor over the size estimate's tetrahedra past which a gmsh mesh with curvature
+/// sizing is reported ([`MeshReport::excess`]): the estimate's documented spread where
+/// curvature sizing sets the elements is about 2.5 (docs/artist-guide.md § 7).
+pub const GMSH_EXCESS: f64 = 3.0;
 
 /// A meshed asset: the mesh (m), the `.msh` bytes to save, and the report.
 #[derive(Clone, Debug)]
@@ -469,11 +478,39 @@ pub fn mesh_surface(
     report.sizing = sizing_words(&report, params, grid.as_ref());
     if report.backend == Backend::Gmsh {
         report.wall_size_m = grid.as_ref().map(|g| g.smallest_m);
+        if curvature.is_some() {
+            report.excess = excess(surface, params, size, mesh.mesh.tets.len());
+        }
     }
     Ok(MeshedAsset {
         mesh: mesh.mesh,
         msh: mesh.msh,
         report,
+    })
+}
+
+/// [`MeshReport::excess`] of a gmsh mesh of `tets` tetrahedra made with curvature sizing at
+/// `size` (m): `None` within [`GMSH_EXCESS`] times the size estimate's tetrahedra.
+fn excess(surface: &SurfaceMesh, params: &MeshParams, size: f64, tets: usize) -> Option<String> {
+    use crate::bake::{format_count, group_digits, SizeEstimate, SurfaceMeasures};
+    let measures = SurfaceMeasures::of(&surface.vertices, &surface.triangles);
+    let estimate = |curvature: bool| {
+        let h = super::sizing::equivalent_size(surface, size, curvature, params.thickness);
+        SizeEstimate::of_surface(&measures, h, false, params.order, 1).tets
+    };
+    let expected = estimate(true);
+    let ratio = tets as f64 / expected;
+    (ratio > GMSH_EXCESS).then(|| {
+        format!(
+            "gmsh made {ratio:.1} times the tetrahedra the size estimate expected ({} for ~{}): \
+             its curvature sizing refined more than the surface's curvature asks for — on a \
+             faceted surface (a low-poly model, as game assets are) it follows the facets' \
+             creases and short feature curves; --uniform-size meshes at one size everywhere \
+             (~{} tetrahedra at this size; check the accuracy with --target-error PCT)",
+            group_digits(tets),
+            format_count(expected),
+            format_count(estimate(false)),
+        )
     })
 }
 
@@ -566,6 +603,7 @@ fn run_backend(
                 volume_m3: volume,
                 flipped: info.flipped,
                 distance: SurfaceDistance::default(),
+                excess: None,
             };
             Ok((
                 Made {
@@ -627,6 +665,7 @@ fn run_backend(
                 volume_m3: volume,
                 flipped: false,
                 distance: SurfaceDistance::default(),
+                excess: None,
             };
             Ok((Made { mesh, msh }, report))
         }
