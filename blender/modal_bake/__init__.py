@@ -90,6 +90,11 @@ class ModalBakeSettings(bpy.types.PropertyGroup):
                                              ("1", "1 (4-node)", "Fast, stiff")], default="2")
     size: FloatProperty(name="Element size", subtype="DISTANCE", default=0.0, min=0.0,
                         description="Target tetrahedron size (scene units; 0: automatic)")
+    uniform_size: BoolProperty(
+        name="Uniform size", default=False,
+        description="One element size everywhere (gmsh): no finer elements where the surface "
+                    "curves. For faceted, low-poly models, whose creases curvature sizing can "
+                    "refine tens of times (the bake log then says so)")
     target_error: FloatProperty(name="Target error (%)", default=0.0, min=0.0, max=100.0,
                                 description="Passed as --target-error when above 0")
     modes: IntProperty(name="Modes", default=12, min=1, max=200)
@@ -142,6 +147,7 @@ def bake_settings(context, obj):
     out = {
         "order": int(s.order),
         "size_m": s.size * unit if s.size > 0 else None,
+        "uniform_size": s.uniform_size,
         "mesher": s.mesher,
         "modes": s.modes,
         "material": None if s.material == "default" else s.material,
@@ -420,6 +426,7 @@ class VIEW3D_PT_modal_bake(bpy.types.Panel):
         col.prop(s, "mesher")
         col.prop(s, "order")
         col.prop(s, "size")
+        col.prop(s, "uniform_size")
         col.prop(s, "target_error")
         col.prop(s, "modes")
         col.prop(s, "output_dir")

@@ -83,10 +83,13 @@ def num(x):
 
 
 def mesh_command(exe, obj, msh, settings):
-    """`modal-bake mesh` arguments for `settings` (a dict: order, size_m, mesher)."""
+    """`modal-bake mesh` arguments for `settings` (a dict: order, size_m, uniform_size,
+    mesher)."""
     cmd = [exe, "mesh", obj, "-o", msh, "--order", str(settings["order"])]
     if settings.get("size_m"):
         cmd += ["--size", num(settings["size_m"])]
+    if settings.get("uniform_size"):
+        cmd += ["--uniform-size"]
     if settings.get("mesher") and settings["mesher"] != "auto":
         cmd += ["--mesher", settings["mesher"]]
     return cmd
@@ -150,7 +153,8 @@ def run_step(cmd, what, progress):
         if opt:
             setting = {"--material": "set Material to Custom (explicit E, ν, ρ) or CLI default",
                        "--mesher": "set Mesher to Auto",
-                       "--target-error": "set Target error to 0"}.get(opt, "reset that setting")
+                       "--target-error": "set Target error to 0",
+                       "--uniform-size": "clear Uniform size"}.get(opt, "reset that setting")
             raise BakeError(
                 f"{what}: this modal-bake ({cmd[0]}) does not know the option {opt}: update "
                 f"modal-bake, or {setting} so the option is not passed")

@@ -17,6 +17,8 @@ user folder, enables it, points its preference at the modal-bake binary, and:
   faces): the ears' vertices stay still, the head between them moves, and a box around both
   ears (which spans the head) would fix over twice as many nodes;
 - checks that a missing binary is a clear error, not a crash;
+- bakes a 16-sided cylinder with *Uniform size*: the CLI's bake with `--uniform-size` has its
+  frequencies, the one without (curvature sizing) does not;
 - meshes Blender's glTF exports (GLB, and .gltf with its .bin) of a placed, rotated and mirrored
   torus with `modal-bake mesh`: the same closed solid as Blender's OBJ export of it;
 - bakes a textured sphere with a shape key and its animation under a scaled, rotated empty from
@@ -300,6 +302,27 @@ def main():
             prefs.binary = exe
 
     check("missing binary: a clear error naming where it looked", missing_binary)
+
+    def uniform_size():
+        # A 16-sided cylinder baked with Uniform size: the add-on passes --uniform-size (the
+        # CLI's bake of its OBJ with the flag gives the same frequencies; without it, gmsh's
+        # curvature sizing meshes the rims finer and they differ).
+        bpy.ops.mesh.primitive_cylinder_add(vertices=16, radius=0.1, depth=0.3,
+                                            location=(3.0, 0.0, 0.0))
+        cyl = bpy.context.active_object
+        cyl.name = "Cylinder16"
+        cyl.modal_bake.order, cyl.modal_bake.modes = "2", 4
+        cyl.modal_bake.uniform_size = True
+        cyl.modal_bake.material = "steel"
+        cyl.modal_bake.output_dir = os.path.join(work, "cylinder")
+        bake_and_check(cyl, 4, ["--uniform-size", "--material", "steel"])
+        curved = os.path.join(work, "cylinder_curved.modes")
+        obj_path = os.path.splitext(cyl["modal_bake_modes"])[0] + ".obj"
+        cli("bake", obj_path, "-o", curved, "--order", "2", "--modes", "4", "--material", "steel")
+        a, b = list(cyl["modal_bake_frequencies_hz"]), cli_freqs(curved)
+        assert any(abs(x / y - 1) > 1e-6 for x, y in zip(a, b)), (a, b)
+
+    check("Uniform size: the add-on meshes with --uniform-size", uniform_size)
 
     def gltf_export():
         # Blender's own glTF exporter (GLB, and .gltf with a .bin beside it) and its OBJ
