@@ -84,7 +84,7 @@ fn floats(doc: &Value, bin: &[u8], acc: usize) -> Vec<f32> {
 /// (`rig`, the parent) holds node 1 (`beam`, the child, placing mesh 0) and node 2 (`other`,
 /// placing mesh 0 as well, 5 m away); mesh 0 has the beam's triangles (textured, with one morph
 /// target `smile` and weights [0.5]) and a two-vertex LINES primitive; `sway` moves `other`
-/// and `blink` steps `beam`'s weight, their data in a second buffer given as a data URI.
+/// and `blink` moves `beam`'s weight on a cubic spline, their data in a second buffer given as a data URI.
 fn write_asset(dir: &Path, base: &ModesFile) -> (Value, Vec<[f64; 3]>) {
     let nv = base.surface_vertices.len();
     let positions: Vec<[f64; 3]> = base
@@ -118,7 +118,10 @@ fn write_asset(dir: &Path, base: &ModesFile) -> (Value, Vec<[f64; 3]>) {
     )
     .unwrap();
     // Times, `other`'s translations, `beam`'s weights.
-    let anim = le_f32(&[0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.25, 0.0, 0.0, 1.0]);
+    // (a cubic spline: in-tangent, value, out-tangent per keyframe).
+    let anim = le_f32(&[
+        0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.25, 0.0, 0.0, 0.0, 0.0, 0.5, 1.0, -0.5,
+    ]);
     let (lo, hi) = (0..3).fold(([f32::MAX; 3], [f32::MIN; 3]), |(mut lo, mut hi), k| {
         for p in pos.chunks(3) {
             lo[k] = lo[k].min(p[k]);
@@ -147,7 +150,7 @@ fn write_asset(dir: &Path, base: &ModesFile) -> (Value, Vec<[f64; 3]>) {
         "animations": [{"name": "sway",
             "samplers": [{"input": 6, "output": 7}],
             "channels": [{"sampler": 0, "target": {"node": 2, "path": "translation"}}]},
-            {"name": "blink", "samplers": [{"input": 6, "output": 8, "interpolation": "STEP"}],
+            {"name": "blink", "samplers": [{"input": 6, "output": 8, "interpolation": "CUBICSPLINE"}],
              "channels": [{"sampler": 0, "target": {"node": 1, "path": "weights"}}]}],
         "buffers": [
             {"uri": "beam.bin", "byteLength": bin.len()},
@@ -161,7 +164,7 @@ fn write_asset(dir: &Path, base: &ModesFile) -> (Value, Vec<[f64; 3]>) {
             {"buffer": 0, "byteOffset": line_at, "byteLength": 24, "target": 34962},
             {"buffer": 1, "byteOffset": 0, "byteLength": 8},
             {"buffer": 1, "byteOffset": 8, "byteLength": 24},
-            {"buffer": 1, "byteOffset": 32, "byteLength": 8}
+            {"buffer": 1, "byteOffset": 32, "byteLength": 24}
         ],
         "accessors": [
             {"bufferView": 0, "componentType": 5126, "count": nv, "type": "VEC3", "min": lo, "max": hi},
@@ -173,7 +176,7 @@ fn write_asset(dir: &Path, base: &ModesFile) -> (Value, Vec<[f64; 3]>) {
             {"componentType": 5126, "count": 2, "type": "VEC3", "min": [0.0, 0.0, 0.0], "max": [0.0, 0.0, 0.0]},
             {"bufferView": 4, "componentType": 5126, "count": 2, "type": "SCALAR", "min": [0.0], "max": [1.0]},
             {"bufferView": 5, "componentType": 5126, "count": 2, "type": "VEC3"},
-            {"bufferView": 6, "componentType": 5126, "count": 2, "type": "SCALAR"}
+            {"bufferView": 6, "componentType": 5126, "count": 6, "type": "SCALAR"}
         ]
     });
     std::fs::write(
@@ -343,16 +346,19 @@ fn targets_in_each_primitives_frame_move_the_placed_vertices_as_the_modes_and_th
     }
     assert_eq!(doc["animations"][0]["name"], "sway");
     assert_eq!(doc["animations"].as_array().unwrap().len(), 2 + m);
-    // `blink` animated beam's one weight: now each keyframe's weight then m zeros.
+    // `blink` animated beam's one weight on a cubic spline: now each of its six values
+    // (in-tangent, value, out-tangent per keyframe) followed by m zeros.
     let blink = &doc["animations"][1];
-    assert_eq!(blink["samplers"][0]["interpolation"], "STEP");
+    assert_eq!(blink["samplers"][0]["interpolation"], "CUBICSPLINE");
     let w = floats(
         &doc,
         &bin,
         blink["samplers"][0]["output"].as_u64().unwrap() as usize,
     );
-    let mut want = vec![0.0f32; 2 * (1 + m)];
-    want[1 + m] = 1.0;
+    let want: Vec<f32> = [0.0f32, 0.0, 0.0, 0.5, 1.0, -0.5]
+        .iter()
+        .flat_map(|&x| std::iter::once(x).chain(std::iter::repeat_n(0.0, m)))
+        .collect();
     assert_eq!(w, want);
 }
 
