@@ -187,23 +187,29 @@ fn write_asset(dir: &Path, base: &ModesFile) -> (Value, Vec<[f64; 3]>) {
     (doc, positions)
 }
 
+/// The beam (`data/meshes/beam.msh`, steel, free-free) baked with `modes` modes into `dir`.
+fn bake_beam(dir: &Path, modes: usize) -> (std::path::PathBuf, ModesFile) {
+    let path = dir.join("beam.modes");
+    let o = Command::new(env!("CARGO_BIN_EXE_modal-bake"))
+        .arg("bake")
+        .arg(repo_root().join("data/meshes/beam.msh"))
+        .args(["-o".as_ref(), path.as_os_str()])
+        .args(["--modes", &modes.to_string(), "--material", "steel"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let base = ModesFile::read(&path).unwrap();
+    (path, base)
+}
+
 #[test]
 fn targets_in_each_primitives_frame_move_the_placed_vertices_as_the_modes_and_the_asset_is_kept() {
     let dir = tempfile::tempdir().unwrap();
     let (asset_dir, out_dir) = (dir.path().join("asset"), dir.path().join("out"));
     std::fs::create_dir_all(&asset_dir).unwrap();
     std::fs::create_dir_all(&out_dir).unwrap();
-    let base_path = dir.path().join("beam.modes");
+    let (base_path, base) = bake_beam(dir.path(), 4);
     let exe = env!("CARGO_BIN_EXE_modal-bake");
-    let o = Command::new(exe)
-        .arg("bake")
-        .arg(repo_root().join("data/meshes/beam.msh"))
-        .args(["-o".as_ref(), base_path.as_os_str()])
-        .args(["--modes", "4", "--material", "steel"])
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let base = ModesFile::read(&base_path).unwrap();
     let (m, nv) = (base.num_modes(), base.surface_vertices.len());
     let (input, local_positions) = write_asset(&asset_dir, &base);
     for (p, w) in local_positions.iter().zip(&base.surface_vertices) {
@@ -368,17 +374,8 @@ fn targets_in_each_primitives_frame_move_the_placed_vertices_as_the_modes_and_th
 #[test]
 fn assets_that_cannot_carry_the_targets_are_refused_and_nothing_is_written() {
     let dir = tempfile::tempdir().unwrap();
-    let base_path = dir.path().join("beam.modes");
+    let (base_path, base) = bake_beam(dir.path(), 2);
     let exe = env!("CARGO_BIN_EXE_modal-bake");
-    let o = Command::new(exe)
-        .arg("bake")
-        .arg(repo_root().join("data/meshes/beam.msh"))
-        .args(["-o".as_ref(), base_path.as_os_str()])
-        .args(["--modes", "2", "--material", "steel"])
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let base = ModesFile::read(&base_path).unwrap();
     let (doc, _) = write_asset(dir.path(), &base);
     type Case = (&'static str, fn(&mut Value), &'static str);
     let cases: [Case; 4] = [
@@ -458,16 +455,7 @@ fn at<'v>(v: &'v mut Value, path: &[Value]) -> &'v mut Value {
 #[test]
 fn mutated_assets_never_panic_the_export() {
     let dir = tempfile::tempdir().unwrap();
-    let base_path = dir.path().join("beam.modes");
-    let o = Command::new(env!("CARGO_BIN_EXE_modal-bake"))
-        .arg("bake")
-        .arg(repo_root().join("data/meshes/beam.msh"))
-        .args(["-o".as_ref(), base_path.as_os_str()])
-        .args(["--modes", "2", "--material", "steel"])
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let base = ModesFile::read(&base_path).unwrap();
+    let (_, base) = bake_beam(dir.path(), 2);
     let (doc, _) = write_asset(dir.path(), &base);
     let mut paths = Vec::new();
     leaves(&doc, &mut Vec::new(), &mut paths);

@@ -316,19 +316,27 @@ impl GltfBuilder {
             .root
             .to_vec()
             .map_err(|e| ExportError::Invalid(format!("glTF JSON: {e}")))?;
-        if json.len() + self.bin.len() > u32::MAX as usize - 64 {
-            return Err(ExportError::Invalid("glTF larger than 4 GiB".into()));
-        }
-        let glb = gltf::binary::Glb {
-            header: gltf::binary::Header {
-                magic: *b"glTF",
-                version: 2,
-                length: 0,
-            },
-            json: json.into(),
-            bin: (!self.bin.is_empty()).then(|| self.bin.into()),
-        };
-        glb.to_vec()
-            .map_err(|e| ExportError::Invalid(format!("GLB: {e}")))
+        glb_container(json, &self.bin).map_err(|e| ExportError::Invalid(format!("glTF {e}")))
     }
+}
+
+/// The GLB container of a JSON document and its binary buffer (none when empty).
+///
+/// # Errors
+/// The text of the refusal when the two exceed the 4 GiB a GLB can hold, or the container
+/// does not serialise.
+pub(super) fn glb_container(json: Vec<u8>, bin: &[u8]) -> Result<Vec<u8>, String> {
+    if json.len() + bin.len() > u32::MAX as usize - 64 {
+        return Err("larger than 4 GiB, the most a GLB holds".into());
+    }
+    let glb = gltf::binary::Glb {
+        header: gltf::binary::Header {
+            magic: *b"glTF",
+            version: 2,
+            length: 0,
+        },
+        json: json.into(),
+        bin: (!bin.is_empty()).then(|| bin.into()),
+    };
+    glb.to_vec().map_err(|e| format!("GLB: {e}"))
 }

@@ -448,6 +448,34 @@ pub(super) fn mode_amplitudes(
         .collect()
 }
 
+/// `extras.dcr` of an `--onto` GLB: `kind: "modes_onto"`, `scale`, `diagonal_m` (m),
+/// `period_s` (s), `max_mapping_distance_m` (m), `fixed_vertices`, `source_hash`, the glTF
+/// asset's `placements` when given, and `modes`.
+pub(super) fn onto_extras(
+    base: &ModesFile,
+    params: &OntoParams,
+    diag: f64,
+    map: &OntoMapping,
+    modes: Vec<serde_json::Value>,
+    placements: Option<Vec<serde_json::Value>>,
+) -> serde_json::Value {
+    let (max_d, _) = map.max_distance();
+    let mut dcr = serde_json::json!({
+        "kind": "modes_onto",
+        "scale": params.scale,
+        "diagonal_m": diag,
+        "period_s": params.period_s,
+        "max_mapping_distance_m": max_d,
+        "fixed_vertices": (0..map.distance.len()).filter(|&v| map.fixed[v]).collect::<Vec<_>>(),
+        "source_hash": base.meta.source_hash,
+        "modes": modes,
+    });
+    if let Some(p) = placements {
+        dcr["placements"] = serde_json::Value::Array(p);
+    }
+    dcr
+}
+
 fn onto_glb_bytes(
     base: &ModesFile,
     asset: &AssetMesh,
@@ -497,16 +525,7 @@ fn onto_glb_bytes(
         (params.period_s, params.keyframes),
     )?;
     b.root.extras = extras_of(&serde_json::json!({
-        "dcr": {
-            "kind": "modes_onto",
-            "scale": params.scale,
-            "diagonal_m": diag,
-            "period_s": params.period_s,
-            "max_mapping_distance_m": max_d,
-            "fixed_vertices": (0..nv).filter(|&v| map.fixed[v]).collect::<Vec<_>>(),
-            "source_hash": base.meta.source_hash,
-            "modes": modes_info,
-        }
+        "dcr": onto_extras(base, params, diag, &map, modes_info, None),
     }));
     let info = OntoInfo {
         vertices: nv,

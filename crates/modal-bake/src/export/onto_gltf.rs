@@ -40,11 +40,15 @@ use std::path::Path;
 use dcr_runtime::format::ModesFile;
 use serde_json::{json, Map, Value};
 
-use super::mode_onto::{check_onto_params, mode_amplitudes};
+use super::gltf_builder::glb_container;
+use super::mode_onto::{check_onto_params, mode_amplitudes, onto_extras};
 use super::{
     diagonal, map_modes_onto, write_file_atomic, ExportError, OntoInfo, OntoMapping, OntoParams,
 };
-use crate::mesh::surface::{read_beside, read_gltf_scene, validate_document, GltfPlacement};
+use crate::mesh::surface::{
+    gltf_component, read_beside, read_gltf_scene, validate_document, GltfPlacement,
+};
+use gltf::accessor::DataType;
 
 /// `bufferView.target` of vertex attributes (`ARRAY_BUFFER`).
 const ARRAY_BUFFER: u64 = 34962;
@@ -102,6 +106,14 @@ impl Doc {
             *v = json!([]);
         }
         v.as_array_mut().expect("an array")
+    }
+
+    /// The length of the top-level array `key` (0 when absent).
+    fn len(&self, key: &str) -> usize {
+        self.json
+            .get(key)
+            .and_then(Value::as_array)
+            .map_or(0, Vec::len)
     }
 
     /// Appends `v` to the top-level array `key`; its index.
@@ -295,17 +307,7 @@ fn onto_gltf_bytes(
     let extras = extras_of(&mut doc.json, "the document", name)?;
     extras.insert(
         "dcr".into(),
-        json!({
-            "kind": "modes_onto",
-            "scale": params.scale,
-            "diagonal_m": diag,
-            "period_s": params.period_s,
-            "max_mapping_distance_m": max_d,
-            "fixed_vertices": (0..nv).filter(|&v| map.fixed[v]).collect::<Vec<_>>(),
-            "source_hash": base.meta.source_hash,
-            "placements": placements_info,
-            "modes": modes_info,
-        }),
+        onto_extras(base, params, diag, &map, modes_info, Some(placements_info)),
     );
     while !doc.bin.len().is_multiple_of(4) {
         doc.bin.push(0);
@@ -546,11 +548,7 @@ fn pad_weight_animations(
     n: usize,
     name: &str,
 ) -> Result<(), ExportError> {
-    let count = doc
-        .json
-        .get("animations")
-        .and_then(Value::as_array)
-        .map_or(0, Vec::len);
+    let count = doc.len("animations");
     for a in 0..count {
         let channels = doc.array("animations")[a]["channels"]
             .as_array()
@@ -631,26 +629,22 @@ fn read_weights(doc: &mut Doc, acc: usize) -> Result<Vec<f32>, String> {
         .checked_mul(width)
         .and_then(|len| doc.bin.get(start..start.checked_add(len)?))
         .ok_or("lie outside the buffer")?;
-    // Normalized integers as glTF maps them: signed max(c / MAX, -1), unsigned c / MAX.
+    let ty = match ty {
+        5120 => DataType::I8,
+        5121 => DataType::U8,
+        5122 => DataType::I16,
+        5123 => DataType::U16,
+        _ => DataType::F32,
+    };
     Ok(bytes
         .chunks_exact(width)
-        .map(|e| match ty {
-            5126 => f32::from_le_bytes([e[0], e[1], e[2], e[3]]),
-            5120 => (f32::from(e[0] as i8) / 127.0).max(-1.0),
-            5121 => f32::from(e[0]) / 255.0,
-            5122 => (f32::from(i16::from_le_bytes([e[0], e[1]])) / 32767.0).max(-1.0),
-            _ => f32::from(u16::from_le_bytes([e[0], e[1]])) / 65535.0,
-        })
+        .map(|e| gltf_component(e, 0, ty, true) as f32)
         .collect())
 }
 
 /// Images in files beside the asset move into the binary buffer (data URIs stay as they are).
 fn embed_images(doc: &mut Doc, name: &str) -> Result<(), ExportError> {
-    let count = doc
-        .json
-        .get("images")
-        .and_then(Value::as_array)
-        .map_or(0, Vec::len);
+    let count = doc.len("images");
     for i in 0..count {
         let Some(uri) = doc.array("images")[i]["uri"].as_str().map(str::to_owned) else {
             continue;
@@ -691,21 +685,9 @@ fn glb(doc: &Doc, name: &str) -> Result<Vec<u8>, ExportError> {
                  please report this with the asset"
             ))
         })?;
-    if json.len() + doc.bin.len() > u32::MAX as usize - 64 {
-        return Err(ExportError::Invalid(format!(
-            "{name} with the morph targets is larger than a GLB can hold (4 GiB); export fewer \
-             modes (--modes)"
-        )));
-    }
-    let glb = gltf::binary::Glb {
-        header: gltf::binary::Header {
-            magic: *b"glTF",
-            version: 2,
-            length: 0,
-        },
-        json: json.into(),
-        bin: Some(doc.bin.as_slice().into()),
-    };
-    glb.to_vec()
-        .map_err(|e| ExportError::Invalid(format!("GLB: {e}")))
+    glb_container(json, &doc.bin).map_err(|e| {
+        ExportError::Invalid(format!(
+            "{name} with the morph targets: {e}; export fewer modes (--modes)"
+        ))
+    })
 }

@@ -612,7 +612,7 @@ impl Collect<'_, '_> {
                 vertices: count,
             });
             for e in raw {
-                let p: [f64; 3] = std::array::from_fn(|k| component(e, k, ty, normalized));
+                let p: [f64; 3] = std::array::from_fn(|k| gltf_component(e, k, ty, normalized));
                 self.positions.push(std::array::from_fn(|r| {
                     m[0][r] * p[0] + m[1][r] * p[1] + m[2][r] * p[2] + m[3][r]
                 }));
@@ -696,9 +696,9 @@ impl Collect<'_, '_> {
     }
 }
 
-/// Component `k` of a little-endian `VEC3` element of type `ty`; a normalized integer as glTF
-/// maps it to [-1, 1] or [0, 1] (signed: `max(c / MAX, -1)`).
-fn component(e: &[u8], k: usize, ty: DataType, normalized: bool) -> f64 {
+/// Component `k` of a little-endian element of type `ty` (`F32`, or 8-/16-bit integers); a
+/// normalized integer as glTF maps it to [-1, 1] or [0, 1] (signed: `max(c / MAX, -1)`).
+pub fn gltf_component(e: &[u8], k: usize, ty: DataType, normalized: bool) -> f64 {
     let (c, max) = match ty {
         DataType::I8 => (f64::from(e[k] as i8), 127.0),
         DataType::U8 => (f64::from(e[k]), 255.0),

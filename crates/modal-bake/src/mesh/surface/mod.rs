@@ -18,7 +18,9 @@ mod surface_mesh;
 use std::io::{BufReader, Cursor};
 use std::path::Path;
 
-pub use gltf_asset::{read_beside, read_gltf_scene, validate_document, GltfPlacement, GltfScene};
+pub use gltf_asset::{
+    gltf_component, read_beside, read_gltf_scene, validate_document, GltfPlacement, GltfScene,
+};
 pub use inspect::{inspect_surface, Defect, DefectKind, SurfaceInspection, MAX_EXAMPLES};
 pub use surface_error::SurfaceError;
 pub use surface_mesh::{SurfaceInfo, SurfaceMesh};
