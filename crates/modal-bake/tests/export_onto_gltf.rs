@@ -524,3 +524,40 @@ fn mutated_assets_never_panic_the_export() {
         "{written} written, {refused} refused"
     );
 }
+
+/// A document without scenes (every mesh read once, as it is): the mesh gains the targets, no
+/// node or animation is invented (glTF refuses empty top-level arrays), and the file passes
+/// the Khronos glTF-Validator.
+#[test]
+fn a_document_without_scenes_gains_targets_and_nothing_else() {
+    let dir = tempfile::tempdir().unwrap();
+    let (base_path, base) = bake_beam(dir.path(), 2);
+    let (mut doc, _) = write_asset(dir.path(), &base);
+    for k in ["scene", "scenes", "nodes", "animations"] {
+        doc.as_object_mut().unwrap().remove(k);
+    }
+    // Unplaced, the mesh lies away from the base (the export warns of the distance and
+    // writes): only the document's structure is checked here.
+    let asset = dir.path().join("noscene.gltf");
+    std::fs::write(&asset, serde_json::to_vec(&doc).unwrap()).unwrap();
+    let out = dir.path().join("noscene.glb");
+    let o = Command::new(env!("CARGO_BIN_EXE_modal-bake"))
+        .arg("export")
+        .arg(&base_path)
+        .args(["--gltf".as_ref(), out.as_os_str()])
+        .args(["--onto".as_ref(), asset.as_os_str()])
+        .args(["--units", "mm"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    validate_gltf(&out);
+    let bytes = std::fs::read(&out).unwrap();
+    let glb = gltf::binary::Glb::from_slice(&bytes).unwrap();
+    let d: Value = serde_json::from_slice(&glb.json).unwrap();
+    assert!(d.get("nodes").is_none() && d.get("animations").is_none());
+    assert_eq!(d["meshes"].as_array().unwrap().len(), 1);
+    for prim in d["meshes"][0]["primitives"].as_array().unwrap() {
+        assert_eq!(prim["targets"].as_array().unwrap().len(), 1 + 2);
+    }
+    assert!(d["extras"]["dcr"]["modes"][0].get("animation").is_none());
+}

@@ -32,8 +32,8 @@
 //!   [`write_modes_glb_onto`](super::write_modes_glb_onto) with its `animation`.
 //!
 //! The JSON is edited as JSON (`serde_json::Value`), not through `gltf-json`'s typed model,
-//! which drops the members and extensions it does not model; the written GLB is parsed and
-//! validated with the `gltf` crate before it is written.
+//! which drops the members and extensions it does not model; the result is parsed and
+//! validated as the reader validates an asset ([`validate_document`]) before it is written.
 
 use std::path::Path;
 
@@ -95,7 +95,8 @@ struct Doc {
 }
 
 impl Doc {
-    /// The top-level array `key`, created empty when absent.
+    /// The top-level array `key`, created empty when absent (push to it: glTF refuses an
+    /// empty top-level array).
     fn array(&mut self, key: &str) -> &mut Vec<Value> {
         let root = self
             .json
@@ -357,8 +358,9 @@ fn own_meshes<'p>(
     doc: &mut Doc,
     placements: &'p [GltfPlacement],
 ) -> Vec<(Option<usize>, usize, Vec<&'p GltfPlacement>)> {
-    let mut users = vec![0usize; doc.array("meshes").len()];
-    for node in doc.array("nodes").iter() {
+    let mut users = vec![0usize; doc.len("meshes")];
+    let nodes = doc.json.get("nodes").and_then(Value::as_array);
+    for node in nodes.into_iter().flatten() {
         if let Some(u) = node
             .get("mesh")
             .and_then(Value::as_u64)

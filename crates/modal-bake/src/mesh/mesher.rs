@@ -479,7 +479,8 @@ pub fn mesh_surface(
     if report.backend == Backend::Gmsh {
         report.wall_size_m = grid.as_ref().map(|g| g.smallest_m);
         if curvature.is_some() {
-            report.excess = excess(surface, params, size, mesh.mesh.tets.len());
+            let walls = params.thickness.then_some(diameters.as_slice());
+            report.excess = excess(surface, params.order, size, walls, mesh.mesh.tets.len());
         }
     }
     Ok(MeshedAsset {
@@ -489,14 +490,21 @@ pub fn mesh_surface(
     })
 }
 
-/// [`MeshReport::excess`] of a gmsh mesh of `tets` tetrahedra made with curvature sizing at
-/// `size` (m): `None` within [`GMSH_EXCESS`] times the size estimate's tetrahedra.
-fn excess(surface: &SurfaceMesh, params: &MeshParams, size: f64, tets: usize) -> Option<String> {
+/// [`MeshReport::excess`] of a gmsh mesh of `tets` tetrahedra of `order` made with curvature
+/// sizing at `size` (m), thickness-aware with the walls' `diameters` when given: `None`
+/// within [`GMSH_EXCESS`] times the size estimate's tetrahedra.
+fn excess(
+    surface: &SurfaceMesh,
+    order: u8,
+    size: f64,
+    diameters: Option<&[Option<f64>]>,
+    tets: usize,
+) -> Option<String> {
     use crate::bake::{format_count, group_digits, SizeEstimate, SurfaceMeasures};
     let measures = SurfaceMeasures::of(&surface.vertices, &surface.triangles);
     let estimate = |curvature: bool| {
-        let h = super::sizing::equivalent_size(surface, size, curvature, params.thickness);
-        SizeEstimate::of_surface(&measures, h, false, params.order, 1).tets
+        let h = super::sizing::equivalent_size_with(surface, size, curvature, diameters);
+        SizeEstimate::of_surface(&measures, h, false, order, 1).tets
     };
     let expected = estimate(true);
     let ratio = tets as f64 / expected;

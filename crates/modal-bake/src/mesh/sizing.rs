@@ -70,16 +70,24 @@ pub fn curvature_elements(size: f64, diag: f64) -> u32 {
 /// part with many small holes; the bake checks the real mesh against the budget again before
 /// the factorization.
 pub fn equivalent_size(surface: &SurfaceMesh, size: f64, curvature: bool, thickness: bool) -> f64 {
-    if !(curvature || thickness) || !(size > 0.0) || surface.triangles.is_empty() {
+    let diameters = (thickness && !surface.triangles.is_empty()).then(|| shape_diameters(surface));
+    equivalent_size_with(surface, size, curvature, diameters.as_deref())
+}
+
+/// [`equivalent_size`] with the triangles' wall thicknesses already measured
+/// ([`shape_diameters`], m): `Some` for thickness-aware sizes, `None` without.
+pub fn equivalent_size_with(
+    surface: &SurfaceMesh,
+    size: f64,
+    curvature: bool,
+    diameters: Option<&[Option<f64>]>,
+) -> f64 {
+    if !(curvature || diameters.is_some()) || !(size > 0.0) || surface.triangles.is_empty() {
         return size;
     }
-    let walls: Vec<f64> = if thickness {
-        shape_diameters(surface)
-            .iter()
-            .map(|t| wall_size(*t, size))
-            .collect()
-    } else {
-        vec![size; surface.triangles.len()]
+    let walls: Vec<f64> = match diameters {
+        Some(d) => d.iter().map(|t| wall_size(*t, size)).collect(),
+        None => vec![size; surface.triangles.len()],
     };
     let n = f64::from(curvature_elements(size, diagonal(surface.bounding_box())));
     let v = &surface.vertices;
