@@ -526,3 +526,91 @@ fn obj_objects_are_selected_by_name_and_stl_has_none() {
         .to_string();
     assert!(e.contains("STL and PLY files name no objects"), "{e}");
 }
+
+// `mesh --dry-run` (no mesher runs: no gmsh needed): the inspection, the objects `--object`
+// accepts (named nodes with a mesh below them, then mesh names; an empty group node is not
+// one), the mesher auto would choose and the estimate; nothing is written; over the budget it
+// exits 1 with the refusal, as the real run would.
+#[test]
+fn a_dry_run_lists_the_objects_and_the_mesher_and_writes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let (mut doc, bin) = cube_document(&cube_triangles(), 4, json!({}));
+    doc["meshes"][0]["name"] = json!("box");
+    doc["scenes"] = json!([{"nodes": [0, 1, 3]}]);
+    doc["nodes"] = json!([
+        {"name": "A", "mesh": 0},
+        {"name": "B", "translation": [5.0, 0.0, 0.0], "children": [2]},
+        {"name": "B-child", "mesh": 0, "translation": [0.0, 1.0, 0.0]},
+        {"name": "empty"}
+    ]);
+    let asset = dir.path().join("two.glb");
+    std::fs::write(&asset, glb(&doc, &bin)).unwrap();
+    let out = dir.path().join("two.msh");
+    let run = |extra: &[&str]| {
+        let mut args: Vec<&std::ffi::OsStr> = vec!["mesh".as_ref(), asset.as_os_str()];
+        args.extend(extra.iter().map(|s| std::ffi::OsStr::new(*s)));
+        modal_bake(&args)
+    };
+    let o = run(&["--dry-run"]);
+    let text = String::from_utf8_lossy(&o.stdout).to_string();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{text}{err}");
+    assert!(
+        text.contains("objects (--object NAME meshes one; this run: the whole file): `A`, `B`, `B-child`, `box`"),
+        "{text}"
+    );
+    // Two separate cubes: not one solid, so fTetWild, naming --object.
+    assert!(
+        text.contains("backend: fTetWild") && text.contains("2 shells"),
+        "{text}"
+    );
+    assert!(
+        err.contains("size estimate for") && text.contains("`mesh` would run (the estimate"),
+        "{text}{err}"
+    );
+    let o = run(&["--dry-run", "--object", "B", "-o", out.to_str().unwrap()]);
+    let text = String::from_utf8_lossy(&o.stdout).to_string();
+    assert!(o.status.success(), "{text}");
+    assert!(
+        text.contains("this run: `B`") && text.contains("backend: gmsh"),
+        "{text}"
+    );
+    assert!(!out.exists(), "a dry run wrote {}", out.display());
+    let o = run(&["--dry-run", "--object", "B", "--size", "0.001"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("refused before meshing or baking"), "{err}");
+    let o = run(&["--dry-run", "--object", "C"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && err.contains("no node or mesh named `C`"),
+        "{err}"
+    );
+    let o = run(&["--dry-run", "--json"]);
+    let v: Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["dry_run"], true);
+    assert_eq!(v["backend"], "ftetwild");
+    assert_eq!(v["objects"], json!(["A", "B", "B-child", "box"]));
+    assert!(v["estimate"]["tets"].as_f64().unwrap() > 0.0);
+}
+
+// The OBJ objects `--object` accepts: `o`/`g` names with faces, in the file's order; STL none.
+#[test]
+fn obj_object_names_are_the_named_groups_with_faces() {
+    use modal_bake::mesh::surface::object_names;
+    let dir = tempfile::tempdir().unwrap();
+    let obj = dir.path().join("parts.obj");
+    std::fs::write(
+        &obj,
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\no lid\nf 1 2 3\ng empty\no pot body\nf 1 3 4\nf 1 2 4\no lid\nf 2 3 4\n",
+    )
+    .unwrap();
+    assert_eq!(object_names(&obj).unwrap(), ["lid", "pot body"]);
+    let stl = dir.path().join("x.stl");
+    std::fs::write(&stl, b"solid x\nendsolid x\n").unwrap();
+    assert!(object_names(&stl).unwrap().is_empty());
+    let e = object_names(&dir.path().join("x.fbx"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("x.fbx"), "{e}");
+}

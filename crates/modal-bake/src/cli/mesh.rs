@@ -221,7 +221,11 @@ impl AssetOptions {
     the solid that was filled, and the Hausdorff distance between the asset and the mesh \
     boundary. Both backends run on one thread with fixed seeds: the same inputs and versions \
     give the same bytes. Install: `pip install gmsh` (or `apt-get install gmsh`) and \
-    `pip install pytetwild==0.4.2`."
+    `pip install pytetwild==0.4.2`.\n\n\
+    Examples:\n  \
+    modal-bake mesh scene.glb --dry-run            (its objects, the mesher, the estimate)\n  \
+    modal-bake mesh scene.glb --object Chair -o chair.msh\n  \
+    modal-bake mesh lowpoly.obj -o lowpoly.msh --uniform-size"
 )]
 pub struct MeshArgs {
     /// Surface asset: .obj, .stl (ASCII or binary), .ply (ASCII or binary), or glTF 2.0 (.glb,
@@ -229,8 +233,18 @@ pub struct MeshArgs {
     /// in the scene's frame (glTF's metres, +Y up).
     pub asset: PathBuf,
     /// Output tetrahedral mesh (gmsh MSH 4.1 binary; written atomically).
-    #[arg(short = 'o', long = "out", value_name = "OUT.msh")]
-    pub out: PathBuf,
+    #[arg(
+        short = 'o',
+        long = "out",
+        value_name = "OUT.msh",
+        required_unless_present = "dry_run"
+    )]
+    pub out: Option<PathBuf>,
+    /// Read and inspect the asset, list its objects, choose the mesher and estimate the work
+    /// against the budget, print them and stop: nothing is meshed or written (-o not needed).
+    /// Exits 1 when the estimate is over the budget, as the real run would refuse it.
+    #[arg(long)]
+    pub dry_run: bool,
     /// The asset's unit (--units; the mesh is written in metres) and meshing options.
     #[command(flatten)]
     pub asset_options: AssetOptions,
@@ -286,14 +300,18 @@ pub fn mesh_asset(asset: &Path, options: &AssetOptions) -> anyhow::Result<Meshed
 }
 
 pub fn run(args: &MeshArgs) -> anyhow::Result<()> {
-    super::check_output(&args.out, "-o", &[&args.asset])?;
+    let out_path = match (&args.out, args.dry_run) {
+        (Some(p), false) => p,
+        _ => return dry_run(args),
+    };
+    super::check_output(out_path, "-o", &[&args.asset])?;
     args.budget
         .check_surface(&args.asset, &args.asset_options, 26, None)?;
     let out = mesh_asset(&args.asset, &args.asset_options)?;
-    dcr_files::write_atomic(&args.out, &out.msh)
-        .with_context(|| format!("writing {}", args.out.display()))?;
+    dcr_files::write_atomic(out_path, &out.msh)
+        .with_context(|| format!("writing {}", out_path.display()))?;
     args.budget
-        .warn_bake(&args.out.display().to_string(), &out.mesh)?;
+        .warn_bake(&out_path.display().to_string(), &out.mesh)?;
     let m = &out.mesh;
     let r = &out.report;
     if args.json {
@@ -301,7 +319,7 @@ pub fn run(args: &MeshArgs) -> anyhow::Result<()> {
             "{}",
             serde_json::to_string_pretty(&serde_json::json!({
                 "asset": args.asset.display().to_string(),
-                "out": args.out.display().to_string(),
+                "out": out_path.display().to_string(),
                 "report": r,
                 "backend": r.backend,
                 "reason": r.reason,
@@ -314,7 +332,7 @@ pub fn run(args: &MeshArgs) -> anyhow::Result<()> {
         );
     } else {
         let i = &r.inspection;
-        outln!("wrote {}", args.out.display());
+        outln!("wrote {}", out_path.display());
         outln!(
             "  surface: {} vertices, {} triangles: {}{}",
             i.vertices,
@@ -376,5 +394,90 @@ pub fn run(args: &MeshArgs) -> anyhow::Result<()> {
             d.spacing_m
         );
     }
+    Ok(())
+}
+
+/// `mesh --dry-run`: what `mesh` would do with the asset, without meshing or writing.
+fn dry_run(args: &MeshArgs) -> anyhow::Result<()> {
+    use modal_bake::mesh::surface::{inspect_surface, object_names, read_surface_object};
+    let asset = &args.asset;
+    let file = asset.display().to_string();
+    let options = &args.asset_options;
+    let params = options.params()?;
+    let mut s = read_surface_object(asset, options.object.as_deref())?;
+    let to_m = options.units.to_metres();
+    if to_m != 1.0 {
+        s.scale(to_m);
+    }
+    let inspection = inspect_surface(&s);
+    let names = object_names(asset)?;
+    let backend = modal_bake::mesh::choose_backend(&s, &inspection, params.mesher, &file);
+    let size = options
+        .size
+        .unwrap_or_else(|| modal_bake::mesh::gmsh::default_size(s.bounding_box()));
+    if args.json {
+        let estimate = args.budget.check_surface(asset, options, 26, None);
+        outln!(
+            "{}",
+            serde_json::to_string_pretty(&serde_json::json!({
+                "asset": file,
+                "dry_run": true,
+                "inspection": inspection,
+                "objects": names,
+                "backend": backend.as_ref().ok().map(|b| b.0),
+                "reason": match &backend {
+                    Ok(b) => b.1.clone(),
+                    Err(e) => e.to_string(),
+                },
+                "size_m": size,
+                "estimate": estimate.as_ref().ok(),
+                "refused": estimate.as_ref().err().map(|e| e.to_string()),
+            }))?
+        );
+        return estimate.map(|_| ()).map_err(|e| anyhow::anyhow!("{e}"));
+    }
+    outln!("dry run: {file} is not meshed and nothing is written");
+    outln!(
+        "  surface: {} vertices, {} triangles: {}{}",
+        inspection.vertices,
+        inspection.triangles,
+        inspection.summary(),
+        match inspection.first_defect() {
+            Some(d) => format!(" (first: {d})"),
+            None => String::new(),
+        }
+    );
+    if !names.is_empty() {
+        let shown: Vec<String> = names.iter().take(20).map(|n| format!("`{n}`")).collect();
+        outln!(
+            "  objects (--object NAME meshes one; this run: {}): {}{}",
+            match &options.object {
+                Some(o) => format!("`{o}`"),
+                None => "the whole file".into(),
+            },
+            shown.join(", "),
+            if names.len() > 20 {
+                format!(", … ({} in all)", names.len())
+            } else {
+                String::new()
+            }
+        );
+    }
+    match &backend {
+        Ok((b, why)) => outln!("  backend: {} — {why}", b.name()),
+        Err(e) => outln!("  backend: none — {e}"),
+    }
+    outln!(
+        "  size: {size:.4e} m{}",
+        if options.size.is_none() {
+            " (the default: 1/20 of the bounding-box diagonal)"
+        } else {
+            ""
+        }
+    );
+    // The estimate (stderr) and the budget's verdict, as the real run prints them.
+    args.budget.check_surface(asset, options, 26, None)?;
+    backend.map_err(anyhow::Error::new)?;
+    outln!("  `mesh` would run (the estimate and the budget: above, on stderr)");
     Ok(())
 }

@@ -331,38 +331,25 @@ fn check_ranges(
     Ok(size)
 }
 
-/// Meshes `surface` (m; as read, not yet checked) following the chain in the module docs.
-/// `file` names the asset in messages; `progress` receives a line for each stage and about
-/// every 15 s while a backend runs.
+/// The backend `mesher` picks for `surface` (inspected as `inspection`) and why, as
+/// [`mesh_surface`] runs it: `Auto` takes gmsh for a surface that bounds one solid as it is
+/// (closed, manifold, consistently oriented, no self-intersection, one shell) and fTetWild
+/// otherwise, naming the first defect.
 ///
 /// # Errors
-/// [`AssetError`]: out of range, too fine, gmsh forced on a defective surface (the defect, its
-/// position, the fix), the backends' failures (both, after a fallback), unreadable output.
-pub fn mesh_surface(
+/// [`AssetError::NotASolid`] when gmsh is forced on a surface that does not bound a solid
+/// (the defect, its position, the fix).
+pub fn choose_backend(
     surface: &SurfaceMesh,
-    params: &MeshParams,
+    inspection: &SurfaceInspection,
+    mesher: MesherChoice,
     file: &str,
-    progress: &dyn Fn(&str),
-) -> Result<MeshedAsset, AssetError> {
-    if !matches!(params.order, 1 | 2) {
-        return Err(AssetError::Params(format!(
-            "--order must be 1 or 2, got {}",
-            params.order
-        )));
-    }
-    let inspection = inspect_surface(surface);
-    let size = check_ranges(surface, &inspection, params, file)?;
+) -> Result<(Backend, String), AssetError> {
     let solid = inspection.is_solid();
     let first = inspection
         .first_defect()
         .map_or_else(|| inspection.summary(), |d| d.to_string());
-    progress(&format!(
-        "inspected {file}: {} vertices, {} triangles: {}",
-        inspection.vertices,
-        inspection.triangles,
-        inspection.summary()
-    ));
-    let (backend, reason) = match params.mesher {
+    Ok(match mesher {
         MesherChoice::Auto if solid => (
             Backend::Gmsh,
             "auto: the surface bounds one solid as it is (closed, manifold, consistently oriented, no self-intersection, one shell), so gmsh remeshes it".to_string(),
@@ -401,7 +388,38 @@ pub fn mesh_surface(
         }
         MesherChoice::Gmsh => (Backend::Gmsh, "--mesher gmsh".to_string()),
         MesherChoice::Ftetwild => (Backend::Ftetwild, "--mesher ftetwild".to_string()),
-    };
+    })
+}
+
+/// Meshes `surface` (m; as read, not yet checked) following the chain in the module docs.
+/// `file` names the asset in messages; `progress` receives a line for each stage and about
+/// every 15 s while a backend runs.
+///
+/// # Errors
+/// [`AssetError`]: out of range, too fine, gmsh forced on a defective surface (the defect, its
+/// position, the fix), the backends' failures (both, after a fallback), unreadable output.
+pub fn mesh_surface(
+    surface: &SurfaceMesh,
+    params: &MeshParams,
+    file: &str,
+    progress: &dyn Fn(&str),
+) -> Result<MeshedAsset, AssetError> {
+    if !matches!(params.order, 1 | 2) {
+        return Err(AssetError::Params(format!(
+            "--order must be 1 or 2, got {}",
+            params.order
+        )));
+    }
+    let inspection = inspect_surface(surface);
+    let size = check_ranges(surface, &inspection, params, file)?;
+    let solid = inspection.is_solid();
+    progress(&format!(
+        "inspected {file}: {} vertices, {} triangles: {}",
+        inspection.vertices,
+        inspection.triangles,
+        inspection.summary()
+    ));
+    let (backend, reason) = choose_backend(surface, &inspection, params.mesher, file)?;
     progress(&format!("meshing with {}: {reason}", backend.name()));
     let curvature = (params.curvature && !params.keep_surface)
         .then(|| super::sizing::curvature_elements(size, diagonal(inspection.bbox)));

@@ -46,7 +46,8 @@ pub use boundary::extract_surface;
 pub use distance::{surface_distance, SurfaceDistance};
 pub use mesh_error::{Location, MeshError, MeshErrorKind};
 pub use mesher::{
-    mesh_surface, AssetError, Backend, MeshParams, MeshReport, MeshedAsset, MesherChoice,
+    choose_backend, mesh_surface, AssetError, Backend, MeshParams, MeshReport, MeshedAsset,
+    MesherChoice,
 };
 pub use msh_writer::msh41_bytes;
 pub(crate) use tet_mesh::tet_faces;

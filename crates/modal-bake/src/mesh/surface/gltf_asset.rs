@@ -61,6 +61,52 @@ pub(super) fn read_gltf(
     Ok((scene.positions, scene.triangles))
 }
 
+/// The names `--object` accepts that place something: the named nodes of the scene (depth
+/// first, in the file's order) with a mesh in their subtree, then the placed meshes' names;
+/// each once. Without scenes: the meshes' names.
+pub(super) fn gltf_object_names(data: &[u8], name: &str) -> Result<Vec<String>, SurfaceError> {
+    let Parsed { doc, .. } = document(data, name)?;
+    let mut out: Vec<String> = Vec::new();
+    let mut push = |n: Option<&str>| {
+        if let Some(n) = n.filter(|n| !out.iter().any(|o| o == n)) {
+            out.push(n.to_string());
+        }
+    };
+    let Some(scene) = doc.default_scene().or_else(|| doc.scenes().next()) else {
+        for mesh in doc.meshes() {
+            push(mesh.name());
+        }
+        return Ok(out);
+    };
+    // Whether each node's subtree places a mesh (children before parents: post-order).
+    let mut places = vec![false; doc.nodes().len()];
+    let mut order = Vec::new();
+    let mut seen = vec![false; doc.nodes().len()];
+    let mut stack: Vec<gltf::Node> = scene.nodes().collect();
+    stack.reverse();
+    while let Some(node) = stack.pop() {
+        if std::mem::replace(&mut seen[node.index()], true) {
+            continue;
+        }
+        order.push(node.clone());
+        let at = stack.len();
+        stack.extend(node.children());
+        stack[at..].reverse();
+    }
+    for node in order.iter().rev() {
+        places[node.index()] = node.mesh().is_some() || node.children().any(|c| places[c.index()]);
+    }
+    for node in &order {
+        if places[node.index()] {
+            push(node.name());
+        }
+    }
+    for node in &order {
+        push(node.mesh().and_then(|m| m.name()));
+    }
+    Ok(out)
+}
+
 /// One triangle primitive the scene places: which node places which mesh's primitive, its
 /// world matrix, and the range of its vertices in [`GltfScene::positions`].
 #[derive(Clone, Debug, PartialEq)]

@@ -67,6 +67,15 @@ pub fn read_surface(path: &Path) -> Result<SurfaceMesh, SurfaceError> {
 /// As [`read_surface`], and [`SurfaceError::Object`] when no object or several nodes have that
 /// name (listing the names the file has), or for STL and PLY, which name no objects.
 pub fn read_surface_object(path: &Path, object: Option<&str>) -> Result<SurfaceMesh, SurfaceError> {
+    let (data, file) = read_asset_file(path)?;
+    let (positions, triangles) = read_surface_unwelded_object(&data, &file, object)?;
+    Ok(SurfaceMesh::welded(positions, triangles))
+}
+
+/// The bytes of the asset at `path` and its name for messages. Only a regular file is opened
+/// (a FIFO would block, `/dev/zero` never ends), and no more than its length when opened is
+/// read.
+fn read_asset_file(path: &Path) -> Result<(Vec<u8>, String), SurfaceError> {
     use dcr_runtime::format::open_regular_file;
     use std::io::Read;
     let file = path.display().to_string();
@@ -74,15 +83,12 @@ pub fn read_surface_object(path: &Path, object: Option<&str>) -> Result<SurfaceM
         file: file.clone(),
         detail,
     };
-    // Only a regular file is opened (a FIFO would block, `/dev/zero` never ends), and no more
-    // than its length when opened is read.
     let (f, len) = open_regular_file(path).map_err(|e| io(e.to_string()))?;
     let mut data = Vec::with_capacity(usize::try_from(len).unwrap_or(0));
     f.take(len)
         .read_to_end(&mut data)
         .map_err(|e| io(e.to_string()))?;
-    let (positions, triangles) = read_surface_unwelded_object(&data, &file, object)?;
-    Ok(SurfaceMesh::welded(positions, triangles))
+    Ok((data, file))
 }
 
 /// [`read_surface`] on bytes in memory; `name` (a file name) chooses the format by its
@@ -154,6 +160,36 @@ pub fn read_surface_unwelded_object(
         }
     }
     finite_and_nonempty(positions, triangles, name)
+}
+
+/// The object names `--object` accepts in the asset at `path` that hold triangles: a glTF's
+/// named nodes with a mesh in their subtree and its meshes' names, an OBJ's `o`/`g` names with
+/// faces (in the file's order, each once); none for STL and PLY.
+///
+/// # Errors
+/// [`SurfaceError`] naming the file: unreadable, unknown extension, a glTF the reader refuses.
+pub fn object_names(path: &Path) -> Result<Vec<String>, SurfaceError> {
+    let (data, name) = read_asset_file(path)?;
+    match format_of(path) {
+        Some(Format::Gltf) => gltf_asset::gltf_object_names(&data, &name),
+        Some(Format::Obj) => {
+            let text = String::from_utf8_lossy(&data);
+            let (mut out, mut current): (Vec<String>, String) = (Vec::new(), String::new());
+            for line in text.lines() {
+                let mut tok = line.split_whitespace();
+                match tok.next() {
+                    Some("o" | "g") => current = tok.collect::<Vec<_>>().join(" "),
+                    Some("f") if !current.is_empty() && !out.contains(&current) => {
+                        out.push(current.clone())
+                    }
+                    _ => {}
+                }
+            }
+            Ok(out)
+        }
+        Some(Format::Stl | Format::Ply) => Ok(Vec::new()),
+        None => Err(SurfaceError::UnknownFormat { file: name }),
+    }
 }
 
 /// `the file's objects: `a`, `b`, … (N in all)`: the distinct names, the first 20.
