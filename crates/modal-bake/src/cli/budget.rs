@@ -11,6 +11,22 @@ use modal_bake::transfer::TransferModes;
 
 use super::mesh::AssetOptions;
 
+/// The surface asset at `path` as `mesh` reads it: `--object` only, scaled to m by `--units`.
+///
+/// # Errors
+/// The reader's, naming the file.
+pub fn read_in_metres(
+    path: &Path,
+    asset: &AssetOptions,
+) -> anyhow::Result<modal_bake::mesh::surface::SurfaceMesh> {
+    let mut s = modal_bake::mesh::surface::read_surface_object(path, asset.object.as_deref())?;
+    let to_m = asset.units.to_metres();
+    if to_m != 1.0 {
+        s.scale(to_m);
+    }
+    Ok(s)
+}
+
 /// The budget of one `mesh` or `bake` run.
 #[derive(Args, Clone, Debug)]
 pub struct BudgetOptions {
@@ -90,13 +106,25 @@ impl BudgetOptions {
         modes: usize,
         table: Option<TransferModes>,
     ) -> anyhow::Result<SizeEstimate> {
-        let budget = self.budget()?;
         // The reader's errors name the file.
-        let mut s = modal_bake::mesh::surface::read_surface_object(path, asset.object.as_deref())?;
-        let to_m = asset.units.to_metres();
-        if to_m != 1.0 {
-            s.scale(to_m);
-        }
+        let s = read_in_metres(path, asset)?;
+        self.check_read_surface(path, &s, asset, modes, table)
+    }
+
+    /// [`BudgetOptions::check_surface`] of the surface `s` already read from `path` (in m:
+    /// `--object` and `--units` applied, as [`read_in_metres`] does).
+    ///
+    /// # Errors
+    /// The estimate over the budget.
+    pub fn check_read_surface(
+        &self,
+        path: &Path,
+        s: &modal_bake::mesh::surface::SurfaceMesh,
+        asset: &AssetOptions,
+        modes: usize,
+        table: Option<TransferModes>,
+    ) -> anyhow::Result<SizeEstimate> {
+        let budget = self.budget()?;
         let measures = SurfaceMeasures::of(&s.vertices, &s.triangles);
         let size = asset
             .size
@@ -112,13 +140,13 @@ impl BudgetOptions {
             super::mesh::MesherArg::Ftetwild => true,
             super::mesh::MesherArg::Gmsh => false,
             super::mesh::MesherArg::Auto => {
-                !modal_bake::mesh::surface::inspect_surface(&s).is_solid()
+                !modal_bake::mesh::surface::inspect_surface(s).is_solid()
             }
         };
         // `k`: the fraction of the estimate's elements the mesh is taken to have (1: the
         // estimate; below 1: the fewest the mesher has made against it).
         let est_k = |size: f64, order: u8, k: f64| {
-            let h = modal_bake::mesh::sizing::equivalent_size(&s, size, curvature, thickness);
+            let h = modal_bake::mesh::sizing::equivalent_size(s, size, curvature, thickness);
             let e = SizeEstimate::of_surface(&measures, h, asset.keep_surface, order, modes);
             let e = if ftetwild { e.for_ftetwild() } else { e }.with_elements(k);
             match table {
@@ -153,7 +181,7 @@ impl BudgetOptions {
                         (true, false) => "curved",
                         _ => "thin",
                     },
-                    modal_bake::mesh::sizing::equivalent_size(&s, size, curvature, thickness)
+                    modal_bake::mesh::sizing::equivalent_size(s, size, curvature, thickness)
                 )
             } else {
                 String::new()
@@ -196,7 +224,7 @@ impl BudgetOptions {
                 SizeEstimate::of_surface(
                     &measures,
                     modal_bake::mesh::sizing::equivalent_size(
-                        &s,
+                        s,
                         size,
                         !asset.uniform_size,
                         !asset.no_thickness_sizing

@@ -399,16 +399,12 @@ pub fn run(args: &MeshArgs) -> anyhow::Result<()> {
 
 /// `mesh --dry-run`: what `mesh` would do with the asset, without meshing or writing.
 fn dry_run(args: &MeshArgs) -> anyhow::Result<()> {
-    use modal_bake::mesh::surface::{inspect_surface, object_names, read_surface_object};
+    use modal_bake::mesh::surface::{inspect_surface, object_names};
     let asset = &args.asset;
     let file = asset.display().to_string();
     let options = &args.asset_options;
     let params = options.params()?;
-    let mut s = read_surface_object(asset, options.object.as_deref())?;
-    let to_m = options.units.to_metres();
-    if to_m != 1.0 {
-        s.scale(to_m);
-    }
+    let s = super::budget::read_in_metres(asset, options)?;
     let inspection = inspect_surface(&s);
     let names = object_names(asset)?;
     let backend = modal_bake::mesh::choose_backend(&s, &inspection, params.mesher, &file);
@@ -416,7 +412,7 @@ fn dry_run(args: &MeshArgs) -> anyhow::Result<()> {
         .size
         .unwrap_or_else(|| modal_bake::mesh::gmsh::default_size(s.bounding_box()));
     if args.json {
-        let estimate = args.budget.check_surface(asset, options, 26, None);
+        let estimate = args.budget.check_read_surface(asset, &s, options, 26, None);
         outln!(
             "{}",
             serde_json::to_string_pretty(&serde_json::json!({
@@ -476,7 +472,8 @@ fn dry_run(args: &MeshArgs) -> anyhow::Result<()> {
         }
     );
     // The estimate (stderr) and the budget's verdict, as the real run prints them.
-    args.budget.check_surface(asset, options, 26, None)?;
+    args.budget
+        .check_read_surface(asset, &s, options, 26, None)?;
     backend.map_err(anyhow::Error::new)?;
     outln!("  `mesh` would run (the estimate and the budget: above, on stderr)");
     Ok(())
