@@ -592,6 +592,15 @@ fn a_dry_run_lists_the_objects_and_the_mesher_and_writes_nothing() {
     assert_eq!(v["backend"], "ftetwild");
     assert_eq!(v["objects"], json!(["A", "B", "B-child", "box"]));
     assert!(v["estimate"]["tets"].as_f64().unwrap() > 0.0);
+    // gmsh forced on the two separate cubes: the reason says why, and the run fails as the
+    // real one would.
+    let o = run(&["--dry-run", "--json", "--mesher", "gmsh"]);
+    let v: Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!(!o.status.success());
+    assert!(
+        v["backend"].is_null() && v["reason"].as_str().unwrap().contains("2 shells"),
+        "{v}"
+    );
 }
 
 // The OBJ objects `--object` accepts: `o`/`g` names with faces, in the file's order; STL none.

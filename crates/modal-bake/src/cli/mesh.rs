@@ -430,7 +430,9 @@ fn dry_run(args: &MeshArgs) -> anyhow::Result<()> {
                 "refused": estimate.as_ref().err().map(|e| e.to_string()),
             }))?
         );
-        return estimate.map(|_| ()).map_err(|e| anyhow::anyhow!("{e}"));
+        // As the real run: refused over the budget, or with gmsh forced on a non-solid.
+        estimate.map_err(|e| anyhow::anyhow!("{e}"))?;
+        return backend.map(|_| ()).map_err(anyhow::Error::new);
     }
     outln!("dry run: {file} is not meshed and nothing is written");
     outln!(
