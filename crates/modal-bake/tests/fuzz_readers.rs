@@ -414,7 +414,12 @@ fn check_one(bytes: &[u8], name: &str, kind: Kind, what: &str) -> bool {
             .map_err(|e| (e.to_string(), true)),
         _ => read_mesh_bytes(bytes, name).map(|_| ()).map_err(|e| {
             let located = e.location != Location::None
-                || matches!(e.kind, MeshErrorKind::NoTets | MeshErrorKind::UnknownFormat);
+                || matches!(
+                    e.kind,
+                    MeshErrorKind::NoTets { .. }
+                        | MeshErrorKind::OtherVolumeElements { .. }
+                        | MeshErrorKind::UnknownFormat
+                );
             (e.to_string(), located)
         }),
     }));

@@ -3,7 +3,10 @@
 //! counts match gmsh's, every bad input is a clean located error, and no prefix or byte flip
 //! of a valid file panics.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+
+#[path = "common/gmsh_gate.rs"]
+mod gmsh_gate;
 
 use modal_bake::mesh::{
     read_json, read_mesh, read_mesh_bytes, read_msh, read_msh_bytes, signed_volume, Location,
@@ -248,7 +251,13 @@ fn bad_msh_files_give_located_errors() {
     assert!(e.to_string().contains("element 6 names node 99"), "{e}");
 
     let e = read_err("bad/no_tets.msh");
-    assert_eq!(e.kind, MeshErrorKind::NoTets);
+    assert_eq!(
+        e.kind,
+        MeshErrorKind::NoTets {
+            found: "2 triangles".into()
+        }
+    );
+    assert!(e.to_string().contains("`gmsh FILE.geo -3`"), "{e}");
     // A 10-node tet reads as second-order; its mid-edge nodes are off the edges (curved).
     let m = read_ok("bad/second_order_only.msh");
     assert!(m.is_quadratic() && m.tets.len() == 1 && m.nodes.len() == 10);
@@ -745,4 +754,176 @@ fn gmsh_ascii_and_binary_forms_hash_alike() {
         geometry_hash(&moved, &fixed),
         geometry_hash(&binary, &fixed)
     );
+}
+
+/// MSH 2.2 ASCII: a tetrahedron (nodes 1–4) under the face 1-2-3, `extra` element lines after
+/// it (numbered from 2), and seven nodes (5–7 above the face, for a prism).
+fn tet_and(extra: &[&str]) -> String {
+    let mut s = String::from(
+        "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n7\n1 0 0 0\n2 1 0 0\n3 0 1 0\n\
+         4 0 0 -1\n5 0 0 1\n6 1 0 1\n7 0 1 1\n$EndNodes\n$Elements\n",
+    );
+    s += &format!("{}\n1 4 2 1 1 1 2 3 4\n", 1 + extra.len());
+    for (i, e) in extra.iter().enumerate() {
+        s += &format!("{} {e}\n", i + 2);
+    }
+    s + "$EndElements\n"
+}
+
+// Expectation: volume elements other than 4- and 10-node tetrahedra (prisms, hexahedra,
+// pyramids, higher-order tetrahedra) beside the tetrahedra are refused, naming their count
+// and type, in MSH and meshio JSON alike: leaving them out would bake part of the object (a
+// lighter object with other modes). Points, lines and quadrangles are still skipped with a
+// note.
+#[test]
+fn other_volume_elements_are_refused_not_left_out() {
+    // The same file without the prism reads, with the line and the quadrangle as notes.
+    let m = read_msh_bytes(
+        tet_and(&["1 2 1 1 1 2", "3 2 1 1 5 6 7 5"]).as_bytes(),
+        "ok.msh",
+    )
+    .unwrap();
+    assert_eq!(m.tets.len(), 1);
+    assert_eq!(m.notes.len(), 3, "{:?}", m.notes);
+    for (extra, what) in [
+        (
+            "6 2 1 1 1 2 3 5 6 7",
+            "1 elements of gmsh type 6 (6-node prism)",
+        ),
+        (
+            "7 2 1 1 1 2 6 5 4",
+            "1 elements of gmsh type 7 (5-node pyramid)",
+        ),
+    ] {
+        let e =
+            read_msh_bytes(tet_and(&["1 2 1 1 1 2", extra]).as_bytes(), "mixed.msh").unwrap_err();
+        assert_eq!(
+            e.kind,
+            MeshErrorKind::OtherVolumeElements { found: what.into() },
+            "{extra}"
+        );
+        let text = e.to_string();
+        assert!(text.starts_with("mixed.msh"), "{text}");
+        assert!(text.contains("Recombine"), "{text}");
+    }
+    // meshio JSON: a tetra block and a wedge block.
+    let json = |second: &str| {
+        format!(
+            r#"{{"points": [[0,0,0],[1,0,0],[0,1,0],[0,0,-1],[0,0,1],[1,0,1],[0,1,1]],
+                "cells": [{{"type": "tetra", "data": [[0,1,2,3]]}}, {second}]}}"#
+        )
+    };
+    let ok = json(r#"{"type": "quad", "data": [[0,1,5,4]]}"#);
+    assert_eq!(
+        read_mesh_bytes(ok.as_bytes(), "ok.json")
+            .unwrap()
+            .tets
+            .len(),
+        1
+    );
+    let bad = json(r#"{"type": "wedge", "data": [[0,1,2,4,5,6], [0,1,2,4,5,6]]}"#);
+    let e = read_mesh_bytes(bad.as_bytes(), "mixed.json").unwrap_err();
+    assert_eq!(
+        e.kind,
+        MeshErrorKind::OtherVolumeElements {
+            found: "2 cells of type \"wedge\"".into()
+        }
+    );
+}
+
+// Expectation: a file without tetrahedra says what it holds instead (a surface mesh's
+// triangles and lines) and how to mesh the volume.
+#[test]
+fn a_mesh_without_tetrahedra_says_what_it_holds() {
+    let surface = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n4\n1 0 0 0\n2 1 0 0\n3 0 1 0\n\
+                   4 0 0 1\n$EndNodes\n$Elements\n3\n1 1 2 1 1 1 2\n2 2 2 1 1 1 2 3\n\
+                   3 3 2 1 1 1 2 3 4\n$EndElements\n";
+    let e = read_msh_bytes(surface.as_bytes(), "t1.msh").unwrap_err();
+    assert_eq!(
+        e.kind,
+        MeshErrorKind::NoTets {
+            found:
+                "1 triangle, 1 elements of gmsh type 1 (2-node line), 1 elements of gmsh type 3 \
+                    (4-node quadrangle)"
+                    .into()
+        }
+    );
+    let e = read_mesh_bytes(br#"{"points": [[0,0,0]], "cells": []}"#, "empty.json").unwrap_err();
+    assert_eq!(
+        e.kind,
+        MeshErrorKind::NoTets {
+            found: "no elements".into()
+        }
+    );
+}
+
+/// A box 0.1 × 0.1 × 0.05 m as gmsh tutorial t3 builds its volumes: a square extruded 0.02 m
+/// in 2 layers (`Recombine`: prisms; without it, tetrahedra), then the top face extruded
+/// 0.03 m as a free volume (tetrahedra). Written by the real gmsh as binary MSH 4.1.
+fn gmsh_extruded_box(dir: &Path, recombine: bool) -> PathBuf {
+    let recombine = if recombine { " Recombine;" } else { "" };
+    let geo = format!(
+        "SetFactory(\"Built-in\");\nMesh.MshFileVersion = 4.1;\nMesh.Binary = 1;\n\
+         lc = 0.02;\nPoint(1) = {{0, 0, 0, lc}};\nPoint(2) = {{0.1, 0, 0, lc}};\n\
+         Point(3) = {{0.1, 0.1, 0, lc}};\nPoint(4) = {{0, 0.1, 0, lc}};\n\
+         Line(1) = {{1, 2}};\nLine(2) = {{2, 3}};\nLine(3) = {{3, 4}};\nLine(4) = {{4, 1}};\n\
+         Curve Loop(1) = {{1, 2, 3, 4}};\nPlane Surface(1) = {{1}};\n\
+         out[] = Extrude {{0, 0, 0.02}} {{ Surface{{1}}; Layers{{2}};{recombine} }};\n\
+         Extrude {{0, 0, 0.03}} {{ Surface{{out[0]}}; }}\n"
+    );
+    let geo_path = dir.join("box.geo");
+    let msh = dir.join("box.msh");
+    std::fs::write(&geo_path, geo).unwrap();
+    let binary = std::process::Command::new("gmsh")
+        .arg(&geo_path)
+        .args(["-3", "-o"])
+        .arg(&msh)
+        .output();
+    let ok = match binary {
+        Ok(out) => out.status.success(),
+        // The PyPI module without its launcher on PATH.
+        Err(_) => std::process::Command::new("python3")
+            .args([
+                "-c",
+                "import gmsh, sys; gmsh.initialize(); gmsh.open(sys.argv[1]); \
+                 gmsh.model.mesh.generate(3); gmsh.write(sys.argv[2]); gmsh.finalize()",
+            ])
+            .arg(&geo_path)
+            .arg(&msh)
+            .status()
+            .is_ok_and(|s| s.success()),
+    };
+    assert!(
+        ok && msh.exists(),
+        "gmsh could not mesh {}",
+        geo_path.display()
+    );
+    msh
+}
+
+// Expectation (real gmsh): a volume extruded in layers with `Recombine` (prisms) next to a
+// tetrahedral one, as gmsh tutorial t3 makes, is refused with the prisms' count — it used to
+// read as the tetrahedral part alone, 60 % of the volume — and the fix the message gives
+// (no `Recombine`) reads as the whole box, 5e-4 m³.
+#[test]
+fn gmsh_extruded_prisms_are_refused_and_the_fix_reads_the_whole_volume() {
+    if !gmsh_gate::have_gmsh("gmsh_extruded_prisms_are_refused_and_the_fix_reads_the_whole_volume")
+    {
+        return;
+    }
+    let tmp = std::env::temp_dir().join(format!("dcr-mixed-volume-{}", std::process::id()));
+    std::fs::create_dir_all(&tmp).unwrap();
+    let msh = gmsh_extruded_box(&tmp, true);
+    let e = read_mesh(&msh).unwrap_err();
+    match &e.kind {
+        MeshErrorKind::OtherVolumeElements { found } => {
+            assert!(found.contains("(6-node prism)"), "{found}")
+        }
+        other => panic!("expected the prisms refused, got {other:?}"),
+    }
+    assert!(e.to_string().contains("Recombine"), "{e}");
+    let m = read_mesh(&gmsh_extruded_box(&tmp, false)).unwrap();
+    let volume = m.volume();
+    assert!((volume - 5e-4).abs() < 1e-12, "volume {volume:e} m³");
+    std::fs::remove_dir_all(&tmp).unwrap();
 }

@@ -6,6 +6,19 @@ use crate::fem::MaterialError;
 use crate::mesh::MeshError;
 use dcr_runtime::format::FormatError;
 
+/// How to bake one piece of a mesh of several, by the kind of file `file` names.
+fn piece_hint(file: &str) -> &'static str {
+    let ext = std::path::Path::new(file)
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    match ext.as_deref() {
+        Some("msh") => "in gmsh, make the piece's volume the only volume of any `Physical Volume` and save again: gmsh then writes only the elements of physical groups",
+        Some("json") => "write one piece's cells per file",
+        _ => "a glTF or OBJ asset's named objects one at a time: --object NAME; `modal-bake mesh ASSET --dry-run` lists them",
+    }
+}
+
 /// Why a bake failed. Every variant names what and where.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
@@ -21,7 +34,8 @@ pub enum BakeError {
     Params(String),
     /// The mesh has several disconnected pieces.
     #[error(
-        "{file}: the mesh has {pieces} disconnected pieces; bake each piece as its own object (a glTF or OBJ asset's named objects one at a time: --object NAME)"
+        "{file}: the mesh has {pieces} disconnected pieces; bake each piece as its own object ({})",
+        piece_hint(file)
     )]
     Disconnected {
         /// Mesh file.

@@ -3,13 +3,14 @@
 //! Layout (meshio's JSON-compatible form): `points` (n×3 numbers, m), `cells` a list of
 //! `{"type", "data"}` blocks with 0-based point indices (`tetra` for 4-node tetrahedra,
 //! `tetra10` for 10-node ones in meshio's (VTK's) node order, `triangle` / `triangle6`; other
-//! types skipped with a note), and optional named groups as meshio
+//! volume cells refused, other types skipped with a note), and optional named groups as meshio
 //! `cell_sets` (`{name: [per-block lists of cell indices]}`) or gmsh-style
 //! `cell_data["gmsh:physical"]` (per-block tag lists) with `field_data` (`{name: [tag, dim]}`).
 //!
 //! Cell types: `cell_info` gives each known type's node count (the width every row of its
 //! block must have) and dimension (for `gmsh:physical` names); `CellFiler` decides what a
-//! block becomes (`tetra` → tetrahedra, `triangle` → triangles, anything else a note). Both
+//! block becomes (`tetra` → tetrahedra, `triangle` → triangles, another volume cell an error,
+//! anything else a note). Both
 //! readers below go through these two, so a new cell type is a row in `cell_info` and an arm
 //! in `CellFiler::file`.
 
@@ -46,12 +47,14 @@ fn cell_info(ty: &str) -> Option<(usize, i32)> {
 /// Files cell blocks into a [`MeshBuilder`] by type — the one place a meshio cell type is
 /// dispatched (both readers use it): `tetra` → `MeshBuilder::push_tet` (ids are 1-based
 /// positions across `tetra` blocks), `triangle` → `MeshBuilder::push_triangle`, every other
-/// type counted, one note per type in order of first appearance. Rows have the width
+/// type counted, one note per type in order of first appearance (other volume cells —
+/// `hexahedron`, `wedge`, `pyramid`, `polyhedron*`, ... — make the build fail). Rows have the width
 /// [`cell_info`] gives their type (checked by the readers).
 #[derive(Default)]
 struct CellFiler {
     tet_id: u64,
-    skipped: Vec<(String, u64)>,
+    /// (what, count, whether they are volume cells).
+    skipped: Vec<(String, u64, bool)>,
 }
 
 impl CellFiler {
@@ -82,9 +85,11 @@ impl CellFiler {
             other => {
                 let what = format!("cells of type {other:?}");
                 let n = rows.len() as u64;
+                let volume = cell_info(other).is_some_and(|(_, dim)| dim == 3)
+                    || other.starts_with("polyhedron");
                 match self.skipped.iter_mut().find(|s| s.0 == what) {
                     Some(s) => s.1 += n,
-                    None => self.skipped.push((what, n)),
+                    None => self.skipped.push((what, n, volume)),
                 }
             }
         }
@@ -92,8 +97,8 @@ impl CellFiler {
 
     /// Records the skipped types as notes.
     fn finish(self, builder: &mut MeshBuilder) {
-        for (what, n) in &self.skipped {
-            builder.skip(what, *n);
+        for (what, n, volume) in &self.skipped {
+            builder.skip(what, *n, *volume);
         }
     }
 }

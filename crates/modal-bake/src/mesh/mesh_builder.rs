@@ -19,7 +19,8 @@ pub(crate) struct MeshBuilder {
     tets10: Vec<(u64, [usize; 10])>,
     triangles: Vec<[usize; 3]>,
     groups: BTreeMap<String, Vec<usize>>,
-    skipped: Vec<(String, u64)>,
+    /// Elements not built, per description: (what, count, whether they are volume elements).
+    skipped: Vec<(String, u64, bool)>,
 }
 
 impl MeshBuilder {
@@ -82,11 +83,36 @@ impl MeshBuilder {
         }
     }
 
-    /// Counts `n` skipped elements described by `what` (one note per distinct `what`).
-    pub fn skip(&mut self, what: &str, n: u64) {
+    /// Counts `n` skipped elements described by `what` (one note per distinct `what`);
+    /// `volume`: they are 3-D elements (hexahedra, prisms, pyramids, higher-order
+    /// tetrahedra), which [`MeshBuilder::finish`] refuses rather than leave part of the object
+    /// out.
+    pub fn skip(&mut self, what: &str, n: u64, volume: bool) {
         match self.skipped.iter_mut().find(|s| s.0 == what) {
             Some(s) => s.1 += n,
-            None => self.skipped.push((what.to_string(), n)),
+            None => self.skipped.push((what.to_string(), n, volume)),
+        }
+    }
+
+    /// What was read besides tetrahedra, for an error: "726 triangles, 70 elements of gmsh
+    /// type 1 (2-node line)"; only the volume elements when `volume_only`.
+    fn found(&self, volume_only: bool) -> String {
+        use crate::bake::group_digits;
+        let mut parts = Vec::new();
+        if !volume_only && !self.triangles.is_empty() {
+            let n = self.triangles.len();
+            let plural = if n == 1 { "" } else { "s" };
+            parts.push(format!("{} triangle{plural}", group_digits(n)));
+        }
+        for (what, n, volume) in &self.skipped {
+            if *volume || !volume_only {
+                parts.push(format!("{} {what}", group_digits(*n as usize)));
+            }
+        }
+        if parts.is_empty() {
+            "no elements".into()
+        } else {
+            parts.join(", ")
         }
     }
 
@@ -99,11 +125,25 @@ impl MeshBuilder {
     ///
     /// # Errors
     /// [`MeshErrorKind::NoTets`] when there is no tetrahedron;
+    /// [`MeshErrorKind::OtherVolumeElements`] when other volume elements were skipped;
     /// [`MeshErrorKind::DuplicateTet`] (at the later element) when two tetrahedra have the
     /// same nodes in different orders: one would count twice.
     pub fn finish(mut self, file: &str) -> Result<TetMesh, MeshError> {
         if self.tets.is_empty() && self.tets10.is_empty() {
-            return Err(MeshError::new(file, Location::None, MeshErrorKind::NoTets));
+            let found = self.found(false);
+            return Err(MeshError::new(
+                file,
+                Location::None,
+                MeshErrorKind::NoTets { found },
+            ));
+        }
+        if self.skipped.iter().any(|s| s.2) {
+            let found = self.found(true);
+            return Err(MeshError::new(
+                file,
+                Location::None,
+                MeshErrorKind::OtherVolumeElements { found },
+            ));
         }
         if !self.tets.is_empty() && !self.tets10.is_empty() {
             return Err(MeshError::new(
@@ -134,7 +174,7 @@ impl MeshBuilder {
             ));
         }
         let mut notes = Vec::new();
-        for (what, n) in &self.skipped {
+        for (what, n, _) in &self.skipped {
             notes.push(format!("skipped {n} {what}"));
         }
         // Canonical element order: by node indices (which follow node tags), so the order in

@@ -173,9 +173,25 @@ pub enum MeshErrorKind {
         /// The other element id.
         second: u64,
     },
-    /// The file holds no 4-node or 10-node tetrahedra.
-    #[error("no 4-node or 10-node tetrahedra in the mesh (other element types are skipped)")]
-    NoTets,
+    /// The file holds no 4-node or 10-node tetrahedra; `found` lists what it holds instead
+    /// (counts and types, or "nothing").
+    #[error(
+        "no 4-node or 10-node tetrahedra in the mesh (it holds {found}): modal-bake bakes a volume meshed with tetrahedra; mesh a volume with tetrahedra (gmsh: a `Volume` in the geometry, `gmsh FILE.geo -3`, no `Recombine`), or give the closed surface as an .obj / .stl / .ply / .glb asset for modal-bake to mesh"
+    )]
+    NoTets {
+        /// The elements the file holds instead, e.g. "726 3-node triangles, 70 2-node lines".
+        found: String,
+    },
+    /// The file holds volume elements other than 4- and 10-node tetrahedra (hexahedra, prisms,
+    /// pyramids, higher-order tetrahedra) beside its tetrahedra: leaving them out would bake
+    /// part of the object.
+    #[error(
+        "the mesh holds {found} beside its tetrahedra: only 4- and 10-node tetrahedra are baked, and leaving the others out would bake part of the object (a wrong mass and wrong modes); mesh the volume with tetrahedra only (gmsh: no `Recombine` in `Extrude`, `Mesh.RecombineAll = 0`, `Mesh.Recombine3DAll = 0`, element order 1 or 2)"
+    )]
+    OtherVolumeElements {
+        /// The other volume elements, e.g. "12,342 6-node prisms (gmsh type 6)".
+        found: String,
+    },
     /// The file mixes 4-node and 10-node tetrahedra.
     #[error(
         "the mesh mixes {linear} 4-node and {quadratic} 10-node tetrahedra; use one element order"

@@ -23,7 +23,10 @@
 //! `MeshBuilder::push_tet`, type 11 (10-node tetrahedron, gmsh node order: corners, then the
 //! mid-edge nodes of edges (0,1), (1,2), (2,0), (3,0), (3,2), (3,1)) → `MeshBuilder::push_tet10`,
 //! types 2 and 9 (3- and 6-node triangles, corners) → `MeshBuilder::push_triangle`, every
-//! other type is counted and reported in [`TetMesh::notes`]. Supporting another type is an arm
+//! other type is counted: other volume elements (hexahedra, prisms, pyramids, tetrahedra of
+//! higher order) are refused ([`MeshErrorKind::OtherVolumeElements`]: leaving them out would
+//! bake part of the object), the rest (points, lines, quadrangles) reported in
+//! [`TetMesh::notes`]. Supporting another type is an arm
 //! there and a `MeshBuilder` method; binary MSH 2.2 and 4.1 element blocks of a type missing
 //! from `element_info` cannot be skipped (their record size is unknown) and are refused.
 
@@ -293,11 +296,11 @@ impl MshReader<'_> {
             }
         }
         for &(ty, n) in &self.skipped {
-            let what = match element_info(ty) {
-                Some((_, _, name)) => format!("elements of gmsh type {ty} ({name})"),
-                None => format!("elements of gmsh type {ty} (unknown type)"),
+            let (what, volume) = match element_info(ty) {
+                Some((_, dim, name)) => (format!("elements of gmsh type {ty} ({name})"), dim == 3),
+                None => (format!("elements of gmsh type {ty} (unknown type)"), false),
             };
-            self.builder.skip(&what, n);
+            self.builder.skip(&what, n, volume);
         }
         let group_name = |names: &BTreeMap<(i32, i64), String>, dim: i32, tag: i64| {
             names
