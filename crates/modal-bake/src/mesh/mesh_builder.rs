@@ -6,6 +6,12 @@ use std::collections::BTreeMap;
 use super::mesh_error::{Location, MeshError, MeshErrorKind};
 use super::tet_mesh::TetMesh;
 
+/// [`MeshErrorKind::NoTets`]'s fix when the file holds other volume elements.
+pub(crate) const NO_TETS_OTHER_VOLUME: &str = "modal-bake bakes 4- and 10-node tetrahedra only; mesh the volume with tetrahedra of order 1 or 2 (gmsh: no `Recombine` in `Extrude`, `Mesh.RecombineAll = 0`, `Mesh.Recombine3DAll = 0`, `-order 1` or `-order 2`)";
+
+/// [`MeshErrorKind::NoTets`]'s fix when the file holds no volume elements at all.
+pub(crate) const NO_TETS_NO_VOLUME: &str = "modal-bake bakes a volume meshed with tetrahedra; mesh a volume (gmsh: a `Volume` in the geometry, `gmsh FILE.geo -3`), or give the closed surface as an .obj / .stl / .ply / .glb asset for modal-bake to mesh";
+
 /// Nodes and elements as read, before canonicalisation. Element node references are indices
 /// into the tag-sorted node table.
 #[derive(Debug, Default)]
@@ -131,10 +137,15 @@ impl MeshBuilder {
     pub fn finish(mut self, file: &str) -> Result<TetMesh, MeshError> {
         if self.tets.is_empty() && self.tets10.is_empty() {
             let found = self.found(false);
+            let how = if self.skipped.iter().any(|s| s.2) {
+                NO_TETS_OTHER_VOLUME
+            } else {
+                NO_TETS_NO_VOLUME
+            };
             return Err(MeshError::new(
                 file,
                 Location::None,
-                MeshErrorKind::NoTets { found },
+                MeshErrorKind::NoTets { found, how },
             ));
         }
         if self.skipped.iter().any(|s| s.2) {

@@ -174,13 +174,15 @@ pub enum MeshErrorKind {
         second: u64,
     },
     /// The file holds no 4-node or 10-node tetrahedra; `found` lists what it holds instead
-    /// (counts and types, or "nothing").
-    #[error(
-        "no 4-node or 10-node tetrahedra in the mesh (it holds {found}): modal-bake bakes a volume meshed with tetrahedra; mesh a volume with tetrahedra (gmsh: a `Volume` in the geometry, `gmsh FILE.geo -3`, no `Recombine`), or give the closed surface as an .obj / .stl / .ply / .glb asset for modal-bake to mesh"
-    )]
+    /// (counts and types, or "no elements") and `how` how to mesh what modal-bake bakes.
+    #[error("no 4-node or 10-node tetrahedra in the mesh (it holds {found}): {how}")]
     NoTets {
-        /// The elements the file holds instead, e.g. "726 3-node triangles, 70 2-node lines".
+        /// The elements the file holds instead, e.g. "726 triangles, 70 elements of gmsh
+        /// type 1 (2-node line)".
         found: String,
+        /// The fix: other volume elements meshed as tetrahedra of order 1 or 2, or a volume
+        /// meshed at all.
+        how: &'static str,
     },
     /// The file holds volume elements other than 4- and 10-node tetrahedra (hexahedra, prisms,
     /// pyramids, higher-order tetrahedra) beside its tetrahedra: leaving them out would bake
