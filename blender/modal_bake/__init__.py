@@ -93,8 +93,9 @@ class ModalBakeSettings(bpy.types.PropertyGroup):
     uniform_size: BoolProperty(
         name="Uniform size", default=False,
         description="One element size everywhere (gmsh): no finer elements where the surface "
-                    "curves. For faceted, low-poly models, whose creases curvature sizing can "
-                    "refine tens of times (the bake log then says so)")
+                    "curves. Where gmsh's curvature sizing over-refines a faceted, low-poly "
+                    "model, the bake already meshes it again with sizes from the model's own "
+                    "curvature (the bake log says so); this is the coarser, simpler choice")
     target_error: FloatProperty(name="Target error (%)", default=0.0, min=0.0, max=100.0,
                                 description="Passed as --target-error when above 0")
     modes: IntProperty(name="Modes", default=12, min=1, max=200)

@@ -232,27 +232,91 @@ fn chamfered_prism(c: f64) -> SurfaceMesh {
 }
 
 /// Where gmsh's curvature sizing makes far more elements than the estimate (a faceted prism
-/// with 1 mm chamfers: about five times), the mesh report says so and names `--uniform-size`
-/// with its estimate; a sphere's mesh, within the estimate's spread, says nothing.
+/// with 1 mm chamfers: about five times), the mesh report says so and the asset is meshed
+/// again with the curvature sizes the estimate measures, which lands within the estimate's
+/// curved-shape factor; a sphere's mesh, within the estimate's spread, is gmsh's own and says
+/// nothing.
 #[test]
-fn a_mesh_far_past_its_estimate_says_so_and_names_the_uniform_size() {
-    if !have_gmsh("a_mesh_far_past_its_estimate_says_so_and_names_the_uniform_size") {
+fn a_mesh_far_past_its_estimate_is_made_again_with_the_estimates_sizes() {
+    if !have_gmsh("a_mesh_far_past_its_estimate_is_made_again_with_the_estimates_sizes") {
         return;
     }
     let p = MeshParams {
         order: 1,
         ..Default::default()
     };
-    let m = mesh_surface(&chamfered_prism(0.001), &p, "prism", &|_| {}).unwrap();
+    let prism = chamfered_prism(0.001);
+    let m = mesh_surface(&prism, &p, "prism", &|_| {}).unwrap();
     let note = m
         .report
         .excess
+        .as_deref()
         .unwrap_or_else(|| panic!("prism: {} tetrahedra, no excess", m.mesh.tets.len()));
     eprintln!("{note}");
     assert!(
-        note.contains("--uniform-size") && note.contains("times the tetrahedra"),
+        note.contains("times the tetrahedra") && note.contains("meshed again"),
         "{note}"
+    );
+    assert!(m.report.curvature_from_surface);
+    let ratio = estimated_tets(&prism, 1) / m.mesh.tets.len() as f64;
+    eprintln!(
+        "prism: {} tetrahedra, estimate / mesh {ratio:.3}",
+        m.mesh.tets.len()
+    );
+    assert!(
+        ratio <= CURVED_FACTOR && ratio >= 1.0 / CURVED_FACTOR,
+        "{ratio}"
     );
     let sphere = mesh_surface(&uv_sphere(0.05, 24, 48), &p, "sphere", &|_| {}).unwrap();
     assert_eq!(sphere.report.excess, None);
+    assert!(!sphere.report.curvature_from_surface);
+}
+
+/// The size estimate's tetrahedra for `s` at the defaults (curvature and thickness sizing).
+fn estimated_tets(s: &SurfaceMesh, order: u8) -> f64 {
+    let size = default_size(s.bounding_box());
+    let measures = SurfaceMeasures::of(&s.vertices, &s.triangles);
+    let h = equivalent_size(s, size, true, true);
+    SizeEstimate::of_surface(&measures, h, false, order, 26).tets
+}
+
+/// A low-poly game asset at the defaults (the npm HP controller's body, 3,314 triangles):
+/// gmsh's curvature sizing follows its facets (233,386 tetrahedra, 48 times the estimate, a
+/// 30 GB bake), so the body is meshed again with the estimate's curvature sizes: within
+/// the curved-shape factor of the estimate, the same solid (volume within 3 % of the asset's)
+/// and the same surface (Hausdorff distance within 3 % of the diagonal).
+#[test]
+fn a_faceted_asset_at_the_defaults_is_meshed_with_the_estimates_sizes() {
+    if !have_gmsh("a_faceted_asset_at_the_defaults_is_meshed_with_the_estimates_sizes") {
+        return;
+    }
+    let body = hp_body();
+    let p = MeshParams {
+        order: 2,
+        ..Default::default()
+    };
+    let m = mesh_surface(&body, &p, "hp_body", &|_| {}).unwrap();
+    let note = m.report.excess.as_deref().unwrap_or("(none)");
+    eprintln!("{note}");
+    assert!(
+        note.contains("233,386") && note.contains("meshed again"),
+        "{note}"
+    );
+    assert!(m.report.curvature_from_surface);
+    let ratio = estimated_tets(&body, 2) / m.mesh.tets.len() as f64;
+    eprintln!(
+        "hp body: {} tetrahedra, estimate / mesh {ratio:.3}",
+        m.mesh.tets.len()
+    );
+    assert!(
+        ratio <= CURVED_FACTOR && ratio >= 1.0 / CURVED_FACTOR,
+        "{ratio}"
+    );
+    let asset_volume = SurfaceMeasures::of(&body.vertices, &body.triangles).volume_m3;
+    let volume = m.mesh.volume();
+    assert!(
+        (volume / asset_volume - 1.0).abs() < 0.03,
+        "{volume:e} vs {asset_volume:e} m³"
+    );
+    assert!(m.report.distance.relative < 0.03, "{:?}", m.report.distance);
 }

@@ -145,6 +145,11 @@ pub struct MeshReport {
     /// gmsh remeshing: elements per full turn of curvature (finer elements where the surface
     /// curves); `None` for a uniform size, `keep_surface` and fTetWild.
     pub curvature_elements: Option<u32>,
+    /// Whether the curvature sizes came from the asset's triangles as the size estimate
+    /// measures them ([`super::sizing::local_sizes`], a `Structured` field), not from gmsh's
+    /// own curvature sizing: the mesh made again after gmsh's was over [`GMSH_EXCESS`] times
+    /// the estimate ([`MeshReport::excess`] says so).
+    pub curvature_from_surface: bool,
     /// Which sizing ran and why, in words: uniform, curvature, thickness-aware (with the
     /// share of the surface it refined and the smallest wall size), or why not.
     pub sizing: String,
@@ -166,14 +171,17 @@ pub struct MeshReport {
     /// Asset ↔ mesh-boundary distances (m).
     pub distance: SurfaceDistance,
     /// Set when gmsh's curvature sizing made more than [`GMSH_EXCESS`] times the tetrahedra the
-    /// size estimate expected: the counts, the likely cause (a faceted surface) and the
-    /// uniform size's estimate, for the user to choose.
+    /// size estimate expected: the counts, the likely cause (a faceted surface), and what was
+    /// done — the asset meshed again with the curvature sizes the estimate assumes
+    /// ([`MeshReport::curvature_from_surface`]), or why that failed.
     pub excess: Option<String>,
 }
 
 /// The factor over the size estimate's tetrahedra past which a gmsh mesh with curvature
-/// sizing is reported ([`MeshReport::excess`]): the estimate's documented spread where
-/// curvature sizing sets the elements is about 2.5 (docs/artist-guide.md § 7).
+/// sizing is set aside and the asset meshed again with the curvature sizes the estimate
+/// measures on its triangles ([`MeshReport::excess`], [`MeshReport::curvature_from_surface`]):
+/// the estimate's documented spread where curvature sizing sets the elements is about 2.5
+/// (docs/artist-guide.md § 7).
 pub const GMSH_EXCESS: f64 = 3.0;
 
 /// A meshed asset: the mesh (m), the `.msh` bytes to save, and the report.
@@ -424,13 +432,14 @@ pub fn mesh_surface(
     let curvature = (params.curvature && !params.keep_surface)
         .then(|| super::sizing::curvature_elements(size, diagonal(inspection.bbox)));
     let diameters = super::sizing::shape_diameters(surface);
-    let grid = (params.thickness && !params.keep_surface)
+    let mut grid = (params.thickness && !params.keep_surface)
         .then(|| super::sizing::thickness_grid_from(surface, &diameters, size))
         .flatten();
     let params = &MeshParams {
         size: Some(size),
         ..params.clone()
     };
+    let walls = params.thickness.then_some(diameters.as_slice());
     let first_try = run_backend(
         backend,
         surface,
@@ -484,6 +493,37 @@ pub fn mesh_surface(
     if report.reason.is_empty() {
         report.reason = reason;
     }
+    let mut mesh = mesh;
+    if report.backend == Backend::Gmsh && curvature.is_some() {
+        if let Some(note) = excess(surface, params.order, size, walls, mesh.mesh.tets.len()) {
+            // gmsh's curvature sizing followed something other than the surface's curvature
+            // (a faceted asset's creases and short feature curves).
+            progress(&format!("{note}: meshing again with {OWN_SIZES}"));
+            let made = mesh_with_own_sizes(
+                surface,
+                &inspection,
+                params,
+                (size, walls, curvature),
+                file,
+                progress,
+            );
+            report.excess = Some(match made {
+                Ok((m, mut r, own)) => {
+                    let note = own_sizes_note(&note, &m);
+                    r.reason = std::mem::take(&mut report.reason);
+                    r.fallback_from = report.fallback_from.take();
+                    r.seconds += report.seconds;
+                    report = r;
+                    mesh = m;
+                    grid = own;
+                    note
+                }
+                Err(e) => format!(
+                    "{note}; meshing again with {OWN_SIZES} failed ({e}), so this is gmsh's mesh"
+                ),
+            });
+        }
+    }
     progress(&format!(
         "measuring the distance between {file} and the mesh boundary"
     ));
@@ -496,10 +536,6 @@ pub fn mesh_surface(
     report.sizing = sizing_words(&report, params, grid.as_ref());
     if report.backend == Backend::Gmsh {
         report.wall_size_m = grid.as_ref().map(|g| g.smallest_m);
-        if curvature.is_some() {
-            let walls = params.thickness.then_some(diameters.as_slice());
-            report.excess = excess(surface, params.order, size, walls, mesh.mesh.tets.len());
-        }
     }
     Ok(MeshedAsset {
         mesh: mesh.mesh,
@@ -531,13 +567,54 @@ fn excess(
             "gmsh made {ratio:.1} times the tetrahedra the size estimate expected ({} for ~{}): \
              its curvature sizing refined more than the surface's curvature asks for — on a \
              faceted surface (a low-poly model, as game assets are) it follows the facets' \
-             creases and short feature curves; --uniform-size meshes at one size everywhere \
-             (~{} tetrahedra at this size; check the accuracy with --target-error PCT)",
+             creases and short feature curves (--uniform-size: one size everywhere, ~{} \
+             tetrahedra at this size; check the accuracy with --target-error PCT)",
             group_digits(tets),
             format_count(expected),
             format_count(estimate(false)),
         )
     })
+}
+
+/// What [`mesh_with_own_sizes`] meshes with, in words.
+const OWN_SIZES: &str = "the curvature sizes the size estimate measures on the asset's triangles (a size field; gmsh's own curvature sizing off)";
+
+/// `note` (why gmsh's own sizing was set aside) and the tetrahedra of the mesh made instead.
+fn own_sizes_note(note: &str, made: &Made) -> String {
+    format!(
+        "{note}; meshed again with {OWN_SIZES}: {} tetrahedra",
+        crate::bake::group_digits(made.mesh.tets.len())
+    )
+}
+
+/// gmsh remeshing `surface` at `size` (m) with the curvature sizes the size estimate assumes
+/// ([`super::sizing::local_sizes`]: the asset's own triangles' curvature, with the walls'
+/// `diameters` when thickness-aware) as a `Structured` field, gmsh's curvature sizing and its
+/// extension of boundary sizes off: the sizing that follows the surface the asset describes,
+/// not its facets. Returns the mesh, its report (`curvature_elements` as asked,
+/// `curvature_from_surface` set) and the field.
+fn mesh_with_own_sizes(
+    surface: &SurfaceMesh,
+    inspection: &SurfaceInspection,
+    params: &MeshParams,
+    (size, walls, curvature): (f64, Option<&[Option<f64>]>, Option<u32>),
+    file: &str,
+    progress: &dyn Fn(&str),
+) -> Result<(Made, MeshReport, Option<super::sizing::SizeGrid>), AssetError> {
+    let sizes = super::sizing::local_sizes(surface, size, true, walls);
+    let own = super::sizing::surface_size_grid(surface, &sizes, size);
+    let (m, mut r) = run_backend(
+        Backend::Gmsh,
+        surface,
+        inspection,
+        params,
+        (None, own.as_ref()),
+        file,
+        progress,
+    )?;
+    r.curvature_elements = curvature;
+    r.curvature_from_surface = true;
+    Ok((m, r, own))
 }
 
 /// The report's `sizing` line.
@@ -557,11 +634,20 @@ fn sizing_words(
         return "gmsh --keep-surface: the asset's triangles set the sizes near the surface, at most the size inside".into();
     }
     let mut parts = vec![match report.curvature_elements {
+        Some(n) if report.curvature_from_surface => {
+            let finest = grid.map_or(size, |g| g.smallest_m);
+            format!(
+                "size {size:.4e} m, finer where the asset's triangles curve ({n} elements per turn, the curvature the size estimate measures, down to {finest:.4e} m with the walls; gmsh's own curvature sizing off)"
+            )
+        }
         Some(n) => {
             format!("size {size:.4e} m, finer where the surface curves ({n} elements per turn)")
         }
         None => format!("uniform size {size:.4e} m (--uniform-size)"),
     }];
+    if report.curvature_from_surface {
+        return parts.remove(0);
+    }
     parts.push(match (params.thickness, grid) {
         (false, _) => "thickness-aware sizing off".into(),
         (true, None) => format!(
@@ -620,6 +706,7 @@ fn run_backend(
                 size_m: out.info.size_m,
                 thin_parts_m: None,
                 curvature_elements: curvature,
+                curvature_from_surface: false,
                 sizing: String::new(),
                 wall_size_m: None,
                 envelope_m: None,
@@ -682,6 +769,7 @@ fn run_backend(
                 size_m: info.size_m,
                 thin_parts_m: None,
                 curvature_elements: None,
+                curvature_from_surface: false,
                 sizing: String::new(),
                 wall_size_m: None,
                 envelope_m: Some(info.envelope_m),

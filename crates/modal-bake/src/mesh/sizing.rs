@@ -85,15 +85,49 @@ pub fn equivalent_size_with(
     if !(curvature || diameters.is_some()) || !(size > 0.0) || surface.triangles.is_empty() {
         return size;
     }
+    let local = local_sizes(surface, size, curvature, diameters);
+    let (mut total, mut weighted) = (0.0, 0.0);
+    for (t, s) in surface.triangles.iter().zip(&local) {
+        let a = triangle_area(surface, *t);
+        total += a;
+        weighted += a / (s * s);
+    }
+    if weighted > 0.0 {
+        (total / weighted).sqrt()
+    } else {
+        size
+    }
+}
+
+/// The area (m²) of triangle `t` of `surface`.
+fn triangle_area(surface: &SurfaceMesh, t: [usize; 3]) -> f64 {
+    let [a, b, c] = t.map(|i| surface.vertices[i]);
+    let cr = dcr_runtime::math::cross(dcr_runtime::math::sub(b, a), dcr_runtime::math::sub(c, a));
+    0.5 * dcr_runtime::math::norm2(cr).sqrt()
+}
+
+/// Each triangle's element size (m) at `--size` `size`: its [`wall_size`] with the walls'
+/// `diameters` (`size` without), and with `curvature` no more than 2π·R/N at its radius of
+/// curvature R (N = [`curvature_elements`]); R as [`equivalent_size`] measures it, from the
+/// edges below [`FEATURE_ANGLE`]. The sizes the size estimate assumes, and the field of
+/// [`surface_size_grid`].
+pub fn local_sizes(
+    surface: &SurfaceMesh,
+    size: f64,
+    curvature: bool,
+    diameters: Option<&[Option<f64>]>,
+) -> Vec<f64> {
     let walls: Vec<f64> = match diameters {
         Some(d) => d.iter().map(|t| wall_size(*t, size)).collect(),
         None => vec![size; surface.triangles.len()],
     };
+    if !curvature {
+        return walls;
+    }
     let n = f64::from(curvature_elements(size, diagonal(surface.bounding_box())));
     let v = &surface.vertices;
     let tri = &surface.triangles;
     let mut normal = Vec::with_capacity(tri.len());
-    let mut centroid = Vec::with_capacity(tri.len());
     let mut area = Vec::with_capacity(tri.len());
     for t in tri {
         let [a, b, c] = t.map(|i| v[i]);
@@ -106,7 +140,6 @@ pub fn equivalent_size_with(
         } else {
             [0.0; 3]
         });
-        centroid.push([0, 1, 2].map(|k| (a[k] + b[k] + c[k]) / 3.0));
     }
     // Edges (sorted vertex pair) with their triangles, sorted for a deterministic pairing.
     let mut edges: Vec<([usize; 2], usize)> = Vec::with_capacity(3 * tri.len());
@@ -119,9 +152,6 @@ pub fn equivalent_size_with(
     edges.sort_unstable();
     let mut curvature_of = vec![0.0f64; tri.len()];
     for w in edges.chunk_by(|x, y| x.0 == y.0) {
-        if !curvature {
-            break;
-        }
         let [(_, a), (_, b)] = w else { continue };
         let (a, b) = (*a, *b);
         let cos = dcr_runtime::math::dot(normal[a], normal[b]).clamp(-1.0, 1.0);
@@ -145,21 +175,17 @@ pub fn equivalent_size_with(
             curvature_of[b] = curvature_of[b].max(k);
         }
     }
-    let (mut total, mut weighted) = (0.0, 0.0);
-    for ((a, k), wall) in area.iter().zip(&curvature_of).zip(&walls) {
-        let local = if *k > 0.0 {
-            wall.min(std::f64::consts::TAU / (n * k))
-        } else {
-            *wall
-        };
-        total += a;
-        weighted += a / (local * local);
-    }
-    if weighted > 0.0 {
-        (total / weighted).sqrt()
-    } else {
-        size
-    }
+    walls
+        .iter()
+        .zip(&curvature_of)
+        .map(|(wall, k)| {
+            if *k > 0.0 {
+                wall.min(std::f64::consts::TAU / (n * k))
+            } else {
+                *wall
+            }
+        })
+        .collect()
 }
 
 /// Fraction of the surface area whose thickness [`thin_parts`] reports: the thinnest 5 %.
@@ -341,6 +367,18 @@ pub fn thickness_grid_from(
     diameters: &[Option<f64>],
     size: f64,
 ) -> Option<SizeGrid> {
+    let sizes: Vec<f64> = diameters.iter().map(|t| wall_size(*t, size)).collect();
+    surface_size_grid(surface, &sizes, size)
+}
+
+/// A grid of the triangles' own element sizes `sizes` (m, one per triangle, at most `size`),
+/// spread as [`thickness_grid`] spreads the wall sizes: every node within one grid diagonal
+/// of a triangle takes the smallest such size, other nodes `size`. `None` when no triangle is
+/// finer than `size` (the field would change nothing) or `size` is not a positive number.
+///
+/// The grid spacing is half the smallest size, coarsened until the grid has at most
+/// [`MAX_GRID_NODES`] nodes.
+pub fn surface_size_grid(surface: &SurfaceMesh, sizes: &[f64], size: f64) -> Option<SizeGrid> {
     use parry3d_f64::math::Vector;
     use parry3d_f64::query::PointQuery;
     use parry3d_f64::shape::Triangle;
@@ -348,13 +386,12 @@ pub fn thickness_grid_from(
         return None;
     }
     let v = &surface.vertices;
-    let sizes: Vec<f64> = diameters.iter().map(|t| wall_size(*t, size)).collect();
     let smallest = sizes.iter().copied().fold(size, f64::min);
     if !(smallest < size) {
         return None;
     }
     let (mut refined, mut total) = (0.0, 0.0);
-    for (t, s) in surface.triangles.iter().zip(&sizes) {
+    for (t, s) in surface.triangles.iter().zip(sizes) {
         let [a, b, c] = t.map(|i| v[i]);
         let cr =
             dcr_runtime::math::cross(dcr_runtime::math::sub(b, a), dcr_runtime::math::sub(c, a));
@@ -375,7 +412,7 @@ pub fn thickness_grid_from(
     let origin = [0, 1, 2].map(|k| lo[k] - g);
     let mut values = vec![size; dims.iter().product()];
     let reach = g * 3f64.sqrt();
-    for (t, s) in surface.triangles.iter().zip(&sizes) {
+    for (t, s) in surface.triangles.iter().zip(sizes) {
         if !(*s < size) {
             continue;
         }
