@@ -264,7 +264,7 @@ fn a_mesh_far_past_its_estimate_is_made_again_with_the_estimates_sizes() {
         m.mesh.tets.len()
     );
     assert!(
-        ratio <= CURVED_FACTOR && ratio >= 1.0 / CURVED_FACTOR,
+        (1.0 / CURVED_FACTOR..=CURVED_FACTOR).contains(&ratio),
         "{ratio}"
     );
     let sphere = mesh_surface(&uv_sphere(0.05, 24, 48), &p, "sphere", &|_| {}).unwrap();
@@ -309,7 +309,7 @@ fn a_faceted_asset_at_the_defaults_is_meshed_with_the_estimates_sizes() {
         m.mesh.tets.len()
     );
     assert!(
-        ratio <= CURVED_FACTOR && ratio >= 1.0 / CURVED_FACTOR,
+        (1.0 / CURVED_FACTOR..=CURVED_FACTOR).contains(&ratio),
         "{ratio}"
     );
     let asset_volume = SurfaceMeasures::of(&body.vertices, &body.triangles).volume_m3;
