@@ -24,7 +24,7 @@ use std::process::Command;
 use std::time::Duration;
 
 use super::surface::SurfaceMesh;
-use super::work::{run_child, WorkDir, DEFAULT_TIMEOUT_S};
+use super::work::{run_child, run_child_watched, WorkDir, DEFAULT_TIMEOUT_S};
 use super::{MeshError, TetMesh};
 
 /// How to install gmsh, for the error when none is found.
@@ -59,6 +59,12 @@ pub struct GmshParams {
     /// `Structured` background field, combined with the size and the curvature sizes by
     /// taking the smallest. `None` (the default here): none. Ignored with `keep_surface`.
     pub size_grid: Option<super::sizing::SizeGrid>,
+    /// Stop gmsh once its surface mesh is known to have more triangles than this, before the
+    /// volume is filled ([`GmshError::SurfaceOverLimit`]): a guard against a sizing that went
+    /// far finer than asked. gmsh's run is unchanged (the same mesh when under the limit);
+    /// its log is watched for the node count it starts the volume from (`Tetrahedrizing N
+    /// nodes`, 2N − 4 triangles on a closed surface). `None` (the default): no limit.
+    pub max_surface_triangles: Option<u64>,
 }
 
 impl Default for GmshParams {
@@ -71,6 +77,7 @@ impl Default for GmshParams {
             timeout: Duration::from_secs_f64(DEFAULT_TIMEOUT_S),
             curvature_elements: 0,
             size_grid: None,
+            max_surface_triangles: None,
         }
     }
 }
@@ -137,9 +144,32 @@ pub enum GmshError {
         /// gmsh's error lines (or exit status).
         detail: String,
     },
+    /// The surface mesh went over [`GmshParams::max_surface_triangles`]; gmsh was stopped
+    /// before filling the volume.
+    #[error("gmsh {version}'s surface mesh of {file} has {triangles} triangles, over the limit of {limit}; gmsh was stopped before filling the volume")]
+    SurfaceOverLimit {
+        /// The surface file.
+        file: String,
+        /// gmsh's version.
+        version: String,
+        /// Triangles of gmsh's surface mesh (2N − 4 for its N nodes).
+        triangles: u64,
+        /// The limit.
+        limit: u64,
+    },
     /// gmsh's output could not be read.
     #[error(transparent)]
     Mesh(#[from] MeshError),
+}
+
+/// The triangles of the closed surface mesh gmsh starts a Delaunay volume from, read from its
+/// log line `Info    : Tetrahedrizing N nodes...` (2N − 4 by Euler's formula).
+fn surface_triangles_of(line: &str) -> Option<u64> {
+    let rest = line.split("Tetrahedrizing ").nth(1)?;
+    let n: u64 = rest.split(' ').next()?.parse().ok()?;
+    rest[rest.find(' ')?..]
+        .starts_with(" nodes")
+        .then(|| (2 * n).saturating_sub(4))
 }
 
 /// Default element size (m): 1/20 of the bounding-box diagonal
@@ -403,9 +433,27 @@ pub fn tetrahedralize_with_progress(
     ];
     let mut cmd = launcher.command(PY_RUN);
     cmd.args(args).current_dir(dir.path());
-    let out = run_child(cmd, params.timeout, progress).map_err(|e| GmshError::NotFound {
-        detail: format!("{}: {e}", launcher.describe()),
+    let over = std::cell::Cell::new(None);
+    let watch = |line: &str| match (params.max_surface_triangles, surface_triangles_of(line)) {
+        (Some(limit), Some(t)) if t > limit => {
+            over.set(Some(t));
+            true
+        }
+        _ => false,
+    };
+    let out = run_child_watched(cmd, params.timeout, progress, &watch).map_err(|e| {
+        GmshError::NotFound {
+            detail: format!("{}: {e}", launcher.describe()),
+        }
     })?;
+    if let (Some(triangles), Some(limit)) = (over.get(), params.max_surface_triangles) {
+        return Err(GmshError::SurfaceOverLimit {
+            file: file.to_string(),
+            version,
+            triangles,
+            limit,
+        });
+    }
     let seconds = out.seconds;
     let Some(status) = out.status else {
         return Err(GmshError::TimedOut {
@@ -450,4 +498,29 @@ pub fn tetrahedralize_with_progress(
             seconds,
         },
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::surface_triangles_of;
+
+    // Expectation: gmsh 4.15's log line before a Delaunay volume gives 2N − 4 triangles for
+    // its N surface nodes; other lines (its "Done tetrahedrizing" count includes the nodes it
+    // inserted) give nothing.
+    #[test]
+    fn the_surface_triangles_come_from_the_tetrahedrizing_line() {
+        assert_eq!(
+            surface_triangles_of("Info    : Tetrahedrizing 12932 nodes..."),
+            Some(25_860)
+        );
+        assert_eq!(
+            surface_triangles_of("Info    : Done tetrahedrizing 12940 nodes (Wall 0.1s, CPU 0.1s)"),
+            None
+        );
+        assert_eq!(
+            surface_triangles_of("Info    : Tetrahedrizing x nodes..."),
+            None
+        );
+        assert_eq!(surface_triangles_of("Info    : 2352 nodes"), None);
+    }
 }

@@ -440,17 +440,44 @@ pub fn mesh_surface(
         ..params.clone()
     };
     let walls = params.thickness.then_some(diameters.as_slice());
+    // gmsh's curvature sizing is stopped once its surface mesh is already far finer than the
+    // estimate's (the volume would be tens of times over): [`SURFACE_GUARD`].
+    let expected_boundary = || {
+        let h = super::sizing::equivalent_size_with(surface, size, true, walls);
+        let measures = crate::bake::SurfaceMeasures::of(&surface.vertices, &surface.triangles);
+        crate::bake::SizeEstimate::of_surface(&measures, h, false, 1, 1).boundary
+    };
+    let surface_limit = curvature.map(|_| (SURFACE_GUARD * expected_boundary()).ceil() as u64);
     let first_try = run_backend(
         backend,
         surface,
         &inspection,
         params,
-        (curvature, grid.as_ref()),
+        (curvature, grid.as_ref(), surface_limit),
         file,
         progress,
     );
     let (mesh, mut report) = match first_try {
         Ok(ok) => ok,
+        Err(AssetError::Gmsh(GmshError::SurfaceOverLimit { triangles, .. })) => {
+            let note = format!(
+                "gmsh's surface mesh had {} triangles, over {SURFACE_GUARD} times the ~{} the size estimate expected, so gmsh was stopped before filling the volume: its curvature sizing refined more than the surface's curvature asks for — on a faceted surface (a low-poly model, as game assets are) it follows the facets' creases and short feature curves",
+                crate::bake::group_digits(triangles as usize),
+                crate::bake::format_count(expected_boundary()),
+            );
+            progress(&format!("{note}: meshing again with {OWN_SIZES}"));
+            let (m, mut r, own) = mesh_with_own_sizes(
+                surface,
+                &inspection,
+                params,
+                (size, walls, curvature),
+                file,
+                progress,
+            )?;
+            r.excess = Some(own_sizes_note(&note, &m));
+            grid = own;
+            (m, r)
+        }
         Err(e) if params.mesher == MesherChoice::Auto => {
             let other = match backend {
                 Backend::Gmsh => Backend::Ftetwild,
@@ -467,7 +494,7 @@ pub fn mesh_surface(
                 surface,
                 &inspection,
                 params,
-                (curvature, grid.as_ref()),
+                (curvature, grid.as_ref(), None),
                 file,
                 progress,
             ) {
@@ -494,7 +521,7 @@ pub fn mesh_surface(
         report.reason = reason;
     }
     let mut mesh = mesh;
-    if report.backend == Backend::Gmsh && curvature.is_some() {
+    if report.backend == Backend::Gmsh && curvature.is_some() && !report.curvature_from_surface {
         if let Some(note) = excess(surface, params.order, size, walls, mesh.mesh.tets.len()) {
             // gmsh's curvature sizing followed something other than the surface's curvature
             // (a faceted asset's creases and short feature curves).
@@ -576,6 +603,14 @@ fn excess(
     })
 }
 
+/// The factor over the size estimate's boundary triangles past which gmsh, remeshing with
+/// its curvature sizing, is stopped before it fills the volume
+/// ([`super::gmsh::GmshParams::max_surface_triangles`]) and the asset meshed with the
+/// estimate's curvature sizes at once: its tetrahedra would be far past [`GMSH_EXCESS`] times
+/// the estimate (they grow at least as the boundary triangles do). The estimate's own spread
+/// on the boundary is within about 2.5 where gmsh's curvature sizing sets it.
+pub const SURFACE_GUARD: f64 = 10.0;
+
 /// What [`mesh_with_own_sizes`] meshes with, in words.
 const OWN_SIZES: &str = "the curvature sizes the size estimate measures on the asset's triangles (a size field; gmsh's own curvature sizing off)";
 
@@ -608,7 +643,7 @@ fn mesh_with_own_sizes(
         surface,
         inspection,
         params,
-        (None, own.as_ref()),
+        (None, own.as_ref(), None),
         file,
         progress,
     )?;
@@ -672,7 +707,7 @@ fn run_backend(
     surface: &SurfaceMesh,
     inspection: &SurfaceInspection,
     params: &MeshParams,
-    (curvature, grid): (Option<u32>, Option<&super::sizing::SizeGrid>),
+    (curvature, grid, surface_limit): (Option<u32>, Option<&super::sizing::SizeGrid>, Option<u64>),
     file: &str,
     progress: &dyn Fn(&str),
 ) -> Result<(Made, MeshReport), AssetError> {
@@ -689,6 +724,7 @@ fn run_backend(
                 timeout: params.timeout,
                 curvature_elements: curvature.unwrap_or(0),
                 size_grid: grid.cloned(),
+                max_surface_triangles: surface_limit,
             };
             let out = gmsh::tetrahedralize_with_progress(&s, &g, file, &tick)?;
             let volume = out.mesh.volume();

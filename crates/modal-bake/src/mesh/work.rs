@@ -78,8 +78,10 @@ pub fn abort_meshing() -> usize {
 /// How a child run ended.
 #[derive(Debug)]
 pub struct ChildOutput {
-    /// Exit status; `None` when the time limit ended it.
+    /// Exit status; `None` when the time limit ended it, or the watcher ([`run_child_watched`]).
     pub status: Option<ExitStatus>,
+    /// Whether the watcher stopped it (then `status` is `None`).
+    pub stopped: bool,
     /// stdout and stderr, joined (lossy UTF-8).
     pub text: String,
     /// Wall-clock seconds.
@@ -93,58 +95,96 @@ pub struct ChildOutput {
 /// # Errors
 /// When the program cannot be started.
 pub fn run_child(
+    cmd: Command,
+    timeout: Duration,
+    progress: &dyn Fn(f64),
+) -> std::io::Result<ChildOutput> {
+    run_child_watched(cmd, timeout, progress, &|_| false)
+}
+
+/// [`run_child`], also showing each complete line of the child's stdout to `stop` as it
+/// arrives (within about 20 ms): the child is killed as soon as `stop` returns true
+/// (`stopped`, `status: None`). As at the time limit, only the child itself is killed: a
+/// process it started that still holds its output open delays the return until it ends (the
+/// meshers run in one process).
+///
+/// # Errors
+/// When the program cannot be started.
+pub fn run_child_watched(
     mut cmd: Command,
     timeout: Duration,
     progress: &dyn Fn(f64),
+    stop: &dyn Fn(&str) -> bool,
 ) -> std::io::Result<ChildOutput> {
     cmd.stdin(Stdio::null())
         .stdout(Stdio::piped())
         .stderr(Stdio::piped());
     let t = Instant::now();
     let mut child = cmd.spawn()?;
-    let drain = |r: Option<Box<dyn Read + Send>>| {
+    let drain = |r: Option<Box<dyn Read + Send>>, into: std::sync::Arc<Mutex<Vec<u8>>>| {
         std::thread::spawn(move || {
-            let mut buf = Vec::new();
-            if let Some(mut r) = r {
-                let _ = r.read_to_end(&mut buf);
+            let Some(mut r) = r else { return };
+            let mut buf = [0u8; 8192];
+            loop {
+                match r.read(&mut buf) {
+                    Ok(0) | Err(_) => break,
+                    Ok(n) => lock(&into).extend_from_slice(&buf[..n]),
+                }
             }
-            buf
         })
     };
+    let stdout = std::sync::Arc::new(Mutex::new(Vec::new()));
+    let stderr = std::sync::Arc::new(Mutex::new(Vec::new()));
     let out = drain(
         child
             .stdout
             .take()
             .map(|s| Box::new(s) as Box<dyn Read + Send>),
+        stdout.clone(),
     );
     let err = drain(
         child
             .stderr
             .take()
             .map(|s| Box::new(s) as Box<dyn Read + Send>),
+        stderr.clone(),
     );
     let id = child.id();
     lock(&CHILDREN).push(child);
     let mut next_note = 15.0;
+    let mut scanned = 0;
+    let mut stopped = false;
     let status = loop {
+        // The complete lines the child has written since the last look.
+        {
+            let bytes = lock(&stdout);
+            while let Some(n) = bytes[scanned..].iter().position(|&b| b == b'\n') {
+                let line = String::from_utf8_lossy(&bytes[scanned..scanned + n]);
+                scanned += n + 1;
+                if stop(&line) {
+                    stopped = true;
+                    break;
+                }
+            }
+        }
         {
             let mut children = lock(&CHILDREN);
             let Some(i) = children.iter().position(|c| c.id() == id) else {
                 break None;
             };
             match children[i].try_wait() {
-                Ok(Some(s)) => {
+                Ok(Some(s)) if !stopped => {
                     // Already reaped by try_wait; wait returns its status at once.
                     let _ = children.remove(i).wait();
                     break Some(s);
                 }
-                Ok(None) if t.elapsed() >= timeout => {
+                Ok(_) if stopped || t.elapsed() >= timeout => {
                     let mut c = children.remove(i);
                     let _ = c.kill();
                     let _ = c.wait();
                     break None;
                 }
-                Ok(None) => {}
+                Ok(_) => {}
                 Err(_) => {
                     let mut c = children.remove(i);
                     break c.wait().ok();
@@ -158,10 +198,13 @@ pub fn run_child(
         }
         std::thread::sleep(Duration::from_millis(20));
     };
-    let mut bytes = out.join().unwrap_or_default();
-    bytes.extend(err.join().unwrap_or_default());
+    let _ = out.join();
+    let _ = err.join();
+    let mut bytes = std::mem::take(&mut *lock(&stdout));
+    bytes.extend(std::mem::take(&mut *lock(&stderr)));
     Ok(ChildOutput {
         status,
+        stopped,
         text: String::from_utf8_lossy(&bytes).into_owned(),
         seconds: t.elapsed().as_secs_f64(),
     })
@@ -178,5 +221,35 @@ pub fn timeout_of(seconds: f64) -> Result<Duration, String> {
         Err(format!(
             "--mesher-timeout must be a positive number of seconds below 1e9, got {seconds}"
         ))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    // Expectation: the watcher sees the child's lines as they come and stops it at once (the
+    // child `exec`s its sleep: a grandchild holding the pipe open would delay the return until
+    // it ends); a watcher that never fires leaves the run as `run_child`'s (status, all the
+    // output).
+    #[test]
+    fn the_watcher_stops_the_child_at_the_line_it_waits_for() {
+        let mut cmd = Command::new("sh");
+        cmd.args(["-c", "echo one; echo 'Info : two 7'; exec sleep 30"]);
+        let seen = std::cell::RefCell::new(Vec::new());
+        let out = run_child_watched(cmd, Duration::from_secs(60), &|_| {}, &|l| {
+            seen.borrow_mut().push(l.to_string());
+            l.contains("two 7")
+        })
+        .unwrap();
+        assert!(out.stopped && out.status.is_none());
+        assert!(out.seconds < 20.0, "stopped after {} s", out.seconds);
+        assert_eq!(*seen.borrow(), ["one", "Info : two 7"]);
+        let mut cmd = Command::new("sh");
+        cmd.args(["-c", "echo one; echo two >&2; exit 3"]);
+        let out = run_child_watched(cmd, Duration::from_secs(60), &|_| {}, &|_| false).unwrap();
+        assert!(!out.stopped);
+        assert_eq!(out.status.and_then(|s| s.code()), Some(3));
+        assert_eq!(out.text, "one\ntwo\n");
     }
 }
