@@ -242,7 +242,7 @@ fn bad_inputs_fail_cleanly_with_located_errors() {
         (
             "bad/two_pieces.msh",
             &[],
-            "2 disconnected pieces; bake each piece as its own object (in gmsh, make the piece's volume the only volume of any `Physical Volume`",
+            "2 disconnected pieces; bake each piece as its own object (--object NAME bakes the tetrahedra of one 3-D physical group",
         ),
         ("bad/bad_shape.json", &[], "bad_shape.json"),
         ("bad/negative_index.json", &[], "negative_index.json"),

@@ -934,3 +934,129 @@ fn gmsh_extruded_prisms_are_refused_and_the_fix_reads_the_whole_volume() {
     assert!((volume - 5e-4).abs() < 1e-12, "volume {volume:e} m³");
     std::fs::remove_dir_all(&tmp).unwrap();
 }
+
+// Expectation: `read_msh_object` keeps the tetrahedra of one 3-D physical group, named or by
+// its number, and only the nodes they use; an element of two groups (MSH 2.2 writes it twice)
+// belongs to both; a name no tetrahedron has is refused with the groups the file has.
+#[test]
+fn one_physical_volume_of_a_msh_is_read_alone() {
+    use modal_bake::mesh::read_msh_object_bytes;
+    let msh = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$PhysicalNames\n2\n3 1 \"left\"\n\
+               3 3 \"both\"\n$EndPhysicalNames\n$Nodes\n8\n1 0 0 0\n2 1 0 0\n3 0 1 0\n\
+               4 0 0 1\n5 5 0 0\n6 6 0 0\n7 5 1 0\n8 5 0 1\n$EndNodes\n$Elements\n4\n\
+               1 4 2 1 1 1 2 3 4\n2 4 2 3 1 1 2 3 4\n3 4 2 2 2 5 6 7 8\n4 4 2 3 2 5 6 7 8\n\
+               $EndElements\n";
+    let whole = read_msh_bytes(msh.as_bytes(), "two.msh").unwrap();
+    assert_eq!(whole.tets.len(), 2);
+    let left = read_msh_object_bytes(msh.as_bytes(), "two.msh", "left").unwrap();
+    assert_eq!((left.tets.len(), left.nodes.len()), (1, 4));
+    assert_eq!(left.nodes[1], [1.0, 0.0, 0.0]);
+    let right = read_msh_object_bytes(msh.as_bytes(), "two.msh", "2").unwrap();
+    assert_eq!((right.tets.len(), right.nodes.len()), (1, 4));
+    assert_eq!(right.nodes[0], [5.0, 0.0, 0.0]);
+    let both = read_msh_object_bytes(msh.as_bytes(), "two.msh", "both").unwrap();
+    assert_eq!(both.tets.len(), 2);
+    let e = read_msh_object_bytes(msh.as_bytes(), "two.msh", "Left").unwrap_err();
+    assert_eq!(
+        e.kind,
+        MeshErrorKind::UnknownObject {
+            name: "Left".into(),
+            available: "2, both, left".into()
+        }
+    );
+    assert!(e.to_string().starts_with("two.msh: "), "{e}");
+}
+
+// Expectation (real gmsh, MSH 4.1 binary): two 0.1 m boxes 0.3 m apart, each its own
+// `Physical Volume`: `bake` refuses the whole file (two pieces) and names `--object`; each
+// box bakes alone with its own mass (ρ·1e-3 m³), `check` with the same `--object` finds the
+// base up to date and the other box's base stale.
+#[test]
+fn gmsh_physical_volumes_bake_one_at_a_time() {
+    if !gmsh_gate::have_gmsh("gmsh_physical_volumes_bake_one_at_a_time") {
+        return;
+    }
+    let tmp = std::env::temp_dir().join(format!("dcr-two-volumes-{}", std::process::id()));
+    std::fs::create_dir_all(&tmp).unwrap();
+    let geo = tmp.join("two.geo");
+    std::fs::write(
+        &geo,
+        "SetFactory(\"OpenCASCADE\");\nMesh.MshFileVersion = 4.1;\nMesh.Binary = 1;\n\
+         Mesh.MeshSizeMax = 0.04;\nBox(1) = {0, 0, 0, 0.1, 0.1, 0.1};\n\
+         Box(2) = {0.4, 0, 0, 0.1, 0.1, 0.1};\nPhysical Volume(\"left\") = {1};\n\
+         Physical Volume(\"right\") = {2};\n",
+    )
+    .unwrap();
+    let msh = tmp.join("two.msh");
+    let made = std::process::Command::new("gmsh")
+        .arg(&geo)
+        .args(["-3", "-o"])
+        .arg(&msh)
+        .output();
+    if made.is_err() {
+        // The PyPI module without its launcher on PATH: the volume mesh through Python.
+        let ok = std::process::Command::new("python3")
+            .args([
+                "-c",
+                "import gmsh, sys; gmsh.initialize(); gmsh.open(sys.argv[1]); \
+                 gmsh.model.mesh.generate(3); gmsh.write(sys.argv[2]); gmsh.finalize()",
+            ])
+            .arg(&geo)
+            .arg(&msh)
+            .status()
+            .is_ok_and(|s| s.success());
+        assert!(ok, "gmsh could not mesh {}", geo.display());
+    }
+    let left = modal_bake::mesh::read_msh_object(&msh, "left").unwrap();
+    let right = modal_bake::mesh::read_msh_object(&msh, "right").unwrap();
+    for (m, name) in [(&left, "left"), (&right, "right")] {
+        assert!(
+            (m.volume() - 1e-3).abs() < 1e-12,
+            "{name}: {} m³",
+            m.volume()
+        );
+    }
+    assert!(left.nodes.iter().all(|p| p[0] <= 0.1 + 1e-12));
+    assert!(right.nodes.iter().all(|p| p[0] >= 0.4 - 1e-12));
+    let bake = |extra: &[&str], out: &str| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_modal-bake"))
+            .arg("bake")
+            .arg(&msh)
+            .arg("-o")
+            .arg(tmp.join(out))
+            .args(["--material", "steel", "--modes", "4"])
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    let whole = bake(&[], "whole.modes");
+    let text = String::from_utf8_lossy(&whole.stderr);
+    assert!(
+        !whole.status.success() && text.contains("--object NAME"),
+        "{text}"
+    );
+    assert!(!tmp.join("whole.modes").exists());
+    for name in ["left", "right"] {
+        let out = bake(&["--object", name], &format!("{name}.modes"));
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert!(text.contains("mass 7.850000 kg"), "{name}: {text}");
+    }
+    let check = |object: &str| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_modal-bake"))
+            .arg("check")
+            .arg(&msh)
+            .arg(tmp.join("left.modes"))
+            .args(["--material", "steel", "--modes", "4", "--object", object])
+            .status()
+            .unwrap()
+            .code()
+    };
+    assert_eq!(check("left"), Some(0));
+    assert_eq!(check("right"), Some(1));
+    std::fs::remove_dir_all(&tmp).unwrap();
+}

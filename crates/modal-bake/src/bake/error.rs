@@ -13,7 +13,7 @@ fn piece_hint(file: &str) -> &'static str {
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase);
     match ext.as_deref() {
-        Some("msh") => "in gmsh, make the piece's volume the only volume of any `Physical Volume` and save again: gmsh then writes only the elements of physical groups",
+        Some("msh") => "--object NAME bakes the tetrahedra of one 3-D physical group; in gmsh, give each piece its own `Physical Volume`",
         Some("json") => "write one piece's cells per file",
         _ => "a glTF or OBJ asset's named objects one at a time: --object NAME; `modal-bake mesh ASSET --dry-run` lists them",
     }

@@ -112,13 +112,21 @@ pub fn load_mesh(
         let out = super::mesh::mesh_asset(path, asset)?;
         return Ok((out.mesh, t.elapsed().as_secs_f64()));
     }
-    if asset.any_set() {
+    if asset.any_meshing_set() {
         anyhow::bail!(
-            "--mesher, --size, --order, --envelope, --gmsh, --ftetwild, --keep-surface, --uniform-size, --mesher-timeout and --object apply to surface assets (.obj, .stl, .ply, .glb, .gltf), not to the volume mesh {}",
+            "--mesher, --size, --order, --envelope, --gmsh, --ftetwild, --keep-surface, --uniform-size and --mesher-timeout apply to surface assets (.obj, .stl, .ply, .glb, .gltf), not to the volume mesh {}",
             path.display()
         );
     }
-    let mut mesh = modal_bake::mesh::read_mesh(path).map_err(anyhow::Error::new)?;
+    let mut mesh = match &asset.object {
+        None => modal_bake::mesh::read_mesh(path),
+        Some(_) if is_json(path) => anyhow::bail!(
+            "--object selects an object of a surface asset or a physical volume of a gmsh .msh, not of the meshio JSON mesh {}: write one object's cells per file",
+            path.display()
+        ),
+        Some(object) => modal_bake::mesh::read_msh_object(path, object),
+    }
+    .map_err(anyhow::Error::new)?;
     if asset.units != super::mesh::Units::M {
         for p in &mut mesh.nodes {
             for c in p.iter_mut() {
@@ -127,6 +135,12 @@ pub fn load_mesh(
         }
     }
     Ok((mesh, t.elapsed().as_secs_f64()))
+}
+
+/// Whether `path` names a meshio-style `.json` mesh (by its extension).
+fn is_json(path: &std::path::Path) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("json"))
 }
 
 /// [`load_mesh`] with a progress stage for reading a volume mesh (meshing a surface asset

@@ -156,9 +156,11 @@ pub struct AssetOptions {
     /// Surface assets: time limit of one mesher run (s); the mesher is stopped past it.
     #[arg(long, value_name = "S", default_value_t = modal_bake::mesh::work::DEFAULT_TIMEOUT_S)]
     pub mesher_timeout: f64,
-    /// Surface assets: mesh only this named object of the file: a glTF node (with its children,
-    /// where the scene places it) or mesh, or an OBJ object or group (`o`/`g`) [default: the
-    /// whole file]. A name the file does not have is refused with the names it has.
+    /// Mesh (or bake) only this named object of the file: a glTF node (with its children,
+    /// where the scene places it) or mesh, an OBJ object or group (`o`/`g`), or, in a gmsh
+    /// `.msh` volume mesh, a 3-D physical group (its name, or its number when it has none)
+    /// [default: the whole file]. A name the file does not have is refused with the names it
+    /// has.
     #[arg(long, value_name = "NAME")]
     pub object: Option<String>,
 }
@@ -208,6 +210,16 @@ impl AssetOptions {
             || self.ftetwild.is_some()
             || self.mesher_timeout != modal_bake::mesh::work::DEFAULT_TIMEOUT_S
             || self.object.is_some()
+    }
+
+    /// Whether an option other than `--object` and `--units` is set: those apply to surface
+    /// assets only (`--object` also selects a physical volume of a `.msh`).
+    pub fn any_meshing_set(&self) -> bool {
+        AssetOptions {
+            object: None,
+            ..self.clone()
+        }
+        .any_set()
     }
 }
 

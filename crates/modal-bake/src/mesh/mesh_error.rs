@@ -184,6 +184,14 @@ pub enum MeshErrorKind {
         /// meshed at all.
         how: &'static str,
     },
+    /// No tetrahedron of the file belongs to the object (a 3-D physical group) asked for.
+    #[error("no tetrahedron belongs to the object {name:?}; the file's volumes (3-D physical groups): {available}")]
+    UnknownObject {
+        /// The name asked for.
+        name: String,
+        /// The 3-D physical groups the file's tetrahedra belong to, comma-separated.
+        available: String,
+    },
     /// The file holds volume elements other than 4- and 10-node tetrahedra (hexahedra, prisms,
     /// pyramids, higher-order tetrahedra) beside its tetrahedra: leaving them out would bake
     /// part of the object.

@@ -132,6 +132,26 @@ pub fn read_msh(path: &Path) -> Result<TetMesh, MeshError> {
     read_msh_bytes(&data, &name)
 }
 
+/// [`read_msh`] keeping only the tetrahedra of one object: the 3-D physical group `object`
+/// (its name, or its number when it has none) — one piece of a file of several volumes.
+/// Nodes outside its tetrahedra are dropped (a note), node groups keep their nodes in it.
+///
+/// # Errors
+/// As [`read_msh`], and [`MeshErrorKind::UnknownObject`] (listing the file's 3-D physical
+/// groups) when no tetrahedron belongs to `object`.
+pub fn read_msh_object(path: &Path, object: &str) -> Result<TetMesh, MeshError> {
+    let (data, name) = read_file(path)?;
+    msh::parse_msh_object(&data, &name, Some(object))
+}
+
+/// [`read_msh_object`] on bytes in memory; `name` is used in error messages.
+///
+/// # Errors
+/// As [`read_msh_object`].
+pub fn read_msh_object_bytes(data: &[u8], name: &str, object: &str) -> Result<TetMesh, MeshError> {
+    msh::parse_msh_object(data, name, Some(object))
+}
+
 /// [`read_msh`] on bytes in memory; `name` is used in error messages.
 ///
 /// # Errors

@@ -114,10 +114,31 @@ struct MshReader<'a> {
     skipped: Vec<(i64, u64)>,
     /// Scratch buffer of node indices of the current element.
     scratch: Vec<usize>,
+    /// Keep only the tetrahedra of this 3-D physical group (name, or number without a name).
+    select: Option<&'a str>,
+    /// The 3-D physical groups the tetrahedra belong to, for the error when `select` matches
+    /// none.
+    volume_groups: std::collections::BTreeSet<String>,
+    /// Tetrahedra kept by `select`.
+    selected: u64,
 }
 
 /// Reads a gmsh MSH 2.2 or 4.1 file (ASCII or binary) from memory; `file` names it in errors.
 pub(crate) fn parse_msh(data: &[u8], file: &str) -> Result<TetMesh, MeshError> {
+    parse_msh_object(data, file, None)
+}
+
+/// [`parse_msh`] keeping, with `select`, only the tetrahedra of that 3-D physical group
+/// (its name, or its number when it has none): one object of a file of several.
+///
+/// # Errors
+/// As [`parse_msh`], and [`MeshErrorKind::UnknownObject`] (with the file's 3-D groups) when no
+/// tetrahedron belongs to `select`.
+pub(crate) fn parse_msh_object(
+    data: &[u8],
+    file: &str,
+    select: Option<&str>,
+) -> Result<TetMesh, MeshError> {
     let mut c = Cursor::new(data, file);
     let (version, format_pos) = read_header(&mut c)?;
     let mut r = MshReader {
@@ -131,6 +152,9 @@ pub(crate) fn parse_msh(data: &[u8], file: &str) -> Result<TetMesh, MeshError> {
         members: BTreeMap::new(),
         skipped: Vec::new(),
         scratch: Vec::new(),
+        select,
+        volume_groups: std::collections::BTreeSet::new(),
+        selected: 0,
     };
     r.read_sections()?;
     r.finish()
@@ -294,6 +318,23 @@ impl MshReader<'_> {
                     .c
                     .error_at(end, false, MeshErrorKind::MissingSection(required)));
             }
+        }
+        if let (Some(name), 0) = (self.select, self.selected) {
+            let groups: Vec<String> = std::mem::take(&mut self.volume_groups)
+                .into_iter()
+                .collect();
+            return Err(MeshError::new(
+                self.file,
+                super::mesh_error::Location::None,
+                MeshErrorKind::UnknownObject {
+                    name: name.to_string(),
+                    available: if groups.is_empty() {
+                        "none: its tetrahedra are in no physical group (define a `Physical Volume` in gmsh)".into()
+                    } else {
+                        groups.join(", ")
+                    },
+                },
+            ));
         }
         for &(ty, n) in &self.skipped {
             let (what, volume) = match element_info(ty) {
@@ -563,8 +604,41 @@ impl MshReader<'_> {
         Ok(())
     }
 
+    /// The physical group names (or numbers) of an element filed under `group` (MSH 2.2:
+    /// its physical tag; 4.1: its entity, whose physical tags `$Entities` gave).
+    fn group_names(&self, group: Option<(i32, i64)>) -> Vec<String> {
+        let Some((dim, tag)) = group else {
+            return Vec::new();
+        };
+        let name = |p: i64| {
+            self.names
+                .get(&(dim, p))
+                .cloned()
+                .unwrap_or_else(|| p.to_string())
+        };
+        match self.version {
+            Version::V22 => vec![name(tag)],
+            Version::V41 => self
+                .entity_physicals
+                .get(&(dim, tag))
+                .into_iter()
+                .flatten()
+                .map(|&p| name(p))
+                .collect(),
+        }
+    }
+
     /// Files the element in `self.scratch` (type `ty`, tag `tag`) and under `group` if any.
     fn add_element(&mut self, ty: i64, tag: u64, group: Option<(i32, i64)>) {
+        if let (Some(select), 4 | 11) = (self.select, ty) {
+            let names = self.group_names(group);
+            let keep = names.iter().any(|n| n == select);
+            self.volume_groups.extend(names);
+            if !keep {
+                return;
+            }
+            self.selected += 1;
+        }
         let v = &self.scratch;
         match ty {
             4 => self.builder.push_tet(tag, [v[0], v[1], v[2], v[3]]),
