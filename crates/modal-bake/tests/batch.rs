@@ -463,6 +463,12 @@ fn hostile_manifests_are_refused_before_any_work_naming_file_entry_and_field() {
             json!({"entries": [{"mesh": mesh, "out": "a.modes", "options": {"rayleigh": [1, 2, 3]}}]}),
             vec!["entries[0].options.rayleigh"],
         ),
+        // `object` selects a physical volume of a .msh (checked when the mesh is read: the
+        // cube has no 3-D group of that name), not of a meshio JSON.
+        (
+            json!({"entries": [{"mesh": data("meshes/cube_cell_sets.json").display().to_string(), "out": "a.modes", "options": {"object": "left"}}]}),
+            vec!["entries[0].options", "meshio JSON"],
+        ),
         // Paths that are inputs, devices, FIFOs, folders; duplicate outputs.
         (
             json!({"entries": [good("a.modes"), {"mesh": mesh, "out": mesh}]}),

@@ -138,7 +138,7 @@ pub fn load_mesh(
 }
 
 /// Whether `path` names a meshio-style `.json` mesh (by its extension).
-fn is_json(path: &std::path::Path) -> bool {
+pub fn is_json(path: &std::path::Path) -> bool {
     path.extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("json"))
 }

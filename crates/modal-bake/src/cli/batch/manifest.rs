@@ -517,9 +517,14 @@ fn check_entry(args: &BakeArgs) -> anyhow::Result<()> {
     }
     if is_surface_asset(&args.mesh) {
         args.asset.params()?;
-    } else if args.asset.any_set() {
+    } else if args.asset.any_meshing_set() {
         bail!(
-            "mesher, size, order, envelope, gmsh, ftetwild, keep-surface, mesher-timeout and object apply to surface assets (.obj, .stl, .ply, .glb, .gltf), not to the volume mesh {}",
+            "mesher, size, order, envelope, gmsh, ftetwild, keep-surface, uniform-size and mesher-timeout apply to surface assets (.obj, .stl, .ply, .glb, .gltf), not to the volume mesh {}",
+            args.mesh.display()
+        );
+    } else if args.asset.object.is_some() && super::super::bake::is_json(&args.mesh) {
+        bail!(
+            "object selects an object of a surface asset or a physical volume of a gmsh .msh, not of the meshio JSON mesh {}",
             args.mesh.display()
         );
     }
