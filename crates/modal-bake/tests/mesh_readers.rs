@@ -879,32 +879,33 @@ fn gmsh_extruded_box(dir: &Path, recombine: bool) -> PathBuf {
          Extrude {{0, 0, 0.03}} {{ Surface{{out[0]}}; }}\n"
     );
     let geo_path = dir.join("box.geo");
-    let msh = dir.join("box.msh");
     std::fs::write(&geo_path, geo).unwrap();
-    let binary = std::process::Command::new("gmsh")
-        .arg(&geo_path)
+    gmsh_volume_mesh(&geo_path)
+}
+
+/// The real gmsh's volume mesh of the `.geo` script `geo`, written beside it as `.msh`: the
+/// `gmsh` launcher, or the PyPI module through Python when the launcher is not on PATH.
+fn gmsh_volume_mesh(geo: &Path) -> PathBuf {
+    let msh = geo.with_extension("msh");
+    let ok = match std::process::Command::new("gmsh")
+        .arg(geo)
         .args(["-3", "-o"])
         .arg(&msh)
-        .output();
-    let ok = match binary {
+        .output()
+    {
         Ok(out) => out.status.success(),
-        // The PyPI module without its launcher on PATH.
         Err(_) => std::process::Command::new("python3")
             .args([
                 "-c",
                 "import gmsh, sys; gmsh.initialize(); gmsh.open(sys.argv[1]); \
                  gmsh.model.mesh.generate(3); gmsh.write(sys.argv[2]); gmsh.finalize()",
             ])
-            .arg(&geo_path)
+            .arg(geo)
             .arg(&msh)
             .status()
             .is_ok_and(|s| s.success()),
     };
-    assert!(
-        ok && msh.exists(),
-        "gmsh could not mesh {}",
-        geo_path.display()
-    );
+    assert!(ok && msh.exists(), "gmsh could not mesh {}", geo.display());
     msh
 }
 
@@ -987,26 +988,7 @@ fn gmsh_physical_volumes_bake_one_at_a_time() {
          Physical Volume(\"right\") = {2};\n",
     )
     .unwrap();
-    let msh = tmp.join("two.msh");
-    let made = std::process::Command::new("gmsh")
-        .arg(&geo)
-        .args(["-3", "-o"])
-        .arg(&msh)
-        .output();
-    if made.is_err() {
-        // The PyPI module without its launcher on PATH: the volume mesh through Python.
-        let ok = std::process::Command::new("python3")
-            .args([
-                "-c",
-                "import gmsh, sys; gmsh.initialize(); gmsh.open(sys.argv[1]); \
-                 gmsh.model.mesh.generate(3); gmsh.write(sys.argv[2]); gmsh.finalize()",
-            ])
-            .arg(&geo)
-            .arg(&msh)
-            .status()
-            .is_ok_and(|s| s.success());
-        assert!(ok, "gmsh could not mesh {}", geo.display());
-    }
+    let msh = gmsh_volume_mesh(&geo);
     let left = modal_bake::mesh::read_msh_object(&msh, "left").unwrap();
     let right = modal_bake::mesh::read_msh_object(&msh, "right").unwrap();
     for (m, name) in [(&left, "left"), (&right, "right")] {

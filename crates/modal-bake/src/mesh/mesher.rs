@@ -465,16 +465,14 @@ pub fn mesh_surface(
                 crate::bake::group_digits(triangles as usize),
                 crate::bake::format_count(expected_boundary()),
             );
-            progress(&format!("{note}: meshing again with {OWN_SIZES}"));
-            let (m, mut r, own) = mesh_with_own_sizes(
+            let (m, r, own) = mesh_with_own_sizes(
                 surface,
                 &inspection,
                 params,
                 (size, walls, curvature),
-                file,
+                (file, &note),
                 progress,
             )?;
-            r.excess = Some(own_sizes_note(&note, &m));
             grid = own;
             (m, r)
         }
@@ -525,30 +523,27 @@ pub fn mesh_surface(
         if let Some(note) = excess(surface, params.order, size, walls, mesh.mesh.tets.len()) {
             // gmsh's curvature sizing followed something other than the surface's curvature
             // (a faceted asset's creases and short feature curves).
-            progress(&format!("{note}: meshing again with {OWN_SIZES}"));
             let made = mesh_with_own_sizes(
                 surface,
                 &inspection,
                 params,
                 (size, walls, curvature),
-                file,
+                (file, &note),
                 progress,
             );
-            report.excess = Some(match made {
+            match made {
                 Ok((m, mut r, own)) => {
-                    let note = own_sizes_note(&note, &m);
                     r.reason = std::mem::take(&mut report.reason);
                     r.fallback_from = report.fallback_from.take();
                     r.seconds += report.seconds;
                     report = r;
                     mesh = m;
                     grid = own;
-                    note
                 }
-                Err(e) => format!(
+                Err(e) => report.excess = Some(format!(
                     "{note}; meshing again with {OWN_SIZES} failed ({e}), so this is gmsh's mesh"
-                ),
-            });
+                )),
+            }
         }
     }
     progress(&format!(
@@ -614,28 +609,22 @@ pub const SURFACE_GUARD: f64 = 10.0;
 /// What [`mesh_with_own_sizes`] meshes with, in words.
 const OWN_SIZES: &str = "the curvature sizes the size estimate measures on the asset's triangles (a size field; gmsh's own curvature sizing off)";
 
-/// `note` (why gmsh's own sizing was set aside) and the tetrahedra of the mesh made instead.
-fn own_sizes_note(note: &str, made: &Made) -> String {
-    format!(
-        "{note}; meshed again with {OWN_SIZES}: {} tetrahedra",
-        crate::bake::group_digits(made.mesh.tets.len())
-    )
-}
-
 /// gmsh remeshing `surface` at `size` (m) with the curvature sizes the size estimate assumes
 /// ([`super::sizing::local_sizes`]: the asset's own triangles' curvature, with the walls'
 /// `diameters` when thickness-aware) as a `Structured` field, gmsh's curvature sizing and its
 /// extension of boundary sizes off: the sizing that follows the surface the asset describes,
-/// not its facets. Returns the mesh, its report (`curvature_elements` as asked,
-/// `curvature_from_surface` set) and the field.
+/// not its facets. `note` says why gmsh's own sizing was set aside. Returns the mesh, its
+/// report (`curvature_elements` as asked, `curvature_from_surface` set, `excess` the note
+/// with the tetrahedra made instead) and the field.
 fn mesh_with_own_sizes(
     surface: &SurfaceMesh,
     inspection: &SurfaceInspection,
     params: &MeshParams,
     (size, walls, curvature): (f64, Option<&[Option<f64>]>, Option<u32>),
-    file: &str,
+    (file, note): (&str, &str),
     progress: &dyn Fn(&str),
 ) -> Result<(Made, MeshReport, Option<super::sizing::SizeGrid>), AssetError> {
+    progress(&format!("{note}: meshing again with {OWN_SIZES}"));
     let sizes = super::sizing::local_sizes(surface, size, true, walls);
     let own = super::sizing::surface_size_grid(surface, &sizes, size);
     let (m, mut r) = run_backend(
@@ -649,6 +638,10 @@ fn mesh_with_own_sizes(
     )?;
     r.curvature_elements = curvature;
     r.curvature_from_surface = true;
+    r.excess = Some(format!(
+        "{note}; meshed again with {OWN_SIZES}: {} tetrahedra",
+        crate::bake::group_digits(m.mesh.tets.len())
+    ));
     Ok((m, r, own))
 }
 
