@@ -540,9 +540,11 @@ pub fn mesh_surface(
                     mesh = m;
                     grid = own;
                 }
-                Err(e) => report.excess = Some(format!(
+                Err(e) => {
+                    report.excess = Some(format!(
                     "{note}; meshing again with {OWN_SIZES} failed ({e}), so this is gmsh's mesh"
-                )),
+                ))
+                }
             }
         }
     }

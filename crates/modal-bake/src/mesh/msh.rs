@@ -343,29 +343,10 @@ impl MshReader<'_> {
             };
             self.builder.skip(&what, n, volume);
         }
-        let group_name = |names: &BTreeMap<(i32, i64), String>, dim: i32, tag: i64| {
-            names
-                .get(&(dim, tag))
-                .cloned()
-                .unwrap_or_else(|| tag.to_string())
-        };
-        for ((dim, tag), nodes) in &self.members {
-            match self.version {
-                Version::V22 => {
-                    let name = group_name(&self.names, *dim, *tag);
-                    self.builder.add_to_group(&name, nodes);
-                }
-                Version::V41 => {
-                    for &p in self
-                        .entity_physicals
-                        .get(&(*dim, *tag))
-                        .into_iter()
-                        .flatten()
-                    {
-                        let name = group_name(&self.names, *dim, p);
-                        self.builder.add_to_group(&name, nodes);
-                    }
-                }
+        let members = std::mem::take(&mut self.members);
+        for (&key, nodes) in &members {
+            for name in self.group_names(Some(key)) {
+                self.builder.add_to_group(&name, nodes);
             }
         }
         self.builder.finish(self.file)
