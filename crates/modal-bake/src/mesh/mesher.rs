@@ -442,12 +442,12 @@ pub fn mesh_surface(
     let walls = params.thickness.then_some(diameters.as_slice());
     // gmsh's curvature sizing is stopped once its surface mesh is already far finer than the
     // estimate's (the volume would be tens of times over): [`SURFACE_GUARD`].
-    let expected_boundary = || {
+    let expected_boundary = curvature.map(|_| {
         let h = super::sizing::equivalent_size_with(surface, size, true, walls);
         let measures = crate::bake::SurfaceMeasures::of(&surface.vertices, &surface.triangles);
         crate::bake::SizeEstimate::of_surface(&measures, h, false, 1, 1).boundary
-    };
-    let surface_limit = curvature.map(|_| (SURFACE_GUARD * expected_boundary()).ceil() as u64);
+    });
+    let surface_limit = expected_boundary.map(|b| (SURFACE_GUARD * b).ceil() as u64);
     let first_try = run_backend(
         backend,
         surface,
@@ -463,7 +463,7 @@ pub fn mesh_surface(
             let note = format!(
                 "gmsh's surface mesh had {} triangles, over {SURFACE_GUARD} times the ~{} the size estimate expected, so gmsh was stopped before filling the volume: its curvature sizing refined more than the surface's curvature asks for — on a faceted surface (a low-poly model, as game assets are) it follows the facets' creases and short feature curves",
                 crate::bake::group_digits(triangles as usize),
-                crate::bake::format_count(expected_boundary()),
+                crate::bake::format_count(expected_boundary.unwrap_or(0.0)),
             );
             let (m, r, own) = mesh_with_own_sizes(
                 surface,
