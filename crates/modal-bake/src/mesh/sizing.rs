@@ -319,7 +319,8 @@ pub struct SizeGrid {
     pub dims: [usize; 3],
     /// Sizes (m), z fastest, then y, then x: node (i, j, k) at `(i·dims[1] + j)·dims[2] + k`.
     pub values: Vec<f64>,
-    /// Fraction of the surface area whose thickness makes it finer than the size.
+    /// Fraction of the surface area whose own size (wall thickness, or curvature) is finer than
+    /// the size.
     pub refined_area_fraction: f64,
     /// The smallest size on the grid (m).
     pub smallest_m: f64,
