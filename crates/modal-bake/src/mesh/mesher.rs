@@ -461,7 +461,7 @@ pub fn mesh_surface(
         Ok(ok) => ok,
         Err(AssetError::Gmsh(GmshError::SurfaceOverLimit { triangles, .. })) => {
             let note = format!(
-                "gmsh's surface mesh had {} triangles, over {SURFACE_GUARD} times the ~{} the size estimate expected, so gmsh was stopped before filling the volume: its curvature sizing refined more than the surface's curvature asks for — on a faceted surface (a low-poly model, as game assets are) it follows the facets' creases and short feature curves",
+                "gmsh's surface mesh had {} triangles, over {SURFACE_GUARD} times the ~{} the size estimate expected, so gmsh was stopped before filling the volume: {OVER_REFINED}",
                 crate::bake::group_digits(triangles as usize),
                 crate::bake::format_count(expected_boundary.unwrap_or(0.0)),
             );
@@ -589,10 +589,8 @@ fn excess(
     (ratio > GMSH_EXCESS).then(|| {
         format!(
             "gmsh made {ratio:.1} times the tetrahedra the size estimate expected ({} for ~{}): \
-             its curvature sizing refined more than the surface's curvature asks for — on a \
-             faceted surface (a low-poly model, as game assets are) it follows the facets' \
-             creases and short feature curves (--uniform-size: one size everywhere, ~{} \
-             tetrahedra at this size; check the accuracy with --target-error PCT)",
+             {OVER_REFINED} (--uniform-size: one size everywhere, ~{} tetrahedra at this size; \
+             check the accuracy with --target-error PCT)",
             group_digits(tets),
             format_count(expected),
             format_count(estimate(false)),
@@ -607,6 +605,9 @@ fn excess(
 /// the estimate (they grow at least as the boundary triangles do). The estimate's own spread
 /// on the boundary is within about 2.5 where gmsh's curvature sizing sets it.
 pub const SURFACE_GUARD: f64 = 10.0;
+
+/// Why gmsh's curvature sizing went past the estimate, in words (both notes).
+const OVER_REFINED: &str = "its curvature sizing refined more than the surface's curvature asks for — on a faceted surface (a low-poly model, as game assets are) it follows the facets' creases and short feature curves";
 
 /// What [`mesh_with_own_sizes`] meshes with, in words.
 const OWN_SIZES: &str = "the curvature sizes the size estimate measures on the asset's triangles (a size field; gmsh's own curvature sizing off)";
