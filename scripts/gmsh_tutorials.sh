@@ -6,7 +6,9 @@
 # (share/doc/gmsh/tutorials) with `gmsh tN.geo -3 -format msh41`, as a gmsh user would, and
 # bakes the result with `modal-bake bake tN.msh --material steel --modes 10`, recording the exit
 # status, wall time, peak memory and the first line of the outcome (the mesh and modes, or the
-# error). Prints a markdown table. Work files go to out/gmsh-tutorials/ (ignored by git).
+# error); a mesh refused as several disconnected pieces is baked again piece by piece
+# (`--piece N`), one row each. Prints a markdown table. Work files go to out/gmsh-tutorials/
+# (ignored by git).
 #
 # Usage: scripts/gmsh_tutorials.sh [--bin PATH-TO-modal-bake]
 # Needs gmsh (`pip install gmsh`; its tutorials come with it) and /usr/bin/time.
@@ -34,6 +36,27 @@ cd "$work"
 
 echo "gmsh $(gmsh --version 2>&1 | tail -1), $("$bin" --version); $(date -u +%Y-%m-%dT%H:%MZ), load $(cut -d' ' -f1-3 /proc/loadavg)"
 echo
+# bake_row LABEL STEM VOLUME [EXTRA bake options]: bakes $t.msh into STEM.modes and prints a
+# table row: exit status, wall time, peak memory and the outcome (mesh and modes, or the error).
+bake_row() {
+  local label="$1" stem="$2" volume="$3" rc wall kb outcome warnings
+  shift 3
+  set +e
+  /usr/bin/time -f "%e %M" -o "$stem.time" "$bin" bake "$t.msh" -o "$stem.modes" --material steel --modes 10 "$@" \
+    > "$stem.bake.out" 2> "$stem.bake.err"
+  rc=$?
+  set -e
+  read -r wall kb < <(tail -1 "$stem.time") || true
+  if [ "$rc" = 0 ]; then
+    outcome="$(grep -E '^  mesh:' "$stem.bake.out" | sed 's/^ *//'); $(grep -E ' modes, ' "$stem.bake.out" | sed 's/^ *//')"
+    warnings="$(grep -c '^warning: ' "$stem.bake.err" || true)"
+    [ "$warnings" != 0 ] && outcome="$outcome; $warnings size/mass warning(s)"
+  else
+    outcome="$(grep -E '^error' "$stem.bake.err" | head -1 | cut -c1-220)"
+  fi
+  echo "| $label | $volume | $rc | $wall | $((kb / 1024)) | ${outcome//|/\\|} |"
+}
+
 echo "| tutorial | gmsh's elements (3-D) | bake exit | wall s | peak MiB | outcome |"
 echo "|---|---|---|---|---|---|"
 for n in $(seq 1 21); do
@@ -60,18 +83,10 @@ for c in m.cells:
 print("VOLUME " + (", ".join(f"{n:,} {k}" for k, n in counts.items()) or "none"))
 EOF
 )"
-  set +e
-  /usr/bin/time -f "%e %M" -o "$t.time" "$bin" bake "$t.msh" -o "$t.modes" --material steel --modes 10 \
-    > "$t.bake.out" 2> "$t.bake.err"
-  rc=$?
-  set -e
-  read -r wall kb < <(tail -1 "$t.time") || true
-  if [ "$rc" = 0 ]; then
-    outcome="$(grep -E '^  mesh:' "$t.bake.out" | sed 's/^ *//'); $(grep -E ' modes, ' "$t.bake.out" | sed 's/^ *//')"
-    warnings="$(grep -c '^warning: ' "$t.bake.err" || true)"
-    [ "$warnings" != 0 ] && outcome="$outcome; $warnings size/mass warning(s)"
-  else
-    outcome="$(grep -E '^error' "$t.bake.err" | head -1 | cut -c1-220)"
-  fi
-  echo "| $t | ${volume:-–} | $rc | $wall | $((kb / 1024)) | ${outcome//|/\\|} |"
+  bake_row "$t" "$t" "${volume:-–}"
+  # A mesh of several pieces: each piece baked alone, as the refusal says.
+  pieces="$(sed -n 's/.*the mesh has \([0-9]*\) disconnected pieces.*/\1/p' "$t.bake.err" | head -1)"
+  for k in $(seq 1 "${pieces:-0}"); do
+    bake_row "$t --piece $k" "$t.p$k" "" --piece "$k"
+  done
 done

@@ -469,6 +469,15 @@ fn hostile_manifests_are_refused_before_any_work_naming_file_entry_and_field() {
             json!({"entries": [{"mesh": data("meshes/cube_cell_sets.json").display().to_string(), "out": "a.modes", "options": {"object": "left"}}]}),
             vec!["entries[0].options", "meshio JSON"],
         ),
+        // `piece` counts from 1 and selects a piece of a volume mesh, not of a surface asset.
+        (
+            json!({"entries": [{"mesh": mesh, "out": "a.modes", "options": {"piece": 0}}]}),
+            vec!["entries[0].options.piece"],
+        ),
+        (
+            json!({"entries": [{"mesh": data("assets/hp_body.obj").display().to_string(), "out": "a.modes", "options": {"piece": 1}}]}),
+            vec!["entries[0].options", "volume mesh", "--object NAME"],
+        ),
         // Paths that are inputs, devices, FIFOs, folders; duplicate outputs.
         (
             json!({"entries": [good("a.modes"), {"mesh": mesh, "out": mesh}]}),

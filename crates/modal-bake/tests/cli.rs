@@ -242,7 +242,7 @@ fn bad_inputs_fail_cleanly_with_located_errors() {
         (
             "bad/two_pieces.msh",
             &[],
-            "2 disconnected pieces; bake each piece as its own object (--object NAME bakes the tetrahedra of one 3-D physical group",
+            "2 disconnected pieces, largest first: piece 1: 1 tetrahedron, 0.1667 m³, from (0, 0, 0) to (1, 1, 1) m; piece 2: 1 tetrahedron, 0.1667 m³, from (5, 0, 0) to (6, 1, 1) m; bake each piece as its own object (--piece N bakes piece N alone; --object NAME",
         ),
         ("bad/bad_shape.json", &[], "bad_shape.json"),
         ("bad/negative_index.json", &[], "negative_index.json"),

@@ -1042,3 +1042,246 @@ fn gmsh_physical_volumes_bake_one_at_a_time() {
     assert_eq!(check("right"), Some(1));
     std::fs::remove_dir_all(&tmp).unwrap();
 }
+
+/// `b` then `a` moved by `dx` (m) along x as one mesh: nodes, tets, element ids 1…n and groups
+/// of both (a group of `a` joins `b`'s group of the same name).
+fn side_by_side(b: &TetMesh, a: &TetMesh, dx: f64) -> TetMesh {
+    let n = b.nodes.len();
+    let mut m = b.clone();
+    m.nodes
+        .extend(a.nodes.iter().map(|p| [p[0] + dx, p[1], p[2]]));
+    m.tets.extend(a.tets.iter().map(|t| t.map(|v| v + n)));
+    m.tet_ids = (1..=m.tets.len() as u64).collect();
+    for (name, nodes) in &a.groups {
+        let g = m.groups.entry(name.clone()).or_default();
+        g.extend(nodes.iter().map(|v| v + n));
+    }
+    m
+}
+
+// Expectation: a mesh of two boxes has two pieces, numbered largest first whatever their
+// order in the file, each with its tetrahedra, volume and bounding box; keeping one gives
+// exactly the mesh of that box alone — nodes, tetrahedra, mid-edge nodes of a second-order
+// mesh and groups — and a number the mesh has no piece for is refused with the list.
+#[test]
+fn connected_pieces_are_numbered_largest_first_and_kept_alone() {
+    let small = TetMesh::structured_box([1, 1, 1], [0.1, 0.1, 0.1]);
+    let large = TetMesh::structured_box([2, 1, 1], [0.2, 0.1, 0.1]);
+    let two = side_by_side(&small, &large, 0.5);
+    let pieces = two.pieces();
+    assert_eq!(pieces.len(), 2);
+    assert_eq!(two.connected_components(), 2);
+    assert_eq!(
+        (
+            pieces[0].number,
+            pieces[0].tets,
+            pieces[1].number,
+            pieces[1].tets
+        ),
+        (1, 12, 2, 6)
+    );
+    assert!((pieces[0].volume - 2e-3).abs() < 1e-15 && (pieces[1].volume - 1e-3).abs() < 1e-15);
+    assert_eq!(pieces[0].bbox, [[0.5, 0.0, 0.0], [0.7, 0.1, 0.1]]);
+    let moved = side_by_side(&TetMesh::default(), &large, 0.5);
+    for (p1, alone) in [(false, &moved), (true, &moved)] {
+        let whole = if p1 { two.to_quadratic() } else { two.clone() };
+        let alone = if p1 {
+            alone.to_quadratic()
+        } else {
+            alone.clone()
+        };
+        let kept = whole.keep_piece(1).unwrap();
+        assert_eq!(kept.nodes, alone.nodes, "second order: {p1}");
+        assert_eq!(kept.tets, alone.tets);
+        assert_eq!(kept.mid_edges, alone.mid_edges);
+        assert_eq!(kept.groups, alone.groups);
+        assert_eq!(kept.tet_ids, (7..=18).collect::<Vec<u64>>());
+        assert!(
+            kept.notes.last().unwrap().starts_with(
+                "kept piece 1: 12 tetrahedra, 0.002 m³, from (0.5, 0, 0) to (0.7, 0.1, 0.1) m"
+            ),
+            "{:?}",
+            kept.notes
+        );
+        let kept = whole.keep_piece(2).unwrap();
+        assert_eq!(
+            (kept.nodes.len(), kept.tets.len()),
+            (small.nodes.len() + if p1 { 19 } else { 0 }, 6)
+        );
+        assert_eq!(
+            kept.groups,
+            if p1 {
+                small.to_quadratic().groups
+            } else {
+                small.groups.clone()
+            }
+        );
+    }
+    for asked in [0, 3] {
+        let e = two.keep_piece(asked).unwrap_err();
+        match &e.kind {
+            MeshErrorKind::NoSuchPiece {
+                asked: a,
+                count,
+                list,
+            } => {
+                assert_eq!((*a, *count), (asked, 2));
+                assert!(
+                    list.contains(
+                        "piece 2: 6 tetrahedra, 0.001 m³, from (0, 0, 0) to (0.1, 0.1, 0.1) m"
+                    ),
+                    "{list}"
+                );
+            }
+            other => panic!("{other:?}"),
+        }
+    }
+    // Tetrahedra sharing one node only are one piece.
+    let mut touching = small.clone();
+    let n = touching.nodes.len();
+    touching
+        .nodes
+        .extend([[0.2, 0.1, 0.1], [0.3, 0.1, 0.1], [0.2, 0.2, 0.1]]);
+    touching.tets.push([7, n, n + 1, n + 2]);
+    assert_eq!(touching.pieces().len(), 1);
+}
+
+/// Runs `modal-bake` with `args` (paths and words alike).
+fn run_bake(args: &[&dyn AsRef<std::ffi::OsStr>]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_modal-bake"))
+        .args(args.iter().map(|a| a.as_ref()))
+        .output()
+        .unwrap()
+}
+
+const STEEL_4: [&str; 4] = ["--material", "steel", "--modes", "4"];
+
+// Expectation: `bake`/`check --piece N` on a meshio JSON of two boxes: the whole file is refused
+// listing both pieces and naming --piece; piece 2 bakes to a base `check` finds up to date
+// against a file holding that box alone (the same canonical mesh) and stale against the other;
+// a piece the file does not have, and --piece with a surface asset, are refused before any work.
+#[test]
+fn a_volume_mesh_of_several_pieces_bakes_piece_by_piece() {
+    let tmp = std::env::temp_dir().join(format!("dcr-pieces-{}", std::process::id()));
+    std::fs::create_dir_all(&tmp).unwrap();
+    let small = TetMesh::structured_box([1, 1, 1], [0.1, 0.1, 0.1]);
+    let large = TetMesh::structured_box([2, 1, 1], [0.2, 0.1, 0.1]);
+    let write = |m: &TetMesh, name: &str| {
+        let path = tmp.join(name);
+        std::fs::write(&path, m.to_meshio_json("zmin", "bottom").to_string()).unwrap();
+        path
+    };
+    let two = write(&side_by_side(&small, &large, 0.5), "two.json");
+    let alone_small = write(&small, "small.json");
+    let alone_large = write(
+        &side_by_side(&TetMesh::default(), &large, 0.5),
+        "large.json",
+    );
+    let modes = tmp.join("p2.modes");
+    let bake = |extra: &[&str]| {
+        let mut a: Vec<&dyn AsRef<std::ffi::OsStr>> = vec![&"bake", &two, &"-o", &modes];
+        a.extend(
+            STEEL_4
+                .iter()
+                .chain(extra)
+                .map(|s| s as &dyn AsRef<std::ffi::OsStr>),
+        );
+        run_bake(&a)
+    };
+    let whole = bake(&[]);
+    let text = String::from_utf8_lossy(&whole.stderr);
+    assert!(!whole.status.success(), "{text}");
+    assert!(
+        text.contains("2 disconnected pieces, largest first: piece 1: 12 tetrahedra, 0.002 m³")
+            && text.contains("piece 2: 6 tetrahedra, 0.001 m³")
+            && text.contains("--piece N bakes piece N alone"),
+        "{text}"
+    );
+    assert!(!modes.exists());
+    let out = bake(&["--piece", "2"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("mass 7.850000 kg") && text.contains("kept piece 2"),
+        "{text}"
+    );
+    let check = |mesh: &Path, piece: Option<&str>| {
+        let piece: Vec<&str> = piece.map_or(vec![], |p| vec!["--piece", p]);
+        let mut a: Vec<&dyn AsRef<std::ffi::OsStr>> = vec![&"check", &mesh, &modes];
+        a.extend(
+            STEEL_4
+                .iter()
+                .chain(&piece)
+                .map(|s| s as &dyn AsRef<std::ffi::OsStr>),
+        );
+        run_bake(&a).status.code()
+    };
+    assert_eq!(check(&alone_small, None), Some(0));
+    assert_eq!(check(&two, Some("2")), Some(0));
+    assert_eq!(check(&two, Some("1")), Some(1));
+    assert_eq!(check(&alone_large, None), Some(1));
+    let missing = bake(&["--piece", "3"]);
+    let text = String::from_utf8_lossy(&missing.stderr);
+    assert!(
+        !missing.status.success()
+            && text.contains("two.json: no piece 3: the mesh has 2 connected piece(s)"),
+        "{text}"
+    );
+    let asset = data("assets/hp_body.obj");
+    let out = run_bake(&[
+        &"bake",
+        &asset,
+        &"-o",
+        &tmp.join("asset.modes"),
+        &"--piece",
+        &"1",
+    ]);
+    let text = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success()
+            && text.contains("--piece 1 selects a connected piece of a volume mesh")
+            && text.contains("--object NAME"),
+        "{text}"
+    );
+    std::fs::remove_dir_all(&tmp).unwrap();
+}
+
+// Expectation (real gmsh): two boxes of different sizes meshed without any physical group (as
+// gmsh's tutorials t18 and t19 are) cannot be selected by --object; --piece bakes each, the
+// larger first: 7.85 kg and 0.98 kg of steel, the volumes of the boxes.
+#[test]
+fn gmsh_volumes_without_physical_groups_bake_piece_by_piece() {
+    if !gmsh_gate::have_gmsh("gmsh_volumes_without_physical_groups_bake_piece_by_piece") {
+        return;
+    }
+    let tmp = std::env::temp_dir().join(format!("dcr-gmsh-pieces-{}", std::process::id()));
+    std::fs::create_dir_all(&tmp).unwrap();
+    let geo = tmp.join("two.geo");
+    std::fs::write(
+        &geo,
+        "SetFactory(\"OpenCASCADE\");\nMesh.MshFileVersion = 4.1;\nMesh.MeshSizeMax = 0.03;\n\
+         Box(1) = {0.4, 0, 0, 0.05, 0.05, 0.05};\nBox(2) = {0, 0, 0, 0.1, 0.1, 0.1};\n",
+    )
+    .unwrap();
+    let msh = gmsh_volume_mesh(&geo);
+    let e = modal_bake::mesh::read_msh_object(&msh, "1").unwrap_err();
+    assert!(e.to_string().contains("no physical group"), "{e}");
+    for (piece, mass) in [("1", "mass 7.850000 kg"), ("2", "mass 0.981250 kg")] {
+        let out_path = tmp.join(format!("p{piece}.modes"));
+        let mut a: Vec<&dyn AsRef<std::ffi::OsStr>> = vec![&"bake", &msh, &"-o", &out_path];
+        a.extend(STEEL_4.iter().map(|s| s as &dyn AsRef<std::ffi::OsStr>));
+        a.extend([&"--piece" as &dyn AsRef<std::ffi::OsStr>, &piece]);
+        let out = run_bake(&a);
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert!(
+            out.status.success() && text.contains(mass),
+            "piece {piece}: {text}{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+    std::fs::remove_dir_all(&tmp).unwrap();
+}

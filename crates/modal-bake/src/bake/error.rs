@@ -13,8 +13,8 @@ fn piece_hint(file: &str) -> &'static str {
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase);
     match ext.as_deref() {
-        Some("msh") => "--object NAME bakes the tetrahedra of one 3-D physical group; in gmsh, give each piece its own `Physical Volume`",
-        Some("json") => "write one piece's cells per file",
+        Some("msh") => "--piece N bakes piece N alone; --object NAME bakes the tetrahedra of one 3-D physical group (in gmsh, a `Physical Volume` per piece)",
+        Some("json") => "--piece N bakes piece N alone",
         _ => "a glTF or OBJ asset's named objects one at a time: --object NAME; `modal-bake mesh ASSET --dry-run` lists them",
     }
 }
@@ -34,14 +34,16 @@ pub enum BakeError {
     Params(String),
     /// The mesh has several disconnected pieces.
     #[error(
-        "{file}: the mesh has {pieces} disconnected pieces; bake each piece as its own object ({})",
+        "{file}: the mesh has {pieces} disconnected pieces, largest first: {list}; bake each piece as its own object ({})",
         piece_hint(file)
     )]
     Disconnected {
         /// Mesh file.
         file: String,
-        /// Number of connected components.
+        /// Number of connected pieces.
         pieces: usize,
+        /// The pieces, largest first: number, tetrahedra, volume (m³), bounding box (m).
+        list: String,
     },
     /// A free-free object did not show exactly six rigid-body modes.
     #[error("{file}: expected 6 rigid-body modes for a free-free object, found {found} eigenvalues with |λ| ≤ {tol:.3e} rad²/s² (a mechanism, or a near-singular mesh)")]

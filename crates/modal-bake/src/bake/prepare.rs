@@ -40,11 +40,12 @@ pub(super) fn prepare(
         .map_err(name_file)?;
     let mid_table = mesh.edge_mid_nodes().map_err(name_file)?;
     mesh.check_overlaps().map_err(name_file)?;
-    let pieces = mesh.connected_components();
-    if pieces != 1 {
+    let pieces = mesh.pieces();
+    if pieces.len() != 1 {
         return Err(BakeError::Disconnected {
             file: file.to_string(),
-            pieces,
+            pieces: pieces.len(),
+            list: crate::mesh::list_pieces(&pieces),
         });
     }
     let FixedNodes {

@@ -101,8 +101,9 @@ impl BakeArgs {
     }
 }
 
-/// The tetrahedral mesh of `path`: read, or (a surface asset) meshed by the meshing chain; with the
-/// seconds it took. Meshing options given with a volume mesh are an error.
+/// The tetrahedral mesh of `path`: read (its `--object` physical volume, its `--piece`
+/// connected piece), or (a surface asset) meshed by the meshing chain; with the seconds it
+/// took. Meshing options given with a volume mesh are an error.
 pub fn load_mesh(
     path: &std::path::Path,
     asset: &AssetOptions,
@@ -121,7 +122,7 @@ pub fn load_mesh(
     let mut mesh = match &asset.object {
         None => modal_bake::mesh::read_mesh(path),
         Some(_) if is_json(path) => anyhow::bail!(
-            "--object selects an object of a surface asset or a physical volume of a gmsh .msh, not of the meshio JSON mesh {}: write one object's cells per file",
+            "--object selects an object of a surface asset or a physical volume of a gmsh .msh, not of the meshio JSON mesh {}: select one of its connected pieces with --piece N, or write one object's cells per file",
             path.display()
         ),
         Some(object) => modal_bake::mesh::read_msh_object(path, object),
@@ -133,6 +134,14 @@ pub fn load_mesh(
                 *c = asset.units.to_metres_of(*c);
             }
         }
+    }
+    if let Some(n) = asset.piece {
+        mesh = mesh
+            .keep_piece(usize::try_from(n).unwrap_or(usize::MAX))
+            .map_err(|mut e| {
+                e.file = path.display().to_string();
+                e
+            })?;
     }
     Ok((mesh, t.elapsed().as_secs_f64()))
 }

@@ -163,6 +163,13 @@ pub struct AssetOptions {
     /// has.
     #[arg(long, value_name = "NAME")]
     pub object: Option<String>,
+    /// Volume meshes (.msh, .json): bake only connected piece N (tetrahedra joined through
+    /// shared nodes; numbered from 1, largest volume first), after --object [default: the
+    /// whole mesh, which must be one piece; a mesh of several is refused with the list of its
+    /// pieces: number, tetrahedra, volume and bounding box]. A surface asset's parts are
+    /// selected by name with --object.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
+    pub piece: Option<u64>,
 }
 
 impl AssetOptions {
@@ -174,8 +181,13 @@ impl AssetOptions {
     /// The meshing parameters.
     ///
     /// # Errors
-    /// An invalid `--mesher-timeout`.
+    /// An invalid `--mesher-timeout`; `--piece`, which applies to volume meshes only.
     pub fn params(&self) -> anyhow::Result<MeshParams> {
+        if let Some(n) = self.piece {
+            anyhow::bail!(
+                "--piece {n} selects a connected piece of a volume mesh (.msh, .json); a surface asset's parts are selected by name: --object NAME (`modal-bake mesh ASSET --dry-run` lists them)"
+            );
+        }
         Ok(MeshParams {
             mesher: match self.mesher {
                 MesherArg::Auto => MesherChoice::Auto,
@@ -210,13 +222,16 @@ impl AssetOptions {
             || self.ftetwild.is_some()
             || self.mesher_timeout != modal_bake::mesh::work::DEFAULT_TIMEOUT_S
             || self.object.is_some()
+            || self.piece.is_some()
     }
 
-    /// Whether an option other than `--object` and `--units` is set: those apply to surface
-    /// assets only (`--object` also selects a physical volume of a `.msh`).
+    /// Whether an option other than `--object`, `--piece` and `--units` is set: those apply
+    /// to surface assets only (`--object` also selects a physical volume of a `.msh`,
+    /// `--piece` applies to volume meshes only).
     pub fn any_meshing_set(&self) -> bool {
         AssetOptions {
             object: None,
+            piece: None,
             ..self.clone()
         }
         .any_set()

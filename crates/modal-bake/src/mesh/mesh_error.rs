@@ -192,6 +192,17 @@ pub enum MeshErrorKind {
         /// The 3-D physical groups the file's tetrahedra belong to, comma-separated.
         available: String,
     },
+    /// The mesh has no connected piece of the number asked for (pieces are numbered from 1,
+    /// largest volume first).
+    #[error("no piece {asked}: the mesh has {count} connected piece(s), largest first: {list}")]
+    NoSuchPiece {
+        /// The piece number asked for.
+        asked: usize,
+        /// How many pieces the mesh has.
+        count: usize,
+        /// The pieces, largest first (number, tetrahedra, volume, bounding box).
+        list: String,
+    },
     /// The file holds volume elements other than 4- and 10-node tetrahedra (hexahedra, prisms,
     /// pyramids, higher-order tetrahedra) beside its tetrahedra: leaving them out would bake
     /// part of the object.

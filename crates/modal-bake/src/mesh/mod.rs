@@ -33,6 +33,7 @@ mod mesh_error;
 pub mod mesher;
 mod msh;
 mod msh_writer;
+mod pieces;
 pub mod sizing;
 pub mod surface;
 mod tet_mesh;
@@ -50,6 +51,8 @@ pub use mesher::{
     MesherChoice,
 };
 pub use msh_writer::msh41_bytes;
+pub(crate) use pieces::list_pieces;
+pub use pieces::MeshPiece;
 pub(crate) use tet_mesh::tet_faces;
 pub use tet_mesh::{signed_volume, TetMesh, TET10_EDGES};
 pub use validate::{DEFAULT_DEGENERATE_REL_TOL, DEFAULT_STRAIGHT_REL_TOL};

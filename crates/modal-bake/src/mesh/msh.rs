@@ -329,7 +329,7 @@ impl MshReader<'_> {
                 MeshErrorKind::UnknownObject {
                     name: name.to_string(),
                     available: if groups.is_empty() {
-                        "none: its tetrahedra are in no physical group (define a `Physical Volume` in gmsh)".into()
+                        "none: its tetrahedra are in no physical group (define a `Physical Volume` in gmsh, or select a connected piece with --piece N)".into()
                     } else {
                         groups.join(", ")
                     },

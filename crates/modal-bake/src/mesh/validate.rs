@@ -1,5 +1,5 @@
-//! Checks on a [`TetMesh`] before assembly: orientation, degenerate tetrahedra, connectivity
-//! and group look-up.
+//! Checks on a [`TetMesh`] before assembly: orientation, degenerate tetrahedra and group
+//! look-up (connectivity: the `pieces` module).
 
 use super::mesh_error::{Location, MeshError, MeshErrorKind};
 use super::tet_mesh::{signed_volume, tet_faces, TetMesh};
@@ -327,52 +327,6 @@ impl TetMesh {
             Location::Element(second),
             MeshErrorKind::OverlappingTets { first, second },
         ))
-    }
-
-    /// Number of connected components of the tetrahedra (two tetrahedra are connected when
-    /// they share a node), by union–find over tetrahedron nodes. Nodes in no tetrahedron are
-    /// not counted. A mesh for baking should have exactly 1.
-    ///
-    /// ```
-    /// use modal_bake::mesh::TetMesh;
-    /// assert_eq!(TetMesh::structured_box([2, 1, 1], [1.0, 1.0, 1.0]).connected_components(), 1);
-    /// ```
-    pub fn connected_components(&self) -> usize {
-        let n = self.nodes.len();
-        let mut parent: Vec<usize> = (0..n).collect();
-        fn find(parent: &mut [usize], mut v: usize) -> usize {
-            while parent[v] != v {
-                parent[v] = parent[parent[v]];
-                v = parent[v];
-            }
-            v
-        }
-        let mut used = vec![false; n];
-        for (i, t) in self.tets.iter().enumerate() {
-            // Mid-edge nodes join their tetrahedron's corners.
-            if let Some(e) = self.mid_edges.get(i) {
-                for &v in e {
-                    used[v] = true;
-                    let (r, r0) = (find(&mut parent, v), find(&mut parent, t[0]));
-                    if r != r0 {
-                        parent[r] = r0;
-                    }
-                }
-            }
-            for &v in t {
-                used[v] = true;
-            }
-            let r0 = find(&mut parent, t[0]);
-            for &v in &t[1..] {
-                let r = find(&mut parent, v);
-                if r != r0 {
-                    parent[r] = r0;
-                }
-            }
-        }
-        (0..n)
-            .filter(|&v| used[v] && find(&mut parent, v) == v)
-            .count()
     }
 
     /// The sorted 0-based node indices of group `name`.

@@ -524,7 +524,7 @@ fn check_entry(args: &BakeArgs) -> anyhow::Result<()> {
         );
     } else if args.asset.object.is_some() && super::super::bake::is_json(&args.mesh) {
         bail!(
-            "object selects an object of a surface asset or a physical volume of a gmsh .msh, not of the meshio JSON mesh {}",
+            "object selects an object of a surface asset or a physical volume of a gmsh .msh, not of the meshio JSON mesh {} (piece selects one of its connected pieces)",
             args.mesh.display()
         );
     }
