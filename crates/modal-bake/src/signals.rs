@@ -14,9 +14,12 @@
 //! the install (a test harness's main thread) keep the signals unblocked; a small handler there
 //! forwards them to the waiting thread.
 //!
-//! Written on `libc` (its signal mask, `sigwait`, `sigaction`, `pthread_kill`), the second
-//! module after `ordering/metis.rs` allowed `unsafe`: std has no signal API, and signal-hook
-//! delivers through a handler, which is what METIS replaces.
+//! [`kill_process_group`] ends a mesher child with the processes it started: each child leads
+//! its own process group (`crate::mesh::work`), and std signals single processes only.
+//!
+//! Written on `libc` (its signal mask, `sigwait`, `sigaction`, `pthread_kill`, `kill`), the
+//! second module after `ordering/metis.rs` allowed `unsafe`: std has no signal API, and
+//! signal-hook delivers through a handler, which is what METIS replaces.
 #![allow(unsafe_code)]
 
 use std::mem::MaybeUninit;
@@ -101,6 +104,21 @@ pub fn remove_temporaries_on_signals() -> std::io::Result<()> {
         }
     }
     Ok(())
+}
+
+/// Sends SIGKILL to every process of process group `pgid` (a child spawned as the leader of its
+/// own group); nothing happens when the group no longer exists. Group numbers 0 and 1 (this
+/// process's own group, every process) are never signalled.
+pub fn kill_process_group(pgid: u32) {
+    if let Ok(pid) = libc::pid_t::try_from(pgid) {
+        if pid > 1 {
+            // SAFETY: kill(2) with a negative pid signals that process group; no memory is
+            // shared with it.
+            unsafe {
+                libc::kill(-pid, libc::SIGKILL);
+            }
+        }
+    }
 }
 
 /// Ends the process as `sig`'s default action does: the default action restored and the

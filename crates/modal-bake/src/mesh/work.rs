@@ -4,7 +4,8 @@
 //! Each backend ([`crate::mesh::gmsh`], [`crate::mesh::ftetwild`]) works in a private folder
 //! under `$TMPDIR` ([`WorkDir`], prefix `modal-bake-gmsh` or `modal-bake-ftetwild`), removed when
 //! it is dropped (success, error, panic unwinding). The folders and the running children are also
-//! registered process-wide, so a signal handler can end the children and remove the folders
+//! registered process-wide, so a signal handler can end the children (each with the processes
+//! it started: a child leads its own process group) and remove the folders
 //! ([`abort_meshing`]; the `modal-bake` binary calls it on SIGINT, SIGTERM and SIGHUP) — the
 //! one case dropping cannot cover. SIGKILL cannot be caught.
 
@@ -19,8 +20,19 @@ pub const DEFAULT_TIMEOUT_S: f64 = 600.0;
 
 /// Work folders alive in this process.
 static DIRS: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
-/// Mesher children running in this process.
-static CHILDREN: Mutex<Vec<Child>> = Mutex::new(Vec::new());
+/// Mesher children running in this process, and whether [`abort_meshing`] has run (no child
+/// is started after it). A child is spawned and registered under this lock, so the abort sees
+/// every child that exists.
+static CHILDREN: Mutex<Children> = Mutex::new(Children {
+    running: Vec::new(),
+    aborted: false,
+});
+
+/// The contents of [`CHILDREN`].
+struct Children {
+    running: Vec<Child>,
+    aborted: bool,
+}
 
 fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
     match m.lock() {
@@ -62,17 +74,30 @@ impl Drop for WorkDir {
     }
 }
 
-/// Ends every running mesher child and removes every work folder of this process; for signal
-/// handlers before the process ends. Returns how many folders were removed.
+/// Ends every running mesher child (with the processes it started) and removes every work
+/// folder of this process; for signal handlers before the process ends. Returns how many
+/// folders were removed.
 pub fn abort_meshing() -> usize {
-    for c in lock(&CHILDREN).iter_mut() {
-        let _ = c.kill();
+    let mut children = lock(&CHILDREN);
+    children.aborted = true;
+    for c in children.running.iter_mut() {
+        kill_group(c);
         let _ = c.wait();
     }
     lock(&DIRS)
         .iter()
         .filter(|p| std::fs::remove_dir_all(p).is_ok())
         .count()
+}
+
+/// Kills `child` and every process in its process group (on Unix each mesher child leads its
+/// own group, [`run_child_watched`]), so a process it started cannot outlive it holding its
+/// output open. After the child has been reaped the group may be empty (nothing is signalled)
+/// or hold what it left running (ended too); its number is not reused while any member lives.
+fn kill_group(child: &mut Child) {
+    #[cfg(unix)]
+    crate::signals::kill_process_group(child.id());
+    let _ = child.kill();
 }
 
 /// How a child run ended.
@@ -104,9 +129,13 @@ pub fn run_child(
 
 /// [`run_child`], also showing each complete line of the child's stdout to `stop` as it
 /// arrives (within about 20 ms): the child is killed as soon as `stop` returns true
-/// (`stopped`, `status: None`). As at the time limit, only the child itself is killed: a
-/// process it started that still holds its output open delays the return until it ends (the
-/// meshers run in one process).
+/// (`stopped`, `status: None`).
+///
+/// On Unix the child leads its own process group, and whenever the run ends — at `stop`, at
+/// the time limit or when the child exits — what is left of the group is killed, so a process
+/// the child started (a launcher's mesher, a background helper) neither outlives the run nor
+/// keeps it waiting on an output pipe it holds open. The group also means a terminal's Ctrl-C
+/// reaches the child through the `modal-bake` binary's handler ([`abort_meshing`]).
 ///
 /// # Errors
 /// When the program cannot be started.
@@ -119,8 +148,24 @@ pub fn run_child_watched(
     cmd.stdin(Stdio::null())
         .stdout(Stdio::piped())
         .stderr(Stdio::piped());
+    #[cfg(unix)]
+    std::os::unix::process::CommandExt::process_group(&mut cmd, 0);
     let t = Instant::now();
-    let mut child = cmd.spawn()?;
+    // Spawned and registered in one step, so `abort_meshing` cannot miss it.
+    let (id, child_out, child_err) = {
+        let mut children = lock(&CHILDREN);
+        if children.aborted {
+            return Err(std::io::Error::new(
+                std::io::ErrorKind::Interrupted,
+                "meshing was interrupted by a signal",
+            ));
+        }
+        let mut child = cmd.spawn()?;
+        let pipes = (child.stdout.take(), child.stderr.take());
+        let id = child.id();
+        children.running.push(child);
+        (id, pipes.0, pipes.1)
+    };
     let drain = |r: Option<Box<dyn Read + Send>>, into: std::sync::Arc<Mutex<Vec<u8>>>| {
         std::thread::spawn(move || {
             let Some(mut r) = r else { return };
@@ -136,21 +181,13 @@ pub fn run_child_watched(
     let stdout = std::sync::Arc::new(Mutex::new(Vec::new()));
     let stderr = std::sync::Arc::new(Mutex::new(Vec::new()));
     let out = drain(
-        child
-            .stdout
-            .take()
-            .map(|s| Box::new(s) as Box<dyn Read + Send>),
+        child_out.map(|s| Box::new(s) as Box<dyn Read + Send>),
         stdout.clone(),
     );
     let err = drain(
-        child
-            .stderr
-            .take()
-            .map(|s| Box::new(s) as Box<dyn Read + Send>),
+        child_err.map(|s| Box::new(s) as Box<dyn Read + Send>),
         stderr.clone(),
     );
-    let id = child.id();
-    lock(&CHILDREN).push(child);
     let mut next_note = 15.0;
     let mut scanned = 0;
     let mut stopped = false;
@@ -169,25 +206,29 @@ pub fn run_child_watched(
         }
         {
             let mut children = lock(&CHILDREN);
-            let Some(i) = children.iter().position(|c| c.id() == id) else {
+            let Some(i) = children.running.iter().position(|c| c.id() == id) else {
                 break None;
             };
-            match children[i].try_wait() {
+            match children.running[i].try_wait() {
                 Ok(Some(s)) if !stopped => {
                     // Already reaped by try_wait; wait returns its status at once.
-                    let _ = children.remove(i).wait();
+                    let mut c = children.running.remove(i);
+                    kill_group(&mut c);
+                    let _ = c.wait();
                     break Some(s);
                 }
                 Ok(_) if stopped || t.elapsed() >= timeout => {
-                    let mut c = children.remove(i);
-                    let _ = c.kill();
+                    let mut c = children.running.remove(i);
+                    kill_group(&mut c);
                     let _ = c.wait();
                     break None;
                 }
                 Ok(_) => {}
                 Err(_) => {
-                    let mut c = children.remove(i);
-                    break c.wait().ok();
+                    let mut c = children.running.remove(i);
+                    let status = c.wait().ok();
+                    kill_group(&mut c);
+                    break status;
                 }
             }
         }
@@ -228,10 +269,8 @@ pub fn timeout_of(seconds: f64) -> Result<Duration, String> {
 mod tests {
     use super::*;
 
-    // Expectation: the watcher sees the child's lines as they come and stops it at once (the
-    // child `exec`s its sleep: a grandchild holding the pipe open would delay the return until
-    // it ends); a watcher that never fires leaves the run as `run_child`'s (status, all the
-    // output).
+    // Expectation: the watcher sees the child's lines as they come and stops it at once; a
+    // watcher that never fires leaves the run as `run_child`'s (status, all the output).
     #[test]
     fn the_watcher_stops_the_child_at_the_line_it_waits_for() {
         let mut cmd = Command::new("sh");
@@ -251,5 +290,32 @@ mod tests {
         assert!(!out.stopped);
         assert_eq!(out.status.and_then(|s| s.code()), Some(3));
         assert_eq!(out.text, "one\ntwo\n");
+    }
+
+    // Expectation: processes the child started go with it — stopped by the watcher, at the
+    // time limit, or left running by a child that exited — so none keeps the run waiting on
+    // the output pipe it holds (each `sleep 30` here would hold it 30 s).
+    #[test]
+    fn what_the_child_started_ends_with_the_run() {
+        let run = |script: &str, timeout: f64, stop: &dyn Fn(&str) -> bool| {
+            let mut cmd = Command::new("sh");
+            cmd.args(["-c", script]);
+            run_child_watched(cmd, Duration::from_secs_f64(timeout), &|_| {}, stop).unwrap()
+        };
+        let out = run("echo one; echo ready; sleep 30 & wait", 60.0, &|l| {
+            l == "ready"
+        });
+        assert!(
+            out.stopped && out.seconds < 20.0,
+            "stopped after {} s",
+            out.seconds
+        );
+        let out = run("sleep 30 & sleep 30 & wait", 0.5, &|_| false);
+        assert!(out.status.is_none() && !out.stopped);
+        assert!(out.seconds < 20.0, "timed out after {} s", out.seconds);
+        let out = run("sleep 30 & echo done", 60.0, &|_| false);
+        assert_eq!(out.status.and_then(|s| s.code()), Some(0));
+        assert_eq!(out.text, "done\n");
+        assert!(out.seconds < 20.0, "returned after {} s", out.seconds);
     }
 }
