@@ -15,7 +15,8 @@ fn piece_hint(file: &str) -> &'static str {
     match ext.as_deref() {
         Some("msh") => "--piece N bakes piece N alone; --object NAME bakes the tetrahedra of one 3-D physical group (in gmsh, a `Physical Volume` per piece)",
         Some("json") => "--piece N bakes piece N alone",
-        _ => "a glTF or OBJ asset's named objects one at a time: --object NAME; `modal-bake mesh ASSET --dry-run` lists them",
+        Some("stl" | "ply") => "an STL or PLY file names no objects: save each piece as its own file, or as one named object each of an OBJ or glTF and bake them one at a time with --object NAME",
+        _ => "a glTF or OBJ asset's named objects one at a time: --object NAME, `modal-bake mesh ASSET --dry-run` lists them; pieces of one object: make each its own object or file",
     }
 }
 
@@ -100,5 +101,38 @@ impl BakeError {
     pub fn is_table_over_budget(&self) -> bool {
         matches!(self, BakeError::Transfer { error, .. }
             if matches!(**error, crate::transfer::TransferError::OverBudget(_)))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::BakeError;
+
+    // Expectation: the refusal of a mesh of several pieces offers what works for its kind of
+    // file: --piece for volume meshes, --object for assets with named objects, and for an STL
+    // or PLY (no names) a file or named object per piece, never an option the file cannot use.
+    #[test]
+    fn a_mesh_of_several_pieces_is_told_what_works_for_its_file() {
+        let text = |file: &str| {
+            BakeError::Disconnected {
+                file: file.into(),
+                pieces: 2,
+                list: "piece 1: …; piece 2: …".into(),
+            }
+            .to_string()
+        };
+        assert!(text("a.msh").contains("--piece N bakes piece N alone; --object NAME"));
+        assert!(text("a.JSON").contains("--piece N") && !text("a.json").contains("--object"));
+        for asset in ["a.stl", "a.PLY"] {
+            let t = text(asset);
+            assert!(
+                t.contains("names no objects") && !t.contains("--piece"),
+                "{t}"
+            );
+        }
+        for asset in ["a.obj", "a.glb", "a.gltf"] {
+            let t = text(asset);
+            assert!(t.contains("--object NAME") && !t.contains("--piece"), "{t}");
+        }
     }
 }
