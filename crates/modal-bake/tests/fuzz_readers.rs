@@ -419,6 +419,7 @@ fn check_one(bytes: &[u8], name: &str, kind: Kind, what: &str) -> bool {
                     MeshErrorKind::NoTets { .. }
                         | MeshErrorKind::OtherVolumeElements { .. }
                         | MeshErrorKind::UnknownFormat
+                        | MeshErrorKind::FluentMsh
                 );
             (e.to_string(), located)
         }),

@@ -1285,3 +1285,67 @@ fn gmsh_volumes_without_physical_groups_bake_piece_by_piece() {
     }
     std::fs::remove_dir_all(&tmp).unwrap();
 }
+
+// Expectation: a file the readers cannot take says what they read and how to convert — and a
+// `.msh` that is an ANSYS Fluent mesh (what meshio writes for a `.msh` name unless told the
+// format, by `meshio.write` and `meshio convert` alike) is named as such with the conversion,
+// not refused for a missing `$MeshFormat`. With meshio installed (CI), the real meshio's
+// default `.msh` is refused so, and its `file_format="gmsh"` one reads as the mesh it was.
+#[test]
+fn other_formats_are_named_with_their_conversion() {
+    let e = read_mesh_bytes(b"(1 \"meshio 5.3.5\")\n(2 3)\n", "a.msh").unwrap_err();
+    assert!(matches!(e.kind, MeshErrorKind::FluentMsh), "{e}");
+    assert!(
+        e.to_string().starts_with("a.msh: an ANSYS Fluent mesh")
+            && e.to_string().contains("-o gmsh")
+    );
+    for name in ["a.vtu", "a.inp", "a.fbx"] {
+        let e = read_mesh_bytes(b"<VTKFile>", name).unwrap_err();
+        assert!(matches!(e.kind, MeshErrorKind::UnknownFormat), "{e}");
+        assert!(
+            e.to_string().contains("meshio convert IN OUT.msh -o gmsh"),
+            "{e}"
+        );
+    }
+    let tmp = tempfile::tempdir().unwrap();
+    let script = r#"
+import sys
+try:
+    import meshio
+except ImportError:
+    print("NO_MESHIO"); sys.exit(0)
+m = meshio.read(sys.argv[1])
+m = meshio.Mesh(m.points, [c for c in m.cells if c.type == "tetra"])
+meshio.write(sys.argv[2], m)
+meshio.write(sys.argv[3], m, file_format="gmsh")
+print("OK")
+"#;
+    let (default, gmsh) = (tmp.path().join("default.msh"), tmp.path().join("gmsh.msh"));
+    let out = std::process::Command::new("python3")
+        .arg("-c")
+        .arg(script)
+        .arg(data("meshes/cube_v41.msh"))
+        .args([&default, &gmsh])
+        .output()
+        .expect("python3 runs");
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    if text.trim() == "NO_MESHIO" {
+        assert!(
+            std::env::var_os("CI").is_none(),
+            "meshio is not installed under CI"
+        );
+        eprintln!("SKIPPED: meshio not installed (pip install meshio)");
+        return;
+    }
+    let e = read_mesh(&default).unwrap_err();
+    assert!(matches!(e.kind, MeshErrorKind::FluentMsh), "{e}");
+    let original = read_ok("meshes/cube_v41.msh");
+    let converted = read_mesh(&gmsh).unwrap();
+    assert_eq!(converted.nodes, original.nodes);
+    assert_eq!(converted.tets, original.tets);
+}

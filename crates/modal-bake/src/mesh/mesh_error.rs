@@ -46,8 +46,15 @@ pub enum MeshErrorKind {
     #[error("not a regular file ({0}); give the path of a mesh file")]
     NotARegularFile(&'static str),
     /// Neither `$MeshFormat` nor a JSON object, and no known extension.
-    #[error("unrecognised mesh format (expected gmsh .msh or meshio-style .json)")]
+    #[error(
+        "unrecognised mesh format: modal-bake reads volume meshes as gmsh .msh (2.2 or 4.1) or meshio-style .json and surface assets as .obj, .stl, .ply, .glb or .gltf; convert another volume mesh (VTK/VTU, Abaqus .inp, Medit .mesh, TetGen, ...) with meshio (`pip install meshio`, then `meshio convert IN OUT.msh -o gmsh`), export another surface format (FBX, 3MF, DAE, ...) as glTF or OBJ"
+    )]
     UnknownFormat,
+    /// A `.msh` that is an ANSYS Fluent mesh (it starts with `(`), not a gmsh one.
+    #[error(
+        "an ANSYS Fluent mesh (it starts with `(`), not a gmsh one: `meshio convert` writes this for a .msh name unless told the format; convert with `meshio convert IN OUT.msh -o gmsh`"
+    )]
+    FluentMsh,
     /// An MSH version other than 2.2 or 4.1.
     #[error("unsupported MSH version {0} (supported: 2.2 and 4.1)")]
     UnsupportedVersion(String),

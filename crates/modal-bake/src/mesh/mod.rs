@@ -97,11 +97,16 @@ pub fn read_mesh(path: &Path) -> Result<TetMesh, MeshError> {
 /// # Errors
 /// As [`read_mesh`].
 pub fn read_mesh_bytes(data: &[u8], name: &str) -> Result<TetMesh, MeshError> {
+    let lower = name.to_ascii_lowercase();
     match data.iter().find(|b| !b.is_ascii_whitespace()) {
         Some(b'$') => msh::parse_msh(data, name),
         Some(b'{') => json::parse_json(data, name),
+        Some(b'(') if lower.ends_with(".msh") => Err(MeshError::new(
+            name,
+            Location::None,
+            MeshErrorKind::FluentMsh,
+        )),
         _ => {
-            let lower = name.to_ascii_lowercase();
             if lower.ends_with(".msh") {
                 msh::parse_msh(data, name)
             } else if lower.ends_with(".json") {
