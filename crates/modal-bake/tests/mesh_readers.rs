@@ -10,7 +10,7 @@ mod gmsh_gate;
 
 use modal_bake::mesh::{
     read_json, read_mesh, read_mesh_bytes, read_msh, read_msh_bytes, signed_volume, Location,
-    MeshError, MeshErrorKind, TetMesh, DEFAULT_DEGENERATE_REL_TOL,
+    MeshError, MeshErrorKind, TetMesh, DEFAULT_DEGENERATE_REL_TOL, DEFAULT_STRAIGHT_REL_TOL,
 };
 
 fn data(rel: &str) -> PathBuf {
@@ -1348,4 +1348,108 @@ print("OK")
     let converted = read_mesh(&gmsh).unwrap();
     assert_eq!(converted.nodes, original.nodes);
     assert_eq!(converted.tets, original.tets);
+}
+
+// Expectation: MSH 2.0 and 2.1 headers, and the version written as other tools write it
+// (Netgen's "Gmsh2 Format": "2.000000"), read as the 2.2 file they equal; MSH 4.0 and gmsh's
+// MSH 1 (`$NOD`, Netgen's "Gmsh Format") are refused at their line with gmsh's re-save
+// command — and (real gmsh) that command turns an MSH 1 file into one that reads.
+#[test]
+fn older_msh_versions_read_or_are_refused_with_the_resave() {
+    let text = std::fs::read_to_string(data("meshes/cube_v22.msh")).unwrap();
+    let original = read_ok("meshes/cube_v22.msh");
+    for version in ["2.0", "2.1", "2", "2.000000"] {
+        let other = text.replacen("2.2 0 8", &format!("{version} 0 8"), 1);
+        let m =
+            read_msh_bytes(other.as_bytes(), "v.msh").unwrap_or_else(|e| panic!("{version}: {e}"));
+        assert_eq!(m, original, "{version}");
+    }
+    let e = read_msh_bytes(text.replacen("2.2 0 8", "4.0 0 8", 1).as_bytes(), "v.msh").unwrap_err();
+    assert_eq!(e.kind, MeshErrorKind::UnsupportedVersion("4.0".into()));
+    assert!(
+        e.to_string()
+            .contains("gmsh IN.msh -save -format msh41 -o OUT.msh"),
+        "{e}"
+    );
+    let msh1 = "$NOD\n4\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n$ENDNOD\n$ELM\n1\n1 4 1 1 4 1 2 3 4\n$ENDELM\n";
+    let e = read_mesh_bytes(msh1.as_bytes(), "old.msh").unwrap_err();
+    assert_eq!(
+        (&e.kind, &e.location),
+        (&MeshErrorKind::Msh1, &Location::Line(1))
+    );
+    assert!(e.to_string().contains("-save -format msh41"), "{e}");
+    if !gmsh_gate::have_gmsh("older_msh_versions_read_or_are_refused_with_the_resave") {
+        return;
+    }
+    let tmp = tempfile::tempdir().unwrap();
+    let (old, new) = (tmp.path().join("old.msh"), tmp.path().join("new.msh"));
+    std::fs::write(&old, msh1).unwrap();
+    let gmsh = |args: &[&std::ffi::OsStr]| {
+        std::process::Command::new("gmsh")
+            .args(args)
+            .output()
+            .map(|o| o.status.success())
+    };
+    let args = [
+        old.as_os_str(),
+        "-save".as_ref(),
+        "-format".as_ref(),
+        "msh41".as_ref(),
+        "-o".as_ref(),
+        new.as_os_str(),
+    ];
+    if gmsh(&args).is_err() {
+        // The PyPI package without its `gmsh` script on PATH: its Python module.
+        let ok = std::process::Command::new("python3")
+            .args(["-c", "import gmsh, sys; gmsh.initialize(); gmsh.open(sys.argv[1]); gmsh.option.setNumber('Mesh.MshFileVersion', 4.1); gmsh.write(sys.argv[2]); gmsh.finalize()"])
+            .args([&old, &new])
+            .status()
+            .is_ok_and(|s| s.success());
+        assert!(ok, "gmsh could not re-save {}", old.display());
+    }
+    let m = read_mesh(&new).unwrap();
+    assert_eq!((m.nodes.len(), m.tets.len()), (4, 1));
+    assert!((m.volume() - 1.0 / 6.0).abs() < 1e-15);
+}
+
+// Expectation: a straight second-order mesh whose coordinates were written with six decimals
+// (Netgen's "Gmsh2 Format", in metres) is straight: its mid-edge nodes are within rounding
+// (≤ 8.7e-7 m) of the midpoints, under the floor of 1e-5 of the diagonal; a mid-edge node
+// moved ten times the floor off its midpoint is still refused as curved.
+#[test]
+fn a_straight_mesh_written_with_six_decimals_is_straight() {
+    let mut m = TetMesh::structured_box([3, 3, 3], [0.2, 0.1, 0.05]).to_quadratic();
+    for p in &mut m.nodes {
+        for c in p.iter_mut() {
+            // Moved off round numbers, then written with six decimals.
+            *c = ((*c + 0.012_345_678_9) * 1e6).round() / 1e6;
+        }
+    }
+    let worst = m
+        .mid_edges
+        .iter()
+        .zip(&m.tets)
+        .flat_map(|(e, t)| {
+            modal_bake::mesh::TET10_EDGES
+                .iter()
+                .zip(e)
+                .map(|(&[a, b], &v)| {
+                    let (x, y, p) = (m.nodes[t[a]], m.nodes[t[b]], m.nodes[v]);
+                    (0..3)
+                        .map(|i| (p[i] - 0.5 * (x[i] + y[i])).powi(2))
+                        .sum::<f64>()
+                        .sqrt()
+                })
+        })
+        .fold(0.0, f64::max);
+    assert!(
+        worst > 1e-6 * 0.0167 && worst <= 8.7e-7,
+        "rounding moved a midpoint {worst} m"
+    );
+    m.check_straight(DEFAULT_STRAIGHT_REL_TOL).unwrap();
+    let floor = modal_bake::mesh::STRAIGHT_DIAGONAL_TOL * m.extent();
+    let v = m.mid_edges[5][2];
+    m.nodes[v][2] += 10.0 * floor;
+    let e = m.check_straight(DEFAULT_STRAIGHT_REL_TOL).unwrap_err();
+    assert!(matches!(e.kind, MeshErrorKind::CurvedTet { .. }), "{e}");
 }

@@ -56,8 +56,11 @@ pub enum MeshErrorKind {
     )]
     FluentMsh,
     /// An MSH version other than 2.2 or 4.1.
-    #[error("unsupported MSH version {0} (supported: 2.2 and 4.1)")]
+    #[error("unsupported MSH version {0} (supported: 2.0–2.2 and 4.1); re-save it with gmsh: `gmsh IN.msh -save -format msh41 -o OUT.msh`")]
     UnsupportedVersion(String),
+    /// gmsh's first file format (`$NOD` … `$ELM`), as Netgen's "Gmsh Format" export writes.
+    #[error("gmsh's MSH 1 format (`$NOD` … `$ELM`), which is not read: re-save it with gmsh, `gmsh IN.msh -save -format msh41 -o OUT.msh` (from Netgen, export \"Gmsh2 Format\")")]
+    Msh1,
     /// A binary data-size other than supported (8 for 2.2; 4 or 8 for 4.1).
     #[error("unsupported data-size {0} in $MeshFormat")]
     UnsupportedDataSize(u64),

@@ -1,6 +1,6 @@
-//! Mesh input: gmsh MSH 2.2 and 4.1 (ASCII and binary) and meshio-style JSON, read into a
-//! canonical [`TetMesh`]: nodes by ascending tag (JSON: point order), nodes outside every
-//! tetrahedron dropped, 0-based indices, tetrahedra and triangles sorted by node indices with
+//! Mesh input: gmsh MSH 2.2 (also 2.0, 2.1) and 4.1 (ASCII and binary) and meshio-style JSON,
+//! read into a canonical [`TetMesh`]: nodes by ascending tag (JSON: point order), nodes outside
+//! every tetrahedron dropped, 0-based indices, tetrahedra and triangles sorted by node indices with
 //! exact repeats removed. Two files holding the same nodes (same tags, bit-identical
 //! positions) and elements give equal meshes, whatever their format or element order.
 //!
@@ -8,10 +8,12 @@
 //! `f64`; an ASCII and a binary file of one gmsh mesh can differ by 1 ulp per coordinate
 //! (the geometry hash, [`crate::bake::geometry_hash`], rounds to 16 digits and sees them as one).
 //!
-//! Supported: 4-node tetrahedra (volume), 3-node triangles (informational) and physical
-//! groups of any dimension (as node sets, for boundary conditions). Unsupported: every other
-//! element type, including second-order tetrahedra, which are skipped with a note in
-//! [`TetMesh::notes`]; MSH versions other than 2.2 and 4.1. How an element type is dispatched
+//! Supported: 4- and 10-node tetrahedra (volume), 3- and 6-node triangles (informational) and
+//! physical groups of any dimension (as node sets, for boundary conditions). Other volume
+//! elements (hexahedra, prisms, pyramids, tetrahedra of higher order) beside tetrahedra are
+//! refused, other elements (points, lines, quadrangles) skipped with a note in
+//! [`TetMesh::notes`]. MSH 1 and 4.0, an ANSYS Fluent `.msh` and unknown formats are refused
+//! with the command that converts them. How an element type is dispatched
 //! is in the `msh` and `json` module docs: one table of node counts per format, one function
 //! that files each element by type.
 //!
@@ -55,7 +57,7 @@ pub(crate) use pieces::list_pieces;
 pub use pieces::MeshPiece;
 pub(crate) use tet_mesh::tet_faces;
 pub use tet_mesh::{signed_volume, TetMesh, TET10_EDGES};
-pub use validate::{DEFAULT_DEGENERATE_REL_TOL, DEFAULT_STRAIGHT_REL_TOL};
+pub use validate::{DEFAULT_DEGENERATE_REL_TOL, DEFAULT_STRAIGHT_REL_TOL, STRAIGHT_DIAGONAL_TOL};
 
 /// Reads a whole regular file, at most as many bytes as its size when opened. A directory,
 /// device, FIFO or socket is refused before it is opened for reading (a FIFO would block, a

@@ -1,4 +1,5 @@
-//! gmsh MSH reader: versions 2.2 and 4.1, ASCII and binary.
+//! gmsh MSH reader: versions 2.2 (and 2.0, 2.1, which write nodes and elements alike) and 4.1,
+//! ASCII and binary. MSH 1 (`$NOD`) and 4.0 are refused with gmsh's command to re-save them.
 //!
 //! Format reference: gmsh manual §10 "Gmsh file formats" (MSH 4.1) and the legacy MSH 2.2
 //! description.
@@ -167,6 +168,9 @@ fn read_header(c: &mut Cursor<'_>) -> Result<(Version, usize), MeshError> {
         let (start, tok) = c.token("$MeshFormat")?;
         match tok.strip_prefix(b"$") {
             Some(b"MeshFormat") => break start,
+            Some(b"NOD" | b"NOE") => {
+                return Err(c.error_at(start, false, MeshErrorKind::Msh1));
+            }
             Some(name) if !name.is_empty() && !name.starts_with(b"End") => {
                 if let Some(section) = known_section(name) {
                     return Err(c.error_at(
@@ -193,14 +197,19 @@ fn read_header(c: &mut Cursor<'_>) -> Result<(Version, usize), MeshError> {
     c.rest_of_line();
     let vpos = c.line();
     let (_, vtok) = c.token("MSH version")?;
-    let version = match vtok {
-        b"2.2" => Version::V22,
-        b"4.1" => Version::V41,
-        other => {
+    // gmsh writes "2.2" and "4.1"; others write the number their own way (Netgen "2.000000").
+    // MSH 2.0 and 2.1 write nodes and elements as 2.2 does (2.1 added `$PhysicalNames`).
+    let number = std::str::from_utf8(vtok)
+        .ok()
+        .and_then(|t| t.parse::<f64>().ok());
+    let version = match number {
+        Some(v) if v == 2.0 || v == 2.1 || v == 2.2 => Version::V22,
+        Some(v) if v == 4.1 => Version::V41,
+        _ => {
             return Err(c.error_at(
                 vpos,
                 false,
-                MeshErrorKind::UnsupportedVersion(shorten(other)),
+                MeshErrorKind::UnsupportedVersion(shorten(vtok)),
             ))
         }
     };
