@@ -5,7 +5,7 @@ write them.
 
 - Netgen (PyPI `netgen-mesher`): a 0.2 x 0.1 x 0.05 m box and the box with a 20 mm hole,
   exported as "Gmsh2 Format" (MSH 2.0, six decimals) at order 1 and 2, and as "Gmsh Format"
-  (MSH 1).
+  (MSH 1); the holed box's curved second-order mesh also with `--straighten`.
 - TetGen (PyPI `tetgen`, with pyvista): a 50 mm sphere of 24 x 24 facets at order 1 and 2,
   saved as VTU and converted with meshio to gmsh's format.
 - meshio (PyPI `meshio`): the TetGen VTU written as `.msh` without a format (meshio's default
@@ -13,8 +13,8 @@ write them.
 
 Each file is baked with `modal-bake bake FILE --material steel --modes 5`; the table gives the
 exit status, the mesh and the lowest frequency, or the first line of the error, with the
-references: the box meshed by gmsh at order 2 and 10 mm (`Mesh.SecondOrderLinear = 1`), and
-the free steel sphere's lowest mode (torsional, n = 2: omega R / c_s = 2.5011). Work files go
+references: the box and the holed box meshed by gmsh at order 2 (`Mesh.SecondOrderLinear = 1`)
+at 10 mm and 6 mm, and the free steel sphere's lowest mode (torsional, n = 2: omega R / c_s = 2.5011). Work files go
 to out/other-meshers/ (ignored by git).
 
 Usage: python3 scripts/other_meshers.py [--bin PATH-TO-modal-bake]
@@ -53,6 +53,9 @@ def netgen_files():
         p2 = os.path.join(WORK, f"{name}_p2.msh")
         mesh.Export(p2, "Gmsh2 Format")
         out.append((f"Netgen {name[7:].replace('_', ' ')}, order 2, Gmsh2 Format", p2))
+        if hole:
+            out.append(("Netgen holed box, order 2, Gmsh2 Format, `--straighten`", p2,
+                        ["--straighten"]))
     return out
 
 
@@ -79,22 +82,31 @@ def tetgen_files():
     return out
 
 
-def gmsh_reference():
-    geo = os.path.join(WORK, "box_ref.geo")
-    with open(geo, "w") as f:
-        f.write('SetFactory("OpenCASCADE");\nBox(1) = {0,0,0,0.2,0.1,0.05};\n'
-                "Mesh.MeshSizeMax = 0.01;\nMesh.ElementOrder = 2;\nMesh.SecondOrderLinear = 1;\n")
-    msh = os.path.join(WORK, "box_ref.msh")
-    subprocess.run(["gmsh", geo, "-3", "-format", "msh41", "-o", msh], check=True,
-                   stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    return ("gmsh box, order 2, 10 mm (reference)", msh)
+def gmsh_references():
+    """The box and the holed box meshed by gmsh at order 2, straight-sided, finer."""
+    out = []
+    for name, size, hole in [("box", 0.01, False), ("holed box", 0.006, True)]:
+        stem = name.replace(" ", "_") + "_ref"
+        geo = os.path.join(WORK, stem + ".geo")
+        with open(geo, "w") as f:
+            f.write('SetFactory("OpenCASCADE");\nBox(1) = {0,0,0,0.2,0.1,0.05};\n')
+            if hole:
+                f.write("Cylinder(2) = {0.1,0.05,0, 0,0,0.05, 0.02};\n"
+                        "BooleanDifference(3) = { Volume{1}; Delete; }{ Volume{2}; Delete; };\n")
+            f.write(f"Mesh.MeshSizeMax = {size};\nMesh.ElementOrder = 2;\n"
+                    "Mesh.SecondOrderLinear = 1;\n")
+        msh = os.path.join(WORK, stem + ".msh")
+        subprocess.run(["gmsh", geo, "-3", "-format", "msh41", "-o", msh], check=True,
+                       stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        out.append((f"gmsh {name}, order 2, {size * 1000:g} mm (reference)", msh))
+    return out
 
 
-def bake(binary, path):
-    modes = path + ".modes"
+def bake(binary, path, extra):
+    modes = path + (".straightened" if extra else "") + ".modes"
     t = time.time()
     r = subprocess.run([binary, "bake", os.path.basename(path), "-o", os.path.basename(modes),
-                        "--material", "steel", "--modes", "5", "--json"],
+                        "--material", "steel", "--modes", "5", "--json", *extra],
                        capture_output=True, text=True, cwd=WORK)
     seconds = time.time() - t
     if r.returncode != 0:
@@ -117,7 +129,7 @@ def main():
     saved = os.dup(1)
     os.dup2(2, 1)
     try:
-        files = netgen_files() + tetgen_files() + [gmsh_reference()]
+        files = netgen_files() + tetgen_files() + gmsh_references()
     finally:
         sys.stdout.flush()
         os.dup2(saved, 1)
@@ -133,8 +145,8 @@ def main():
     print("| file | bake exit | tetrahedra | mass kg | lowest elastic mode Hz | outcome |")
     print("|---|---|---|---|---|---|")
     material = None
-    for label, path in files:
-        rc, _seconds, report, error = bake(a.bin, path)
+    for label, path, *extra in files:
+        rc, _seconds, report, error = bake(a.bin, path, extra[0] if extra else [])
         if rc == 0:
             material = report["material"]
             print(f"| {label} | 0 | {report['tets']:,} (order {report['order']}) | "

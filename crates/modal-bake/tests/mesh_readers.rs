@@ -1453,3 +1453,90 @@ fn a_straight_mesh_written_with_six_decimals_is_straight() {
     let e = m.check_straight(DEFAULT_STRAIGHT_REL_TOL).unwrap_err();
     assert!(matches!(e.kind, MeshErrorKind::CurvedTet { .. }), "{e}");
 }
+
+// Expectation (real gmsh): gmsh's default second-order mesh (mid-edge nodes on the curved
+// surface) is refused naming --straighten; straightened it is exactly the mesh gmsh makes with
+// `Mesh.SecondOrderLinear = 1` (binary files: bit for bit), so `bake --straighten` gives the
+// base of the straight mesh (same source hash) and `check --straighten` finds it up to date.
+// A surface asset, meshed straight-sided already, refuses the option.
+#[test]
+fn a_curved_gmsh_mesh_bakes_straightened_as_gmsh_s_straight_one() {
+    if !gmsh_gate::have_gmsh("a_curved_gmsh_mesh_bakes_straightened_as_gmsh_s_straight_one") {
+        return;
+    }
+    let tmp = tempfile::tempdir().unwrap();
+    let sphere = |linear: u8| {
+        let geo = tmp.path().join(format!("s{linear}.geo"));
+        std::fs::write(
+            &geo,
+            format!(
+                "SetFactory(\"OpenCASCADE\");\nSphere(1) = {{0, 0, 0, 0.05}};\n\
+                 Mesh.MeshSizeMax = 0.02;\nMesh.ElementOrder = 2;\n\
+                 Mesh.SecondOrderLinear = {linear};\nMesh.Binary = 1;\nMesh.MshFileVersion = 4.1;\n"
+            ),
+        )
+        .unwrap();
+        gmsh_volume_mesh(&geo)
+    };
+    let (curved, straight) = (sphere(0), sphere(1));
+    let mut m = read_mesh(&curved).unwrap();
+    let e = m.check_straight(DEFAULT_STRAIGHT_REL_TOL).unwrap_err();
+    assert!(e.to_string().contains("--straighten"), "{e}");
+    let (moved, relative) = m.straighten();
+    assert!(moved > 1e-4 && relative > 0.01, "{moved} m, {relative}");
+    let s = read_mesh(&straight).unwrap();
+    assert_eq!(
+        (&m.nodes, &m.tets, &m.mid_edges),
+        (&s.nodes, &s.tets, &s.mid_edges)
+    );
+    let hash = |mesh: &Path, extra: &[&str], out: &str| {
+        let mut a: Vec<&dyn AsRef<std::ffi::OsStr>> = vec![&"bake", &mesh, &"-o"];
+        let out = tmp.path().join(out);
+        a.push(&out);
+        a.extend(
+            STEEL_4
+                .iter()
+                .chain(extra)
+                .map(|s| s as &dyn AsRef<std::ffi::OsStr>),
+        );
+        a.push(&"--json");
+        let o = run_bake(&a);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        v["source_hash"].as_str().unwrap().to_string()
+    };
+    assert_eq!(
+        hash(&curved, &["--straighten"], "c.modes"),
+        hash(&straight, &[], "s.modes")
+    );
+    let base = tmp.path().join("c.modes");
+    let check = |extra: &[&str]| {
+        let mut a: Vec<&dyn AsRef<std::ffi::OsStr>> = vec![&"check", &curved, &base];
+        a.extend(
+            STEEL_4
+                .iter()
+                .chain(extra)
+                .map(|s| s as &dyn AsRef<std::ffi::OsStr>),
+        );
+        run_bake(&a).status.code()
+    };
+    assert_eq!(check(&["--straighten"]), Some(0));
+    assert_eq!(
+        check(&[]),
+        Some(2),
+        "without --straighten the curved mesh is refused"
+    );
+    let asset = data("assets/hp_body.obj");
+    let o = run_bake(&[
+        &"bake",
+        &asset,
+        &"-o",
+        &tmp.path().join("a.modes"),
+        &"--straighten",
+    ]);
+    let text = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && text.contains("--straighten applies to second-order volume meshes"),
+        "{text}"
+    );
+}

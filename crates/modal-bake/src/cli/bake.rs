@@ -102,8 +102,8 @@ impl BakeArgs {
 }
 
 /// The tetrahedral mesh of `path`: read (its `--object` physical volume, its `--piece`
-/// connected piece), or (a surface asset) meshed by the meshing chain; with the seconds it
-/// took. Meshing options given with a volume mesh are an error.
+/// connected piece, `--straighten`ed), or (a surface asset) meshed by the meshing chain; with
+/// the seconds it took. Meshing options given with a volume mesh are an error.
 pub fn load_mesh(
     path: &std::path::Path,
     asset: &AssetOptions,
@@ -142,6 +142,18 @@ pub fn load_mesh(
                 e.file = path.display().to_string();
                 e
             })?;
+    }
+    if asset.straighten {
+        let note = if mesh.is_quadratic() {
+            let (moved, relative) = mesh.straighten();
+            format!(
+                "--straighten: every mid-edge node at its edge's midpoint; the largest move {moved:.3e} m ({:.3} % of its edge)",
+                100.0 * relative
+            )
+        } else {
+            "--straighten: a linear mesh, nothing to move".to_string()
+        };
+        mesh.notes.push(note);
     }
     Ok((mesh, t.elapsed().as_secs_f64()))
 }

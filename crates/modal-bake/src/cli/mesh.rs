@@ -170,6 +170,12 @@ pub struct AssetOptions {
     /// selected by name with --object.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
     pub piece: Option<u64>,
+    /// Volume meshes of order 2 (.msh, .json): move every mid-edge node to its edge's midpoint,
+    /// so a curved mesh (gmsh's `-order 2` default, Netgen's second order) bakes as
+    /// straight-sided, its boundary faceted at the corner nodes as `modal-bake mesh --order 2`
+    /// makes it; the largest move is noted [default: a curved element is refused].
+    #[arg(long)]
+    pub straighten: bool,
 }
 
 impl AssetOptions {
@@ -181,11 +187,17 @@ impl AssetOptions {
     /// The meshing parameters.
     ///
     /// # Errors
-    /// An invalid `--mesher-timeout`; `--piece`, which applies to volume meshes only.
+    /// An invalid `--mesher-timeout`; `--piece` or `--straighten`, which apply to volume
+    /// meshes only.
     pub fn params(&self) -> anyhow::Result<MeshParams> {
         if let Some(n) = self.piece {
             anyhow::bail!(
                 "--piece {n} selects a connected piece of a volume mesh (.msh, .json); a surface asset's parts are selected by name: --object NAME (`modal-bake mesh ASSET --dry-run` lists them)"
+            );
+        }
+        if self.straighten {
+            anyhow::bail!(
+                "--straighten applies to second-order volume meshes (.msh, .json); a surface asset is meshed straight-sided already"
             );
         }
         Ok(MeshParams {
@@ -223,15 +235,17 @@ impl AssetOptions {
             || self.mesher_timeout != modal_bake::mesh::work::DEFAULT_TIMEOUT_S
             || self.object.is_some()
             || self.piece.is_some()
+            || self.straighten
     }
 
-    /// Whether an option other than `--object`, `--piece` and `--units` is set: those apply
-    /// to surface assets only (`--object` also selects a physical volume of a `.msh`,
-    /// `--piece` applies to volume meshes only).
+    /// Whether an option other than `--object`, `--piece`, `--straighten` and `--units` is
+    /// set: those apply to surface assets only (`--object` also selects a physical volume of a
+    /// `.msh`; `--piece` and `--straighten` apply to volume meshes only).
     pub fn any_meshing_set(&self) -> bool {
         AssetOptions {
             object: None,
             piece: None,
+            straighten: false,
             ..self.clone()
         }
         .any_set()

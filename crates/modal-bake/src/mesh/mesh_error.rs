@@ -277,8 +277,9 @@ pub enum MeshErrorKind {
     #[error(
         "curved 10-node tetrahedron {element}: a mid-edge node is {offset:e} m off its edge's \
          midpoint (edge length {edge_length:e} m); only straight-sided second-order elements are \
-         supported: mesh with gmsh's `Mesh.SecondOrderLinear = 1` (what `modal-bake mesh \
-         --order 2` does) or bake the linear mesh"
+         supported: bake it with --straighten (every mid-edge node moved to its edge's \
+         midpoint: the boundary faceted at the corners, as `modal-bake mesh --order 2` makes it), \
+         mesh with gmsh's `Mesh.SecondOrderLinear = 1`, or bake the linear mesh"
     )]
     CurvedTet {
         /// The element id (see [`crate::mesh::TetMesh::tet_ids`]).
