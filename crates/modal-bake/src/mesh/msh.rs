@@ -203,8 +203,8 @@ fn read_header(c: &mut Cursor<'_>) -> Result<(Version, usize), MeshError> {
         .ok()
         .and_then(|t| t.parse::<f64>().ok());
     let version = match number {
-        Some(v) if v == 2.0 || v == 2.1 || v == 2.2 => Version::V22,
-        Some(v) if v == 4.1 => Version::V41,
+        Some(2.0 | 2.1 | 2.2) => Version::V22,
+        Some(4.1) => Version::V41,
         _ => {
             return Err(c.error_at(
                 vpos,
