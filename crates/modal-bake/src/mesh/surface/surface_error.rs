@@ -14,8 +14,12 @@ pub enum SurfaceError {
         /// What the operating system said.
         detail: String,
     },
-    /// The extension is not one of `.obj`, `.stl`, `.ply`, `.glb`, `.gltf`.
-    #[error("{file}: unrecognised surface format (expected .obj, .stl, .ply, .glb or .gltf)")]
+    /// The extension is not one of `.obj`, `.stl`, `.ply`, `.glb`, `.gltf`; the message says
+    /// what to do with the file (bake a volume mesh directly, convert another format).
+    #[error(
+        "{file}: unrecognised surface format (surface assets are .obj, .stl, .ply, .glb or .gltf): {}",
+        format_hint(file)
+    )]
     UnknownFormat {
         /// The file.
         file: String,
@@ -138,4 +142,39 @@ pub enum SurfaceError {
         /// Number of shells.
         shells: usize,
     },
+}
+
+/// What to do with `file`, which is not a surface asset, by its extension.
+fn format_hint(file: &str) -> String {
+    let ext = std::path::Path::new(file)
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    match ext.as_deref() {
+        Some("msh" | "json") => format!(
+            "{file} is a volume mesh, meshed already: bake it directly (`modal-bake bake {file} -o OUT.modes`)"
+        ),
+        _ => "export another format (FBX, 3MF, DAE, …) as glTF or OBJ (Blender: File ▸ Export); convert a surface in VTK, VTU or OFF with meshio (`pip install meshio`, `meshio convert IN OUT.stl`)".to_string(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::SurfaceError;
+
+    // Expectation: a volume mesh given where a surface asset is read is told to bake it
+    // directly; another format is told how to convert it.
+    #[test]
+    fn an_unknown_surface_format_is_told_what_to_do() {
+        let text = |file: &str| SurfaceError::UnknownFormat { file: file.into() }.to_string();
+        assert!(text("t5.msh").contains("`modal-bake bake t5.msh -o OUT.modes`"));
+        assert!(text("m.JSON").contains("is a volume mesh"));
+        for file in ["chair.fbx", "part.3mf", "s.vtu"] {
+            let t = text(file);
+            assert!(
+                t.starts_with(file) && t.contains("as glTF or OBJ") && t.contains("meshio convert"),
+                "{t}"
+            );
+        }
+    }
 }
