@@ -18,8 +18,10 @@ pub const PLAUSIBLE_MASS_KG: [f64; 2] = [1e-4, 1e6];
 /// lamp post … a 50 kHz bead (a 100 m tower can sway below 1 Hz: the warning is a hint).
 pub const PLAUSIBLE_LOWEST_HZ: [f64; 2] = [2.0, 5e4];
 
-/// Plausible bar wave speeds √(E/ρ) of solids (m/s): soft foams ~ 50 … diamond ~ 18,000.
-pub const PLAUSIBLE_WAVE_SPEED: [f64; 2] = [50.0, 2e4];
+/// Plausible bar wave speeds √(E/ρ) of solids (m/s): soft silicone rubber ~ 15 (E 0.25 MPa,
+/// ρ 1100 kg/m³) … diamond ~ 18,000. A modulus typed in MPa or GPa lands below (steel 5 and
+/// 0.005 m/s, oak 3.8 m/s, ABS 1.5 m/s), a density in g/cm³ above (steel 1.6e5 m/s).
+pub const PLAUSIBLE_WAVE_SPEED: [f64; 2] = [10.0, 2e4];
 
 /// What the size of an object `extent_m` across (bounding-box diagonal, m) says about its
 /// length unit, when it is implausible: the likely unit and the fix. `None` for a plausible
@@ -148,6 +150,29 @@ mod tests {
         };
         let w = plausibility_warnings(Some(0.3), 10.0, &gpa_as_pa, None);
         assert!(w.len() == 1 && w[0].contains("wave speed"), "{w:?}");
+        // E typed in MPa: 2e5 Pa → c = 5 m/s; ρ in g/cm³: 7.85 → 1.6e5 m/s.
+        for wrong in [
+            MaterialSi {
+                youngs: 2e5,
+                ..steel
+            },
+            MaterialSi {
+                density: 7.85,
+                ..steel
+            },
+        ] {
+            let w = plausibility_warnings(Some(0.3), 10.0, &wrong, None);
+            assert!(w.len() == 1 && w[0].contains("wave speed"), "{w:?}");
+        }
+        // Rubber (E 1 MPa, ρ 1100 kg/m³: 30 m/s) and soft silicone (0.25 MPa: 15 m/s) are solids.
+        for youngs in [1e6, 2.5e5] {
+            let rubber = MaterialSi {
+                youngs,
+                poisson: 0.49,
+                density: 1100.0,
+            };
+            assert!(plausibility_warnings(Some(0.3), 1.0, &rubber, None).is_empty());
+        }
         assert!(plausibility_warnings(Some(0.3), 10.0, &steel, Some(2000.0)).is_empty());
     }
 }
