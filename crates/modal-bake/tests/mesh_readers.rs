@@ -883,28 +883,33 @@ fn gmsh_extruded_box(dir: &Path, recombine: bool) -> PathBuf {
     gmsh_volume_mesh(&geo_path)
 }
 
-/// The real gmsh's volume mesh of the `.geo` script `geo`, written beside it as `.msh`: the
-/// `gmsh` launcher, or the PyPI module through Python when the launcher is not on PATH.
-fn gmsh_volume_mesh(geo: &Path) -> PathBuf {
-    let msh = geo.with_extension("msh");
-    let ok = match std::process::Command::new("gmsh")
-        .arg(geo)
-        .args(["-3", "-o"])
-        .arg(&msh)
-        .output()
-    {
+/// Runs the real gmsh with its command line `args`: the `gmsh` launcher, or the PyPI module
+/// through Python when the launcher is not on PATH (as `modal-bake` itself runs it); whether
+/// it succeeded.
+fn run_gmsh(args: &[&std::ffi::OsStr]) -> bool {
+    match std::process::Command::new("gmsh").args(args).output() {
         Ok(out) => out.status.success(),
         Err(_) => std::process::Command::new("python3")
             .args([
                 "-c",
-                "import gmsh, sys; gmsh.initialize(); gmsh.open(sys.argv[1]); \
-                 gmsh.model.mesh.generate(3); gmsh.write(sys.argv[2]); gmsh.finalize()",
+                "import gmsh, sys; gmsh.initialize(['gmsh'] + sys.argv[1:], \
+                 readConfigFiles=False, run=True); gmsh.finalize()",
             ])
-            .arg(geo)
-            .arg(&msh)
-            .status()
-            .is_ok_and(|s| s.success()),
-    };
+            .args(args)
+            .output()
+            .is_ok_and(|o| o.status.success()),
+    }
+}
+
+/// The real gmsh's volume mesh of the `.geo` script `geo`, written beside it as `.msh`.
+fn gmsh_volume_mesh(geo: &Path) -> PathBuf {
+    let msh = geo.with_extension("msh");
+    let ok = run_gmsh(&[
+        geo.as_os_str(),
+        "-3".as_ref(),
+        "-o".as_ref(),
+        msh.as_os_str(),
+    ]);
     assert!(ok && msh.exists(), "gmsh could not mesh {}", geo.display());
     msh
 }
@@ -1384,12 +1389,6 @@ fn older_msh_versions_read_or_are_refused_with_the_resave() {
     let tmp = tempfile::tempdir().unwrap();
     let (old, new) = (tmp.path().join("old.msh"), tmp.path().join("new.msh"));
     std::fs::write(&old, msh1).unwrap();
-    let gmsh = |args: &[&std::ffi::OsStr]| {
-        std::process::Command::new("gmsh")
-            .args(args)
-            .output()
-            .map(|o| o.status.success())
-    };
     let args = [
         old.as_os_str(),
         "-save".as_ref(),
@@ -1398,15 +1397,7 @@ fn older_msh_versions_read_or_are_refused_with_the_resave() {
         "-o".as_ref(),
         new.as_os_str(),
     ];
-    if gmsh(&args).is_err() {
-        // The PyPI package without its `gmsh` script on PATH: its Python module.
-        let ok = std::process::Command::new("python3")
-            .args(["-c", "import gmsh, sys; gmsh.initialize(); gmsh.open(sys.argv[1]); gmsh.option.setNumber('Mesh.MshFileVersion', 4.1); gmsh.write(sys.argv[2]); gmsh.finalize()"])
-            .args([&old, &new])
-            .status()
-            .is_ok_and(|s| s.success());
-        assert!(ok, "gmsh could not re-save {}", old.display());
-    }
+    assert!(run_gmsh(&args), "gmsh could not re-save {}", old.display());
     let m = read_mesh(&new).unwrap();
     assert_eq!((m.nodes.len(), m.tets.len()), (4, 1));
     assert!((m.volume() - 1.0 / 6.0).abs() < 1e-15);
@@ -1539,4 +1530,57 @@ fn a_curved_gmsh_mesh_bakes_straightened_as_gmsh_s_straight_one() {
         !o.status.success() && text.contains("--straighten applies to second-order volume meshes"),
         "{text}"
     );
+}
+
+// Expectation (real gmsh): a gmsh surface mesh (`-2`) given as a volume mesh is told it holds
+// triangles only, with gmsh's command that writes the surface as an STL asset — and that
+// command's STL reads as the same closed surface.
+#[test]
+fn a_gmsh_surface_mesh_is_told_how_to_become_an_asset() {
+    if !gmsh_gate::have_gmsh("a_gmsh_surface_mesh_is_told_how_to_become_an_asset") {
+        return;
+    }
+    let tmp = tempfile::tempdir().unwrap();
+    let geo = tmp.path().join("s.geo");
+    std::fs::write(
+        &geo,
+        "SetFactory(\"OpenCASCADE\");\nSphere(1) = {0, 0, 0, 0.05};\nMesh.MeshSizeMax = 0.02;\n",
+    )
+    .unwrap();
+    let msh = tmp.path().join("s.msh");
+    let stl = tmp.path().join("s.stl");
+    let gmsh = |args: &[&std::ffi::OsStr]| assert!(run_gmsh(args), "gmsh {args:?}");
+    gmsh(&[
+        geo.as_os_str(),
+        "-2".as_ref(),
+        "-o".as_ref(),
+        msh.as_os_str(),
+    ]);
+    let e = read_mesh(&msh).unwrap_err();
+    let MeshErrorKind::NoTets { found, .. } = &e.kind else {
+        panic!("{e}")
+    };
+    let triangles: usize = found
+        .split(' ')
+        .next()
+        .unwrap()
+        .replace(',', "")
+        .parse()
+        .unwrap();
+    assert!(
+        e.to_string()
+            .contains("`gmsh FILE.msh -0 -format stl -o FILE.stl`"),
+        "{e}"
+    );
+    gmsh(&[
+        msh.as_os_str(),
+        "-0".as_ref(),
+        "-format".as_ref(),
+        "stl".as_ref(),
+        "-o".as_ref(),
+        stl.as_os_str(),
+    ]);
+    let mut surface = modal_bake::mesh::surface::read_surface(&stl).unwrap();
+    assert_eq!(surface.triangles.len(), triangles);
+    surface.check_closed("s.stl").unwrap();
 }

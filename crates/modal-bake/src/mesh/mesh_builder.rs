@@ -10,7 +10,7 @@ use super::tet_mesh::TetMesh;
 pub(crate) const NO_TETS_OTHER_VOLUME: &str = "modal-bake bakes 4- and 10-node tetrahedra only; mesh the volume with tetrahedra of order 1 or 2 (gmsh: no `Recombine` in `Extrude`, `Mesh.RecombineAll = 0`, `Mesh.Recombine3DAll = 0`, `-order 1` or `-order 2`)";
 
 /// [`MeshErrorKind::NoTets`]'s fix when the file holds no volume elements at all.
-pub(crate) const NO_TETS_NO_VOLUME: &str = "modal-bake bakes a volume meshed with tetrahedra; mesh a volume (gmsh: a `Volume` in the geometry, `gmsh FILE.geo -3`), or give the closed surface as an .obj / .stl / .ply / .glb asset for modal-bake to mesh";
+pub(crate) const NO_TETS_NO_VOLUME: &str = "modal-bake bakes a volume meshed with tetrahedra; mesh a volume (gmsh: a `Volume` in the geometry, `gmsh FILE.geo -3`), or give the closed surface as an .obj / .stl / .ply / .glb asset for modal-bake to mesh (a gmsh surface mesh: `gmsh FILE.msh -0 -format stl -o FILE.stl`)";
 
 /// Nodes and elements as read, before canonicalisation. Element node references are indices
 /// into the tag-sorted node table.
