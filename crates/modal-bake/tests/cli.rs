@@ -1,5 +1,5 @@
 //! End-to-end tests of the `modal-bake` binary: byte-identical bases across input forms and
-//! runs, `check` exit codes, `info --json` keys, and the bad-input corpus (clear error naming
+//! runs, `check` exit codes, `info --json` keys, `info` of a volume mesh, and the bad-input corpus (clear error naming
 //! the file and location, non-zero exit, no panic, no output left behind).
 
 use std::path::{Path, PathBuf};
@@ -224,6 +224,64 @@ fn info_json_has_the_documented_keys() {
         let (f, l) = (f.as_f64().unwrap(), l.as_f64().unwrap());
         assert!((f - l.sqrt() / (2.0 * std::f64::consts::PI)).abs() <= 1e-12 * f);
     }
+}
+
+/// `info MESH`: a volume mesh is summarised before baking — its size and volume, its pieces
+/// largest first (the numbers `--piece` takes, and the pieces' volumes add up to the mesh's),
+/// its groups with node counts, and a curved second-order mesh is told `--straighten`; a
+/// surface asset is sent to `mesh --dry-run`; an unreadable mesh is the reader's located error.
+#[test]
+fn info_summarises_a_volume_mesh_before_baking() {
+    let o = run(&[
+        "info",
+        data("bad/two_pieces.msh").to_str().unwrap(),
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(
+        (v["kind"].as_str(), v["tets"].as_u64(), v["order"].as_u64()),
+        (Some("volume mesh"), Some(2), Some(1))
+    );
+    let pieces = v["pieces"].as_array().unwrap();
+    assert_eq!(pieces.len(), 2);
+    let sum: f64 = pieces
+        .iter()
+        .map(|p| p["volume_m3"].as_f64().unwrap())
+        .sum();
+    assert!(
+        (sum - v["volume_m3"].as_f64().unwrap()).abs() < 1e-15 && (sum - 1.0 / 3.0).abs() < 1e-15
+    );
+    assert_eq!(
+        pieces[1]["bbox_m"],
+        serde_json::json!([[5.0, 0.0, 0.0], [6.0, 1.0, 1.0]])
+    );
+    let o = run(&["info", data("meshes/cube_v41.msh").to_str().unwrap()]);
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for part in [
+        "1,140 4-node tetrahedra (order 1)",
+        "volume 1 m³",
+        "pieces: 1 (connected)",
+        "bottom (58 nodes)",
+        "corner (1 node)",
+    ] {
+        assert!(text.contains(part), "{part}: {text}");
+    }
+    let o = run(&["info", data("bad/second_order_only.msh").to_str().unwrap()]);
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        text.contains("elements: curved (element 1") && text.contains("bake with --straighten"),
+        "{text}"
+    );
+    let o = run(&["info", data("assets/hp_body.obj").to_str().unwrap()]);
+    assert!(!o.status.success() && String::from_utf8_lossy(&o.stderr).contains("--dry-run"));
+    let o = run(&["info", data("bad/missing_node.msh").to_str().unwrap()]);
+    let text = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && text.contains("missing_node.msh:") && text.contains("names node 99"),
+        "{text}"
+    );
 }
 
 /// Each bad input: exit ≠ 0, no panic, a message naming the file (and where), no output file.

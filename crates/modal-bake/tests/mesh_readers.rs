@@ -144,7 +144,7 @@ fn cube_groups_geometry_and_notes() {
         let m = read_ok(form);
         assert!(
             m.notes
-                .contains(&"skipped 1 elements of gmsh type 15 (1-node point)".to_string()),
+                .contains(&"skipped 1 element of gmsh type 15 (1-node point)".to_string()),
             "{form}: {:?}",
             m.notes
         );
@@ -786,11 +786,11 @@ fn other_volume_elements_are_refused_not_left_out() {
     for (extra, what) in [
         (
             "6 2 1 1 1 2 3 5 6 7",
-            "1 elements of gmsh type 6 (6-node prism)",
+            "1 element of gmsh type 6 (6-node prism)",
         ),
         (
             "7 2 1 1 1 2 6 5 4",
-            "1 elements of gmsh type 7 (5-node pyramid)",
+            "1 element of gmsh type 7 (5-node pyramid)",
         ),
     ] {
         let e =
@@ -837,7 +837,7 @@ fn a_mesh_without_tetrahedra_says_what_it_holds() {
                    4 0 0 1\n$EndNodes\n$Elements\n3\n1 1 2 1 1 1 2\n2 2 2 1 1 1 2 3\n\
                    3 3 2 1 1 1 2 3 4\n$EndElements\n";
     let e = read_msh_bytes(surface.as_bytes(), "t1.msh").unwrap_err();
-    let found = "1 triangle, 1 elements of gmsh type 1 (2-node line), 1 elements of gmsh type 3 \
+    let found = "1 triangle, 1 element of gmsh type 1 (2-node line), 1 element of gmsh type 3 \
                  (4-node quadrangle)";
     assert!(
         matches!(&e.kind, MeshErrorKind::NoTets { found: f, .. } if f == found),
@@ -858,7 +858,7 @@ fn a_mesh_without_tetrahedra_says_what_it_holds() {
     let e = read_msh_bytes(p3.as_bytes(), "p3.msh").unwrap_err();
     assert!(
         matches!(&e.kind, MeshErrorKind::NoTets { found, .. }
-            if found == "1 elements of gmsh type 29 (20-node tetrahedron)"),
+            if found == "1 element of gmsh type 29 (20-node tetrahedron)"),
         "{e}"
     );
     assert!(e.to_string().contains("`-order 1` or `-order 2`"), "{e}");

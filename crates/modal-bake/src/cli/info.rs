@@ -8,7 +8,8 @@ use dcr_runtime::format::ModesFile;
 
 #[derive(Args)]
 pub struct InfoArgs {
-    /// A .modes base.
+    /// A .modes base, or a volume mesh (.msh, .json): its size, extent, connected pieces
+    /// (--piece), node groups (--fixed, --object) and whether its elements are straight.
     pub file: PathBuf,
     /// One JSON object on stdout instead of the summary.
     #[arg(long)]
@@ -111,6 +112,16 @@ fn warnings(base: &ModesFile) -> Vec<String> {
 }
 
 pub fn run(args: &InfoArgs) -> anyhow::Result<()> {
+    if super::info_mesh::is_volume_mesh(&args.file) {
+        return super::info_mesh::run(&args.file, args.json);
+    }
+    if modal_bake::mesh::surface::is_surface_asset(&args.file) {
+        anyhow::bail!(
+            "{} is a surface asset: `modal-bake mesh {} --dry-run` inspects it (its objects, the mesher, the size estimate)",
+            args.file.display(),
+            args.file.display()
+        );
+    }
     // FormatError messages name the file and the entry at fault.
     let base = ModesFile::read(&args.file)?;
     let warnings = warnings(&base);

@@ -15,6 +15,7 @@ mod check;
 mod export;
 mod geodesic;
 mod info;
+mod info_mesh;
 mod lab_alias;
 mod mesh;
 mod parse;
@@ -50,7 +51,8 @@ enum Command {
     /// Tetrahedralize a surface asset (OBJ, STL, PLY, glTF) into a .msh mesh: inspected, then gmsh
     /// or fTetWild (--mesher auto).
     Mesh(mesh::MeshArgs),
-    /// Print a readable summary of a .modes file (or one JSON object with --json).
+    /// Print a readable summary of a .modes file, or of a volume mesh (.msh, .json) before
+    /// baking it (or one JSON object with --json).
     Info(info::InfoArgs),
     /// Exit 0 if OUT.modes is up to date for MESH and the options, 1 if stale or missing,
     /// 2 on an error (unreadable mesh, bad options).

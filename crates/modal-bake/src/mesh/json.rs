@@ -83,7 +83,7 @@ impl CellFiler {
                 }
             }
             other => {
-                let what = format!("cells of type {other:?}");
+                let what = format!("of type {other:?}");
                 let n = rows.len() as u64;
                 let volume = cell_info(other).is_some_and(|(_, dim)| dim == 3)
                     || other.starts_with("polyhedron");
@@ -98,7 +98,8 @@ impl CellFiler {
     /// Records the skipped types as notes.
     fn finish(self, builder: &mut MeshBuilder) {
         for (what, n, volume) in &self.skipped {
-            builder.skip(what, *n, *volume);
+            let noun = if *n == 1 { "cell" } else { "cells" };
+            builder.skip(&format!("{noun} {what}"), *n, *volume);
         }
     }
 }

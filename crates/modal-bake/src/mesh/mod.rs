@@ -54,7 +54,7 @@ pub use mesher::{
 };
 pub use msh_writer::msh41_bytes;
 pub(crate) use pieces::list_pieces;
-pub use pieces::MeshPiece;
+pub use pieces::{four_digits, MeshPiece};
 pub(crate) use tet_mesh::tet_faces;
 pub use tet_mesh::{signed_volume, TetMesh, TET10_EDGES};
 pub use validate::{DEFAULT_DEGENERATE_REL_TOL, DEFAULT_STRAIGHT_REL_TOL, STRAIGHT_DIAGONAL_TOL};

@@ -346,9 +346,10 @@ impl MshReader<'_> {
             ));
         }
         for &(ty, n) in &self.skipped {
+            let noun = if n == 1 { "element" } else { "elements" };
             let (what, volume) = match element_info(ty) {
-                Some((_, dim, name)) => (format!("elements of gmsh type {ty} ({name})"), dim == 3),
-                None => (format!("elements of gmsh type {ty} (unknown type)"), false),
+                Some((_, dim, name)) => (format!("{noun} of gmsh type {ty} ({name})"), dim == 3),
+                None => (format!("{noun} of gmsh type {ty} (unknown type)"), false),
             };
             self.builder.skip(&what, n, volume);
         }

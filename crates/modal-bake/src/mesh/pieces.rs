@@ -40,7 +40,7 @@ impl std::fmt::Display for MeshPiece {
         let [lo, hi] = self.bbox;
         let zero = 1e-6 * (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt();
         let p = |x: [f64; 3]| {
-            let c = x.map(|c| short(if c.abs() < zero { 0.0 } else { c }));
+            let c = x.map(|c| four_digits(if c.abs() < zero { 0.0 } else { c }));
             format!("({}, {}, {})", c[0], c[1], c[2])
         };
         write!(
@@ -53,15 +53,23 @@ impl std::fmt::Display for MeshPiece {
             } else {
                 "tetrahedra"
             },
-            short(self.volume),
+            four_digits(self.volume),
             p(lo),
             p(hi)
         )
     }
 }
 
-/// `x` with four significant digits, without trailing zeros: `0.05`, `1`, `-1.25e-5`.
-fn short(x: f64) -> String {
+/// `x` with four significant digits, without trailing zeros: `0.05`, `1`, `-1.25e-5`, `12350`
+/// (plain between 1e-3 and 1e4, else in e-notation); `-0` prints as `0`.
+///
+/// ```
+/// use modal_bake::mesh::four_digits;
+/// assert_eq!(four_digits(0.050001), "0.05");
+/// assert_eq!(four_digits(-1.23456e-5), "-1.235e-5");
+/// assert_eq!(four_digits(-0.0), "0");
+/// ```
+pub fn four_digits(x: f64) -> String {
     if x == 0.0 || !x.is_finite() {
         return format!("{}", if x == 0.0 { 0.0 } else { x });
     }
