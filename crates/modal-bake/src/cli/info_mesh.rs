@@ -1,7 +1,7 @@
 //! `modal-bake info MESH`: what a volume mesh holds and how to bake it — its size, extent,
 //! connected pieces (for `--piece`), node groups (for `--fixed` and, 3-D physical groups of a
-//! `.msh`, `--object`), whether its second-order elements are straight (else `--straighten`)
-//! and the readers' notes. Coordinates as the file gives them (m unless `bake --units` says
+//! `.msh`, `--object`), whether its second-order elements are straight (else `--straighten`),
+//! the bake's estimated time and memory at its defaults and the readers' notes. Coordinates as the file gives them (m unless `bake --units` says
 //! otherwise).
 
 use std::fmt::Write as _;
@@ -55,6 +55,10 @@ pub fn run(file: &Path, json: bool) -> anyhow::Result<()> {
     let bbox = bounding_box(&mesh);
     let order = if mesh.is_quadratic() { 2 } else { 1 };
     let name = file.display().to_string();
+    // The bake at its defaults (20 modes, free-free) against the default budget.
+    let estimate =
+        modal_bake::bake::SizeEstimate::of_bake(&mesh, &modal_bake::bake::BakeParams::default());
+    let fits = estimate.fits(&modal_bake::bake::Budget::default());
     let text = if json {
         let v = serde_json::json!({
             "file": name,
@@ -79,6 +83,11 @@ pub fn run(file: &Path, json: bool) -> anyhow::Result<()> {
                 "edge_length_m": edge,
             })),
             "notes": mesh.notes,
+            "bake_estimate": {
+                "seconds": estimate.bake_s,
+                "peak_bytes": estimate.bake_bytes,
+                "within_default_budget": fits,
+            },
         });
         format!("{}\n", serde_json::to_string_pretty(&v)?)
     } else {
@@ -145,6 +154,17 @@ pub fn run(file: &Path, json: bool) -> anyhow::Result<()> {
                 "  elements: curved (element {element}: a mid-edge node {offset:.3e} m off its edge's midpoint, edge {edge:.3e} m): bake with --straighten"
             )?,
         }
+        writeln!(
+            s,
+            "  bake (20 modes, free-free): about {} and {}{}",
+            modal_bake::bake::format_seconds(estimate.bake_s),
+            modal_bake::bake::format_bytes(estimate.bake_bytes),
+            if fits {
+                ""
+            } else {
+                ": over the default budget of 2 GB and 5 min, so `bake` refuses it without --max-memory / --max-time or --force"
+            }
+        )?;
         for note in &mesh.notes {
             writeln!(s, "  note: {note}")?;
         }
