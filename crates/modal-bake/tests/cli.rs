@@ -256,6 +256,8 @@ fn info_summarises_a_volume_mesh_before_baking() {
         pieces[1]["bbox_m"],
         serde_json::json!([[5.0, 0.0, 0.0], [6.0, 1.0, 1.0]])
     );
+    assert_eq!(v["bake_estimate"]["within_default_budget"], true);
+    assert!(v["bake_estimate"]["peak_bytes"].as_f64().unwrap() > 0.0);
     let o = run(&["info", data("meshes/cube_v41.msh").to_str().unwrap()]);
     let text = String::from_utf8_lossy(&o.stdout);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
@@ -265,6 +267,7 @@ fn info_summarises_a_volume_mesh_before_baking() {
         "pieces: 1 (connected)",
         "bottom (58 nodes)",
         "corner (1 node)",
+        "bake (20 modes, free-free): about",
     ] {
         assert!(text.contains(part), "{part}: {text}");
     }
