@@ -60,7 +60,7 @@ impl std::fmt::Display for MeshPiece {
     }
 }
 
-/// `x` with four significant digits, without trailing zeros: `0.05`, `1`, `-1.25e-5`, `12350`
+/// `x` with four significant digits, without trailing zeros: `0.05`, `1`, `-1.25e-5`, `1.235e4`
 /// (plain between 1e-3 and 1e4, else in e-notation); `-0` prints as `0`.
 ///
 /// ```
@@ -68,6 +68,7 @@ impl std::fmt::Display for MeshPiece {
 /// assert_eq!(four_digits(0.050001), "0.05");
 /// assert_eq!(four_digits(-1.23456e-5), "-1.235e-5");
 /// assert_eq!(four_digits(-0.0), "0");
+/// assert_eq!(four_digits(12_346.0), "1.235e4");
 /// ```
 pub fn four_digits(x: f64) -> String {
     if x == 0.0 || !x.is_finite() {
