@@ -5,6 +5,8 @@
 //! message and no file written.
 
 mod common;
+#[path = "common/meshio_gate.rs"]
+mod meshio_gate;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -55,36 +57,16 @@ fn vtu_opened_by_meshio_carries_the_surface_and_every_mode_shape_exactly() {
     let vtu = dir.path().join("beam.vtu");
     let o = run(&["export", s(&base_path), "--vtu", s(&vtu)]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let script = r#"
-import json, sys
-try:
-    import meshio
-except ImportError:
-    print("NO_MESHIO"); sys.exit(0)
+    let body = r#"
 m = meshio.read(sys.argv[1])
 tri = [c.data.tolist() for c in m.cells if c.type == "triangle"]
 print(json.dumps({"points": m.points.tolist(), "types": [c.type for c in m.cells],
                   "triangles": tri[0] if tri else [],
                   "point_data": {k: v.tolist() for k, v in m.point_data.items()}}))
 "#;
-    let out = Command::new("python3")
-        .args(["-c", script, s(&vtu)])
-        .output()
-        .expect("python3 runs");
-    let text = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success(),
-        "meshio failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    if text.trim() == "NO_MESHIO" {
-        assert!(
-            std::env::var_os("CI").is_none(),
-            "meshio is not installed under CI"
-        );
-        eprintln!("SKIPPED: meshio not installed (pip install meshio)");
+    let Some(text) = meshio_gate::run_with_meshio(body, &[vtu.as_os_str()]) else {
         return;
-    }
+    };
     let v: serde_json::Value = serde_json::from_str(&text).unwrap();
     let base = ModesFile::read(&base_path).unwrap();
     // Geometry: same points and triangles, bit for bit.
@@ -438,35 +420,15 @@ fn p2_base_exports_mid_edge_points_with_their_rows() {
         }
     }
 
-    let script = r#"
-import json, sys
-try:
-    import meshio
-except ImportError:
-    print("NO_MESHIO"); sys.exit(0)
+    let body = r#"
 m = meshio.read(sys.argv[1])
 print(json.dumps({"points": m.points.tolist(),
                   "triangles": [c.data.tolist() for c in m.cells if c.type == "triangle"][0],
                   "point_data": {k: v.tolist() for k, v in m.point_data.items()}}))
 "#;
-    let out = Command::new("python3")
-        .args(["-c", script, s(&vtu)])
-        .output()
-        .expect("python3 runs");
-    let text = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    if text.trim() == "NO_MESHIO" {
-        assert!(
-            std::env::var_os("CI").is_none(),
-            "meshio is not installed under CI"
-        );
-        eprintln!("SKIPPED: meshio not installed (pip install meshio)");
+    let Some(text) = meshio_gate::run_with_meshio(body, &[vtu.as_os_str()]) else {
         return;
-    }
+    };
     let v: serde_json::Value = serde_json::from_str(&text).unwrap();
     let pts = v["points"].as_array().unwrap();
     assert_eq!(pts.len(), ns + ne);

@@ -7,6 +7,8 @@ use std::path::{Path, PathBuf};
 
 #[path = "common/gmsh_gate.rs"]
 mod gmsh_gate;
+#[path = "common/meshio_gate.rs"]
+mod meshio_gate;
 
 use modal_bake::mesh::{
     read_json, read_mesh, read_mesh_bytes, read_msh, read_msh_bytes, signed_volume, Location,
@@ -1313,38 +1315,16 @@ fn other_formats_are_named_with_their_conversion() {
         );
     }
     let tmp = tempfile::tempdir().unwrap();
-    let script = r#"
-import sys
-try:
-    import meshio
-except ImportError:
-    print("NO_MESHIO"); sys.exit(0)
+    let body = r#"
 m = meshio.read(sys.argv[1])
 m = meshio.Mesh(m.points, [c for c in m.cells if c.type == "tetra"])
 meshio.write(sys.argv[2], m)
 meshio.write(sys.argv[3], m, file_format="gmsh")
-print("OK")
 "#;
     let (default, gmsh) = (tmp.path().join("default.msh"), tmp.path().join("gmsh.msh"));
-    let out = std::process::Command::new("python3")
-        .arg("-c")
-        .arg(script)
-        .arg(data("meshes/cube_v41.msh"))
-        .args([&default, &gmsh])
-        .output()
-        .expect("python3 runs");
-    let text = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    if text.trim() == "NO_MESHIO" {
-        assert!(
-            std::env::var_os("CI").is_none(),
-            "meshio is not installed under CI"
-        );
-        eprintln!("SKIPPED: meshio not installed (pip install meshio)");
+    let cube = data("meshes/cube_v41.msh");
+    let args = [cube.as_os_str(), default.as_os_str(), gmsh.as_os_str()];
+    if meshio_gate::run_with_meshio(body, &args).is_none() {
         return;
     }
     let e = read_mesh(&default).unwrap_err();
