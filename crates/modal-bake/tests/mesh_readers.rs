@@ -880,9 +880,7 @@ fn gmsh_extruded_box(dir: &Path, recombine: bool) -> PathBuf {
          out[] = Extrude {{0, 0, 0.02}} {{ Surface{{1}}; Layers{{2}};{recombine} }};\n\
          Extrude {{0, 0, 0.03}} {{ Surface{{out[0]}}; }}\n"
     );
-    let geo_path = dir.join("box.geo");
-    std::fs::write(&geo_path, geo).unwrap();
-    gmsh_volume_mesh(&geo_path)
+    gmsh_volume_mesh(dir, "box", &geo)
 }
 
 /// Runs the real gmsh with its command line `args`: the `gmsh` launcher, or the PyPI module
@@ -903,16 +901,25 @@ fn run_gmsh(args: &[&std::ffi::OsStr]) -> bool {
     }
 }
 
-/// The real gmsh's volume mesh of the `.geo` script `geo`, written beside it as `.msh`.
-fn gmsh_volume_mesh(geo: &Path) -> PathBuf {
-    let msh = geo.with_extension("msh");
+/// The real gmsh's volume mesh of the `.geo` script `geo` (its text), both written in `dir`
+/// as `STEM.geo` and `STEM.msh`.
+fn gmsh_volume_mesh(dir: &Path, stem: &str, geo: &str) -> PathBuf {
+    let (geo_path, msh) = (
+        dir.join(format!("{stem}.geo")),
+        dir.join(format!("{stem}.msh")),
+    );
+    std::fs::write(&geo_path, geo).unwrap();
     let ok = run_gmsh(&[
-        geo.as_os_str(),
+        geo_path.as_os_str(),
         "-3".as_ref(),
         "-o".as_ref(),
         msh.as_os_str(),
     ]);
-    assert!(ok && msh.exists(), "gmsh could not mesh {}", geo.display());
+    assert!(
+        ok && msh.exists(),
+        "gmsh could not mesh {}",
+        geo_path.display()
+    );
     msh
 }
 
@@ -986,16 +993,14 @@ fn gmsh_physical_volumes_bake_one_at_a_time() {
     }
     let tmp = std::env::temp_dir().join(format!("dcr-two-volumes-{}", std::process::id()));
     std::fs::create_dir_all(&tmp).unwrap();
-    let geo = tmp.join("two.geo");
-    std::fs::write(
-        &geo,
+    let msh = gmsh_volume_mesh(
+        &tmp,
+        "two",
         "SetFactory(\"OpenCASCADE\");\nMesh.MshFileVersion = 4.1;\nMesh.Binary = 1;\n\
          Mesh.MeshSizeMax = 0.04;\nBox(1) = {0, 0, 0, 0.1, 0.1, 0.1};\n\
          Box(2) = {0.4, 0, 0, 0.1, 0.1, 0.1};\nPhysical Volume(\"left\") = {1};\n\
          Physical Volume(\"right\") = {2};\n",
-    )
-    .unwrap();
-    let msh = gmsh_volume_mesh(&geo);
+    );
     let left = modal_bake::mesh::read_msh_object(&msh, "left").unwrap();
     let right = modal_bake::mesh::read_msh_object(&msh, "right").unwrap();
     for (m, name) in [(&left, "left"), (&right, "right")] {
@@ -1267,14 +1272,12 @@ fn gmsh_volumes_without_physical_groups_bake_piece_by_piece() {
     }
     let tmp = std::env::temp_dir().join(format!("dcr-gmsh-pieces-{}", std::process::id()));
     std::fs::create_dir_all(&tmp).unwrap();
-    let geo = tmp.join("two.geo");
-    std::fs::write(
-        &geo,
+    let msh = gmsh_volume_mesh(
+        &tmp,
+        "two",
         "SetFactory(\"OpenCASCADE\");\nMesh.MshFileVersion = 4.1;\nMesh.MeshSizeMax = 0.03;\n\
          Box(1) = {0.4, 0, 0, 0.05, 0.05, 0.05};\nBox(2) = {0, 0, 0, 0.1, 0.1, 0.1};\n",
-    )
-    .unwrap();
-    let msh = gmsh_volume_mesh(&geo);
+    );
     let e = modal_bake::mesh::read_msh_object(&msh, "1").unwrap_err();
     assert!(e.to_string().contains("no physical group"), "{e}");
     for (piece, mass) in [("1", "mass 7.850000 kg"), ("2", "mass 0.981250 kg")] {
@@ -1437,17 +1440,12 @@ fn a_curved_gmsh_mesh_bakes_straightened_as_gmsh_s_straight_one() {
     }
     let tmp = tempfile::tempdir().unwrap();
     let sphere = |linear: u8| {
-        let geo = tmp.path().join(format!("s{linear}.geo"));
-        std::fs::write(
-            &geo,
-            format!(
-                "SetFactory(\"OpenCASCADE\");\nSphere(1) = {{0, 0, 0, 0.05}};\n\
-                 Mesh.MeshSizeMax = 0.02;\nMesh.ElementOrder = 2;\n\
-                 Mesh.SecondOrderLinear = {linear};\nMesh.Binary = 1;\nMesh.MshFileVersion = 4.1;\n"
-            ),
-        )
-        .unwrap();
-        gmsh_volume_mesh(&geo)
+        let geo = format!(
+            "SetFactory(\"OpenCASCADE\");\nSphere(1) = {{0, 0, 0, 0.05}};\n\
+             Mesh.MeshSizeMax = 0.02;\nMesh.ElementOrder = 2;\n\
+             Mesh.SecondOrderLinear = {linear};\nMesh.Binary = 1;\nMesh.MshFileVersion = 4.1;\n"
+        );
+        gmsh_volume_mesh(tmp.path(), &format!("s{linear}"), &geo)
     };
     let (curved, straight) = (sphere(0), sphere(1));
     let mut m = read_mesh(&curved).unwrap();
