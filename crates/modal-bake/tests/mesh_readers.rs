@@ -1221,6 +1221,10 @@ fn a_volume_mesh_of_several_pieces_bakes_piece_by_piece() {
         text.contains("mass 7.850000 kg") && text.contains("kept piece 2"),
         "{text}"
     );
+    // The base says which part of its file it is.
+    let info = run_bake(&[&"info", &modes]);
+    let text = String::from_utf8_lossy(&info.stdout);
+    assert!(text.contains("  input: --piece 2 of its file"), "{text}");
     let check = |mesh: &Path, piece: Option<&str>| {
         let piece: Vec<&str> = piece.map_or(vec![], |p| vec!["--piece", p]);
         let mut a: Vec<&dyn AsRef<std::ffi::OsStr>> = vec![&"check", &mesh, &modes];

@@ -313,15 +313,34 @@ pub fn before_factorization(
 }
 
 /// Records in `base`'s free-form `meta.bake_params` where its material came from
-/// (`material_choice`) and what each fixed-node selector fixed (`fixed_by`); neither enters
-/// `params_hash`.
-pub fn annotate(base: &mut ModesFile, options: &BakeOptions, report: &BakeReport) {
+/// (`material_choice`), what each fixed-node selector fixed (`fixed_by`) and, when any was
+/// given, which part of the input file the base is (`selection`: `object`, `piece`,
+/// `straighten`); none enters `params_hash` (the geometry hash covers the selected mesh).
+pub fn annotate(
+    base: &mut ModesFile,
+    options: &BakeOptions,
+    asset: &AssetOptions,
+    report: &BakeReport,
+) {
     if let Some(obj) = base.meta.bake_params.as_object_mut() {
         obj.insert(
             "material_choice".into(),
             options.model.material_choice().to_json(),
         );
         obj.insert("fixed_by".into(), serde_json::json!(report.fixed_by));
+        let mut selection = serde_json::Map::new();
+        if let Some(o) = &asset.object {
+            selection.insert("object".into(), o.clone().into());
+        }
+        if let Some(n) = asset.piece {
+            selection.insert("piece".into(), n.into());
+        }
+        if asset.straighten {
+            selection.insert("straighten".into(), true.into());
+        }
+        if !selection.is_empty() {
+            obj.insert("selection".into(), selection.into());
+        }
     }
 }
 
@@ -408,7 +427,7 @@ pub fn bake_and_write(
         .and_then(|(mut base, mut report)| {
             report.read_s = read_s;
             report.material_name = args.options.model.material_choice().describe();
-            annotate(&mut base, &args.options, &report);
+            annotate(&mut base, &args.options, &args.asset, &report);
             on_stage(BakeStage::Write);
             let t = std::time::Instant::now();
             super::create_parent(&args.out)?;

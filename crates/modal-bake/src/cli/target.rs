@@ -75,7 +75,7 @@ pub fn run(args: &BakeArgs, asset: &AssetOptions, target: f64) -> anyhow::Result
     } =
         res.with_context(|| format!("baking {} failed; nothing was written", args.mesh.display()))?;
     report.material_name = args.options.model.material_choice().describe();
-    annotate(&mut base, &args.options, &report);
+    annotate(&mut base, &args.options, asset, &report);
     base.write_atomic(&args.out)
         .with_context(|| format!("writing {} failed", args.out.display()))?;
     let acc = base
