@@ -440,18 +440,38 @@ fn out_of_range_vertex_and_too_fine_size_are_refused_before_meshing() {
     assert!(!dir.path().join("cube.msh").exists());
 }
 
-/// A fake gmsh that answers `--version` and then hangs.
+/// A fake gmsh that answers `--version` and then hangs as a launcher would: it starts a
+/// `sleep 60` (holding the output pipe), writes its pid to `DIR/helper.pid` and waits for it.
 #[cfg(unix)]
 fn hanging_gmsh(dir: &Path) -> PathBuf {
     use std::os::unix::fs::PermissionsExt;
     let p = dir.join("fake-gmsh");
+    let pid = dir.join("helper.pid");
     std::fs::write(
         &p,
-        "#!/bin/sh\nif [ \"$1\" = \"--version\" ]; then echo 4.99.0; exit 0; fi\nexec sleep 60\n",
+        format!(
+            "#!/bin/sh\nif [ \"$1\" = \"--version\" ]; then echo 4.99.0; exit 0; fi\n\
+             sleep 60 &\necho $! > '{}'\nwait\n",
+            pid.display()
+        ),
     )
     .unwrap();
     std::fs::set_permissions(&p, std::fs::Permissions::from_mode(0o755)).unwrap();
     p
+}
+
+/// Whether the process the fake gmsh started (its pid in `DIR/helper.pid`) still runs (a
+/// zombie waiting for its reaper counts as ended).
+#[cfg(unix)]
+fn helper_runs(dir: &Path) -> bool {
+    let Ok(pid) = std::fs::read_to_string(dir.join("helper.pid")) else {
+        return false;
+    };
+    std::fs::read_to_string(format!("/proc/{}/stat", pid.trim())).is_ok_and(|stat| {
+        stat.rsplit(')')
+            .next()
+            .is_some_and(|rest| !rest.trim_start().starts_with('Z'))
+    })
 }
 
 fn work_dirs(tmp: &Path) -> Vec<String> {
@@ -463,8 +483,9 @@ fn work_dirs(tmp: &Path) -> Vec<String> {
         .collect()
 }
 
-/// A hanging gmsh is stopped at `--mesher-timeout` with a message naming the option, and its
-/// work folder is removed.
+/// A hanging gmsh is stopped at `--mesher-timeout` with a message naming the option — with
+/// the process it started, which holds the output pipe (else the run would wait 60 s for it)
+/// — and its work folder is removed.
 #[cfg(unix)]
 #[test]
 fn a_hanging_mesher_times_out_and_leaves_nothing() {
@@ -473,6 +494,7 @@ fn a_hanging_mesher_times_out_and_leaves_nothing() {
     std::fs::create_dir(&tmp).unwrap();
     let fake = hanging_gmsh(dir.path());
     let asset = write_obj(dir.path(), "cube.obj", &surface(&[cube([0.0; 3], 1.0)]));
+    let start = std::time::Instant::now();
     let out = bin()
         .arg("mesh")
         .arg(&asset)
@@ -484,6 +506,16 @@ fn a_hanging_mesher_times_out_and_leaves_nothing() {
         .output()
         .unwrap();
     assert!(!out.status.success());
+    // Not the helper's 60 s: the run does not wait for the pipe it held.
+    assert!(
+        start.elapsed().as_secs() < 30,
+        "returned after {:?}",
+        start.elapsed()
+    );
+    assert!(
+        !helper_runs(dir.path()),
+        "the fake gmsh's helper outlived the run"
+    );
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(
         err.contains("did not finish meshing")
@@ -495,7 +527,8 @@ fn a_hanging_mesher_times_out_and_leaves_nothing() {
     assert!(!dir.path().join("cube.msh").exists());
 }
 
-/// SIGTERM while the mesher runs: modal-bake ends by the signal and removes its work folder.
+/// SIGTERM while the mesher runs: modal-bake ends by the signal, ends the mesher with the
+/// process it started, and removes its work folder.
 #[cfg(unix)]
 #[test]
 fn sigterm_while_meshing_removes_the_work_folder() {
@@ -534,6 +567,10 @@ fn sigterm_while_meshing_removes_the_work_folder() {
     let status = child.wait().unwrap();
     assert!(!status.success());
     assert!(work_dirs(&tmp).is_empty(), "{:?}", work_dirs(&tmp));
+    assert!(
+        !helper_runs(dir.path()),
+        "the fake gmsh's helper outlived modal-bake"
+    );
 }
 
 /// `auto` on a clean cube with a gmsh that fails: fTetWild runs instead, and the report names
