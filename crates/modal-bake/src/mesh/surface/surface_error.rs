@@ -152,7 +152,7 @@ fn format_hint(file: &str) -> String {
         .map(str::to_ascii_lowercase);
     match ext.as_deref() {
         Some("msh" | "json") => format!(
-            "{file} is a volume mesh, meshed already: bake it directly (`modal-bake bake {file} -o OUT.modes`)"
+            "{file} is a volume mesh, meshed already: bake it directly (`modal-bake bake {file} -o OUT.modes`; `modal-bake info {file}` summarises it first)"
         ),
         _ => "export another format (FBX, 3MF, DAE, …) as glTF or OBJ (Blender: File ▸ Export); convert a surface in VTK, VTU or OFF with meshio (`pip install meshio`, `meshio convert IN OUT.stl`)".to_string(),
     }
