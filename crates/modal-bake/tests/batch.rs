@@ -209,6 +209,9 @@ fn stale_bases_are_rebaked_with_their_reason_and_a_failed_entry_does_not_stop_th
     let a = actions(&report);
     assert_eq!(a[&0], ("skipped".into(), "up_to_date".into()));
     assert_eq!(a[&1], ("baked".into(), "parameters_changed".into()));
+    // The report and the progress say what changed, read before the base was replaced.
+    let detail = "--modes/--max-freq: 6 modes in the base, 5 modes asked";
+    assert_eq!(report["entries"][1]["detail"], detail, "{report}");
     assert_eq!(a[&2], ("baked".into(), "unreadable".into()));
     assert_eq!(a[&3].0, "failed");
     let failed = &report["entries"][3];
@@ -223,6 +226,10 @@ fn stale_bases_are_rebaked_with_their_reason_and_a_failed_entry_does_not_stop_th
     for i in 0..4 {
         assert!(stderr.contains(&format!("entries[{i}]")), "{stderr}");
     }
+    assert!(
+        stderr.contains(&format!("stale (parameters changed: {detail}): baking")),
+        "{stderr}"
+    );
 }
 
 #[test]

@@ -498,8 +498,21 @@ fn units_mm_bakes_the_metre_mesh_and_check_needs_the_same_units() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert!(!stderr.contains("warning"), "{stderr}");
+    // The same bits but for the record of the unit each was read in.
+    let read = |p: &Path| dcr_runtime::format::ModesFile::read(p).unwrap();
+    let (mut a, mut b) = (read(&m_base), read(&mm_base));
+    assert_eq!(a.meta.bake_params["selection"]["units"], "m");
+    assert_eq!(b.meta.bake_params["selection"]["units"], "mm");
+    for base in [&mut a, &mut b] {
+        base.meta.bake_params["selection"]["units"] = serde_json::Value::Null;
+    }
+    let bytes = |m: &dcr_runtime::format::ModesFile| {
+        let path = dir.path().join("cmp.modes");
+        m.write_atomic(&path).unwrap();
+        std::fs::read(&path).unwrap()
+    };
     assert!(
-        std::fs::read(&m_base).unwrap() == std::fs::read(&mm_base).unwrap(),
+        bytes(&a) == bytes(&b),
         "--units mm on a whole-millimetre mesh must give the metre mesh's bits"
     );
     // check: fresh with the same --units, stale (geometry changed) without.
@@ -523,7 +536,15 @@ fn units_mm_bakes_the_metre_mesh_and_check_needs_the_same_units() {
     );
     let o = check(&[]);
     assert_eq!(o.status.code(), Some(1));
-    assert!(String::from_utf8_lossy(&o.stdout).contains("geometry_changed"));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["reason"], "geometry_changed");
+    let detail = v["detail"].as_str().unwrap();
+    assert!(
+        detail.starts_with(
+            "the base was read from its file as `--units mm`, this as the whole file in metres"
+        ) && detail.contains("this mesh is 1000× the base's size"),
+        "{detail}"
+    );
     // Without --units the millimetre mesh is 1.7 km across: the warning suggests --units mm.
     let o = bake(&mm_mesh, &dir.path().join("huge.modes"), &args);
     assert!(o.status.success());

@@ -362,6 +362,127 @@ fn scaled_cube(path: &Path, scale: f64, outlier: Option<f64>) {
     std::fs::write(path, text).unwrap();
 }
 
+// Expectation: a stale base says what differs, by the options that change it, so that a farm
+// knows whether the mesh, an option or the tool moved: each parameter with both values, the
+// mesh's counts, size, moved nodes and fixed set, the unit and selection the base was read
+// with, the tool's output version and the transfer table's options.
+#[test]
+fn check_names_what_differs() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = dir.path().join("c.modes");
+    let b = base.to_str().unwrap();
+    let cube = data("meshes/cube_v41.msh");
+    let check = |mesh: &Path, extra: &[&str]| {
+        let mut a = vec!["check", mesh.to_str().unwrap(), b];
+        if !extra.contains(&"--modes") {
+            a.extend_from_slice(&["--modes", "4"]);
+        }
+        a.extend_from_slice(extra);
+        let o = run(&a);
+        let mut j = a.clone();
+        j.push("--json");
+        let v: serde_json::Value = serde_json::from_slice(&run(&j).stdout).unwrap();
+        let text = String::from_utf8_lossy(&o.stdout).trim().to_string();
+        let detail = v["detail"].as_str().unwrap_or("").to_string();
+        // The plain line carries the JSON's detail.
+        assert!(text.ends_with(&detail), "{text} / {v}");
+        (
+            o.status.code(),
+            v["reason"].as_str().unwrap().to_string(),
+            detail,
+        )
+    };
+    assert!(bake_to(&base, &cube).status.success());
+    assert_eq!(
+        check(&cube, &[]),
+        (Some(0), "up_to_date".into(), String::new())
+    );
+
+    // Parameters: exactly the ones that differ, with both values and units.
+    let (_, reason, d) = check(&cube, &["--density", "800", "--rayleigh", "5,1e-7"]);
+    assert_eq!(reason, "parameters_changed");
+    assert_eq!(
+        d,
+        "--density: 770 kg/m³ in the base, 800 kg/m³ asked; --rayleigh: 10,1e-7 in the base, 5,1e-7 asked"
+    );
+    let (_, _, d) = check(&cube, &["--modes", "6", "--f32"]);
+    assert!(
+        d.contains("--modes/--max-freq: 4 modes in the base, 6 modes asked"),
+        "{d}"
+    );
+    assert!(d.contains("--f32: off in the base, on asked"), "{d}");
+    assert!(!d.contains("--youngs") && !d.contains("--density"), "{d}");
+
+    // Geometry: the size, the unit, the fixed set, a moved node.
+    let other = dir.path().join("other.msh");
+    scaled_cube(&other, 2.0, None);
+    let (_, reason, d) = check(&other, &[]);
+    assert_eq!(reason, "geometry_changed");
+    assert!(d.contains("this mesh is 2× the base's size"), "{d}");
+    let (_, _, d) = check(&cube, &["--units", "cm"]);
+    assert!(
+        d.starts_with(
+            "the base was read from its file as the whole file in metres, this as `--units cm`"
+        ),
+        "{d}"
+    );
+    assert!(d.contains("0.01× the base's size"), "{d}");
+    let (_, _, d) = check(&cube, &["--fixed-below", "z=0.01"]);
+    let fixed = modal_bake::mesh::read_mesh(&cube)
+        .unwrap()
+        .nodes
+        .iter()
+        .filter(|p| p[2] <= 0.01)
+        .count();
+    assert!(fixed > 0);
+    assert_eq!(
+        d,
+        format!("the base fixes 0 nodes, these options fix {fixed} (--fixed, --fixed-below, --fixed-box, --fixed-near)")
+    );
+    let x0 = modal_bake::mesh::read_mesh(&cube).unwrap().nodes[0][0];
+    scaled_cube(&other, 1.0, Some(x0 + 1e-3));
+    let (_, _, d) = check(&other, &[]);
+    assert!(d.contains("surface nodes moved by up to 1.000e-3 m"), "{d}");
+    assert!(d.contains("volume node 0)"), "{d}");
+
+    // The transfer table: asked for and missing, then built with another step.
+    let (_, reason, d) = check(&cube, &["--transfer-h", "0.01"]);
+    assert_eq!(reason, "transfer_table_changed");
+    assert_eq!(
+        d,
+        "the base has no transfer table; --transfer-h 0.01 asks for one"
+    );
+    let o = run(&[
+        "bake",
+        cube.to_str().unwrap(),
+        "-o",
+        b,
+        "--modes",
+        "4",
+        "--transfer-h",
+        "0.01",
+        "--transfer-modes",
+        "12",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (_, _, d) = check(&cube, &["--transfer-h", "0.005", "--transfer-modes", "12"]);
+    assert_eq!(d, "--transfer-h: 0.01 in the base, 0.005 asked");
+    let (_, _, d) = check(&cube, &[]);
+    assert_eq!(
+        d,
+        "the base holds a transfer table (--transfer-h 0.01 s); no --transfer-h was given"
+    );
+
+    // The tool: another output version.
+    let mut old = dcr_runtime::format::ModesFile::read(&base).unwrap();
+    old.meta.bake_params["output_version"] = serde_json::json!(0);
+    old.write_atomic(&base).unwrap();
+    let (_, reason, d) = check(&cube, &[]);
+    assert_eq!(reason, "tool_changed");
+    assert!(d.contains("(output version 0); this modal-bake"), "{d}");
+    assert!(d.ends_with("writes output version 1"), "{d}");
+}
+
 // Regression: numerical internals instead of causes — a mesh scaled by 1e100 or 1e150 ("Ritz
 // vectors not M-independent", "|volume| inf m³ below NaN m³"), a coordinate of 2147483648
 // ("NonPositivePivot"), an outlier node at 1e12 m (a healthy tet blamed), E = 1e300 or 1e308,

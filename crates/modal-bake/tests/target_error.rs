@@ -113,6 +113,48 @@ fn the_cheapest_representation_within_the_target_is_chosen_and_recorded() {
         .output()
         .unwrap();
     assert!(text(&o).contains("accuracy target 70 %"), "{}", text(&o));
+    // `check` finds each choice up to date with the options the bake printed in place of
+    // --target-error, and stale, saying so, with the bake's own.
+    let check = |base: &Path, extra: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_modal-bake"))
+            .args(["check", beam().to_str().unwrap(), base.to_str().unwrap()])
+            .args(["--fixed", "clamp"])
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    assert_eq!(check(&lax, &["--modes", "5"]).status.code(), Some(0));
+    let (n, order) = (t.modes.to_string(), t.order.to_string());
+    let table = [
+        "--transfer-h",
+        "0.002",
+        "--modes",
+        "20",
+        "--transfer-modes",
+        &n,
+        "--transfer-order",
+        &order,
+    ];
+    assert_eq!(
+        check(&strict, &table).status.code(),
+        Some(0),
+        "{}",
+        text(&check(&strict, &table))
+    );
+    let o = check(&strict, &["--transfer-h", "0.002"]);
+    let printed = format!(
+        "`--modes 20 --transfer-modes {n} --transfer-order {order}` in place of --target-error"
+    );
+    assert_eq!(o.status.code(), Some(1));
+    assert!(text(&o).contains(&printed), "{}", text(&o));
+    let o = bake(&strict, "70");
+    assert!(text(&o).contains(&printed), "{}", text(&o));
+    let o = check(&lax, &["--transfer-h", "0.002"]);
+    assert!(
+        text(&o).contains("check it with the bake's options, `--modes 5` in place of --target-error, without --transfer-h"),
+        "{}",
+        text(&o)
+    );
 }
 
 #[test]

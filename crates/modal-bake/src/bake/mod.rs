@@ -21,6 +21,7 @@ mod pipeline;
 mod plausibility;
 mod prepare;
 mod report;
+mod stale_detail;
 mod staleness;
 mod surface;
 
@@ -38,6 +39,7 @@ pub use fixed_nodes::{FixedNodes, FixedSelectors};
 pub use hashing::{geometry_hash, round_16_digits};
 pub use mode_set::{mode_set_dense, mode_set_from_dense, mode_set_lanczos};
 pub use params::{BakeParams, FixedBelow, ModeRequest};
+pub(crate) use pipeline::transfer_meta;
 pub use pipeline::{
     bake_file, bake_mesh, MAX_RESIDUAL, OUTPUT_VERSION, RIGID_REL_TOL, TOOL_VERSION,
 };

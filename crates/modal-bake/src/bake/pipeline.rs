@@ -453,7 +453,7 @@ fn bake_with_table(
 /// `"modes_fixed_by": "every selector"`: its table's extra modes are solved with those nodes
 /// fixed, where tables baked before that was so were solved with the physical groups alone —
 /// such bases lack the key and are stale.
-pub(super) fn transfer_meta(
+pub(crate) fn transfer_meta(
     tp: &crate::transfer::TransferParams,
     params: &BakeParams,
 ) -> serde_json::Value {

@@ -6,6 +6,7 @@ use std::path::Path;
 
 use super::pipeline::transfer_meta;
 use super::prepare::prepare;
+use super::stale_detail;
 use super::{BakeError, BakeParams, OUTPUT_VERSION};
 use crate::mesh::TetMesh;
 use dcr_runtime::format::ModesFile;
@@ -27,7 +28,9 @@ pub fn is_up_to_date(
     Ok(base_status(mesh_path, params, modes)? == BaseStatus::UpToDate)
 }
 
-/// Whether a base is up to date, and if not why (what `modal-bake check --json` reports).
+/// Whether a base is up to date, and if not why (what `modal-bake check --json` reports);
+/// each stale reason carries one line naming what differs, by the options that change it
+/// ([`BaseStatus::detail`]).
 #[derive(Clone, Debug, PartialEq, Eq)]
 #[non_exhaustive]
 pub enum BaseStatus {
@@ -39,13 +42,13 @@ pub enum BaseStatus {
     Unreadable(String),
     /// Written by a `modal-bake` whose output differs ([`OUTPUT_VERSION`]), or without what
     /// this one stores (the heat-geodesic order).
-    ToolChanged,
+    ToolChanged(String),
     /// The mesh's geometry or fixed set differs ([`geometry_hash`](super::geometry_hash)).
-    GeometryChanged,
+    GeometryChanged(String),
     /// The bake parameters differ ([`BakeParams::hash`]).
-    ParametersChanged,
+    ParametersChanged(String),
     /// The peak-transfer table is missing, unwanted or built with other parameters.
-    TransferTableChanged,
+    TransferTableChanged(String),
 }
 
 impl BaseStatus {
@@ -56,10 +59,23 @@ impl BaseStatus {
             BaseStatus::UpToDate => "up_to_date",
             BaseStatus::Missing => "missing",
             BaseStatus::Unreadable(_) => "unreadable",
-            BaseStatus::ToolChanged => "tool_changed",
-            BaseStatus::GeometryChanged => "geometry_changed",
-            BaseStatus::ParametersChanged => "parameters_changed",
-            BaseStatus::TransferTableChanged => "transfer_table_changed",
+            BaseStatus::ToolChanged(_) => "tool_changed",
+            BaseStatus::GeometryChanged(_) => "geometry_changed",
+            BaseStatus::ParametersChanged(_) => "parameters_changed",
+            BaseStatus::TransferTableChanged(_) => "transfer_table_changed",
+        }
+    }
+
+    /// What differs, in one line (`--modes/--max-freq: 10 modes in the base, 12 modes asked`),
+    /// or why the base is unreadable; `None` when up to date or missing.
+    pub fn detail(&self) -> Option<&str> {
+        match self {
+            BaseStatus::UpToDate | BaseStatus::Missing => None,
+            BaseStatus::Unreadable(d)
+            | BaseStatus::ToolChanged(d)
+            | BaseStatus::GeometryChanged(d)
+            | BaseStatus::ParametersChanged(d)
+            | BaseStatus::TransferTableChanged(d) => Some(d),
         }
     }
 }
@@ -130,37 +146,53 @@ pub fn mesh_base_status(
         Ok(base) => base,
         Err(e) => return Ok(BaseStatus::Unreadable(e.to_string())),
     };
-    let output_version = base.meta.bake_params.get("output_version");
+    let version_matches =
+        base.meta.bake_params.get("output_version") == Some(&serde_json::json!(OUTPUT_VERSION));
     // A base without the stored heat-geodesic order (baked before it existed, or written
     // elsewhere) is stale when this tool would store one.
     let order_matches = base.surface_order.is_some()
         || crate::ordering::plan_surface_order(&base.surface_vertices, &base.surface_triangles)
             .is_err();
-    if output_version != Some(&serde_json::json!(OUTPUT_VERSION)) || !order_matches {
-        return Ok(BaseStatus::ToolChanged);
+    if !version_matches || !order_matches {
+        return Ok(BaseStatus::ToolChanged(stale_detail::tool_difference(
+            &base,
+            version_matches,
+        )));
     }
     if base.meta.source_hash != prepared.hash {
-        return Ok(BaseStatus::GeometryChanged);
+        return Ok(BaseStatus::GeometryChanged(
+            stale_detail::geometry_difference(&base, &prepared),
+        ));
     }
     if base.meta.params_hash != params.hash() {
-        return Ok(BaseStatus::ParametersChanged);
+        return Ok(BaseStatus::ParametersChanged(
+            stale_detail::with_target_choice(
+                &base,
+                stale_detail::parameter_difference(&base, params),
+            ),
+        ));
     }
     // The bake records the table's mode count resolved for the mesh (`auto` → `all` or a
     // Lanczos count), so compare with the same resolution.
     let free_dofs = 3 * (prepared.mesh.nodes.len() - prepared.fixed.len());
-    let table_matches = match &params.transfer {
+    let expected = params.transfer.as_ref().map(|tp| {
+        let resolved = crate::transfer::TransferParams {
+            modes: tp.modes.resolve(free_dofs),
+            ..tp.clone()
+        };
+        transfer_meta(&resolved, params)
+    });
+    let table_matches = match &expected {
         None => base.transfer.is_none(),
-        Some(tp) => {
-            let resolved = crate::transfer::TransferParams {
-                modes: tp.modes.resolve(free_dofs),
-                ..tp.clone()
-            };
-            base.transfer.is_some()
-                && base.meta.bake_params.get("transfer") == Some(&transfer_meta(&resolved, params))
-        }
+        Some(e) => base.transfer.is_some() && base.meta.bake_params.get("transfer") == Some(e),
     };
     if !table_matches {
-        return Ok(BaseStatus::TransferTableChanged);
+        return Ok(BaseStatus::TransferTableChanged(
+            stale_detail::with_target_choice(
+                &base,
+                stale_detail::transfer_difference(&base, expected.as_ref()),
+            ),
+        ));
     }
     Ok(BaseStatus::UpToDate)
 }

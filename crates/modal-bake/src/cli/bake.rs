@@ -4,7 +4,9 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::Args;
-use modal_bake::bake::{self, BakeParams, BakeReport, BakeStage, ModeRequest, ModesPrecision};
+use modal_bake::bake::{
+    self, BakeParams, BakeReport, BakeStage, BaseStatus, ModeRequest, ModesPrecision,
+};
 use modal_bake::transfer::{TableOrder, TransferModes, TransferParams};
 
 use super::budget::BudgetOptions;
@@ -314,8 +316,9 @@ pub fn before_factorization(
 
 /// Records in `base`'s free-form `meta.bake_params` where its material came from
 /// (`material_choice`), what each fixed-node selector fixed (`fixed_by`) and, when any was
-/// given, which part of the input file the base is (`selection`: `object`, `piece`,
-/// `straighten`); none enters `params_hash` (the geometry hash covers the selected mesh).
+/// which part of the input file the base is and in which unit it was read
+/// ([`selection_record`]); none enters `params_hash` (the geometry hash covers the selected
+/// mesh, in metres).
 pub fn annotate(
     base: &mut ModesFile,
     options: &BakeOptions,
@@ -328,19 +331,104 @@ pub fn annotate(
             options.model.material_choice().to_json(),
         );
         obj.insert("fixed_by".into(), serde_json::json!(report.fixed_by));
-        let mut selection = serde_json::Map::new();
-        if let Some(o) = &asset.object {
-            selection.insert("object".into(), o.clone().into());
+        obj.insert("selection".into(), selection_record(asset).into());
+    }
+}
+
+/// The record `meta.bake_params.selection` of how the input was read: `object`, `piece` and
+/// `straighten` when given, and always `units` (`m`, `cm`, `mm`, `in`).
+pub fn selection_record(asset: &AssetOptions) -> serde_json::Map<String, serde_json::Value> {
+    let mut selection = serde_json::Map::new();
+    if let Some(o) = &asset.object {
+        selection.insert("object".into(), o.clone().into());
+    }
+    if let Some(n) = asset.piece {
+        selection.insert("piece".into(), n.into());
+    }
+    if asset.straighten {
+        selection.insert("straighten".into(), true.into());
+    }
+    selection.insert("units".into(), asset.units.name().into());
+    selection
+}
+
+/// A [`selection_record`] as the options that make it (`--piece 2 --units mm`; metres, the
+/// default, unsaid); empty for the whole file in metres.
+pub fn selection_options(selection: &serde_json::Map<String, serde_json::Value>) -> String {
+    let mut parts = Vec::new();
+    if let Some(o) = selection.get("object").and_then(|v| v.as_str()) {
+        parts.push(format!("--object {o}"));
+    }
+    if let Some(n) = selection.get("piece").and_then(serde_json::Value::as_u64) {
+        parts.push(format!("--piece {n}"));
+    }
+    if selection
+        .get("straighten")
+        .and_then(serde_json::Value::as_bool)
+        == Some(true)
+    {
+        parts.push("--straighten".into());
+    }
+    match selection.get("units").and_then(|v| v.as_str()) {
+        Some(u) if u != "m" => parts.push(format!("--units {u}")),
+        _ => {}
+    }
+    parts.join(" ")
+}
+
+/// When the base at `out` was read from its file with another selection or unit than
+/// `asset` gives (its recorded [`selection_record`]), the sentence that says so; `None` when
+/// they agree or the base cannot be read. A base without the record (baked by an older tool)
+/// is compared on `object`, `piece` and `straighten` only.
+pub fn selection_mismatch(out: &std::path::Path, asset: &AssetOptions) -> Option<String> {
+    let base = ModesFile::read(out).ok()?;
+    let mut recorded = base
+        .meta
+        .bake_params
+        .get("selection")
+        .and_then(|v| v.as_object())
+        .cloned()
+        .unwrap_or_default();
+    let mut asked = selection_record(asset);
+    if !recorded.contains_key("units") {
+        asked.remove("units");
+    }
+    if recorded == asked {
+        return None;
+    }
+    let show = |s: &mut serde_json::Map<String, serde_json::Value>| {
+        let options = selection_options(s);
+        let unit = if s.contains_key("units") {
+            ""
+        } else {
+            " (unit not recorded)"
+        };
+        if options.is_empty() {
+            format!("the whole file in metres{unit}")
+        } else {
+            format!("`{options}`{unit}")
         }
-        if let Some(n) = asset.piece {
-            selection.insert("piece".into(), n.into());
-        }
-        if asset.straighten {
-            selection.insert("straighten".into(), true.into());
-        }
-        if !selection.is_empty() {
-            obj.insert("selection".into(), selection.into());
-        }
+    };
+    Some(format!(
+        "the base was read from its file as {}, this as {}: give the bake's --object, --piece, --straighten and --units",
+        show(&mut recorded),
+        show(&mut asked)
+    ))
+}
+
+/// A stale status's one-line detail, with the selection mismatch when the geometry differs.
+pub fn stale_detail(
+    status: &BaseStatus,
+    out: &std::path::Path,
+    asset: &AssetOptions,
+) -> Option<String> {
+    let detail = status.detail()?.to_string();
+    match status {
+        BaseStatus::GeometryChanged(_) => Some(match selection_mismatch(out, asset) {
+            Some(m) => format!("{m}; {detail}"),
+            None => detail,
+        }),
+        _ => Some(detail),
     }
 }
 

@@ -26,7 +26,8 @@ pub struct CheckArgs {
     pub asset: AssetOptions,
     /// Print one JSON object: {"base", "mesh", "up_to_date", "reason" (up_to_date, missing,
     /// unreadable, tool_changed, geometry_changed, parameters_changed, transfer_table_changed),
-    /// "detail"} (or {"error"} with exit 2).
+    /// "detail" (what differs, by the options that change it; null when up to date or
+    /// missing)} (or {"error"} with exit 2).
     #[arg(long)]
     pub json: bool,
 }
@@ -48,11 +49,8 @@ pub fn run(args: &CheckArgs) -> ExitCode {
     match status {
         Ok(status) => {
             let fresh = status == BaseStatus::UpToDate;
+            let detail = super::bake::stale_detail(&status, &args.out, &asset);
             if args.json {
-                let detail = match &status {
-                    BaseStatus::Unreadable(d) => Some(d.clone()),
-                    _ => None,
-                };
                 outln!(
                     "{}",
                     serde_json::json!({
@@ -67,9 +65,10 @@ pub fn run(args: &CheckArgs) -> ExitCode {
                 outln!("{}: up to date", args.out.display());
             } else {
                 outln!(
-                    "{}: stale ({})",
+                    "{}: stale ({}){}",
                     args.out.display(),
-                    status.reason().replace('_', " ")
+                    status.reason().replace('_', " "),
+                    detail.map(|d| format!(": {d}")).unwrap_or_default()
                 );
             }
             if fresh {

@@ -232,17 +232,10 @@ fn write_model(out: &mut String, file: &Path, base: &ModesFile) -> std::fmt::Res
         .get("selection")
         .and_then(|v| v.as_object())
     {
-        let mut parts = Vec::new();
-        if let Some(o) = sel.get("object").and_then(|v| v.as_str()) {
-            parts.push(format!("--object {o}"));
+        let options = super::bake::selection_options(sel);
+        if !options.is_empty() {
+            writeln!(out, "  input: its file with {options}")?;
         }
-        if let Some(n) = sel.get("piece").and_then(|v| v.as_u64()) {
-            parts.push(format!("--piece {n}"));
-        }
-        if sel.get("straighten").and_then(|v| v.as_bool()) == Some(true) {
-            parts.push("--straighten".into());
-        }
-        writeln!(out, "  input: {} of its file", parts.join(" "))?;
     }
     if base.fixed_nodes.is_empty() {
         writeln!(

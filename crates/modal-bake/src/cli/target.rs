@@ -83,12 +83,19 @@ pub fn run(args: &BakeArgs, asset: &AssetOptions, target: f64) -> anyhow::Result
         .accuracy
         .clone()
         .expect("recorded by bake_to_target");
+    let check = modal_bake::target_error::check_options(&base).expect("a target-error base");
     if args.json {
         outln!(
             "{}",
             serde_json::to_string_pretty(&serde_json::json!({
                 "report": report,
                 "accuracy": acc,
+                // The options `check` takes in place of --target-error (null: leave out).
+                "check_options": {
+                    "modes": base.num_modes(),
+                    "transfer_modes": base.transfer.as_ref().map(|t| t.modes),
+                    "transfer_order": base.transfer.as_ref().map(|t| t.order),
+                },
                 "tried": tried.iter().map(|c: &Candidate| serde_json::json!({
                     "representation": describe(c.representation),
                     "median_pct": c.median_pct,
@@ -128,6 +135,7 @@ pub fn run(args: &BakeArgs, asset: &AssetOptions, target: f64) -> anyhow::Result
         acc.query_cost / acc.query_cost_20,
         acc.payload_bytes as f64 / 1024.0
     );
+    outln!("  check it with the bake's options, {check}");
     for c in &tried {
         outln!(
             "    tried {:<42} median {:>7.2} %  worst {:>7.2} %  cost {:>9.0}  {:>9.1} KiB",

@@ -246,7 +246,9 @@ pub fn bake_to_target(
         // The most accurate tried.
         None => tried.best.take().expect("a candidate at least"),
     };
-    record_accuracy(&mut base, &c, met, &pairs, h, target_pct, cost20);
+    record_accuracy(
+        &mut base, &c, met, &pairs, params, transfer, target_pct, cost20,
+    );
     let mut report = report20;
     report.modes = base.num_modes();
     report.frequencies_hz = base.frequencies_hz();
@@ -397,14 +399,18 @@ fn try_tables(
     Ok(None)
 }
 
-/// Records the chosen candidate `c` in `base`: `meta.accuracy` and, in `meta.bake_params`, the
-/// table's h, modes and order and the target.
+/// Records the chosen candidate `c` in `base`: `meta.accuracy`, and in `meta.bake_params` the
+/// target and the parameters of what was chosen as `bake` records them — the mode count, and
+/// the table's full record (`transfer` with the chosen modes and order) — with `params_hash`
+/// of those parameters, so that `check` with [`check_options`] finds the base up to date.
+#[allow(clippy::too_many_arguments)]
 fn record_accuracy(
     base: &mut ModesFile,
     c: &Candidate,
     met: bool,
     pairs: &ReferencePairs,
-    h: f64,
+    params: &BakeParams,
+    transfer: &TransferParams,
     target_pct: f64,
     cost20: f64,
 ) {
@@ -416,7 +422,7 @@ fn record_accuracy(
         median_pct: c.median_pct,
         worst_pct: c.worst_pct,
         pairs: pairs.pairs(),
-        h,
+        h: transfer.h,
         truth: pairs.truth_method.into(),
         truth_dt: pairs.truth.dt,
         truth_error_pct: 100.0 * pairs.truth.estimated_error,
@@ -427,15 +433,53 @@ fn record_accuracy(
         query_cost_20: cost20,
         payload_bytes: c.payload_bytes,
     });
-    if let (Some(obj), Some(t)) = (base.meta.bake_params.as_object_mut(), &base.transfer) {
-        obj.insert(
-            "transfer".into(),
-            serde_json::json!({ "h": t.h, "modes": t.modes, "order": t.order }),
-        );
-    }
+    let recorded = BakeParams {
+        modes: ModeRequest::Count(base.num_modes()),
+        transfer: None,
+        ..params.clone()
+    };
+    base.meta.params_hash = recorded.hash();
+    let table = base.transfer.as_ref().map(|t| {
+        let chosen = TransferParams {
+            modes: TransferModes::Count(t.modes as usize),
+            order: match t.order {
+                1 => TableOrder::Linear,
+                2 => TableOrder::Quadratic,
+                _ => TableOrder::Cubic,
+            },
+            ..transfer.clone()
+        };
+        crate::bake::transfer_meta(&chosen, params)
+    });
     if let Some(obj) = base.meta.bake_params.as_object_mut() {
+        obj.insert(
+            "modes".into(),
+            serde_json::to_value(recorded.modes).expect("a mode request serialises"),
+        );
+        if let Some(table) = table {
+            obj.insert("transfer".into(), table);
+        }
         obj.insert("target_error_pct".into(), serde_json::json!(target_pct));
     }
+}
+
+/// For a base `bake --target-error` chose (it records `target_error_pct`), how `modal-bake
+/// check` is given the choice with the bake's other options: `--modes M`, and for a table
+/// `--transfer-modes N --transfer-order O`, in place of `--target-error` — a modal choice
+/// without `--transfer-h` and the other `--transfer-*` options (it has no table); `None` for
+/// any other base.
+pub fn check_options(base: &ModesFile) -> Option<String> {
+    base.meta.bake_params.get("target_error_pct")?;
+    let modes = base.num_modes();
+    Some(match &base.transfer {
+        Some(t) => format!(
+            "`--modes {modes} --transfer-modes {} --transfer-order {}` in place of --target-error",
+            t.modes, t.order
+        ),
+        None => format!(
+            "`--modes {modes}` in place of --target-error, without --transfer-h and the other --transfer-* options"
+        ),
+    })
 }
 
 /// The lowest `m` modes of the mode set `set` in the layout and metadata of `base20` (same

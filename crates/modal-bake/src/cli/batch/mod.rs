@@ -87,7 +87,8 @@ struct EntryRecord {
     /// tool_changed, geometry_changed, parameters_changed, transfer_table_changed); null when
     /// the mesh could not be checked.
     reason: Option<&'static str>,
-    /// Why the base was unreadable.
+    /// What made the base stale, by the options that change it, or why it was unreadable;
+    /// null when up to date or missing.
     detail: Option<String>,
     /// Why the entry failed.
     error: Option<String>,
@@ -299,16 +300,19 @@ fn run_entry(entry: &Entry, tag: &str, start: Instant) -> EntryRecord {
         let (mesh, read_s) = super::bake::load_mesh(&args.mesh, &asset)?;
         let file = args.mesh.display().to_string();
         let status = bake::mesh_base_status(mesh.clone(), &file, &params, &args.out)?;
-        status_seen = Some(status.clone());
+        // Read before the bake replaces the base.
+        let detail = super::bake::stale_detail(&status, &args.out, &asset);
+        status_seen = Some((status.reason(), detail.clone()));
         if status == BaseStatus::UpToDate {
             return Ok((status, false));
         }
         line(
             start,
             &format!(
-                "{tag} {}: stale ({}): baking",
+                "{tag} {}: stale ({}{}): baking",
                 args.out.display(),
-                status.reason().replace('_', " ")
+                status.reason().replace('_', " "),
+                detail.map(|d| format!(": {d}")).unwrap_or_default()
             ),
         );
         if let Some(w) = args.options.model.default_material_warning() {
@@ -333,9 +337,7 @@ fn run_entry(entry: &Entry, tag: &str, start: Instant) -> EntryRecord {
                 if baked { "baked" } else { "skipped" },
                 Some(status.reason()),
             );
-            if let BaseStatus::Unreadable(d) = &status {
-                r.detail = Some(d.clone());
-            }
+            r.detail = status_seen.and_then(|(_, d)| d);
             line(
                 start,
                 &format!(
@@ -351,14 +353,9 @@ fn run_entry(entry: &Entry, tag: &str, start: Instant) -> EntryRecord {
             r
         }
         Err(e) => {
-            let mut r = record_of(
-                entry,
-                "failed",
-                status_seen.as_ref().map(BaseStatus::reason),
-            );
-            if let Some(BaseStatus::Unreadable(d)) = &status_seen {
-                r.detail = Some(d.clone());
-            }
+            let (reason, detail) = status_seen.unzip();
+            let mut r = record_of(entry, "failed", reason);
+            r.detail = detail.flatten();
             let msg = super::one_line(&e);
             line(
                 start,
