@@ -282,4 +282,19 @@ fn cli_runs_on_a_small_mesh() {
         !bad.status.success() && err.contains("nope") && !err.contains("panicked"),
         "{err}"
     );
+    // The mesh is read as the bake reads it: read in millimetres the 1 m beam is 1 mm long,
+    // so a box over its far half (x ≥ 0.5 m, in metres) holds no node; a piece it does not
+    // have is refused with the list.
+    let mm = run(&["--units", "mm", "--fixed-box", "0.5,-1,-1,2,1,1"]);
+    let err = String::from_utf8_lossy(&mm.stderr);
+    assert!(
+        !mm.status.success() && err.contains("fixes no node"),
+        "{err}"
+    );
+    let piece = run(&["--fixed", "clamp", "--piece", "2"]);
+    let err = String::from_utf8_lossy(&piece.stderr);
+    assert!(
+        !piece.status.success() && err.contains("no piece 2: the mesh has 1 connected piece(s)"),
+        "{err}"
+    );
 }

@@ -181,3 +181,77 @@ fn truth_exit_status_says_whether_it_converged() {
     let s = String::from_utf8_lossy(&text.stdout);
     assert!(s.contains("converged at dt ="), "{s}");
 }
+
+/// The reference reads its mesh as `modal-bake bake` does: the beam written in millimetres
+/// beside a half-size copy of itself, read with `--units mm --piece 1`, answers as the metre
+/// beam alone (to rounding: the coordinates went through ×1000 and ÷1000); the whole file is
+/// refused with its pieces, and a surface asset with the `modal-bake mesh` that makes its
+/// bake's tetrahedra.
+#[test]
+fn truth_reads_the_mesh_as_the_bake_does() {
+    let dir = tempfile::tempdir().unwrap();
+    let beam = modal_bake::mesh::read_mesh(&data("meshes/beam.msh")).unwrap();
+    let mut two = beam.clone();
+    let n = beam.nodes.len();
+    two.nodes.extend(
+        beam.nodes
+            .iter()
+            .map(|p| [0.5 * p[0], 0.5 * p[1] + 1.0, 0.5 * p[2]]),
+    );
+    two.tets.extend(beam.tets.iter().map(|t| t.map(|v| v + n)));
+    two.tet_ids = (1..=two.tets.len() as u64).collect();
+    let clamp = two.groups.get_mut("clamp").unwrap();
+    clamp.extend(beam.groups["clamp"].iter().map(|v| v + n));
+    for p in &mut two.nodes {
+        *p = p.map(|x| x * 1000.0);
+    }
+    let path = dir.path().join("two_mm.json");
+    std::fs::write(&path, two.to_meshio_json("clamp", "clamp").to_string()).unwrap();
+    let run = |mesh: &Path, extra: &[&str]| {
+        let mut a = vec!["truth", mesh.to_str().unwrap(), "--fixed", "clamp"];
+        a.extend_from_slice(&[
+            "--impact",
+            "1.0,0.05,0.1",
+            "--impulse",
+            "1",
+            "--contact",
+            "0.5,0.05,0.1",
+            "--contact",
+            "0.8,0.0,0.05",
+            "--h",
+            "0.002",
+            "--dt",
+            "5e-7",
+            "--json",
+            "--method",
+            "modal-all",
+        ]);
+        a.extend_from_slice(extra);
+        Command::new(env!("CARGO_BIN_EXE_dcr-lab"))
+            .args(&a)
+            .output()
+            .unwrap()
+    };
+    let metre = peaks(&run(&data("meshes/beam.msh"), &[]));
+    let selected = peaks(&run(&path, &["--units", "mm", "--piece", "1"]));
+    for (a, b) in metre.iter().zip(&selected) {
+        assert!(((a - b) / a).abs() < 1e-9, "{metre:?} vs {selected:?}");
+    }
+    let whole = run(&path, &["--units", "mm"]);
+    let err = String::from_utf8_lossy(&whole.stderr);
+    assert!(
+        !whole.status.success()
+            && err.contains("2 disconnected pieces")
+            && err.contains("--piece N"),
+        "{err}"
+    );
+    let asset = data("assets/hp_body.obj");
+    let o = run(&asset, &[]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success()
+            && err.contains("a surface asset; dcr-lab truth works on a mesh of 4-node tetrahedra: mesh the asset as the bake did, `modal-bake mesh ")
+            && err.contains(" --order 1` with the bake's --units"),
+        "{err}"
+    );
+}

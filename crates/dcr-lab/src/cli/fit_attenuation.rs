@@ -9,6 +9,7 @@ use clap::{Args, ValueEnum};
 use dcr_lab::attenuation_fit::{self, AttenuationFitParams, FitProgress, FitTruth};
 use modal_bake::args::ModelOptions;
 
+use super::mesh_input::MeshInput;
 use super::progress::Progress;
 
 /// Truth used for the pairs.
@@ -24,8 +25,10 @@ pub enum FitTruthArg {
 
 #[derive(Args, Clone, Debug)]
 pub struct FitAttenuationArgs {
-    /// Tetrahedral mesh: gmsh .msh (2.2 or 4.1, ASCII or binary) or meshio-style .json.
+    /// Tetrahedral mesh: gmsh .msh (2.0–2.2 or 4.1, ASCII or binary) or meshio-style .json.
     pub mesh: PathBuf,
+    #[command(flatten)]
+    pub input: MeshInput,
     #[command(flatten)]
     pub model: ModelOptions,
     /// Random (impact, contact) surface vertex pairs.
@@ -79,8 +82,7 @@ impl FitAttenuationArgs {
 }
 
 pub fn run(args: &FitAttenuationArgs) -> anyhow::Result<()> {
-    let mesh = modal_bake::mesh::read_mesh(&args.mesh)
-        .with_context(|| format!("reading {} failed", args.mesh.display()))?;
+    let mesh = args.input.read(&args.mesh, "fit-attenuation")?;
     let mut progress = Progress::new("fit-attenuation");
     let rep = attenuation_fit::fit_attenuation_mesh(
         mesh,

@@ -3,6 +3,7 @@
 mod accuracy;
 mod fit_attenuation;
 mod fit_gain;
+mod mesh_input;
 mod progress;
 mod scene_truth;
 mod soft_body;

@@ -9,6 +9,7 @@ use clap::{Args, ValueEnum};
 use dcr_lab::truth::{self, CrossCheck, TruthImpact, TruthMethod, TruthParams};
 use modal_bake::full_order::RefineParams;
 
+use super::mesh_input::MeshInput;
 use super::progress::Progress;
 use modal_bake::args::{self as parse, ModelOptions};
 
@@ -40,8 +41,10 @@ pub const EXIT_NOT_CONVERGED: u8 = 3;
 /// within --max-refinements; the peaks and `"converged": false` are still printed).
 #[derive(Args, Clone, Debug)]
 pub struct TruthArgs {
-    /// Tetrahedral mesh: gmsh .msh (2.2 or 4.1, ASCII or binary) or meshio-style .json.
+    /// Tetrahedral mesh: gmsh .msh (2.0–2.2 or 4.1, ASCII or binary) or meshio-style .json.
     pub mesh: PathBuf,
+    #[command(flatten)]
+    pub input: MeshInput,
     #[command(flatten)]
     pub model: ModelOptions,
     /// Impact point (m, object frame), mapped to the closest surface point (refused farther than
@@ -137,10 +140,16 @@ pub fn run(args: &TruthArgs) -> anyhow::Result<ExitCode> {
         impulse: args.impulse,
         direction: args.direction,
     };
+    let mesh = args.input.read(&args.mesh, "truth")?;
     let mut progress = Progress::new("truth");
-    let res = truth::truth_file(&args.mesh, &params, &impact, &args.contacts, &mut |p| {
-        progress.count(&format!("step {:.3e} s", p.dt), p.done, p.total)
-    });
+    let res = truth::run_truth(
+        mesh,
+        &params,
+        &impact,
+        &args.contacts,
+        &args.mesh.display().to_string(),
+        &mut |p| progress.count(&format!("step {:.3e} s", p.dt), p.done, p.total),
+    );
     progress.finish();
     let res = res.with_context(|| format!("truth for {} failed", args.mesh.display()))?;
     let code = if res.convergence.converged || args.max_refinements == 0 {

@@ -121,49 +121,8 @@ pub fn load_mesh(
             path.display()
         );
     }
-    let mut mesh = match &asset.object {
-        None => modal_bake::mesh::read_mesh(path),
-        Some(_) if is_json(path) => anyhow::bail!(
-            "--object selects an object of a surface asset or a physical volume of a gmsh .msh, not of the meshio JSON mesh {}: select one of its connected pieces with --piece N, or write one object's cells per file",
-            path.display()
-        ),
-        Some(object) => modal_bake::mesh::read_msh_object(path, object),
-    }
-    .map_err(anyhow::Error::new)?;
-    if asset.units != super::mesh::Units::M {
-        for p in &mut mesh.nodes {
-            for c in p.iter_mut() {
-                *c = asset.units.to_metres_of(*c);
-            }
-        }
-    }
-    if let Some(n) = asset.piece {
-        mesh = mesh
-            .keep_piece(usize::try_from(n).unwrap_or(usize::MAX))
-            .map_err(|mut e| {
-                e.file = path.display().to_string();
-                e
-            })?;
-    }
-    if asset.straighten {
-        let note = if mesh.is_quadratic() {
-            let (moved, relative) = mesh.straighten();
-            format!(
-                "--straighten: every mid-edge node at its edge's midpoint; the largest move {moved:.3e} m ({:.3} % of its edge)",
-                100.0 * relative
-            )
-        } else {
-            "--straighten: a linear mesh, nothing to move".to_string()
-        };
-        mesh.notes.push(note);
-    }
+    let mesh = asset.volume_selection().read(path)?;
     Ok((mesh, t.elapsed().as_secs_f64()))
-}
-
-/// Whether `path` names a meshio-style `.json` mesh (by its extension).
-pub fn is_json(path: &std::path::Path) -> bool {
-    path.extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("json"))
 }
 
 /// [`load_mesh`] with a progress stage for reading a volume mesh (meshing a surface asset

@@ -6,53 +6,7 @@ use anyhow::Context;
 use clap::Args;
 use modal_bake::mesh::{MeshParams, MeshedAsset, MesherChoice};
 
-/// Length unit of a mesh's or surface asset's coordinates.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub enum Units {
-    /// Metres (Blender's default export).
-    M,
-    /// Centimetres.
-    Cm,
-    /// Millimetres (most CAD exports).
-    Mm,
-    /// Inches.
-    In,
-}
-
-impl Units {
-    /// Metres per unit.
-    pub fn to_metres(self) -> f64 {
-        match self {
-            Units::M => 1.0,
-            Units::Cm => 0.01,
-            Units::Mm => 0.001,
-            Units::In => 0.0254,
-        }
-    }
-
-    /// The coordinate `x` (in this unit) in metres. Centimetres and millimetres divide by 100
-    /// and 1000 (one correctly rounded operation, so a coordinate exactly representable in
-    /// the unit, such as a whole number of millimetres, gives the same bits as the metre value
-    /// written in decimal); inches multiply by 0.0254.
-    pub fn to_metres_of(self, x: f64) -> f64 {
-        match self {
-            Units::M => x,
-            Units::Cm => x / 100.0,
-            Units::Mm => x / 1000.0,
-            Units::In => x * 0.0254,
-        }
-    }
-
-    /// The option's spelling (`m`, `cm`, `mm`, `in`).
-    pub fn name(self) -> &'static str {
-        match self {
-            Units::M => "m",
-            Units::Cm => "cm",
-            Units::Mm => "mm",
-            Units::In => "in",
-        }
-    }
-}
+pub use modal_bake::mesh::Units;
 
 /// Warns (stderr) when an object `extent_m` across (bounding-box diagonal, m) is outside
 /// plausible object sizes (0.01 … 100 m), suggesting the `--units` that would bring it
@@ -179,6 +133,16 @@ pub struct AssetOptions {
 }
 
 impl AssetOptions {
+    /// How a volume mesh is read: `--object`, `--units`, `--piece`, `--straighten`.
+    pub fn volume_selection(&self) -> modal_bake::mesh::VolumeSelection {
+        modal_bake::mesh::VolumeSelection {
+            object: self.object.clone(),
+            units: self.units,
+            piece: self.piece,
+            straighten: self.straighten,
+        }
+    }
+
     /// The element order: `--order`, else [`DEFAULT_ORDER`].
     pub fn order(&self) -> u8 {
         self.order.unwrap_or(DEFAULT_ORDER)

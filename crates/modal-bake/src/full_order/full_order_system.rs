@@ -75,11 +75,17 @@ impl FullOrderSystem {
         }
         mesh.orient_tets(DEFAULT_DEGENERATE_REL_TOL)
             .map_err(name_file)?;
-        let pieces = mesh.connected_components();
-        if pieces != 1 {
-            return Err(FullOrderError::Params(format!(
-                "{file}: the mesh has {pieces} disconnected pieces"
-            )));
+        let pieces = mesh.pieces();
+        if pieces.len() != 1 {
+            // The bake's refusal: the pieces, largest first, and what selects one.
+            return Err(FullOrderError::Params(
+                crate::bake::BakeError::Disconnected {
+                    file: file.to_string(),
+                    pieces: pieces.len(),
+                    list: crate::mesh::list_pieces(&pieces),
+                }
+                .to_string(),
+            ));
         }
         let fixed = params
             .fixed_selectors()

@@ -202,6 +202,11 @@ pub enum MeshErrorKind {
         /// The 3-D physical groups the file's tetrahedra belong to, comma-separated.
         available: String,
     },
+    /// An object was asked of a meshio JSON file, which has no physical volumes.
+    #[error(
+        "--object selects an object of a surface asset or a physical volume of a gmsh .msh, not of a meshio JSON mesh: select one of its connected pieces with --piece N, or write one object's cells per file"
+    )]
+    ObjectOfJson,
     /// The mesh has no connected piece of the number asked for (pieces are numbered from 1,
     /// largest volume first).
     #[error("no piece {asked}: the mesh has {count} connected piece(s), largest first: {list}")]

@@ -36,6 +36,7 @@ pub mod mesher;
 mod msh;
 mod msh_writer;
 mod pieces;
+mod selection;
 pub mod sizing;
 pub mod surface;
 mod tet_mesh;
@@ -55,6 +56,7 @@ pub use mesher::{
 pub use msh_writer::msh41_bytes;
 pub(crate) use pieces::list_pieces;
 pub use pieces::{four_digits, MeshPiece};
+pub use selection::{is_json, Units, VolumeSelection};
 pub(crate) use tet_mesh::tet_faces;
 pub use tet_mesh::{signed_volume, TetMesh, TET10_EDGES};
 pub use validate::{DEFAULT_DEGENERATE_REL_TOL, DEFAULT_STRAIGHT_REL_TOL, STRAIGHT_DIAGONAL_TOL};

@@ -522,7 +522,7 @@ fn check_entry(args: &BakeArgs) -> anyhow::Result<()> {
             "mesher, size, order, envelope, gmsh, ftetwild, keep-surface, uniform-size and mesher-timeout apply to surface assets (.obj, .stl, .ply, .glb, .gltf), not to the volume mesh {}",
             args.mesh.display()
         );
-    } else if args.asset.object.is_some() && super::super::bake::is_json(&args.mesh) {
+    } else if args.asset.object.is_some() && modal_bake::mesh::is_json(&args.mesh) {
         bail!(
             "object selects an object of a surface asset or a physical volume of a gmsh .msh, not of the meshio JSON mesh {} (piece selects one of its connected pieces)",
             args.mesh.display()
