@@ -421,6 +421,47 @@ fn real_asset_mesh_bake_probe_and_a_holed_copy() {
     }
 }
 
+// Expectation: a base of a surface asset records the meshing options it was meshed with;
+// `info` shows them and a stale `check` names the ones that differ (the usual cause of a
+// changed geometry for an asset), while the same options find it up to date.
+#[test]
+fn an_asset_base_records_its_meshing_and_check_names_a_change() {
+    if !have_gmsh("an_asset_base_records_its_meshing_and_check_names_a_change") {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let asset = dir.path().join("cube.obj");
+    std::fs::write(&asset, obj(&CUBE_V.map(|p| p.map(|x| 0.1 * x)), false)).unwrap();
+    let base = dir.path().join("cube.modes");
+    let run = |cmd: &str, extra: &[&str]| {
+        bin()
+            .arg(cmd)
+            .arg(&asset)
+            .args(if cmd == "bake" { vec!["-o"] } else { vec![] })
+            .arg(&base)
+            .args(["--modes", "4", "--material", "steel", "--order", "1"])
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    let o = run("bake", &["--size", "0.05"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let info = bin().arg("info").arg(&base).output().unwrap();
+    let text = String::from_utf8_lossy(&info.stdout);
+    assert!(
+        text.contains("  meshed from its surface asset with --mesher auto --size 0.05 --order 1\n"),
+        "{text}"
+    );
+    assert_eq!(run("check", &["--size", "0.05"]).status.code(), Some(0));
+    let o = run("check", &["--size", "0.04", "--uniform-size"]);
+    assert_eq!(o.status.code(), Some(1));
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        text.contains("stale (geometry changed): the base's asset was meshed with `--mesher auto --size 0.05 --order 1`, this with `--mesher auto --size 0.04 --order 1 --uniform-size`: give the bake's meshing options; "),
+        "{text}"
+    );
+}
+
 /// A missing gmsh is an error that says how to install it.
 #[test]
 fn missing_gmsh_says_how_to_install() {

@@ -77,10 +77,23 @@ pub(super) fn geometry_difference(base: &ModesFile, prepared: &Prepared) -> Stri
         }),
     );
     let ratio = d_now / d_base;
-    if d_base > 0.0 && ratio.is_finite() && !(0.99..=1.01).contains(&ratio) {
+    let resized = d_base > 0.0 && ratio.is_finite() && !(0.99..=1.01).contains(&ratio);
+    // A factor between two of the units --units reads (m, cm, mm, in), within 1 %.
+    let unit_like = resized
+        && [10.0, 100.0, 1000.0, 2.54, 25.4, 1.0 / 0.0254]
+            .iter()
+            .any(|&f: &f64| (ratio.max(1.0 / ratio) / f - 1.0).abs() < 0.01);
+    // Another mesh of the same object (a remeshed asset) differs in size a little: say so
+    // when the counts match (a moved or scaled mesh), the factor is a unit's or large.
+    if resized && (same_counts || unit_like || !(0.8..=1.25).contains(&ratio)) {
         parts.push(format!(
-            "this mesh is {} the base's size ({d_now:.4e} m across, the base {d_base:.4e} m; read with another --units?)",
-            times(ratio)
+            "this mesh is {} the base's size ({d_now:.4e} m across, the base {d_base:.4e} m{})",
+            times(ratio),
+            if unit_like {
+                "; read with another --units?"
+            } else {
+                ""
+            }
         ));
     } else if same_counts && now_surface.len() == base.surface_vertices.len() {
         let (moved, at) = base

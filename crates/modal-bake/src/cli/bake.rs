@@ -274,14 +274,16 @@ pub fn before_factorization(
 }
 
 /// Records in `base`'s free-form `meta.bake_params` where its material came from
-/// (`material_choice`), what each fixed-node selector fixed (`fixed_by`) and, when any was
-/// which part of the input file the base is and in which unit it was read
-/// ([`selection_record`]); none enters `params_hash` (the geometry hash covers the selected
-/// mesh, in metres).
+/// (`material_choice`), what each fixed-node selector fixed (`fixed_by`), which part of the
+/// input file `input` the base is and in which unit it was read ([`selection_record`]) and,
+/// for a surface asset, the meshing options it was meshed with ([`meshing_record`]; `asset`
+/// resolved by [`asset_for`]); none enters `params_hash` (the geometry hash covers the
+/// selected mesh, in metres).
 pub fn annotate(
     base: &mut ModesFile,
     options: &BakeOptions,
     asset: &AssetOptions,
+    input: &std::path::Path,
     report: &BakeReport,
 ) {
     if let Some(obj) = base.meta.bake_params.as_object_mut() {
@@ -291,7 +293,58 @@ pub fn annotate(
         );
         obj.insert("fixed_by".into(), serde_json::json!(report.fixed_by));
         obj.insert("selection".into(), selection_record(asset).into());
+        if is_surface_asset(input) {
+            obj.insert("meshing".into(), meshing_record(asset).into());
+        }
     }
+}
+
+/// The record `meta.bake_params.meshing` of the options a surface asset was meshed with:
+/// `mesher` (`auto`, `gmsh`, `ftetwild`: the choice asked for), `size` (m; null: the
+/// default), `order`, `envelope` (m; null: the default), `keep_surface`, `uniform_size`,
+/// `thickness_sizing`.
+pub fn meshing_record(asset: &AssetOptions) -> serde_json::Map<String, serde_json::Value> {
+    let v = serde_json::json!({
+        "mesher": asset.mesher.name(),
+        "size": asset.size,
+        "order": asset.order(),
+        "envelope": asset.envelope,
+        "keep_surface": asset.keep_surface,
+        "uniform_size": asset.uniform_size,
+        "thickness_sizing": !asset.no_thickness_sizing,
+    });
+    match v {
+        serde_json::Value::Object(m) => m,
+        _ => unreachable!("a JSON object literal"),
+    }
+}
+
+/// A [`meshing_record`] as the options that make it (`--mesher auto --size 0.005 --order 2`;
+/// defaults of size and envelope unsaid).
+pub fn meshing_options(meshing: &serde_json::Map<String, serde_json::Value>) -> String {
+    let mut parts = Vec::new();
+    if let Some(m) = meshing.get("mesher").and_then(|v| v.as_str()) {
+        parts.push(format!("--mesher {m}"));
+    }
+    if let Some(s) = meshing.get("size").and_then(serde_json::Value::as_f64) {
+        parts.push(format!("--size {s}"));
+    }
+    if let Some(o) = meshing.get("order").and_then(serde_json::Value::as_u64) {
+        parts.push(format!("--order {o}"));
+    }
+    if let Some(e) = meshing.get("envelope").and_then(serde_json::Value::as_f64) {
+        parts.push(format!("--envelope {e}"));
+    }
+    for (key, flag, when) in [
+        ("keep_surface", "--keep-surface", true),
+        ("uniform_size", "--uniform-size", true),
+        ("thickness_sizing", "--no-thickness-sizing", false),
+    ] {
+        if meshing.get(key).and_then(serde_json::Value::as_bool) == Some(when) {
+            parts.push(flag.into());
+        }
+    }
+    parts.join(" ")
 }
 
 /// The record `meta.bake_params.selection` of how the input was read: `object`, `piece` and
@@ -375,6 +428,29 @@ pub fn selection_mismatch(out: &std::path::Path, asset: &AssetOptions) -> Option
     ))
 }
 
+/// When the base at `out` was meshed from its surface asset with other meshing options than
+/// `asset` (resolved by [`asset_for`]) gives (its recorded [`meshing_record`]), the sentence
+/// that says so; `None` when they agree, the base records none or cannot be read.
+pub fn meshing_mismatch(out: &std::path::Path, asset: &AssetOptions) -> Option<String> {
+    let base = ModesFile::read(out).ok()?;
+    let recorded = base.meta.bake_params.get("meshing")?.as_object()?.clone();
+    let asked = meshing_record(asset);
+    if recorded == asked {
+        return None;
+    }
+    let chosen = base
+        .meta
+        .bake_params
+        .get("target_error_pct")
+        .map(|p| format!(" (the --size `bake --target-error {p}` chose)"))
+        .unwrap_or_default();
+    Some(format!(
+        "the base's asset was meshed with `{}`{chosen}, this with `{}`: give the bake's meshing options",
+        meshing_options(&recorded),
+        meshing_options(&asked)
+    ))
+}
+
 /// A stale status's one-line detail, with the selection mismatch when the geometry differs.
 pub fn stale_detail(
     status: &BaseStatus,
@@ -383,10 +459,15 @@ pub fn stale_detail(
 ) -> Option<String> {
     let detail = status.detail()?.to_string();
     match status {
-        BaseStatus::GeometryChanged(_) => Some(match selection_mismatch(out, asset) {
-            Some(m) => format!("{m}; {detail}"),
-            None => detail,
-        }),
+        BaseStatus::GeometryChanged(_) => {
+            let mut parts: Vec<String> =
+                [selection_mismatch(out, asset), meshing_mismatch(out, asset)]
+                    .into_iter()
+                    .flatten()
+                    .collect();
+            parts.push(detail);
+            Some(parts.join("; "))
+        }
         _ => Some(detail),
     }
 }
@@ -426,29 +507,36 @@ pub fn run(args: &BakeArgs, asset: &AssetOptions) -> anyhow::Result<()> {
         )?;
     }
     let (mesh, read_s) = load_mesh_with_progress(&args.mesh, asset)?;
-    bake_loaded(args, &params, mesh, read_s)
+    bake_loaded(args, asset, &params, mesh, read_s)
 }
 
-/// Bakes the mesh `--target-error` chose for a surface asset, as `bake` would.
+/// Bakes the mesh `--target-error` chose for a surface asset, meshed with `chosen` (the
+/// chosen `--size`), as `bake` would.
 ///
 /// # Errors
 /// As `bake`.
-pub fn bake_chosen_mesh(args: &BakeArgs, mesh: modal_bake::mesh::TetMesh) -> anyhow::Result<()> {
+pub fn bake_chosen_mesh(
+    args: &BakeArgs,
+    chosen: &AssetOptions,
+    mesh: modal_bake::mesh::TetMesh,
+) -> anyhow::Result<()> {
     let params = BakeParams {
         transfer: args.transfer.params(),
         ..args.options.params()
     };
-    bake_loaded(args, &params, mesh, 0.0)
+    bake_loaded(args, chosen, &params, mesh, 0.0)
 }
 
 /// The checks before the factorization, the bake of a mesh in memory (read in `read_s`
-/// seconds), the record of the material and selectors and the atomic write of `args.out`;
+/// seconds, with `asset`: the options it was read or meshed with, resolved by [`asset_for`]),
+/// the record of the material, selectors and input and the atomic write of `args.out`;
 /// `on_stage` sees each stage. Shared by `bake` and `batch`.
 ///
 /// # Errors
 /// The estimate over the budget, or a failed bake or write (nothing is written).
 pub fn bake_and_write(
     args: &BakeArgs,
+    asset: &AssetOptions,
     params: &BakeParams,
     mesh: modal_bake::mesh::TetMesh,
     read_s: f64,
@@ -474,7 +562,7 @@ pub fn bake_and_write(
         .and_then(|(mut base, mut report)| {
             report.read_s = read_s;
             report.material_name = args.options.model.material_choice().describe();
-            annotate(&mut base, &args.options, &args.asset, &report);
+            annotate(&mut base, &args.options, asset, &args.mesh, &report);
             on_stage(BakeStage::Write);
             let t = std::time::Instant::now();
             super::create_parent(&args.out)?;
@@ -490,13 +578,16 @@ pub fn bake_and_write(
 /// the report.
 fn bake_loaded(
     args: &BakeArgs,
+    asset: &AssetOptions,
     params: &BakeParams,
     mesh: modal_bake::mesh::TetMesh,
     read_s: f64,
 ) -> anyhow::Result<()> {
     let file = args.mesh.display().to_string();
     let mut progress = Progress::new("bake");
-    let report = bake_and_write(args, params, mesh, read_s, &mut |s| progress.update(s));
+    let report = bake_and_write(args, asset, params, mesh, read_s, &mut |s| {
+        progress.update(s);
+    });
     progress.finish();
     let report = report?;
     if let Some(w) = bake::plausibility_warnings(

@@ -237,6 +237,18 @@ fn write_model(out: &mut String, file: &Path, base: &ModesFile) -> std::fmt::Res
             writeln!(out, "  input: its file with {options}")?;
         }
     }
+    if let Some(m) = base
+        .meta
+        .bake_params
+        .get("meshing")
+        .and_then(|v| v.as_object())
+    {
+        writeln!(
+            out,
+            "  meshed from its surface asset with {}",
+            super::bake::meshing_options(m)
+        )?;
+    }
     if base.fixed_nodes.is_empty() {
         writeln!(
             out,

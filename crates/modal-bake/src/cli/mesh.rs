@@ -51,6 +51,17 @@ pub enum MesherArg {
     Ftetwild,
 }
 
+impl MesherArg {
+    /// The option's spelling (`auto`, `gmsh`, `ftetwild`).
+    pub fn name(self) -> &'static str {
+        match self {
+            MesherArg::Auto => "auto",
+            MesherArg::Gmsh => "gmsh",
+            MesherArg::Ftetwild => "ftetwild",
+        }
+    }
+}
+
 /// Element order of a surface asset's tetrahedra when `--order` is not given: 10-node
 /// (order 2), far more accurate per degree of freedom than 4-node tetrahedra in bending.
 pub const DEFAULT_ORDER: u8 = 2;

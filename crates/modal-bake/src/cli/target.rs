@@ -75,7 +75,7 @@ pub fn run(args: &BakeArgs, asset: &AssetOptions, target: f64) -> anyhow::Result
     } =
         res.with_context(|| format!("baking {} failed; nothing was written", args.mesh.display()))?;
     report.material_name = args.options.model.material_choice().describe();
-    annotate(&mut base, &args.options, asset, &report);
+    annotate(&mut base, &args.options, asset, &args.mesh, &report);
     base.write_atomic(&args.out)
         .with_context(|| format!("writing {} failed", args.out.display()))?;
     let acc = base
@@ -245,5 +245,9 @@ fn choose_mesh_and_bake(args: &BakeArgs, asset: &AssetOptions, target: f64) -> a
             e.map_or("unknown".into(), |e| format!("≈ {e:.2} %"))
         ),
     }
-    super::bake::bake_chosen_mesh(args, choice.mesh)
+    let chosen = AssetOptions {
+        size: Some(last.size_m),
+        ..asset.clone()
+    };
+    super::bake::bake_chosen_mesh(args, &chosen, choice.mesh)
 }
