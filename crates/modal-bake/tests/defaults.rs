@@ -559,6 +559,37 @@ fn target_error_refines_the_mesh_of_a_surface_asset() {
         .unwrap();
     assert_eq!(r["tets"].as_u64().unwrap(), last_tets);
     assert_eq!(r["order"], 2);
+    // The base records the choice: the size chosen (the last printed) as its meshing, and
+    // `check` finds it up to date at that --size, stale at the size asked for, saying why.
+    let base = dcr_runtime::format::ModesFile::read(&out).unwrap();
+    let choice = &base.meta.bake_params["mesh_choice"];
+    let size = base.meta.bake_params["meshing"]["size"].as_f64().unwrap();
+    assert_eq!(choice["size"].as_f64(), Some(size));
+    assert_eq!(
+        (choice["target_error_pct"].as_f64(), &choice["met"]),
+        (Some(5.0), &serde_json::json!(true))
+    );
+    assert_eq!(choice["meshes"].as_u64(), Some(steps as u64));
+    assert!(
+        e.contains(&format!("met at --size {size:.4e} m")),
+        "{size} {e}"
+    );
+    let check = |size: &str| {
+        let mut a = vec!["check", asset.to_str().unwrap(), out.to_str().unwrap()];
+        a.extend(["--material", "aluminium", "--modes", "3", "--size", size]);
+        Command::new(env!("CARGO_BIN_EXE_modal-bake"))
+            .args(&a)
+            .output()
+            .unwrap()
+    };
+    assert_eq!(check(&size.to_string()).status.code(), Some(0));
+    let o = check("0.04");
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.code() == Some(1)
+            && text.contains(&format!("meshed with `--mesher auto --size {size} --order 2` (the --size `bake --target-error 5` chose), this with `--mesher auto --size 0.04 --order 2`")),
+        "{text}"
+    );
     // An unreachable target within a tiny budget: baked anyway at the finest mesh that fits,
     // with the warning.
     let mut a = common.to_vec();

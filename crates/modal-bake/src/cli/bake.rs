@@ -441,7 +441,9 @@ pub fn meshing_mismatch(out: &std::path::Path, asset: &AssetOptions) -> Option<S
     let chosen = base
         .meta
         .bake_params
-        .get("target_error_pct")
+        .get("mesh_choice")
+        .and_then(|c| c.get("target_error_pct"))
+        .and_then(serde_json::Value::as_f64)
         .map(|p| format!(" (the --size `bake --target-error {p}` chose)"))
         .unwrap_or_default();
     Some(format!(
@@ -507,7 +509,7 @@ pub fn run(args: &BakeArgs, asset: &AssetOptions) -> anyhow::Result<()> {
         )?;
     }
     let (mesh, read_s) = load_mesh_with_progress(&args.mesh, asset)?;
-    bake_loaded(args, asset, &params, mesh, read_s)
+    bake_loaded(args, asset, None, &params, mesh, read_s)
 }
 
 /// Bakes the mesh `--target-error` chose for a surface asset, meshed with `chosen` (the
@@ -518,25 +520,28 @@ pub fn run(args: &BakeArgs, asset: &AssetOptions) -> anyhow::Result<()> {
 pub fn bake_chosen_mesh(
     args: &BakeArgs,
     chosen: &AssetOptions,
+    choice: serde_json::Value,
     mesh: modal_bake::mesh::TetMesh,
 ) -> anyhow::Result<()> {
     let params = BakeParams {
         transfer: args.transfer.params(),
         ..args.options.params()
     };
-    bake_loaded(args, chosen, &params, mesh, 0.0)
+    bake_loaded(args, chosen, Some(choice), &params, mesh, 0.0)
 }
 
 /// The checks before the factorization, the bake of a mesh in memory (read in `read_s`
 /// seconds, with `asset`: the options it was read or meshed with, resolved by [`asset_for`]),
-/// the record of the material, selectors and input and the atomic write of `args.out`;
-/// `on_stage` sees each stage. Shared by `bake` and `batch`.
+/// the record of the material, selectors and input (and `mesh_choice`, the record of a mesh
+/// `--target-error` chose, as `meta.bake_params.mesh_choice`) and the atomic write of
+/// `args.out`; `on_stage` sees each stage. Shared by `bake` and `batch`.
 ///
 /// # Errors
 /// The estimate over the budget, or a failed bake or write (nothing is written).
 pub fn bake_and_write(
     args: &BakeArgs,
     asset: &AssetOptions,
+    mesh_choice: Option<serde_json::Value>,
     params: &BakeParams,
     mesh: modal_bake::mesh::TetMesh,
     read_s: f64,
@@ -563,6 +568,10 @@ pub fn bake_and_write(
             report.read_s = read_s;
             report.material_name = args.options.model.material_choice().describe();
             annotate(&mut base, &args.options, asset, &args.mesh, &report);
+            if let (Some(obj), Some(choice)) = (base.meta.bake_params.as_object_mut(), mesh_choice)
+            {
+                obj.insert("mesh_choice".into(), choice);
+            }
             on_stage(BakeStage::Write);
             let t = std::time::Instant::now();
             super::create_parent(&args.out)?;
@@ -579,13 +588,14 @@ pub fn bake_and_write(
 fn bake_loaded(
     args: &BakeArgs,
     asset: &AssetOptions,
+    mesh_choice: Option<serde_json::Value>,
     params: &BakeParams,
     mesh: modal_bake::mesh::TetMesh,
     read_s: f64,
 ) -> anyhow::Result<()> {
     let file = args.mesh.display().to_string();
     let mut progress = Progress::new("bake");
-    let report = bake_and_write(args, asset, params, mesh, read_s, &mut |s| {
+    let report = bake_and_write(args, asset, mesh_choice, params, mesh, read_s, &mut |s| {
         progress.update(s);
     });
     progress.finish();

@@ -249,6 +249,24 @@ fn write_model(out: &mut String, file: &Path, base: &ModesFile) -> std::fmt::Res
             super::bake::meshing_options(m)
         )?;
     }
+    if let Some(c) = base.meta.bake_params.get("mesh_choice") {
+        let num = |k: &str| c.get(k).and_then(serde_json::Value::as_f64);
+        writeln!(
+            out,
+            "  mesh chosen by --target-error {} %: {} — --size {:.4e} m (mesh {} of the refinement); the lowest {} modes moved ≤ {} in the last refinement, estimated error {}",
+            num("target_error_pct").unwrap_or(f64::NAN),
+            if c.get("met") == Some(&serde_json::Value::Bool(true)) {
+                "met"
+            } else {
+                "NOT met (the finest mesh within the budget)"
+            },
+            num("size").unwrap_or(f64::NAN),
+            c.get("meshes").and_then(serde_json::Value::as_u64).unwrap_or(0),
+            c.get("modes_compared").and_then(serde_json::Value::as_u64).unwrap_or(0),
+            num("last_change_pct").map_or("(one mesh only)".into(), |x| format!("{x:.2} %")),
+            num("estimated_error_pct").map_or("unknown".into(), |x| format!("≈ {x:.2} %")),
+        )?;
+    }
     if base.fixed_nodes.is_empty() {
         writeln!(
             out,

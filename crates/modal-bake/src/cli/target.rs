@@ -249,5 +249,14 @@ fn choose_mesh_and_bake(args: &BakeArgs, asset: &AssetOptions, target: f64) -> a
         size: Some(last.size_m),
         ..asset.clone()
     };
-    super::bake::bake_chosen_mesh(args, &chosen, choice.mesh)
+    let record = serde_json::json!({
+        "target_error_pct": target,
+        "met": choice.converged,
+        "size": last.size_m,
+        "meshes": choice.steps.len(),
+        "last_change_pct": last.change_pct,
+        "estimated_error_pct": choice.error_pct(),
+        "modes_compared": MESH_CHOICE_MODES,
+    });
+    super::bake::bake_chosen_mesh(args, &chosen, record, choice.mesh)
 }

@@ -319,7 +319,7 @@ fn run_entry(entry: &Entry, tag: &str, start: Instant) -> EntryRecord {
             eprintln!("warning: {}: {w}", args.mesh.display());
         }
         let mut stage_name = "";
-        super::bake::bake_and_write(args, &asset, &params, mesh, read_s, &mut |s| {
+        super::bake::bake_and_write(args, &asset, None, &params, mesh, read_s, &mut |s| {
             // Long bakes say which stage they are in.
             let name = s.label();
             if name != stage_name && t.elapsed().as_secs_f64() >= 5.0 {
