@@ -473,6 +473,27 @@ fn check_names_what_differs() {
         "the base holds a transfer table (--transfer-h 0.01 s); no --transfer-h was given"
     );
 
+    // An edited record: the hash alone, then the parameters unreadable.
+    let mut edited = dcr_runtime::format::ModesFile::read(&base).unwrap();
+    edited.meta.params_hash = "sha256:0".into();
+    edited.write_atomic(&base).unwrap();
+    let table = ["--transfer-h", "0.01", "--transfer-modes", "12"];
+    let (_, reason, d) = check(&cube, &table);
+    assert_eq!(reason, "parameters_changed");
+    assert!(
+        d.starts_with(
+            "every recorded parameter equals these options, but the base's parameter hash does not"
+        ),
+        "{d}"
+    );
+    edited.meta.bake_params["material"] = serde_json::json!("steel");
+    edited.write_atomic(&base).unwrap();
+    let (_, _, d) = check(&cube, &table);
+    assert!(
+        d.starts_with("its recorded parameters (meta.bake_params) do not read as this modal-bake"),
+        "{d}"
+    );
+
     // The tool: another output version.
     let mut old = dcr_runtime::format::ModesFile::read(&base).unwrap();
     old.meta.bake_params["output_version"] = serde_json::json!(0);
