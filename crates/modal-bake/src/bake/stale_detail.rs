@@ -134,7 +134,8 @@ pub(super) fn with_target_choice(base: &ModesFile, detail: String) -> String {
 }
 
 /// The parameters recorded in `base` that differ from `params`, each named by its option:
-/// `--modes: 10 in the base, 12 asked`.
+/// `--density: 700 kg/m³ in the base, 750 kg/m³ asked; --modes/--max-freq: 10 modes in the
+/// base, 12 modes asked`.
 pub(super) fn parameter_difference(base: &ModesFile, params: &BakeParams) -> String {
     let recorded: BakeParams = match serde_json::from_value(base.meta.bake_params.clone()) {
         Ok(p) => p,

@@ -388,12 +388,11 @@ pub fn selection_options(selection: &serde_json::Map<String, serde_json::Value>)
     parts.join(" ")
 }
 
-/// When the base at `out` was read from its file with another selection or unit than
-/// `asset` gives (its recorded [`selection_record`]), the sentence that says so; `None` when
-/// they agree or the base cannot be read. A base without the record (baked by an older tool)
-/// is compared on `object`, `piece` and `straighten` only.
-pub fn selection_mismatch(out: &std::path::Path, asset: &AssetOptions) -> Option<String> {
-    let base = ModesFile::read(out).ok()?;
+/// When `base` was read from its file with another selection or unit than `asset` gives (its
+/// recorded [`selection_record`]), the sentence that says so; `None` when they agree. A base
+/// without the record (baked by an older tool) is compared on `object`, `piece` and
+/// `straighten` only.
+pub fn selection_mismatch(base: &ModesFile, asset: &AssetOptions) -> Option<String> {
     let mut recorded = base
         .meta
         .bake_params
@@ -428,11 +427,10 @@ pub fn selection_mismatch(out: &std::path::Path, asset: &AssetOptions) -> Option
     ))
 }
 
-/// When the base at `out` was meshed from its surface asset with other meshing options than
-/// `asset` (resolved by [`asset_for`]) gives (its recorded [`meshing_record`]), the sentence
-/// that says so; `None` when they agree, the base records none or cannot be read.
-pub fn meshing_mismatch(out: &std::path::Path, asset: &AssetOptions) -> Option<String> {
-    let base = ModesFile::read(out).ok()?;
+/// When `base` was meshed from its surface asset with other meshing options than `asset`
+/// (resolved by [`asset_for`]) gives (its recorded [`meshing_record`]), the sentence that says
+/// so; `None` when they agree or the base records none.
+pub fn meshing_mismatch(base: &ModesFile, asset: &AssetOptions) -> Option<String> {
     let recorded = base.meta.bake_params.get("meshing")?.as_object()?.clone();
     let asked = meshing_record(asset);
     if recorded == asked {
@@ -453,7 +451,9 @@ pub fn meshing_mismatch(out: &std::path::Path, asset: &AssetOptions) -> Option<S
     ))
 }
 
-/// A stale status's one-line detail, with the selection mismatch when the geometry differs.
+/// A stale status's one-line detail; when the geometry differs, led by how the base at `out`
+/// was read or meshed differently from what `asset` asks ([`selection_mismatch`],
+/// [`meshing_mismatch`]).
 pub fn stale_detail(
     status: &BaseStatus,
     out: &std::path::Path,
@@ -462,11 +462,12 @@ pub fn stale_detail(
     let detail = status.detail()?.to_string();
     match status {
         BaseStatus::GeometryChanged(_) => {
-            let mut parts: Vec<String> =
-                [selection_mismatch(out, asset), meshing_mismatch(out, asset)]
-                    .into_iter()
-                    .flatten()
-                    .collect();
+            let base = ModesFile::read(out).ok();
+            let mut parts: Vec<String> = base
+                .iter()
+                .flat_map(|b| [selection_mismatch(b, asset), meshing_mismatch(b, asset)])
+                .flatten()
+                .collect();
             parts.push(detail);
             Some(parts.join("; "))
         }
