@@ -453,6 +453,32 @@ fn an_asset_base_records_its_meshing_and_check_names_a_change() {
         "{text}"
     );
     assert_eq!(run("check", &["--size", "0.05"]).status.code(), Some(0));
+    // The options `info` rebuilds from the record check it too.
+    let v: serde_json::Value = serde_json::from_slice(
+        &bin()
+            .arg("info")
+            .arg(&base)
+            .arg("--json")
+            .output()
+            .unwrap()
+            .stdout,
+    )
+    .unwrap();
+    let args: Vec<&str> = v["check_args"]["args"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_str().unwrap())
+        .collect();
+    assert!(args.windows(2).any(|w| w == ["--size", "0.05"]), "{args:?}");
+    let o = bin()
+        .arg("check")
+        .arg(&asset)
+        .arg(&base)
+        .args(&args)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{args:?}");
     let o = run("check", &["--size", "0.04", "--uniform-size"]);
     assert_eq!(o.status.code(), Some(1));
     let text = String::from_utf8_lossy(&o.stdout);

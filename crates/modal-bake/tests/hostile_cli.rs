@@ -504,6 +504,106 @@ fn check_names_what_differs() {
     assert!(d.ends_with("writes output version 1"), "{d}");
 }
 
+// Expectation: `info` rebuilds from a base's record the options `check` finds it up to date
+// with — every parameter, selector, selection and table option, negative values included —
+// so a base found on a farm says how to check (and bake) it again.
+#[test]
+fn info_gives_the_options_that_check_the_base() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = dir.path().join("rich.modes");
+    let b = base.to_str().unwrap();
+    let cube = data("meshes/cube_v41.msh");
+    let m = cube.to_str().unwrap();
+    let options = [
+        "--material",
+        "oak",
+        "--youngs",
+        "1.3e10",
+        "--modes",
+        "5",
+        "--fixed",
+        "bottom",
+        "--fixed-box=-0.1,-0.1,0.99,1.1,1.1,1.1",
+        "--rayleigh",
+        "5,2e-7",
+        "--lumped",
+        "--f32",
+        "--transfer-h",
+        "0.004",
+        "--transfer-modes",
+        "30",
+        "--transfer-region=-0.1,-0.1,0.5,1.1,1.1,1.1",
+        "--transfer-up",
+        "0,0,1",
+        "--transfer-oversample",
+        "2",
+        "--transfer-order",
+        "2",
+    ];
+    let mut a = vec!["bake", m, "-o", b];
+    a.extend(options);
+    let o = run(&a);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&run(&["info", b, "--json"]).stdout).unwrap();
+    let args: Vec<String> = v["check_args"]["args"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_str().unwrap().to_string())
+        .collect();
+    assert!(v["check_args"]["missing"].as_array().unwrap().is_empty());
+    for needed in [
+        "--lumped",
+        "--f32",
+        "--fixed-box=-0.1,-0.1,0.99,1.1,1.1,1.1",
+        "--transfer-up",
+    ] {
+        assert!(args.iter().any(|x| x == needed), "{needed}: {args:?}");
+    }
+    let mut c = vec!["check", m, b];
+    c.extend(args.iter().map(String::as_str));
+    let o = run(&c);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&o.stdout)
+    );
+    // The text says the same, with MESH for the file the base does not name.
+    let text = String::from_utf8_lossy(&run(&["info", b]).stdout).into_owned();
+    assert!(
+        text.contains(&format!(
+            "  check it with: modal-bake check MESH {b} {}\n",
+            args.join(" ")
+        )),
+        "{text}"
+    );
+    // Each option dropped in turn makes the base stale: none is printed for nothing.
+    for i in 0..args.len() {
+        if args[i].starts_with("--")
+            && !args[i].contains('=')
+            && args.get(i + 1).is_some_and(|v| !v.starts_with("--"))
+        {
+            let mut fewer: Vec<&str> = vec!["check", m, b];
+            fewer.extend(
+                args.iter()
+                    .enumerate()
+                    .filter(|(j, _)| *j != i && *j != i + 1)
+                    .map(|(_, x)| x.as_str()),
+            );
+            let o = run(&fewer);
+            // Stale, or (without --transfer-h) an error: never up to date.
+            assert_ne!(
+                o.status.code(),
+                Some(0),
+                "without {} {}",
+                args[i],
+                args[i + 1]
+            );
+        }
+    }
+}
+
 // Regression: numerical internals instead of causes — a mesh scaled by 1e100 or 1e150 ("Ritz
 // vectors not M-independent", "|volume| inf m³ below NaN m³"), a coordinate of 2147483648
 // ("NonPositivePivot"), an outlier node at 1e12 m (a healthy tet blamed), E = 1e300 or 1e308,

@@ -1243,6 +1243,19 @@ fn a_volume_mesh_of_several_pieces_bakes_piece_by_piece() {
     assert_eq!(check(&alone_small, None).0, Some(0));
     assert_eq!(check(&two, Some("2")).0, Some(0));
     assert_eq!(check(&two, Some("1")).0, Some(1));
+    // `info` gives the options that check it, --piece included.
+    let v: serde_json::Value =
+        serde_json::from_slice(&run_bake(&[&"info", &modes, &"--json"]).stdout).unwrap();
+    let args: Vec<String> = v["check_args"]["args"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_str().unwrap().to_string())
+        .collect();
+    assert!(args.windows(2).any(|w| w == ["--piece", "2"]), "{args:?}");
+    let mut a: Vec<&dyn AsRef<std::ffi::OsStr>> = vec![&"check", &two, &modes];
+    a.extend(args.iter().map(|s| s as &dyn AsRef<std::ffi::OsStr>));
+    assert_eq!(run_bake(&a).status.code(), Some(0), "{args:?}");
     // A stale check names the selection the base was read with.
     let (code, text) = check(&alone_large, None);
     assert_eq!(code, Some(1));

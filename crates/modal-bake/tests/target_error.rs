@@ -149,6 +149,26 @@ fn the_cheapest_representation_within_the_target_is_chosen_and_recorded() {
     assert!(text(&o).contains(&printed), "{}", text(&o));
     let o = bake(&strict, "70");
     assert!(text(&o).contains(&printed), "{}", text(&o));
+    // `info` rebuilds the same options from each base's record.
+    for base in [&lax, &strict] {
+        let o = Command::new(env!("CARGO_BIN_EXE_modal-bake"))
+            .args(["info", base.to_str().unwrap(), "--json"])
+            .output()
+            .unwrap();
+        let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        let args: Vec<&str> = v["check_args"]["args"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_str().unwrap())
+            .collect();
+        let o = Command::new(env!("CARGO_BIN_EXE_modal-bake"))
+            .args(["check", beam().to_str().unwrap(), base.to_str().unwrap()])
+            .args(&args)
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(0), "{args:?}: {}", text(&o));
+    }
     let o = check(&lax, &["--transfer-h", "0.002"]);
     assert!(
         text(&o).contains("check it with the bake's options, `--modes 5` in place of --target-error, without --transfer-h"),

@@ -48,4 +48,5 @@ pub use plausibility::{
     PLAUSIBLE_WAVE_SPEED,
 };
 pub use report::{BakeReport, BakeStage, TransferReport};
+pub use stale_detail::option_number;
 pub use staleness::{base_status, is_mesh_up_to_date, is_up_to_date, mesh_base_status, BaseStatus};

@@ -154,14 +154,18 @@ pub(super) fn parameter_difference(base: &ModesFile, params: &BakeParams) -> Str
     let (m0, m1) = (&recorded.material, &params.material);
     differ(
         "--youngs",
-        format!("{} Pa", num(m0.youngs)),
-        format!("{} Pa", num(m1.youngs)),
+        format!("{} Pa", option_number(m0.youngs)),
+        format!("{} Pa", option_number(m1.youngs)),
     );
-    differ("--poisson", num(m0.poisson), num(m1.poisson));
+    differ(
+        "--poisson",
+        option_number(m0.poisson),
+        option_number(m1.poisson),
+    );
     differ(
         "--density",
-        format!("{} kg/m³", num(m0.density)),
-        format!("{} kg/m³", num(m1.density)),
+        format!("{} kg/m³", option_number(m0.density)),
+        format!("{} kg/m³", option_number(m1.density)),
     );
     differ(
         "--modes/--max-freq",
@@ -179,7 +183,12 @@ pub(super) fn parameter_difference(base: &ModesFile, params: &BakeParams) -> Str
     let boxes = |b: &[[f64; 6]]| {
         list(
             &b.iter()
-                .map(|b| b.iter().map(|&x| num(x)).collect::<Vec<_>>().join(","))
+                .map(|b| {
+                    b.iter()
+                        .map(|&x| option_number(x))
+                        .collect::<Vec<_>>()
+                        .join(",")
+                })
                 .collect::<Vec<_>>(),
         )
     };
@@ -198,7 +207,7 @@ pub(super) fn parameter_difference(base: &ModesFile, params: &BakeParams) -> Str
                         s.triangles.len(),
                         s.distance.map_or_else(
                             || "default distance".to_string(),
-                            |d| format!("{} m", num(d))
+                            |d| format!("{} m", option_number(d))
                         )
                     )
                 })
@@ -212,10 +221,14 @@ pub(super) fn parameter_difference(base: &ModesFile, params: &BakeParams) -> Str
         "--rayleigh",
         format!(
             "{},{}",
-            num(recorded.rayleigh[0]),
-            num(recorded.rayleigh[1])
+            option_number(recorded.rayleigh[0]),
+            option_number(recorded.rayleigh[1])
         ),
-        format!("{},{}", num(params.rayleigh[0]), num(params.rayleigh[1])),
+        format!(
+            "{},{}",
+            option_number(params.rayleigh[0]),
+            option_number(params.rayleigh[1])
+        ),
     );
     differ("--lumped", on_off(recorded.lumped), on_off(params.lumped));
     let f32 = |p: &BakeParams| on_off(p.precision == dcr_runtime::format::ModesPrecision::F32);
@@ -239,7 +252,7 @@ pub(super) fn transfer_difference(
     match (&base.transfer, expected) {
         (Some(t), None) => format!(
             "the base holds a transfer table (--transfer-h {} s); no --transfer-h was given",
-            num(t.h)
+            option_number(t.h)
         ),
         (None, Some(e)) => format!(
             "the base has no transfer table; --transfer-h {} asks for one",
@@ -287,8 +300,9 @@ pub(super) fn transfer_difference(
     }
 }
 
-/// `x` in the shortest form that reads back: `1.1e9`, `0.3`, `770`.
-fn num(x: f64) -> String {
+/// `x` in the shortest form that parses back to the same `f64`, as an option's value is
+/// typed: `1.1e9`, `0.3`, `770`, `1e-7` (exponent form outside 1e-3 … 1e5).
+pub fn option_number(x: f64) -> String {
     if x != 0.0 && (x.abs() >= 1e5 || x.abs() < 1e-3) {
         format!("{x:e}")
     } else {
@@ -300,7 +314,7 @@ fn num(x: f64) -> String {
 fn modes(m: ModeRequest) -> String {
     match m {
         ModeRequest::Count(n) => format!("{n} modes"),
-        ModeRequest::MaxFreqHz(f) => format!("below {} Hz", num(f)),
+        ModeRequest::MaxFreqHz(f) => format!("below {} Hz", option_number(f)),
     }
 }
 
@@ -319,7 +333,7 @@ fn on_off(b: bool) -> String {
 /// `ratio` as a factor to four significant digits: `1000×`, `0.0254×`.
 fn times(ratio: f64) -> String {
     let rounded: f64 = format!("{ratio:.3e}").parse().unwrap_or(ratio);
-    format!("{}×", num(rounded))
+    format!("{}×", option_number(rounded))
 }
 
 /// The diagonal (m) of the bounding box of `points`; 0 for none.
@@ -347,10 +361,10 @@ mod tests {
 
     #[test]
     fn numbers_read_as_typed() {
-        assert_eq!(num(1.1e9), "1.1e9");
-        assert_eq!(num(0.3), "0.3");
-        assert_eq!(num(770.0), "770");
-        assert_eq!(num(1e-7), "1e-7");
+        assert_eq!(option_number(1.1e9), "1.1e9");
+        assert_eq!(option_number(0.3), "0.3");
+        assert_eq!(option_number(770.0), "770");
+        assert_eq!(option_number(1e-7), "1e-7");
         assert_eq!(times(1_000.000_000_1), "1000×");
         assert_eq!(times(1e6), "1e6×");
         assert_eq!(times(0.0254), "0.0254×");

@@ -180,7 +180,38 @@ fn info_json(file: &Path, base: &ModesFile, warnings: &[String]) -> serde_json::
             "max_peak_m_per_ns": t.peaks.iter().fold(0.0f32, |a, &b| a.max(b)),
         })),
         "accuracy": base.meta.accuracy,
+        // The options `check MESH BASE …` finds it up to date with (null: not a bake's
+        // record), and what the base does not record.
+        "check_args": super::bake_options::bake_options_of(base).ok().map(|o| serde_json::json!({
+            "args": o.args,
+            "missing": o.missing,
+        })),
     })
+}
+
+/// The `check` command that finds the base up to date, rebuilt from its record
+/// ([`bake_options_of`](super::bake_options::bake_options_of)); `MESH` stands for the file it
+/// was baked from, which a base does not record.
+fn write_bake_options(out: &mut String, file: &Path, base: &ModesFile) -> std::fmt::Result {
+    match super::bake_options::bake_options_of(base) {
+        Ok(o) => {
+            writeln!(
+                out,
+                "  check it with: modal-bake check MESH {} {}",
+                file.display(),
+                o.args.join(" ")
+            )?;
+            writeln!(
+                out,
+                "    (MESH: the file it was baked from; `bake MESH -o OUT` with the same options bakes it again)"
+            )?;
+            for m in o.missing {
+                writeln!(out, "    add by hand: {m}")?;
+            }
+        }
+        Err(e) => writeln!(out, "  check options: not known ({e})")?,
+    }
+    Ok(())
 }
 
 /// `info`: the base's summary as text, then the warnings and the mode table.
@@ -193,6 +224,7 @@ fn info_text(
     write_model(&mut out, file, base)?;
     write_surface(&mut out, base)?;
     write_tables(&mut out, base)?;
+    write_bake_options(&mut out, file, base)?;
     for w in warnings {
         writeln!(out, "  warning: {w}")?;
     }

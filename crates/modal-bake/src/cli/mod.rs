@@ -9,6 +9,7 @@ macro_rules! outln {
 }
 
 mod bake;
+mod bake_options;
 mod batch;
 mod budget;
 mod check;
