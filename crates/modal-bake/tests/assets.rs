@@ -11,6 +11,8 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+use sha2::Digest;
+
 use modal_bake::mesh::gmsh::{tetrahedralize, GmshParams};
 use modal_bake::mesh::surface::{read_surface_bytes, SurfaceError, SurfaceMesh};
 use modal_bake::mesh::DEFAULT_STRAIGHT_REL_TOL;
@@ -269,6 +271,14 @@ fn t13_asset(test: &str) -> Option<PathBuf> {
     }
 }
 
+/// A base's `meta.bake_params`.
+fn modal_bake_base(path: &Path) -> serde_json::Value {
+    dcr_runtime::format::ModesFile::read(path)
+        .unwrap()
+        .meta
+        .bake_params
+}
+
 fn bin() -> Command {
     Command::new(env!("CARGO_BIN_EXE_modal-bake"))
 }
@@ -479,6 +489,57 @@ fn an_asset_base_records_its_meshing_and_check_names_a_change() {
         .output()
         .unwrap();
     assert_eq!(o.status.code(), Some(0), "{args:?}");
+    // An unchanged asset is not meshed again: the base records its bytes, the meshers'
+    // versions and this build. Other bytes of the same surface (a comment) are meshed again
+    // and found up to date; a base from another build is meshed again.
+    let json = |extra: &[&str]| {
+        let mut e = vec!["--size", "0.05", "--json"];
+        e.extend_from_slice(extra);
+        let o = run("check", &e);
+        let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        (
+            v["up_to_date"].clone(),
+            v["meshed_again"].clone(),
+            String::from_utf8_lossy(&o.stderr).into_owned(),
+        )
+    };
+    let (fresh, again, err) = json(&[]);
+    assert_eq!((fresh, again), (true.into(), false.into()), "{err}");
+    assert!(!err.contains("meshing"), "{err}");
+    let key = &modal_bake_base(&base)["asset_key"];
+    assert_eq!(key["build"], modal_bake::mesh::BUILD_HASH);
+    assert!(
+        key["meshers"]["gmsh"].is_string()
+            && key["sha256"].as_str().unwrap().starts_with("sha256:"),
+        "{key}"
+    );
+    let (_, _, err) = json(&["--youngs", "3e9"]);
+    assert!(
+        err.contains("meshing"),
+        "a stale base's detail comes from meshing: {err}"
+    );
+    let mut text = std::fs::read_to_string(&asset).unwrap();
+    text += "# the same surface\n";
+    std::fs::write(&asset, &text).unwrap();
+    let (fresh, again, err) = json(&[]);
+    assert_eq!((fresh, again), (true.into(), true.into()), "{err}");
+    let mut b = dcr_runtime::format::ModesFile::read(&base).unwrap();
+    b.meta.bake_params["asset_key"]["bytes"] = (text.len() as u64).into();
+    b.meta.bake_params["asset_key"]["sha256"] =
+        format!("sha256:{:x}", sha2::Sha256::digest(text.as_bytes())).into();
+    b.write_atomic(&base).unwrap();
+    assert_eq!(
+        json(&[]).1,
+        serde_json::json!(false),
+        "the key now names these bytes"
+    );
+    b.meta.bake_params["asset_key"]["build"] = "sha256:another build".into();
+    b.write_atomic(&base).unwrap();
+    assert_eq!(
+        json(&[]).1,
+        serde_json::json!(true),
+        "another build meshes again"
+    );
     let o = run("check", &["--size", "0.04", "--uniform-size"]);
     assert_eq!(o.status.code(), Some(1));
     let text = String::from_utf8_lossy(&o.stdout);

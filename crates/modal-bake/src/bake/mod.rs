@@ -49,4 +49,7 @@ pub use plausibility::{
 };
 pub use report::{BakeReport, BakeStage, TransferReport};
 pub use stale_detail::option_number;
-pub use staleness::{base_status, is_mesh_up_to_date, is_up_to_date, mesh_base_status, BaseStatus};
+pub use staleness::{
+    base_status, is_mesh_up_to_date, is_up_to_date, mesh_base_status, same_mesh_base_status,
+    BaseStatus,
+};

@@ -139,13 +139,48 @@ pub fn mesh_base_status(
 ) -> Result<BaseStatus, BakeError> {
     check_options(params, file)?;
     let prepared = prepare(mesh, params, file)?;
-    if std::fs::symlink_metadata(modes).is_err() {
-        return Ok(BaseStatus::Missing);
-    }
-    let base = match ModesFile::read(modes) {
+    let base = match read_base(modes) {
         Ok(base) => base,
-        Err(e) => return Ok(BaseStatus::Unreadable(e.to_string())),
+        Err(status) => return Ok(status),
     };
+    compare(&base, params, Some(&prepared))
+}
+
+/// As [`base_status`] for the mesh the base at `modes` was baked from, known to be the same
+/// without reading it (a surface asset whose bytes, meshing options, meshers and build are
+/// those recorded: [`AssetKey`](crate::mesh::AssetKey)): the tool, parameters and table are
+/// compared, the geometry is taken as the base's, and the table's mode count is resolved with
+/// the base's free dofs.
+///
+/// # Errors
+/// Invalid parameters (what `check` exits 2 on).
+pub fn same_mesh_base_status(
+    file: &str,
+    params: &BakeParams,
+    modes: &Path,
+) -> Result<BaseStatus, BakeError> {
+    check_options(params, file)?;
+    let base = match read_base(modes) {
+        Ok(base) => base,
+        Err(status) => return Ok(status),
+    };
+    compare(&base, params, None)
+}
+
+/// The base at `modes`, or its status when it is missing or unreadable.
+fn read_base(modes: &Path) -> Result<ModesFile, BaseStatus> {
+    if std::fs::symlink_metadata(modes).is_err() {
+        return Err(BaseStatus::Missing);
+    }
+    ModesFile::read(modes).map_err(|e| BaseStatus::Unreadable(e.to_string()))
+}
+
+/// `base` against a bake with `params` of `prepared` (`None`: of the base's own mesh).
+fn compare(
+    base: &ModesFile,
+    params: &BakeParams,
+    prepared: Option<&super::prepare::Prepared>,
+) -> Result<BaseStatus, BakeError> {
     let version_matches =
         base.meta.bake_params.get("output_version") == Some(&serde_json::json!(OUTPUT_VERSION));
     // A base without the stored heat-geodesic order (baked before it existed, or written
@@ -155,26 +190,36 @@ pub fn mesh_base_status(
             .is_err();
     if !version_matches || !order_matches {
         return Ok(BaseStatus::ToolChanged(stale_detail::tool_difference(
-            &base,
+            base,
             version_matches,
         )));
     }
-    if base.meta.source_hash != prepared.hash {
-        return Ok(BaseStatus::GeometryChanged(
-            stale_detail::geometry_difference(&base, &prepared),
-        ));
+    if let Some(prepared) = prepared {
+        if base.meta.source_hash != prepared.hash {
+            return Ok(BaseStatus::GeometryChanged(
+                stale_detail::geometry_difference(base, prepared),
+            ));
+        }
     }
     if base.meta.params_hash != params.hash() {
         return Ok(BaseStatus::ParametersChanged(
             stale_detail::with_target_choice(
-                &base,
-                stale_detail::parameter_difference(&base, params),
+                base,
+                stale_detail::parameter_difference(base, params),
             ),
         ));
     }
     // The bake records the table's mode count resolved for the mesh (`auto` → `all` or a
     // Lanczos count), so compare with the same resolution.
-    let free_dofs = 3 * (prepared.mesh.nodes.len() - prepared.fixed.len());
+    let free_dofs = match prepared {
+        Some(p) => 3 * (p.mesh.nodes.len() - p.fixed.len()),
+        None => {
+            3 * base
+                .meta
+                .volume_nodes
+                .saturating_sub(base.fixed_nodes.len())
+        }
+    };
     let expected = params.transfer.as_ref().map(|tp| {
         let resolved = crate::transfer::TransferParams {
             modes: tp.modes.resolve(free_dofs),
@@ -189,8 +234,8 @@ pub fn mesh_base_status(
     if !table_matches {
         return Ok(BaseStatus::TransferTableChanged(
             stale_detail::with_target_choice(
-                &base,
-                stale_detail::transfer_difference(&base, expected.as_ref()),
+                base,
+                stale_detail::transfer_difference(base, expected.as_ref()),
             ),
         ));
     }

@@ -16,6 +16,7 @@ pub use super::progress::Progress;
 use dcr_runtime::format::ModesFile;
 pub use modal_bake::args::ModelOptions;
 use modal_bake::mesh::surface::is_surface_asset;
+use modal_bake::mesh::AssetKey;
 
 /// Options that determine a base (shared by `bake` and `check`).
 #[derive(Args, Clone, Debug)]
@@ -103,17 +104,29 @@ impl BakeArgs {
     }
 }
 
+/// A mesh loaded for a bake or a check, and what its base records of how it was made.
+pub struct Loaded {
+    /// The tetrahedral mesh (m).
+    pub mesh: modal_bake::mesh::TetMesh,
+    /// Seconds reading or meshing took.
+    pub seconds: f64,
+    /// The key of a surface asset whose mesh is reproducible ([`AssetKey::of`]).
+    pub asset_key: Option<AssetKey>,
+}
+
 /// The tetrahedral mesh of `path`: read (its `--object` physical volume, its `--piece`
-/// connected piece, `--straighten`ed), or (a surface asset) meshed by the meshing chain; with
-/// the seconds it took. Meshing options given with a volume mesh are an error.
-pub fn load_mesh(
-    path: &std::path::Path,
-    asset: &AssetOptions,
-) -> anyhow::Result<(modal_bake::mesh::TetMesh, f64)> {
+/// connected piece, `--straighten`ed), or (a surface asset) meshed by the meshing chain, with
+/// its [`AssetKey`]. Meshing options given with a volume mesh are an error.
+pub fn load_mesh(path: &std::path::Path, asset: &AssetOptions) -> anyhow::Result<Loaded> {
     let t = std::time::Instant::now();
     if is_surface_asset(path) {
         let out = super::mesh::mesh_asset(path, asset)?;
-        return Ok((out.mesh, t.elapsed().as_secs_f64()));
+        let asset_key = AssetKey::of(path, &asset.params()?, &out.report);
+        return Ok(Loaded {
+            mesh: out.mesh,
+            seconds: t.elapsed().as_secs_f64(),
+            asset_key,
+        });
     }
     if asset.any_meshing_set() {
         anyhow::bail!(
@@ -122,7 +135,11 @@ pub fn load_mesh(
         );
     }
     let mesh = asset.volume_selection().read(path)?;
-    Ok((mesh, t.elapsed().as_secs_f64()))
+    Ok(Loaded {
+        mesh,
+        seconds: t.elapsed().as_secs_f64(),
+        asset_key: None,
+    })
 }
 
 /// [`load_mesh`] with a progress stage for reading a volume mesh (meshing a surface asset
@@ -133,7 +150,7 @@ pub fn load_mesh(
 pub fn load_mesh_with_progress(
     path: &std::path::Path,
     asset: &AssetOptions,
-) -> anyhow::Result<(modal_bake::mesh::TetMesh, f64)> {
+) -> anyhow::Result<Loaded> {
     if is_surface_asset(path) {
         return load_mesh(path, asset);
     }
@@ -295,6 +312,61 @@ pub fn annotate(
         obj.insert("selection".into(), selection_record(asset).into());
         if is_surface_asset(input) {
             obj.insert("meshing".into(), meshing_record(asset).into());
+        }
+    }
+}
+
+/// Whether the base at `out` of the surface asset `path` is up to date without meshing the
+/// asset again: its recorded [`AssetKey`] matches the asset now (its bytes, this build, the
+/// meshers' versions), its recorded selection and meshing options are `asset`'s, and it is up
+/// to date for `params` ([`bake::same_mesh_base_status`]). `false` means "mesh and compare"
+/// (so a stale base's detail always comes from the real comparison), never "stale".
+///
+/// # Errors
+/// Invalid parameters (as the full check).
+pub fn unchanged_asset_up_to_date(
+    path: &std::path::Path,
+    asset: &AssetOptions,
+    params: &BakeParams,
+    out: &std::path::Path,
+) -> anyhow::Result<bool> {
+    if !is_surface_asset(path) {
+        return Ok(false);
+    }
+    let Ok(base) = ModesFile::read(out) else {
+        return Ok(false);
+    };
+    let record = &base.meta.bake_params;
+    let Some(key) = record
+        .get("asset_key")
+        .and_then(|k| serde_json::from_value::<AssetKey>(k.clone()).ok())
+    else {
+        return Ok(false);
+    };
+    let same_options = record.get("selection").and_then(|v| v.as_object())
+        == Some(&selection_record(asset))
+        && record.get("meshing").and_then(|v| v.as_object()) == Some(&meshing_record(asset));
+    let Ok(mesh_params) = asset.params() else {
+        return Ok(false);
+    };
+    if !same_options || !key.matches_now(path, &mesh_params) {
+        return Ok(false);
+    }
+    let file = path.display().to_string();
+    Ok(bake::same_mesh_base_status(&file, params, out)? == BaseStatus::UpToDate)
+}
+
+/// Records `provenance` in `base`'s `meta.bake_params` (`mesh_choice`, `asset_key`).
+pub fn record_provenance(base: &mut ModesFile, provenance: Provenance) {
+    if let Some(obj) = base.meta.bake_params.as_object_mut() {
+        if let Some(choice) = provenance.mesh_choice {
+            obj.insert("mesh_choice".into(), choice);
+        }
+        if let Some(key) = provenance.asset_key {
+            obj.insert(
+                "asset_key".into(),
+                serde_json::to_value(key).expect("a key serialises"),
+            );
         }
     }
 }
@@ -509,8 +581,28 @@ pub fn run(args: &BakeArgs, asset: &AssetOptions) -> anyhow::Result<()> {
             args.table_modes(),
         )?;
     }
-    let (mesh, read_s) = load_mesh_with_progress(&args.mesh, asset)?;
-    bake_loaded(args, asset, None, &params, mesh, read_s)
+    let loaded = load_mesh_with_progress(&args.mesh, asset)?;
+    let provenance = Provenance {
+        mesh_choice: None,
+        asset_key: loaded.asset_key,
+    };
+    bake_loaded(
+        args,
+        asset,
+        provenance,
+        &params,
+        loaded.mesh,
+        loaded.seconds,
+    )
+}
+
+/// What a base records of how its mesh was made, beside the options ([`annotate`]).
+#[derive(Default)]
+pub struct Provenance {
+    /// `meta.bake_params.mesh_choice`: a mesh `--target-error` chose.
+    pub mesh_choice: Option<serde_json::Value>,
+    /// `meta.bake_params.asset_key`: what the mesh of a surface asset depends on.
+    pub asset_key: Option<AssetKey>,
 }
 
 /// Bakes the mesh `--target-error` chose for a surface asset, meshed with `chosen` (the
@@ -528,21 +620,24 @@ pub fn bake_chosen_mesh(
         transfer: args.transfer.params(),
         ..args.options.params()
     };
-    bake_loaded(args, chosen, Some(choice), &params, mesh, 0.0)
+    let provenance = Provenance {
+        mesh_choice: Some(choice),
+        asset_key: None,
+    };
+    bake_loaded(args, chosen, provenance, &params, mesh, 0.0)
 }
 
 /// The checks before the factorization, the bake of a mesh in memory (read in `read_s`
 /// seconds, with `asset`: the options it was read or meshed with, resolved by [`asset_for`]),
-/// the record of the material, selectors and input (and `mesh_choice`, the record of a mesh
-/// `--target-error` chose, as `meta.bake_params.mesh_choice`) and the atomic write of
-/// `args.out`; `on_stage` sees each stage. Shared by `bake` and `batch`.
+/// the record of the material, selectors and input (and the mesh's [`Provenance`]) and the
+/// atomic write of `args.out`; `on_stage` sees each stage. Shared by `bake` and `batch`.
 ///
 /// # Errors
 /// The estimate over the budget, or a failed bake or write (nothing is written).
 pub fn bake_and_write(
     args: &BakeArgs,
     asset: &AssetOptions,
-    mesh_choice: Option<serde_json::Value>,
+    provenance: Provenance,
     params: &BakeParams,
     mesh: modal_bake::mesh::TetMesh,
     read_s: f64,
@@ -569,10 +664,7 @@ pub fn bake_and_write(
             report.read_s = read_s;
             report.material_name = args.options.model.material_choice().describe();
             annotate(&mut base, &args.options, asset, &args.mesh, &report);
-            if let (Some(obj), Some(choice)) = (base.meta.bake_params.as_object_mut(), mesh_choice)
-            {
-                obj.insert("mesh_choice".into(), choice);
-            }
+            record_provenance(&mut base, provenance);
             on_stage(BakeStage::Write);
             let t = std::time::Instant::now();
             super::create_parent(&args.out)?;
@@ -589,14 +681,14 @@ pub fn bake_and_write(
 fn bake_loaded(
     args: &BakeArgs,
     asset: &AssetOptions,
-    mesh_choice: Option<serde_json::Value>,
+    provenance: Provenance,
     params: &BakeParams,
     mesh: modal_bake::mesh::TetMesh,
     read_s: f64,
 ) -> anyhow::Result<()> {
     let file = args.mesh.display().to_string();
     let mut progress = Progress::new("bake");
-    let report = bake_and_write(args, asset, mesh_choice, params, mesh, read_s, &mut |s| {
+    let report = bake_and_write(args, asset, provenance, params, mesh, read_s, &mut |s| {
         progress.update(s);
     });
     progress.finish();

@@ -5,6 +5,7 @@ use std::process::ExitCode;
 
 use clap::Args;
 use modal_bake::bake::{self, BaseStatus};
+use modal_bake::mesh::surface::is_surface_asset;
 
 use super::bake::{BakeOptions, TransferOptions};
 use super::mesh::AssetOptions;
@@ -27,7 +28,9 @@ pub struct CheckArgs {
     /// Print one JSON object: {"base", "mesh", "up_to_date", "reason" (up_to_date, missing,
     /// unreadable, tool_changed, geometry_changed, parameters_changed, transfer_table_changed),
     /// "detail" (what differs, by the options that change it; null when up to date or
-    /// missing)} (or {"error"} with exit 2).
+    /// missing), "meshed_again" (false when a surface asset's base records the same bytes,
+    /// options, meshers and build, so the asset was not meshed again)} (or {"error"} with
+    /// exit 2).
     #[arg(long)]
     pub json: bool,
 }
@@ -40,12 +43,29 @@ pub fn run(args: &CheckArgs) -> ExitCode {
     let file = args.mesh.display().to_string();
     let asset = super::bake::asset_for(&args.asset, args.transfer.transfer_h.is_some(), &args.mesh);
     // The options are checked as `bake` checks them, naming the option.
+    // An unchanged asset is not meshed again (minutes on a large one) when its base records
+    // the same bytes, options, meshers and build.
+    let mut remeshed = true;
     let status = args
         .options
         .model
         .check_ranges()
-        .and_then(|()| super::bake::load_mesh(&args.mesh, &asset))
-        .and_then(|(mesh, _)| Ok(bake::mesh_base_status(mesh, &file, &params, &args.out)?));
+        .and_then(|()| {
+            super::bake::unchanged_asset_up_to_date(&args.mesh, &asset, &params, &args.out)
+        })
+        .and_then(|unchanged| {
+            if unchanged {
+                remeshed = false;
+                return Ok(BaseStatus::UpToDate);
+            }
+            let loaded = super::bake::load_mesh(&args.mesh, &asset)?;
+            Ok(bake::mesh_base_status(
+                loaded.mesh,
+                &file,
+                &params,
+                &args.out,
+            )?)
+        });
     match status {
         Ok(status) => {
             let fresh = status == BaseStatus::UpToDate;
@@ -59,7 +79,13 @@ pub fn run(args: &CheckArgs) -> ExitCode {
                         "up_to_date": fresh,
                         "reason": status.reason(),
                         "detail": detail,
+                        "meshed_again": is_surface_asset(&args.mesh) && remeshed,
                     })
+                );
+            } else if fresh && !remeshed {
+                outln!(
+                    "{}: up to date (the asset's bytes, options, meshers and build are the base's: not meshed again)",
+                    args.out.display()
                 );
             } else if fresh {
                 outln!("{}: up to date", args.out.display());

@@ -35,7 +35,8 @@ pub fn run(args: &BakeArgs, asset: &AssetOptions, target: f64) -> anyhow::Result
         args.budget
             .check_surface(&args.mesh, asset, args.options.modes_for_estimate(), None)?;
     }
-    let (mesh, _) = super::bake::load_mesh_with_progress(&args.mesh, asset)?;
+    let loaded = super::bake::load_mesh_with_progress(&args.mesh, asset)?;
+    let mesh = loaded.mesh;
     let file = args.mesh.display().to_string();
     // The choice solves for the table's every-mode set (dense where it fits, else Lanczos) and
     // holds each candidate table to the budget.
@@ -76,6 +77,13 @@ pub fn run(args: &BakeArgs, asset: &AssetOptions, target: f64) -> anyhow::Result
         res.with_context(|| format!("baking {} failed; nothing was written", args.mesh.display()))?;
     report.material_name = args.options.model.material_choice().describe();
     annotate(&mut base, &args.options, asset, &args.mesh, &report);
+    super::bake::record_provenance(
+        &mut base,
+        super::bake::Provenance {
+            mesh_choice: None,
+            asset_key: loaded.asset_key,
+        },
+    );
     base.write_atomic(&args.out)
         .with_context(|| format!("writing {} failed", args.out.display()))?;
     let acc = base

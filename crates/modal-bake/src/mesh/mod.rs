@@ -24,6 +24,7 @@
 //! their line, byte offset or element ids. Every error is a [`MeshError`] naming the file.
 
 mod asset;
+mod asset_key;
 mod boundary;
 mod cursor;
 mod distance;
@@ -46,6 +47,7 @@ pub mod work;
 use std::path::Path;
 
 pub use asset::mesh_asset;
+pub use asset_key::{AssetKey, BUILD_HASH};
 pub use boundary::extract_surface;
 pub use distance::{surface_distance, SurfaceDistance};
 pub use mesh_error::{Location, MeshError, MeshErrorKind};

@@ -289,6 +289,17 @@ fn run_entry(entry: &Entry, tag: &str, start: Instant) -> EntryRecord {
             transfer: args.transfer.params(),
             ..args.options.params()
         };
+        if super::bake::unchanged_asset_up_to_date(&args.mesh, &asset, &params, &args.out)? {
+            line(
+                start,
+                &format!(
+                    "{tag} {}: the asset's bytes, options, meshers and build are the base's: not meshed again",
+                    args.out.display()
+                ),
+            );
+            status_seen = Some(("up_to_date", None));
+            return Ok((BaseStatus::UpToDate, false));
+        }
         if is_surface_asset(&args.mesh) {
             args.budget.check_surface(
                 &args.mesh,
@@ -297,7 +308,8 @@ fn run_entry(entry: &Entry, tag: &str, start: Instant) -> EntryRecord {
                 args.table_modes(),
             )?;
         }
-        let (mesh, read_s) = super::bake::load_mesh(&args.mesh, &asset)?;
+        let loaded = super::bake::load_mesh(&args.mesh, &asset)?;
+        let (mesh, read_s) = (loaded.mesh, loaded.seconds);
         let file = args.mesh.display().to_string();
         let status = bake::mesh_base_status(mesh.clone(), &file, &params, &args.out)?;
         // Read before the bake replaces the base.
@@ -319,7 +331,11 @@ fn run_entry(entry: &Entry, tag: &str, start: Instant) -> EntryRecord {
             eprintln!("warning: {}: {w}", args.mesh.display());
         }
         let mut stage_name = "";
-        super::bake::bake_and_write(args, &asset, None, &params, mesh, read_s, &mut |s| {
+        let provenance = super::bake::Provenance {
+            mesh_choice: None,
+            asset_key: loaded.asset_key,
+        };
+        super::bake::bake_and_write(args, &asset, provenance, &params, mesh, read_s, &mut |s| {
             // Long bakes say which stage they are in.
             let name = s.label();
             if name != stage_name && t.elapsed().as_secs_f64() >= 5.0 {

@@ -1,0 +1,99 @@
+//! When meshing a surface asset again can be skipped: an [`AssetKey`] records what a mesh of
+//! an asset depends on — the asset file's bytes, this build of the meshing chain
+//! ([`BUILD_HASH`]) and the meshers' versions — so that `check` and `batch` find a base of an
+//! unchanged asset up to date without meshing it again (minutes on a large asset), with the
+//! same answer meshing would give.
+//!
+//! Why that answer is the same: the meshers run on one thread with fixed seeds, so the same
+//! asset bytes, options (recorded beside the key: `selection`, `meshing`) and mesher versions
+//! give the same mesh bytes (docs/artist-guide.md; fTetWild only where its fixed-sequence
+//! random device is loaded — a mesh that is not reproducible gets no key). glTF assets get no
+//! key: a `.gltf` may read other files (buffers) the key would not cover.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use sha2::{Digest, Sha256};
+
+use super::{Backend, MeshParams, MeshReport};
+
+/// A SHA-256 of the sources of this crate and the workspace crates it builds on, its
+/// `Cargo.lock`, the compiler's version and the target (computed by `build.rs`): two builds
+/// with the same hash mesh an asset alike.
+pub const BUILD_HASH: &str = env!("MODAL_BAKE_BUILD_HASH");
+
+/// What a mesh of a surface asset depends on besides the options
+/// (`meta.bake_params.asset_key` of its base).
+#[derive(Clone, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct AssetKey {
+    /// `sha256:<hex>` of the asset file's bytes.
+    pub sha256: String,
+    /// The asset file's size (bytes).
+    pub bytes: u64,
+    /// The [`BUILD_HASH`] of the `modal-bake` that meshed it.
+    pub build: String,
+    /// The version of each mesher when it was meshed (`gmsh`, `ftetwild`; absent: not
+    /// installed): both, since `auto` may run either and fall back to the other.
+    pub meshers: BTreeMap<String, String>,
+}
+
+impl AssetKey {
+    /// The key of the asset at `path` as it is now, meshed with `params` (whose `--gmsh` /
+    /// `--ftetwild` choose the meshers asked for their versions); `None` for a glTF asset or a
+    /// mesh `report` says is not reproducible, or a file that cannot be read.
+    pub fn of(path: &Path, params: &MeshParams, report: &MeshReport) -> Option<AssetKey> {
+        let ftetwild_ran = report.backend == Backend::Ftetwild;
+        if is_gltf(path) || (ftetwild_ran && !report.reproducible) {
+            return None;
+        }
+        Self::now(path, params)
+    }
+
+    /// The key the asset at `path` would get now, with the meshers `params` would run.
+    fn now(path: &Path, params: &MeshParams) -> Option<AssetKey> {
+        let bytes = std::fs::read(path).ok()?;
+        let mut meshers = BTreeMap::new();
+        if let Ok(v) = super::gmsh::gmsh_version(params.gmsh.as_deref()) {
+            meshers.insert("gmsh".to_string(), v);
+        }
+        let ftetwild = match params.ftetwild.as_deref() {
+            // A FloatTetwild_bin names no version: its bytes identify it.
+            Some(p) => std::fs::read(p)
+                .ok()
+                .map(|b| format!("FloatTetwild_bin {}", sha256(&b))),
+            None => super::ftetwild::ftetwild_version(None).ok(),
+        };
+        if let Some(v) = ftetwild {
+            meshers.insert("ftetwild".to_string(), v);
+        }
+        Some(AssetKey {
+            sha256: sha256(&bytes),
+            bytes: bytes.len() as u64,
+            build: BUILD_HASH.to_string(),
+            meshers,
+        })
+    }
+
+    /// Whether the asset at `path`, this build and the meshers `params` would run now are
+    /// those of this key (the options are compared apart).
+    pub fn matches_now(&self, path: &Path, params: &MeshParams) -> bool {
+        // Cheap tests first: the build, then the size, before hashing the file and asking
+        // the meshers their versions.
+        if self.build != BUILD_HASH || is_gltf(path) {
+            return false;
+        }
+        if std::fs::metadata(path).map(|m| m.len()).ok() != Some(self.bytes) {
+            return false;
+        }
+        Self::now(path, params).as_ref() == Some(self)
+    }
+}
+
+fn sha256(bytes: &[u8]) -> String {
+    format!("sha256:{:x}", Sha256::digest(bytes))
+}
+
+fn is_gltf(path: &Path) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("gltf") || e.eq_ignore_ascii_case("glb"))
+}
