@@ -549,6 +549,45 @@ fn an_asset_base_records_its_meshing_and_check_names_a_change() {
     );
 }
 
+// Expectation: `batch` skips an unchanged asset's base without meshing it again, and
+// re-bakes it (meshing) when an option changes.
+#[test]
+fn batch_skips_an_unchanged_asset_without_meshing() {
+    if !have_gmsh("batch_skips_an_unchanged_asset_without_meshing") {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let asset = dir.path().join("cube.obj");
+    std::fs::write(&asset, obj(&CUBE_V.map(|p| p.map(|x| 0.1 * x)), false)).unwrap();
+    let manifest = dir.path().join("m.json");
+    let write = |modes: u32| {
+        let m = serde_json::json!({"version": 1, "entries": [
+            {"mesh": asset, "out": "cube.modes",
+             "options": {"modes": modes, "material": "steel", "size": 0.05, "order": 1}}]});
+        std::fs::write(&manifest, m.to_string()).unwrap();
+    };
+    let batch = || {
+        let o = bin()
+            .arg("batch")
+            .arg(&manifest)
+            .arg("--json")
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        let e = &v["entries"][0];
+        (
+            e["action"].as_str().unwrap().to_string(),
+            String::from_utf8_lossy(&o.stderr).contains("not meshed again"),
+        )
+    };
+    write(4);
+    assert_eq!(batch(), ("baked".to_string(), false));
+    assert_eq!(batch(), ("skipped".to_string(), true));
+    write(5);
+    assert_eq!(batch(), ("baked".to_string(), false));
+}
+
 /// A missing gmsh is an error that says how to install it.
 #[test]
 fn missing_gmsh_says_how_to_install() {
