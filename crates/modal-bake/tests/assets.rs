@@ -17,6 +17,10 @@ use modal_bake::mesh::gmsh::{tetrahedralize, GmshParams};
 use modal_bake::mesh::surface::{read_surface_bytes, SurfaceError, SurfaceMesh};
 use modal_bake::mesh::DEFAULT_STRAIGHT_REL_TOL;
 
+#[path = "common/check_args.rs"]
+mod check_args;
+use check_args::check_args;
+
 #[path = "common/gmsh_gate.rs"]
 mod gmsh_gate;
 use gmsh_gate::have_gmsh;
@@ -464,22 +468,7 @@ fn an_asset_base_records_its_meshing_and_check_names_a_change() {
     );
     assert_eq!(run("check", &["--size", "0.05"]).status.code(), Some(0));
     // The options `info` rebuilds from the record check it too.
-    let v: serde_json::Value = serde_json::from_slice(
-        &bin()
-            .arg("info")
-            .arg(&base)
-            .arg("--json")
-            .output()
-            .unwrap()
-            .stdout,
-    )
-    .unwrap();
-    let args: Vec<&str> = v["check_args"]["args"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|x| x.as_str().unwrap())
-        .collect();
+    let args = check_args(&base);
     assert!(args.windows(2).any(|w| w == ["--size", "0.05"]), "{args:?}");
     let o = bin()
         .arg("check")

@@ -6,6 +6,10 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
+#[path = "common/check_args.rs"]
+mod check_args;
+use check_args::check_args;
+
 fn bin() -> Command {
     Command::new(env!("CARGO_BIN_EXE_modal-bake"))
 }
@@ -545,12 +549,7 @@ fn info_gives_the_options_that_check_the_base() {
     let o = run(&a);
     assert!(o.status.success(), "{}", stderr(&o));
     let v: serde_json::Value = serde_json::from_slice(&run(&["info", b, "--json"]).stdout).unwrap();
-    let args: Vec<String> = v["check_args"]["args"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|x| x.as_str().unwrap().to_string())
-        .collect();
+    let args = check_args(&base);
     assert!(v["check_args"]["missing"].as_array().unwrap().is_empty());
     for needed in [
         "--lumped",

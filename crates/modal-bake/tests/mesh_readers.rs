@@ -5,6 +5,9 @@
 
 use std::path::{Path, PathBuf};
 
+#[path = "common/check_args.rs"]
+mod check_args;
+use check_args::check_args;
 #[path = "common/gmsh_gate.rs"]
 mod gmsh_gate;
 #[path = "common/meshio_gate.rs"]
@@ -1244,14 +1247,7 @@ fn a_volume_mesh_of_several_pieces_bakes_piece_by_piece() {
     assert_eq!(check(&two, Some("2")).0, Some(0));
     assert_eq!(check(&two, Some("1")).0, Some(1));
     // `info` gives the options that check it, --piece included.
-    let v: serde_json::Value =
-        serde_json::from_slice(&run_bake(&[&"info", &modes, &"--json"]).stdout).unwrap();
-    let args: Vec<String> = v["check_args"]["args"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|x| x.as_str().unwrap().to_string())
-        .collect();
+    let args = check_args(&modes);
     assert!(args.windows(2).any(|w| w == ["--piece", "2"]), "{args:?}");
     let mut a: Vec<&dyn AsRef<std::ffi::OsStr>> = vec![&"check", &two, &modes];
     a.extend(args.iter().map(|s| s as &dyn AsRef<std::ffi::OsStr>));

@@ -13,6 +13,10 @@ use modal_bake::full_order::{FullOrderSystem, ModalAll, SystemParams};
 use modal_bake::target_error::{PairsParams, ReferencePairs};
 use modal_bake::transfer::select_region;
 
+#[path = "common/check_args.rs"]
+mod check_args;
+use check_args::check_args;
+
 fn beam() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/meshes/beam.msh")
 }
@@ -151,17 +155,7 @@ fn the_cheapest_representation_within_the_target_is_chosen_and_recorded() {
     assert!(text(&o).contains(&printed), "{}", text(&o));
     // `info` rebuilds the same options from each base's record.
     for base in [&lax, &strict] {
-        let o = Command::new(env!("CARGO_BIN_EXE_modal-bake"))
-            .args(["info", base.to_str().unwrap(), "--json"])
-            .output()
-            .unwrap();
-        let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
-        let args: Vec<&str> = v["check_args"]["args"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|x| x.as_str().unwrap())
-            .collect();
+        let args = check_args(base);
         let o = Command::new(env!("CARGO_BIN_EXE_modal-bake"))
             .args(["check", beam().to_str().unwrap(), base.to_str().unwrap()])
             .args(&args)
