@@ -255,3 +255,101 @@ fn truth_reads_the_mesh_as_the_bake_does() {
         "{err}"
     );
 }
+
+/// `--base`: the reference of a base's own object (material, damping, fixed nodes from its
+/// record) — the same peaks, bit for bit, as with those options typed — beside the base's
+/// response at the same points with its error; another mesh, or material options with
+/// `--base`, are refused.
+#[test]
+fn truth_of_a_base_compares_the_base() {
+    let dir = tempfile::tempdir().unwrap();
+    let beam = data("meshes/beam.msh");
+    let base = dir.path().join("beam.modes");
+    let params = modal_bake::bake::BakeParams {
+        material: dcr_runtime::format::MaterialSi {
+            youngs: 2e11,
+            poisson: 0.29,
+            density: 7850.0,
+        },
+        fixed: vec!["clamp".into()],
+        ..Default::default()
+    };
+    modal_bake::bake::bake_file(&beam, &params, &base, &mut |_| {}).unwrap();
+    let points = [
+        "--impact",
+        "1.0,0.05,0.1",
+        "--impulse",
+        "1",
+        "--contact",
+        "0.5,0.05,0.1",
+        "--contact",
+        "0.8,0.0,0.05",
+        "--h",
+        "0.002",
+        "--dt",
+        "5e-7",
+        "--json",
+        "--method",
+        "modal-all",
+    ];
+    let run = |mesh: &Path, extra: &[&str]| {
+        let mut a = vec!["truth", mesh.to_str().unwrap()];
+        a.extend_from_slice(&points);
+        a.extend_from_slice(extra);
+        Command::new(env!("CARGO_BIN_EXE_dcr-lab"))
+            .args(&a)
+            .output()
+            .unwrap()
+    };
+    let with_base = run(&beam, &["--base", base.to_str().unwrap()]);
+    let typed = run(
+        &beam,
+        &[
+            "--youngs",
+            "2e11",
+            "--poisson",
+            "0.29",
+            "--density",
+            "7850",
+            "--fixed",
+            "clamp",
+        ],
+    );
+    let truth = peaks(&with_base);
+    assert_eq!(truth, peaks(&typed));
+    let v: serde_json::Value = serde_json::from_slice(&with_base.stdout).unwrap();
+    let b = &v["base"];
+    assert_eq!(b["modes"], 20);
+    for (k, t) in truth.iter().enumerate() {
+        let c = &b["contacts"][k];
+        let peak = c["peak_displacement_m"].as_f64().unwrap();
+        assert!(peak > 0.0 && c["served_by"] == "modal", "{c}");
+        let e = c["error_pct"].as_f64().unwrap();
+        assert!((e - 100.0 * (peak - t) / t).abs() < 1e-9, "{c}");
+    }
+    // Near the impact 20 modes are within a few percent of the reference.
+    assert!(
+        b["contacts"][0]["error_pct"].as_f64().unwrap().abs() < 5.0,
+        "{b}"
+    );
+    let other = run(
+        &data("meshes/cube_v41.msh"),
+        &["--base", base.to_str().unwrap()],
+    );
+    let err = String::from_utf8_lossy(&other.stderr);
+    assert!(
+        !other.status.success()
+            && err.contains("cube_v41.msh is not the mesh")
+            && err.contains("beam.modes was baked from"),
+        "{err}"
+    );
+    let both = run(
+        &beam,
+        &["--base", base.to_str().unwrap(), "--youngs", "1e9"],
+    );
+    let err = String::from_utf8_lossy(&both.stderr);
+    assert!(
+        !both.status.success() && err.contains("cannot be used with"),
+        "{err}"
+    );
+}

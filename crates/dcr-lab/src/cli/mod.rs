@@ -8,6 +8,7 @@ mod progress;
 mod scene_truth;
 mod soft_body;
 mod truth;
+mod truth_base;
 
 use std::process::ExitCode;
 

@@ -11,6 +11,7 @@ use modal_bake::full_order::RefineParams;
 
 use super::mesh_input::MeshInput;
 use super::progress::Progress;
+use super::truth_base::BaseUnderTest;
 use modal_bake::args::{self as parse, ModelOptions};
 
 /// Truth method.
@@ -43,6 +44,20 @@ pub const EXIT_NOT_CONVERGED: u8 = 3;
 pub struct TruthArgs {
     /// Tetrahedral mesh: gmsh .msh (2.0–2.2 or 4.1, ASCII or binary) or meshio-style .json.
     pub mesh: PathBuf,
+    /// The base whose object this is: its material, damping and fixed nodes, and how its mesh
+    /// file is read (--units, --object, --piece), come from its record; MESH must be the mesh
+    /// it was baked from (checked), and the base's own response at the same points (its
+    /// transfer table where it serves, else its modes) is printed beside the reference, with
+    /// its error.
+    #[arg(
+        long,
+        value_name = "BASE.modes",
+        conflicts_with_all = [
+            "material", "youngs", "poisson", "density", "fixed", "fixed_below", "fixed_box",
+            "fixed_near", "fixed_near_distance", "rayleigh", "lumped", "units", "object", "piece",
+        ]
+    )]
+    pub base: Option<PathBuf>,
     #[command(flatten)]
     pub input: MeshInput,
     #[command(flatten)]
@@ -134,13 +149,22 @@ pub fn run(args: &TruthArgs) -> anyhow::Result<ExitCode> {
     if args.modes == Some(0) {
         anyhow::bail!("--modes must be at least 1");
     }
-    let params = args.params();
+    let mut params = args.params();
     let impact = TruthImpact {
         point: args.impact,
         impulse: args.impulse,
         direction: args.direction,
     };
-    let mesh = args.input.read(&args.mesh, "truth")?;
+    let base = args.base.as_deref().map(BaseUnderTest::load).transpose()?;
+    let mesh = match &base {
+        Some(b) => {
+            params.system = b.system();
+            let mesh = b.input().read(&args.mesh, "truth")?;
+            b.check_mesh(&mesh, &args.mesh.display().to_string())?;
+            mesh
+        }
+        None => args.input.read(&args.mesh, "truth")?,
+    };
     let mut progress = Progress::new("truth");
     let res = truth::run_truth(
         mesh,
@@ -157,8 +181,28 @@ pub fn run(args: &TruthArgs) -> anyhow::Result<ExitCode> {
     } else {
         ExitCode::from(EXIT_NOT_CONVERGED)
     };
+    let truth_peaks: Vec<f64> = res.contacts.iter().map(|c| c.peak_displacement_m).collect();
+    let base_peaks = match &base {
+        Some(b) => Some(b.peaks(
+            args.h,
+            args.impact,
+            res.info.impact_direction,
+            args.impulse,
+            &args.contacts,
+            &truth_peaks,
+        )?),
+        None => None,
+    };
     if args.json {
-        super::emit(&format!("{}\n", serde_json::to_string_pretty(&res)?))?;
+        let mut v = serde_json::to_value(&res)?;
+        if let (Some(b), Some(p)) = (&base, &base_peaks) {
+            v["base"] = serde_json::json!({
+                "file": b.path().display().to_string(),
+                "modes": b.modes(),
+                "contacts": p,
+            });
+        }
+        super::emit(&format!("{}\n", serde_json::to_string_pretty(&v)?))?;
         return Ok(code);
     }
     let i = &res.info;
@@ -201,6 +245,19 @@ pub fn run(args: &TruthArgs) -> anyhow::Result<ExitCode> {
         i.setup_s, i.solve_s, i.step_s, i.distance_kind
     );
     s += &convergence_lines(&res.convergence, args.max_refinements);
+    if let (Some(b), Some(p)) = (&base, &base_peaks) {
+        s += &format!(
+            "  base {} ({} modes), the same impact:\n",
+            b.path().display(),
+            b.modes()
+        );
+        for (k, c) in p.iter().enumerate() {
+            s += &format!(
+                "  {k:>3}  peak disp {:.6e} m ({}), error {:+.2} % against the reference\n",
+                c.peak_displacement_m, c.served_by, c.error_pct
+            );
+        }
+    }
     super::emit(&s)?;
     Ok(code)
 }
