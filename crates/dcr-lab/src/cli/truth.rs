@@ -253,8 +253,13 @@ pub fn run(args: &TruthArgs) -> anyhow::Result<ExitCode> {
         );
         for (k, c) in p.iter().enumerate() {
             s += &format!(
-                "  {k:>3}  peak disp {:.6e} m ({}), error {:+.2} % against the reference\n",
-                c.peak_displacement_m, c.served_by, c.error_pct
+                "  {k:>3}  peak disp {:.6e} m ({}), {}\n",
+                c.peak_displacement_m,
+                c.served_by,
+                c.error_pct.map_or_else(
+                    || "the reference is 0 here (a fixed point)".to_string(),
+                    |e| format!("error {e:+.2} % against the reference")
+                )
             );
         }
     }

@@ -31,8 +31,8 @@ pub struct BasePeak {
     pub peak_displacement_m: f64,
     /// What served it: `modal`, `transfer_table`, `unmapped`.
     pub served_by: &'static str,
-    /// (base − truth) / truth × 100 (%).
-    pub error_pct: f64,
+    /// (base − truth) / truth × 100 (%); `None` where the reference is 0 (a fixed point).
+    pub error_pct: Option<f64>,
 }
 
 impl BaseUnderTest {
@@ -148,7 +148,7 @@ impl BaseUnderTest {
                     ServedBy::TransferTable => "transfer_table",
                     ServedBy::Unmapped => "unmapped",
                 },
-                error_pct: 100.0 * (o.peak_displacement - t) / t,
+                error_pct: (t != 0.0).then(|| 100.0 * (o.peak_displacement - t) / t),
             })
             .collect())
     }
