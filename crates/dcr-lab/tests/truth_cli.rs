@@ -182,6 +182,34 @@ fn truth_exit_status_says_whether_it_converged() {
     assert!(s.contains("converged at dt ="), "{s}");
 }
 
+/// `dcr-lab truth MESH --json --method modal-all` at the beam's impact and two contacts
+/// (h = 2 ms, dt 5e-7 s), with `extra` options.
+fn beam_points_truth(mesh: &Path, extra: &[&str]) -> Output {
+    let mut a = vec!["truth", mesh.to_str().unwrap()];
+    a.extend_from_slice(&[
+        "--impact",
+        "1.0,0.05,0.1",
+        "--impulse",
+        "1",
+        "--contact",
+        "0.5,0.05,0.1",
+        "--contact",
+        "0.8,0.0,0.05",
+        "--h",
+        "0.002",
+        "--dt",
+        "5e-7",
+        "--json",
+        "--method",
+        "modal-all",
+    ]);
+    a.extend_from_slice(extra);
+    Command::new(env!("CARGO_BIN_EXE_dcr-lab"))
+        .args(&a)
+        .output()
+        .expect("dcr-lab runs")
+}
+
 /// The reference reads its mesh as `modal-bake bake` does: the beam written in millimetres
 /// beside a half-size copy of itself, read with `--units mm --piece 1`, answers as the metre
 /// beam alone (to rounding: the coordinates went through ×1000 and ÷1000); the whole file is
@@ -208,29 +236,9 @@ fn truth_reads_the_mesh_as_the_bake_does() {
     let path = dir.path().join("two_mm.json");
     std::fs::write(&path, two.to_meshio_json("clamp", "clamp").to_string()).unwrap();
     let run = |mesh: &Path, extra: &[&str]| {
-        let mut a = vec!["truth", mesh.to_str().unwrap(), "--fixed", "clamp"];
-        a.extend_from_slice(&[
-            "--impact",
-            "1.0,0.05,0.1",
-            "--impulse",
-            "1",
-            "--contact",
-            "0.5,0.05,0.1",
-            "--contact",
-            "0.8,0.0,0.05",
-            "--h",
-            "0.002",
-            "--dt",
-            "5e-7",
-            "--json",
-            "--method",
-            "modal-all",
-        ]);
+        let mut a = vec!["--fixed", "clamp"];
         a.extend_from_slice(extra);
-        Command::new(env!("CARGO_BIN_EXE_dcr-lab"))
-            .args(&a)
-            .output()
-            .unwrap()
+        beam_points_truth(mesh, &a)
     };
     let metre = peaks(&run(&data("meshes/beam.msh"), &[]));
     let selected = peaks(&run(&path, &["--units", "mm", "--piece", "1"]));
@@ -275,32 +283,7 @@ fn truth_of_a_base_compares_the_base() {
         ..Default::default()
     };
     modal_bake::bake::bake_file(&beam, &params, &base, &mut |_| {}).unwrap();
-    let points = [
-        "--impact",
-        "1.0,0.05,0.1",
-        "--impulse",
-        "1",
-        "--contact",
-        "0.5,0.05,0.1",
-        "--contact",
-        "0.8,0.0,0.05",
-        "--h",
-        "0.002",
-        "--dt",
-        "5e-7",
-        "--json",
-        "--method",
-        "modal-all",
-    ];
-    let run = |mesh: &Path, extra: &[&str]| {
-        let mut a = vec!["truth", mesh.to_str().unwrap()];
-        a.extend_from_slice(&points);
-        a.extend_from_slice(extra);
-        Command::new(env!("CARGO_BIN_EXE_dcr-lab"))
-            .args(&a)
-            .output()
-            .unwrap()
-    };
+    let run = beam_points_truth;
     let with_base = run(&beam, &["--base", base.to_str().unwrap()]);
     let typed = run(
         &beam,

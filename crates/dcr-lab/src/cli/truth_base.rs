@@ -9,7 +9,7 @@ use std::sync::Arc;
 use anyhow::Context;
 use clap::ValueEnum;
 use dcr_runtime::format::ModesFile;
-use dcr_runtime::response::{Impact, RestingContact, ServedBy};
+use dcr_runtime::response::{Impact, RestingContact};
 use dcr_runtime::{DistantResponse, ModalModel, ResponseParams};
 use modal_bake::bake::{BakeParams, BaseStatus};
 use modal_bake::full_order::SystemParams;
@@ -142,12 +142,7 @@ impl BaseUnderTest {
             .zip(truth)
             .map(|(o, &t)| BasePeak {
                 peak_displacement_m: o.peak_displacement,
-                served_by: match o.served_by {
-                    ServedBy::Modal => "modal",
-                    ServedBy::Attenuation => "attenuation",
-                    ServedBy::TransferTable => "transfer_table",
-                    ServedBy::Unmapped => "unmapped",
-                },
+                served_by: o.served_by.name(),
                 error_pct: (t != 0.0).then(|| 100.0 * (o.peak_displacement - t) / t),
             })
             .collect())

@@ -43,3 +43,15 @@ pub enum ServedBy {
     /// Not mapped to the surface: zero response.
     Unmapped,
 }
+
+impl ServedBy {
+    /// The method's name in reports: `modal`, `attenuation`, `transfer_table`, `unmapped`.
+    pub fn name(self) -> &'static str {
+        match self {
+            ServedBy::Modal => "modal",
+            ServedBy::Attenuation => "attenuation",
+            ServedBy::TransferTable => "transfer_table",
+            ServedBy::Unmapped => "unmapped",
+        }
+    }
+}

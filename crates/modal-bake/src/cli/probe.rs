@@ -11,9 +11,7 @@ use std::sync::Arc;
 
 use anyhow::{bail, Context};
 use dcr_runtime::model::SurfacePoint;
-use dcr_runtime::response::{
-    AttenuationParams, Impact, RestingContact, Sampling, ServedBy, Variant,
-};
+use dcr_runtime::response::{AttenuationParams, Impact, RestingContact, Sampling, Variant};
 use dcr_runtime::{DistantResponse, Method, ModalModel, ResponseParams};
 
 /// Distant-response model selectable from the command line.
@@ -223,12 +221,7 @@ pub fn run(args: &ProbeArgs) -> anyhow::Result<()> {
                 "distance_m": d,
                 "peak_displacement_m": o.peak_displacement,
                 "delta_v_mps": o.delta_v,
-                "served_by": match o.served_by {
-                    ServedBy::Modal => "modal",
-                    ServedBy::Attenuation => "attenuation",
-                    ServedBy::TransferTable => "transfer_table",
-                    ServedBy::Unmapped => "unmapped",
-                },
+                "served_by": o.served_by.name(),
             })
         })
         .collect();
