@@ -28,7 +28,6 @@
 //!   contact with its barycentric weights; Euclidean if the geodesic solver cannot be built
 //!   (reported in [`TruthInfo::distance_kind`]).
 
-use std::path::Path;
 use std::time::Instant;
 
 pub use modal_bake::full_order::MaterialSi;
@@ -526,28 +525,6 @@ pub fn run_truth(
         info,
         convergence,
     })
-}
-
-/// [`run_truth`] on a mesh file (gmsh MSH 2.2/4.1 or meshio JSON).
-///
-/// # Errors
-/// As [`run_truth`], plus reading errors.
-pub fn truth_file(
-    path: &Path,
-    params: &TruthParams,
-    impact: &TruthImpact,
-    contacts: &[[f64; 3]],
-    progress: &mut dyn FnMut(RefineProgress),
-) -> Result<TruthResult, TruthError> {
-    let mesh = modal_bake::mesh::read_mesh(path)?;
-    run_truth(
-        mesh,
-        params,
-        impact,
-        contacts,
-        &path.display().to_string(),
-        progress,
-    )
 }
 
 /// `a/|a|`, or zero for a zero or non-finite vector.
