@@ -409,6 +409,49 @@ fn the_cli_bakes_a_glb_as_the_same_obj_and_exports_onto_it() {
     }
     assert_eq!(freqs[0], freqs[1]);
     assert_eq!(freqs[0].as_array().unwrap().len(), 4);
+    // A self-contained GLB is checked without meshing it again; a .gltf whose buffer is
+    // another file gets no key (the key would not cover that file), so it is meshed again.
+    let beside = dir.path().join("beside.gltf");
+    let mut doc_beside = doc.clone();
+    doc_beside["buffers"][0]["uri"] = json!("beside.bin");
+    std::fs::write(dir.path().join("beside.bin"), &bin).unwrap();
+    std::fs::write(&beside, serde_json::to_vec(&doc_beside).unwrap()).unwrap();
+    let options = ["--material=steel", "--order=1", "--modes=4", "--size=0.05"];
+    // (cube.modes is the OBJ's now: both files are named cube.)
+    let glb_base = dir.path().join("glb.modes");
+    for (asset, base) in [
+        (&glb_path, &glb_base),
+        (&beside, &beside.with_extension("modes")),
+    ] {
+        let mut a: Vec<&std::ffi::OsStr> = vec![
+            "bake".as_ref(),
+            asset.as_os_str(),
+            "-o".as_ref(),
+            base.as_os_str(),
+        ];
+        a.extend(options.iter().map(std::ffi::OsStr::new));
+        let o = modal_bake(&a);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    }
+    for (asset, base, meshed_again) in [
+        (&glb_path, glb_base.clone(), false),
+        (&beside, beside.with_extension("modes"), true),
+    ] {
+        let mut a: Vec<&std::ffi::OsStr> = vec![
+            "check".as_ref(),
+            asset.as_os_str(),
+            base.as_os_str(),
+            "--json".as_ref(),
+        ];
+        a.extend(options.iter().map(std::ffi::OsStr::new));
+        let v: Value = serde_json::from_slice(&modal_bake(&a).stdout).unwrap();
+        assert_eq!(
+            (&v["up_to_date"], &v["meshed_again"]),
+            (&json!(true), &json!(meshed_again)),
+            "{}: {v}",
+            asset.display()
+        );
+    }
     let out = dir.path().join("modes.glb");
     let o = modal_bake(&[
         "export".as_ref(),

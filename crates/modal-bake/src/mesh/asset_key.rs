@@ -7,8 +7,9 @@
 //! Why that answer is the same: the meshers run on one thread with fixed seeds, so the same
 //! asset bytes, options (recorded beside the key: `selection`, `meshing`) and mesher versions
 //! give the same mesh bytes (docs/artist-guide.md; fTetWild only where its fixed-sequence
-//! random device is loaded — a mesh that is not reproducible gets no key). glTF assets get no
-//! key: a `.gltf` may read other files (buffers) the key would not cover.
+//! random device is loaded — a mesh that is not reproducible gets no key). A glTF asset gets a
+//! key only when it is self-contained (a `.glb`'s own binary chunk or `data:` URIs): buffers
+//! read from other files are not covered by the key.
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -43,15 +44,19 @@ impl AssetKey {
     /// mesh `report` says is not reproducible, or a file that cannot be read.
     pub fn of(path: &Path, params: &MeshParams, report: &MeshReport) -> Option<AssetKey> {
         let ftetwild_ran = report.backend == Backend::Ftetwild;
-        if is_gltf(path) || (ftetwild_ran && !report.reproducible) {
+        if ftetwild_ran && !report.reproducible {
             return None;
         }
         Self::now(path, params)
     }
 
-    /// The key the asset at `path` would get now, with the meshers `params` would run.
+    /// The key the asset at `path` would get now, with the meshers `params` would run; `None`
+    /// for an unreadable file or a glTF asset that reads other files.
     fn now(path: &Path, params: &MeshParams) -> Option<AssetKey> {
         let bytes = std::fs::read(path).ok()?;
+        if is_gltf(path) && !self_contained_gltf(&bytes) {
+            return None;
+        }
         let mut meshers = BTreeMap::new();
         if let Ok(v) = super::gmsh::gmsh_version(params.gmsh.as_deref()) {
             meshers.insert("gmsh".to_string(), v);
@@ -79,7 +84,7 @@ impl AssetKey {
     pub fn matches_now(&self, path: &Path, params: &MeshParams) -> bool {
         // Cheap tests first: the build, then the size, before hashing the file and asking
         // the meshers their versions.
-        if self.build != BUILD_HASH || is_gltf(path) {
+        if self.build != BUILD_HASH {
             return false;
         }
         if std::fs::metadata(path).map(|m| m.len()).ok() != Some(self.bytes) {
@@ -93,7 +98,81 @@ fn sha256(bytes: &[u8]) -> String {
     format!("sha256:{:x}", Sha256::digest(bytes))
 }
 
+/// Whether a glTF document (`.glb` or `.gltf` bytes) holds all its buffers: each buffer is
+/// the `.glb`'s binary chunk (no `uri`) or a `data:` URI. Anything unreadable is not.
+fn self_contained_gltf(bytes: &[u8]) -> bool {
+    let json = if bytes.starts_with(b"glTF") {
+        // Header (12 bytes), then the first chunk: length, type `JSON`, content.
+        let word = |at: usize| {
+            bytes
+                .get(at..at + 4)
+                .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize)
+        };
+        match (word(12), bytes.get(16..20)) {
+            (Some(len), Some(b"JSON")) => match bytes.get(20..20usize.saturating_add(len)) {
+                Some(j) => j,
+                None => return false,
+            },
+            _ => return false,
+        }
+    } else {
+        bytes
+    };
+    let Ok(doc) = serde_json::from_slice::<serde_json::Value>(json) else {
+        return false;
+    };
+    match doc.get("buffers") {
+        None => true,
+        Some(serde_json::Value::Array(buffers)) => buffers.iter().all(|b| match b.get("uri") {
+            None => true,
+            Some(u) => u.as_str().is_some_and(|u| u.starts_with("data:")),
+        }),
+        Some(_) => false,
+    }
+}
+
 fn is_gltf(path: &Path) -> bool {
     path.extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("gltf") || e.eq_ignore_ascii_case("glb"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::self_contained_gltf;
+
+    fn glb(json: &str) -> Vec<u8> {
+        let mut j = json.as_bytes().to_vec();
+        while j.len() % 4 != 0 {
+            j.push(b' ');
+        }
+        let mut out = b"glTF".to_vec();
+        out.extend(2u32.to_le_bytes());
+        out.extend(((20 + j.len()) as u32).to_le_bytes());
+        out.extend((j.len() as u32).to_le_bytes());
+        out.extend(b"JSON");
+        out.extend(j);
+        out
+    }
+
+    #[test]
+    fn only_gltf_that_holds_its_buffers_is_self_contained() {
+        assert!(self_contained_gltf(&glb(
+            r#"{"buffers": [{"byteLength": 8}]}"#
+        )));
+        assert!(self_contained_gltf(
+            br#"{"buffers": [{"uri": "data:application/octet-stream;base64,AAAA"}]}"#
+        ));
+        assert!(!self_contained_gltf(&glb(
+            r#"{"buffers": [{"uri": "mesh.bin"}]}"#
+        )));
+        assert!(!self_contained_gltf(
+            br#"{"buffers": [{"byteLength": 8}, {"uri": "b.bin"}]}"#
+        ));
+        // Truncated or malformed: not.
+        assert!(!self_contained_gltf(
+            &glb(r#"{"buffers": [{"byteLength": 8}]}"#)[..22]
+        ));
+        assert!(!self_contained_gltf(b"glTF"));
+        assert!(!self_contained_gltf(br#"{"buffers": 3}"#));
+    }
 }
