@@ -15,9 +15,15 @@ fn truth(extra: &[&str]) -> Output {
 
 /// `dcr-lab truth` on the beam with the fixed-node options `fixed`.
 fn truth_fixed(fixed: &[&str], extra: &[&str]) -> Output {
-    let beam = data("meshes/beam.msh");
-    let mut a = vec!["truth", beam.to_str().unwrap()];
-    a.extend_from_slice(fixed);
+    let mut a = fixed.to_vec();
+    a.extend_from_slice(extra);
+    truth_at_beam_points(&data("meshes/beam.msh"), &a)
+}
+
+/// `dcr-lab truth MESH` at the beam's impact (1 N·s) and two contacts, with h = 2 ms and dt =
+/// 5e-7 s unless `extra` sets them, and `extra`.
+fn truth_at_beam_points(mesh: &Path, extra: &[&str]) -> Output {
+    let mut a = vec!["truth", mesh.to_str().unwrap()];
     a.extend_from_slice(&[
         "--impact",
         "1.0,0.05,0.1",
@@ -182,32 +188,11 @@ fn truth_exit_status_says_whether_it_converged() {
     assert!(s.contains("converged at dt ="), "{s}");
 }
 
-/// `dcr-lab truth MESH --json --method modal-all` at the beam's impact and two contacts
-/// (h = 2 ms, dt 5e-7 s), with `extra` options.
+/// [`truth_at_beam_points`] with `--json --method modal-all` and `extra`.
 fn beam_points_truth(mesh: &Path, extra: &[&str]) -> Output {
-    let mut a = vec!["truth", mesh.to_str().unwrap()];
-    a.extend_from_slice(&[
-        "--impact",
-        "1.0,0.05,0.1",
-        "--impulse",
-        "1",
-        "--contact",
-        "0.5,0.05,0.1",
-        "--contact",
-        "0.8,0.0,0.05",
-        "--h",
-        "0.002",
-        "--dt",
-        "5e-7",
-        "--json",
-        "--method",
-        "modal-all",
-    ]);
+    let mut a = vec!["--json", "--method", "modal-all"];
     a.extend_from_slice(extra);
-    Command::new(env!("CARGO_BIN_EXE_dcr-lab"))
-        .args(&a)
-        .output()
-        .expect("dcr-lab runs")
+    truth_at_beam_points(mesh, &a)
 }
 
 /// The reference reads its mesh as `modal-bake bake` does: the beam written in millimetres

@@ -9,6 +9,7 @@ use modal_bake::bake::{
 };
 use modal_bake::transfer::{TableOrder, TransferModes, TransferParams};
 
+use super::bake_options::{meshing_pairs, options_line, selection_pairs};
 use super::budget::BudgetOptions;
 use super::mesh::AssetOptions;
 use super::parse;
@@ -391,34 +392,6 @@ pub fn meshing_record(asset: &AssetOptions) -> serde_json::Map<String, serde_jso
     }
 }
 
-/// A [`meshing_record`] as the options that make it (`--mesher auto --size 0.005 --order 2`;
-/// defaults of size and envelope unsaid).
-pub fn meshing_options(meshing: &serde_json::Map<String, serde_json::Value>) -> String {
-    let mut parts = Vec::new();
-    if let Some(m) = meshing.get("mesher").and_then(|v| v.as_str()) {
-        parts.push(format!("--mesher {m}"));
-    }
-    if let Some(s) = meshing.get("size").and_then(serde_json::Value::as_f64) {
-        parts.push(format!("--size {s}"));
-    }
-    if let Some(o) = meshing.get("order").and_then(serde_json::Value::as_u64) {
-        parts.push(format!("--order {o}"));
-    }
-    if let Some(e) = meshing.get("envelope").and_then(serde_json::Value::as_f64) {
-        parts.push(format!("--envelope {e}"));
-    }
-    for (key, flag, when) in [
-        ("keep_surface", "--keep-surface", true),
-        ("uniform_size", "--uniform-size", true),
-        ("thickness_sizing", "--no-thickness-sizing", false),
-    ] {
-        if meshing.get(key).and_then(serde_json::Value::as_bool) == Some(when) {
-            parts.push(flag.into());
-        }
-    }
-    parts.join(" ")
-}
-
 /// The record `meta.bake_params.selection` of how the input was read: `object`, `piece` and
 /// `straighten` when given, and always `units` (`m`, `cm`, `mm`, `in`).
 pub fn selection_record(asset: &AssetOptions) -> serde_json::Map<String, serde_json::Value> {
@@ -434,30 +407,6 @@ pub fn selection_record(asset: &AssetOptions) -> serde_json::Map<String, serde_j
     }
     selection.insert("units".into(), asset.units.name().into());
     selection
-}
-
-/// A [`selection_record`] as the options that make it (`--piece 2 --units mm`; metres, the
-/// default, unsaid); empty for the whole file in metres.
-pub fn selection_options(selection: &serde_json::Map<String, serde_json::Value>) -> String {
-    let mut parts = Vec::new();
-    if let Some(o) = selection.get("object").and_then(|v| v.as_str()) {
-        parts.push(format!("--object {o}"));
-    }
-    if let Some(n) = selection.get("piece").and_then(serde_json::Value::as_u64) {
-        parts.push(format!("--piece {n}"));
-    }
-    if selection
-        .get("straighten")
-        .and_then(serde_json::Value::as_bool)
-        == Some(true)
-    {
-        parts.push("--straighten".into());
-    }
-    match selection.get("units").and_then(|v| v.as_str()) {
-        Some(u) if u != "m" => parts.push(format!("--units {u}")),
-        _ => {}
-    }
-    parts.join(" ")
 }
 
 /// When `base` was read from its file with another selection or unit than `asset` gives (its
@@ -480,7 +429,7 @@ pub fn selection_mismatch(base: &ModesFile, asset: &AssetOptions) -> Option<Stri
         return None;
     }
     let show = |s: &mut serde_json::Map<String, serde_json::Value>| {
-        let options = selection_options(s);
+        let options = options_line(selection_pairs(s));
         let unit = if s.contains_key("units") {
             ""
         } else {
@@ -518,8 +467,8 @@ pub fn meshing_mismatch(base: &ModesFile, asset: &AssetOptions) -> Option<String
         .unwrap_or_default();
     Some(format!(
         "the base's asset was meshed with `{}`{chosen}, this with `{}`: give the bake's meshing options",
-        meshing_options(&recorded),
-        meshing_options(&asked)
+        options_line(meshing_pairs(&recorded)),
+        options_line(meshing_pairs(&asked))
     ))
 }
 

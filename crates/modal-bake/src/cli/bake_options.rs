@@ -24,18 +24,7 @@ pub fn bake_options_of(base: &ModesFile) -> Result<BakeOptionsOf, String> {
     let p: BakeParams = serde_json::from_value(record.clone())
         .map_err(|e| format!("its recorded parameters do not read as a bake's: {e}"))?;
     let mut args: Vec<String> = Vec::new();
-    // A value starting with `-` is joined to its option (`--fixed-below=y=-0.01`), which no
-    // parser can mistake for another option.
-    let mut push = |option: &str, value: String| {
-        if value.starts_with('-') {
-            args.push(shell_word(&format!("{option}={value}")));
-        } else {
-            args.push(option.to_string());
-            if !value.is_empty() {
-                args.push(shell_word(&value));
-            }
-        }
-    };
+    let mut push = |option: &str, value: String| push_option(&mut args, option, &value);
     push("--youngs", num(p.material.youngs));
     push("--poisson", num(p.material.poisson));
     push("--density", num(p.material.density));
@@ -73,43 +62,15 @@ pub fn bake_options_of(base: &ModesFile) -> Result<BakeOptionsOf, String> {
         push("--f32", String::new());
     }
     let get = |v: &serde_json::Value, k: &str| v.get(k).cloned().unwrap_or_default();
-    if let Some(sel) = record.get("selection") {
-        if let Some(o) = get(sel, "object").as_str() {
-            push("--object", o.to_string());
-        }
-        if let Some(n) = get(sel, "piece").as_u64() {
-            push("--piece", n.to_string());
-        }
-        if get(sel, "straighten").as_bool() == Some(true) {
-            push("--straighten", String::new());
-        }
-        match get(sel, "units").as_str() {
-            Some(u) if u != "m" => push("--units", u.to_string()),
-            _ => {}
-        }
+    let empty = serde_json::Map::new();
+    let as_map = |k: &str| record.get(k).and_then(|v| v.as_object()).unwrap_or(&empty);
+    for (option, value) in selection_pairs(as_map("selection")) {
+        push(option, value);
     }
-    if let Some(m) = record.get("meshing") {
-        match get(m, "mesher").as_str() {
-            Some(x) if x != "auto" => push("--mesher", x.to_string()),
-            _ => {}
-        }
-        if let Some(s) = get(m, "size").as_f64() {
-            push("--size", num(s));
-        }
-        if let Some(o) = get(m, "order").as_u64() {
-            push("--order", o.to_string());
-        }
-        if let Some(e) = get(m, "envelope").as_f64() {
-            push("--envelope", num(e));
-        }
-        for (key, flag, when) in [
-            ("keep_surface", "--keep-surface", true),
-            ("uniform_size", "--uniform-size", true),
-            ("thickness_sizing", "--no-thickness-sizing", false),
-        ] {
-            if get(m, key).as_bool() == Some(when) {
-                push(flag, String::new());
-            }
+    for (option, value) in meshing_pairs(as_map("meshing")) {
+        // `auto` is the default.
+        if (option, value.as_str()) != ("--mesher", "auto") {
+            push(option, value);
         }
     }
     if let Some(t) = record.get("transfer") {
@@ -137,6 +98,87 @@ pub fn bake_options_of(base: &ModesFile) -> Result<BakeOptionsOf, String> {
         push("--transfer-order", value(get(t, "order")));
     }
     Ok(BakeOptionsOf { args, missing })
+}
+
+/// A recorded `selection` (`meta.bake_params.selection`) as (option, value) pairs, a flag's
+/// value empty: `--object`, `--piece`, `--straighten`, and `--units` other than metres.
+pub fn selection_pairs(
+    selection: &serde_json::Map<String, serde_json::Value>,
+) -> Vec<(&'static str, String)> {
+    let mut pairs = Vec::new();
+    if let Some(o) = selection.get("object").and_then(|v| v.as_str()) {
+        pairs.push(("--object", o.to_string()));
+    }
+    if let Some(n) = selection.get("piece").and_then(serde_json::Value::as_u64) {
+        pairs.push(("--piece", n.to_string()));
+    }
+    if selection
+        .get("straighten")
+        .and_then(serde_json::Value::as_bool)
+        == Some(true)
+    {
+        pairs.push(("--straighten", String::new()));
+    }
+    match selection.get("units").and_then(|v| v.as_str()) {
+        Some(u) if u != "m" => pairs.push(("--units", u.to_string())),
+        _ => {}
+    }
+    pairs
+}
+
+/// A recorded `meshing` (`meta.bake_params.meshing`) as (option, value) pairs: `--mesher`
+/// (always), `--size` and `--envelope` when not the default, `--order`, and the flags
+/// `--keep-surface`, `--uniform-size`, `--no-thickness-sizing` when set.
+pub fn meshing_pairs(
+    meshing: &serde_json::Map<String, serde_json::Value>,
+) -> Vec<(&'static str, String)> {
+    let mut pairs = Vec::new();
+    let number = |k: &str| meshing.get(k).and_then(serde_json::Value::as_f64);
+    if let Some(m) = meshing.get("mesher").and_then(|v| v.as_str()) {
+        pairs.push(("--mesher", m.to_string()));
+    }
+    if let Some(s) = number("size") {
+        pairs.push(("--size", num(s)));
+    }
+    if let Some(o) = meshing.get("order").and_then(serde_json::Value::as_u64) {
+        pairs.push(("--order", o.to_string()));
+    }
+    if let Some(e) = number("envelope") {
+        pairs.push(("--envelope", num(e)));
+    }
+    for (key, flag, when) in [
+        ("keep_surface", "--keep-surface", true),
+        ("uniform_size", "--uniform-size", true),
+        ("thickness_sizing", "--no-thickness-sizing", false),
+    ] {
+        if meshing.get(key).and_then(serde_json::Value::as_bool) == Some(when) {
+            pairs.push((flag, String::new()));
+        }
+    }
+    pairs
+}
+
+/// (option, value) pairs as one line of shell words (`--piece 2 --units mm`).
+pub fn options_line(pairs: Vec<(&'static str, String)>) -> String {
+    let mut words = Vec::new();
+    for (option, value) in pairs {
+        push_option(&mut words, option, &value);
+    }
+    words.join(" ")
+}
+
+/// Appends `option` and its `value` (none for a flag's empty value) as shell words; a value
+/// starting with `-` is joined to its option (`--fixed-below=y=-0.01`), which no parser can
+/// mistake for another option.
+fn push_option(words: &mut Vec<String>, option: &str, value: &str) {
+    if value.starts_with('-') {
+        words.push(shell_word(&format!("{option}={value}")));
+    } else {
+        words.push(option.to_string());
+        if !value.is_empty() {
+            words.push(shell_word(value));
+        }
+    }
 }
 
 /// Numbers joined by commas, as a list option is typed (`0,0,1`).

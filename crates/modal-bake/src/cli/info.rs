@@ -264,7 +264,7 @@ fn write_model(out: &mut String, file: &Path, base: &ModesFile) -> std::fmt::Res
         .get("selection")
         .and_then(|v| v.as_object())
     {
-        let options = super::bake::selection_options(sel);
+        let options = super::bake_options::options_line(super::bake_options::selection_pairs(sel));
         if !options.is_empty() {
             writeln!(out, "  input: its file with {options}")?;
         }
@@ -278,7 +278,7 @@ fn write_model(out: &mut String, file: &Path, base: &ModesFile) -> std::fmt::Res
         writeln!(
             out,
             "  meshed from its surface asset with {}",
-            super::bake::meshing_options(m)
+            super::bake_options::options_line(super::bake_options::meshing_pairs(m))
         )?;
     }
     if let Some(c) = base.meta.bake_params.get("mesh_choice") {
