@@ -146,25 +146,21 @@ pub fn mesh_base_status(
     compare(&base, params, Some(&prepared))
 }
 
-/// As [`base_status`] for the mesh the base at `modes` was baked from, known to be the same
-/// without reading it (a surface asset whose bytes, meshing options, meshers and build are
-/// those recorded: [`AssetKey`](crate::mesh::AssetKey)): the tool, parameters and table are
-/// compared, the geometry is taken as the base's, and the table's mode count is resolved with
-/// the base's free dofs.
+/// As [`base_status`] for `base` (already read) and the mesh it was baked from, known to be
+/// the same without reading it (a surface asset whose bytes, meshing options, meshers and
+/// build are those recorded: [`AssetKey`](crate::mesh::AssetKey)): the tool, parameters and
+/// table are compared, the geometry is taken as the base's, and the table's mode count is
+/// resolved with the base's free dofs; `file` names the mesh in messages.
 ///
 /// # Errors
 /// Invalid parameters (what `check` exits 2 on).
 pub fn same_mesh_base_status(
     file: &str,
     params: &BakeParams,
-    modes: &Path,
+    base: &ModesFile,
 ) -> Result<BaseStatus, BakeError> {
     check_options(params, file)?;
-    let base = match read_base(modes) {
-        Ok(base) => base,
-        Err(status) => return Ok(status),
-    };
-    compare(&base, params, None)
+    compare(base, params, None)
 }
 
 /// The base at `modes`, or its status when it is missing or unreadable.

@@ -354,7 +354,7 @@ pub fn unchanged_asset_up_to_date(
         return Ok(false);
     }
     let file = path.display().to_string();
-    Ok(bake::same_mesh_base_status(&file, params, out)? == BaseStatus::UpToDate)
+    Ok(bake::same_mesh_base_status(&file, params, &base)? == BaseStatus::UpToDate)
 }
 
 /// Records `provenance` in `base`'s `meta.bake_params` (`mesh_choice`, `asset_key`).
