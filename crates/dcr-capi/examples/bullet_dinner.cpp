@@ -23,7 +23,7 @@
  * ends its first step with asked_mps, as Bullet integrates it: what the response asked for. A
  * plate that scrapes the table on the way, or loses g h to gravity in the step it leaves, rises
  * less. --trace prints each step's contacts and events on stderr. --no-support runs without the
- * support compensation (the world's gravity left at its default, zero), to see what it does.
+ * support compensation (the world's gravity set to zero), to see what it does.
  * Exit status: 0 on success, 1 on an error (message on stderr), 2 on a usage error.
  *
  * The integration is what an engine team writes (about 100 lines, marked "dcr:" below):
@@ -224,11 +224,9 @@ int run(const DcrModel *table_model, long steps, bool trace, bool support, Outco
         DcrWorldParams wp;
         dcr_world_params_default(&wp);
         wp.h = H;
-        if (support) {
-            wp.gravity[0] = 0.0;
-            wp.gravity[1] = -GRAVITY;
-            wp.gravity[2] = 0.0;
-        }
+        wp.gravity[0] = 0.0;
+        wp.gravity[1] = support ? -GRAVITY : 0.0; /* m/s^2: Bullet's, or none */
+        wp.gravity[2] = 0.0;
         DcrStatus st = dcr_world_create(&wp, &world);
         if (st != DCR_STATUS_OK) return fail("cannot create the world", st);
         DcrElasticObjectDesc desc;

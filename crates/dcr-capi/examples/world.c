@@ -142,6 +142,9 @@ int main(int argc, char **argv) {
     DcrWorldParams wp;
     dcr_world_params_default(&wp);
     wp.h = 0.01; /* s: the engine's fixed step */
+    /* m/s^2, world: the engine's gravity for the support compensation (e.g. {0, -9.81, 0} for
+       a y-up engine). The bodies here are not moved by an engine, so none: {0, 0, 0}. */
+    wp.gravity[0] = wp.gravity[1] = wp.gravity[2] = 0.0;
     st = dcr_world_create(&wp, &world);
     if (st != DCR_STATUS_OK) {
         rc = fail("cannot create the world", st);

@@ -111,10 +111,12 @@ pub struct DcrWorldParams {
     /// Gravity (m/s², world frame) for the support compensation: a body a response lifts off
     /// (Δv ≥ g·h along the normal) also gets, at its centre of mass, the normal velocity
     /// gravity takes off over the step in which it leaves (its own event, `delta_v` 0), so
-    /// that it ends that step with Δv. Default zero (no compensation): set it to the engine's
-    /// gravity — also when the engine replays the events in its contact solver as a bounce or
-    /// a velocity target, after which gravity acts over the body's first free step just the
-    /// same.
+    /// that it ends that step with Δv. Default **unset** (NaN), which `dcr_world_create`
+    /// refuses (`DCR_STATUS_INVALID_ARGUMENT`): set it to the engine's gravity, e.g.
+    /// `{0, -9.81, 0}` for a y-up engine — also when the engine replays the events in its
+    /// contact solver as a bounce or a velocity target, after which gravity acts over the
+    /// body's first free step just the same — or to `{0, 0, 0}` for no compensation (a body a
+    /// response lifts off then loses g·h of its push).
     pub gravity: [f64; 3],
 }
 

@@ -315,7 +315,7 @@ fn world_c_events_equal_the_rust_world() {
     }
     assert_eq!(steps.len(), 10);
     assert_eq!(bodies.len(), 2);
-    let mut world = DcrWorld::new(WorldParams::default()).unwrap();
+    let mut world = DcrWorld::new(WorldParams::with_gravity([0.0; 3])).unwrap();
     let mut desc = ElasticObjectDesc::new(model, 1);
     desc.response.method = Method::Modal;
     desc.response.impact_threshold = 0.05;

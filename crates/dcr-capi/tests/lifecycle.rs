@@ -37,7 +37,8 @@ fn model() -> *mut DcrModel {
 #[test]
 fn removed_handles_are_stale_and_setters_check_values() {
     let m = model();
-    let wp = DcrWorldParams::defaults();
+    let mut wp = DcrWorldParams::defaults();
+    wp.gravity = [0.0; 3];
     let mut w = std::ptr::null_mut();
     // SAFETY: valid pointers throughout; handles freed once at the end.
     unsafe {

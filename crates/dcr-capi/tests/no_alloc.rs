@@ -111,6 +111,7 @@ fn per_step_calls_do_not_allocate_after_warm_up() {
     // World: the plate static on body 1, boxes 10..19 resting on it, a ball hitting it.
     let mut wp = DcrWorldParams::defaults();
     wp.energy_bound = false;
+    wp.gravity = [0.0; 3];
     let mut world = std::ptr::null_mut();
     let mut desc = DcrElasticObjectDesc::defaults();
     desc.model = model;

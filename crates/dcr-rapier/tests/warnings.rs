@@ -3,7 +3,9 @@
 //! Expectations: an elastic object whose contacts lie far from its base's surface (here its
 //! collider sits 0.5 m below the base's face, as a base in another frame would) gets its
 //! unmapped contacts counted in the world's totals and exactly one warning, however many
-//! impacts follow; rapier's dt other than the world's h is warned once.
+//! impacts follow; rapier's dt other than the world's h is warned once; an adapter stepped
+//! with `after_step` whose world was never given rapier's gravity is warned once (one stepped
+//! with `DcrRapier::step`, which gives it, is not).
 
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
@@ -15,6 +17,7 @@ use dcr_rapier::{ElasticObjectDesc, ModalModel, WorldParams};
 
 static UNMAPPED: AtomicUsize = AtomicUsize::new(0);
 static TIMESTEP: AtomicUsize = AtomicUsize::new(0);
+static GRAVITY: AtomicUsize = AtomicUsize::new(0);
 static LAST: Mutex<String> = Mutex::new(String::new());
 
 struct Counter;
@@ -33,6 +36,9 @@ impl log::Log for Counter {
         }
         if text.contains("rapier's dt") {
             TIMESTEP.fetch_add(1, Ordering::SeqCst);
+        }
+        if text.contains("never given rapier's gravity") {
+            GRAVITY.fetch_add(1, Ordering::SeqCst);
         }
         *LAST.lock().unwrap() = text;
     }
@@ -98,4 +104,30 @@ fn unmapped_contacts_and_a_wrong_step_are_warned_once() {
         LAST.lock().unwrap()
     );
     assert_eq!(TIMESTEP.load(Ordering::SeqCst), 1);
+    assert_eq!(
+        GRAVITY.load(Ordering::SeqCst),
+        0,
+        "DcrRapier::step gives the gravity"
+    );
+    assert_eq!(dcr.world().params().gravity, [0.0, 0.0, -9.81]);
+
+    // Stepped by hand without set_gravity: the world has none, and says so once.
+    let mut world = PhysicsWorld::default();
+    world.integration_parameters.dt = 0.01;
+    world.gravity = Vector::new(0.0, 0.0, -9.81);
+    let mut dcr = DcrRapier::new(WorldParams::default(), AdapterParams::default()).unwrap();
+    assert_eq!(dcr.world().params().gravity, [0.0; 3]);
+    for _ in 0..3 {
+        dcr.before_step(&mut world.bodies);
+        world.step_with_events(dcr.hooks(), &());
+        dcr.after_step(&mut world.bodies, &world.colliders, &world.narrow_phase);
+    }
+    assert_eq!(
+        GRAVITY.load(Ordering::SeqCst),
+        1,
+        "{}",
+        LAST.lock().unwrap()
+    );
+    dcr.set_gravity(world.gravity);
+    assert_eq!(dcr.world().params().gravity, [0.0, 0.0, -9.81]);
 }

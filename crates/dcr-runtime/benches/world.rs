@@ -35,7 +35,7 @@ fn scene(n: usize) -> Scene {
         17,
     );
     let model = Arc::new(ModalModel::from_base(base).unwrap());
-    let mut world = DcrWorld::new(WorldParams::default()).unwrap();
+    let mut world = DcrWorld::new(WorldParams::with_gravity([0.0; 3])).unwrap();
     let mut desc = ElasticObjectDesc::new(model, FLOOR);
     desc.response.sampling = Sampling::Substep(0.01 / 11.0);
     world.add_object(desc).unwrap();

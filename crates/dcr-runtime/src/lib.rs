@@ -20,7 +20,10 @@
 //! // A base (real ones come from `ModalModel::load("table.modes")`): a 1 m × 0.6 m plate in its
 //! // object frame's z = 0 plane, outward normal +z.
 //! let model = Arc::new(ModalModel::from_base(testing::plate_base())?);
-//! let mut world = DcrWorld::new(WorldParams { h: 0.01, ..Default::default() })?;
+//! // The engine's step (s) and gravity (m/s², world frame; z up here), which the world must be
+//! // told: a body a response lifts off gets back the g·h gravity takes in the step it leaves.
+//! let mut world = DcrWorld::new(WorldParams { h: 0.01, gravity: [0.0, 0.0, -9.81],
+//!     ..Default::default() })?;
 //!
 //! // The plate is a static elastic object on engine body 1, tilted 30° about the world x axis
 //! // and lifted 0.8 m: object → world is x_w = R x_o + t.

@@ -119,6 +119,7 @@ fn injected_energy_is_bounded_by_eta_times_dissipated() {
             let mut rng = SplitMix64(1000 + seed);
             let mut world = DcrWorld::new(WorldParams {
                 energy_eta: Some(eta),
+                gravity: [0.0; 3],
                 ..Default::default()
             })
             .unwrap();

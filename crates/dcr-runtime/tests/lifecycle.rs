@@ -27,6 +27,7 @@ fn model_of(base: ModesFile) -> Arc<ModalModel> {
 fn params() -> WorldParams {
     WorldParams {
         energy_eta: None,
+        gravity: [0.0; 3],
         ..Default::default()
     }
 }

@@ -310,6 +310,7 @@ fn world_steps_do_not_allocate(model: &Arc<ModalModel>) {
     const FRIDGE: u64 = 2;
     let mut world = DcrWorld::new(WorldParams {
         energy_eta: Some(0.5),
+        gravity: [0.0; 3],
         ..Default::default()
     })
     .unwrap();

@@ -31,6 +31,7 @@ fn model() -> Arc<ModalModel> {
 fn world_params(eta: Option<f64>) -> WorldParams {
     WorldParams {
         energy_eta: eta,
+        gravity: [0.0; 3],
         ..Default::default()
     }
 }
@@ -539,6 +540,7 @@ fn a_table_that_does_not_apply_is_refused_or_counted() {
     let h = 1.0 / 60.0;
     let mut w = DcrWorld::new(WorldParams {
         h,
+        gravity: [0.0; 3],
         ..Default::default()
     })
     .unwrap();
@@ -580,7 +582,7 @@ fn a_table_that_does_not_apply_is_refused_or_counted() {
     assert_eq!(info.table_fallback, Some(TableFallback::Unavailable));
 
     // At the table's h it serves; a contact outside its region is counted with its reason.
-    let mut w = DcrWorld::new(WorldParams::default()).unwrap();
+    let mut w = DcrWorld::new(WorldParams::with_gravity([0.0; 3])).unwrap();
     let mut desc = ElasticObjectDesc::new(m, PLATE);
     desc.response.table_policy = TablePolicy::Refuse;
     let plate = w.add_object(desc).unwrap();
@@ -840,4 +842,24 @@ fn sustained_pushes_drain_the_ringing_that_pays_for_them() {
         })
         .sum();
     assert!(undrained > 2.0 * start, "{undrained} J vs {start} J");
+}
+
+/// The default gravity is unset and refused with the fix (an engine's gravity or zero), so no
+/// world silently loses g·h of every lifting push; a set one is kept, and `set_gravity` keeps
+/// the old value when given a non-finite one.
+#[test]
+fn gravity_must_be_given() {
+    let err = match DcrWorld::new(WorldParams::default()) {
+        Ok(_) => panic!("the default (unset) gravity is accepted"),
+        Err(e) => e.to_string(),
+    };
+    for needle in ["gravity", "is not set", "[0, -9.81, 0]", "[0, 0, 0]", "g·h"] {
+        assert!(err.contains(needle), "`{needle}` not in `{err}`");
+    }
+    let mut w = DcrWorld::new(WorldParams::with_gravity([0.0, -9.81, 0.0])).unwrap();
+    assert_eq!(w.params().gravity, [0.0, -9.81, 0.0]);
+    assert!(w.set_gravity([f64::NAN, 0.0, 0.0]).is_err());
+    assert_eq!(w.params().gravity, [0.0, -9.81, 0.0]);
+    assert!(DcrWorld::new(WorldParams::with_gravity([0.0; 3])).is_ok());
+    assert!(DcrWorld::new(WorldParams::with_gravity([0.0, f64::INFINITY, 0.0])).is_err());
 }

@@ -203,6 +203,11 @@ int main(int argc, char **argv) {
     CHECK(dcr_world_params_default(&wp) == DCR_STATUS_OK);
     CHECK(wp.h == 0.01 && wp.energy_bound && wp.energy_eta == 1.0 && wp.max_chain_depth == 4);
     DcrWorld *world = (DcrWorld *)&checks;
+    /* The gravity is unset by default: the caller must give the engine's (or zero). */
+    CHECK(isnan(wp.gravity[0]) && isnan(wp.gravity[1]) && isnan(wp.gravity[2]));
+    CHECK(dcr_world_create(&wp, &world) == DCR_STATUS_INVALID_ARGUMENT && world == NULL);
+    CHECK(last_error_has("gravity") && last_error_has("is not set"));
+    wp.gravity[0] = wp.gravity[1] = wp.gravity[2] = 0.0;
     DcrWorldParams wbad = wp;
     wbad.energy_eta = 2.0;
     CHECK(dcr_world_create(&wbad, &world) == DCR_STATUS_INVALID_ARGUMENT && world == NULL);

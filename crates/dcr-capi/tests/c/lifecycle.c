@@ -117,6 +117,7 @@ int main(int argc, char **argv) {
     DcrWorldParams wp;
     dcr_world_params_default(&wp);
     wp.energy_bound = false; /* Delta-v exactly linear in the gain */
+    wp.gravity[0] = wp.gravity[1] = wp.gravity[2] = 0.0; /* no support compensation */
     DcrWorld *world = NULL;
     CHECK(dcr_world_create(&wp, &world) == DCR_STATUS_OK);
     DcrElasticObjectDesc desc;

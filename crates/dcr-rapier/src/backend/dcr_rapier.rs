@@ -221,18 +221,29 @@ pub struct DcrRapier {
     h_mismatch_steps: u64,
     /// Whether the coming `after_step` runs with an h other than rapier's dt.
     pending_mismatch: bool,
+    /// Whether the world knows rapier's gravity (given in the parameters or by
+    /// [`DcrRapier::set_gravity`]); until then it has none and `after_step` warns once.
+    gravity_known: bool,
+    warned_gravity: bool,
 }
 
 impl DcrRapier {
     /// An adapter with an empty world of parameters `params` (`h` must be rapier's
     /// `integration_parameters.dt`). Under [`StepGate::ImpactSteps`] the world classifies with
-    /// engine newness (`params.classify.engine_newness` is set).
+    /// engine newness (`params.classify.engine_newness` is set). `params.gravity` may stay
+    /// unset (the default): [`DcrRapier::step`] gives the world rapier's gravity every step,
+    /// and callers of [`DcrRapier::after_step`] give it with [`DcrRapier::set_gravity`] (until
+    /// they do, the world has none and the first `after_step` logs a warning).
     ///
     /// # Errors
     /// [`AdapterError::World`] for invalid world parameters ([`DcrWorld::new`]).
     pub fn new(mut params: WorldParams, adapter: AdapterParams) -> Result<DcrRapier, AdapterError> {
         if adapter.gate == StepGate::ImpactSteps {
             params.classify.engine_newness = true;
+        }
+        let gravity_known = !params.gravity_unset();
+        if !gravity_known {
+            params.gravity = [0.0; 3];
         }
         Ok(DcrRapier {
             world: DcrWorld::new(params)?,
@@ -257,6 +268,8 @@ impl DcrRapier {
             refused_dt: None,
             h_mismatch_steps: 0,
             pending_mismatch: false,
+            gravity_known,
+            warned_gravity: false,
         })
     }
 
@@ -488,9 +501,9 @@ impl DcrRapier {
     /// gravity changes.
     pub fn set_gravity(&mut self, gravity: Vector) {
         let g = arr(gravity);
-        if g != self.world.params().gravity {
+        if g != self.world.params().gravity || !self.gravity_known {
             // Finite gravity only; rapier's own step fails on a non-finite one anyway.
-            let _ = self.world.set_gravity(g);
+            self.gravity_known |= self.world.set_gravity(g).is_ok();
         }
     }
 
@@ -575,6 +588,17 @@ impl DcrRapier {
         if self.params.apply == ApplyMode::InSolver {
             self.settle_replays(bodies);
         }
+        if !self.gravity_known && !self.warned_gravity {
+            self.warned_gravity = true;
+            log::warn!(
+                target: "dcr_rapier",
+                "the world was never given rapier's gravity (WorldParams::gravity unset, \
+                 DcrRapier::set_gravity not called): a body a response lifts off gets no support \
+                 compensation and loses g·h of its push; call \
+                 dcr.set_gravity(gravity) at set-up, or step with DcrRapier::step (reported once)"
+            );
+        }
+
         if self.params.gate == StepGate::ImpactSteps {
             let hot = self.scan(narrow_phase);
             if !hot && !self.must_step() {

@@ -176,7 +176,11 @@ struct Slot {
 ///     Pose, WorldParams};
 ///
 /// let model = Arc::new(ModalModel::from_base(testing::plate_base())?);
-/// let mut world = DcrWorld::new(WorldParams { energy_eta: None, ..Default::default() })?;
+/// let mut world = DcrWorld::new(WorldParams {
+///     energy_eta: None,
+///     gravity: [0.0; 3], // no support compensation: this example lifts nothing off
+///     ..Default::default()
+/// })?;
 /// // The plate (engine body 1) stands upright: its +z normal points along world +x.
 /// let mut desc = ElasticObjectDesc::new(model, 1);
 /// desc.pose = Pose::from_axis_angle([0.0, 1.0, 0.0], std::f64::consts::FRAC_PI_2, [2.0, 0.0, 0.0]);
@@ -249,13 +253,22 @@ impl DcrWorld {
     /// An empty world.
     ///
     /// # Errors
-    /// [`WorldError::Params`] for a non-positive or non-finite `h`, a non-finite gravity, or
-    /// `energy_eta` outside [0, 1].
+    /// [`WorldError::Params`] for a non-positive or non-finite `h`, an unset (the default) or
+    /// non-finite gravity, or `energy_eta` outside [0, 1].
     pub fn new(params: WorldParams) -> Result<DcrWorld, WorldError> {
         if !(params.h.is_finite() && params.h > 0.0) {
             return Err(invalid(
                 "h",
                 format!("{} s (must be finite and > 0)", params.h),
+            ));
+        }
+        if params.gravity_unset() {
+            return Err(invalid(
+                "gravity",
+                "is not set: give the engine's gravity (m/s², world frame), e.g. [0, -9.81, 0] \
+                 for a y-up engine (WorldParams::with_gravity), or [0, 0, 0] for no support \
+                 compensation (a body a response lifts off then loses g·h of its push)"
+                    .into(),
             ));
         }
         if !params.gravity.iter().all(|g| g.is_finite()) {
