@@ -478,9 +478,10 @@ fn an_asset_base_records_its_meshing_and_check_names_a_change() {
         .output()
         .unwrap();
     assert_eq!(o.status.code(), Some(0), "{args:?}");
-    // An unchanged asset is not meshed again: the base records its bytes, the meshers'
-    // versions and this build. Other bytes of the same surface (a comment) are meshed again
-    // and found up to date; a base from another build is meshed again.
+    // An unchanged asset is not meshed again: the base records its bytes, its surface, the
+    // meshers' versions and this build. Other bytes of the same surface (a comment) are not
+    // meshed again either; a moved vertex is meshed again and found stale; a base recorded
+    // without the surface matches the same bytes only; one from another build is meshed again.
     let json = |extra: &[&str]| {
         let mut e = vec!["--size", "0.05", "--json"];
         e.extend_from_slice(extra);
@@ -511,8 +512,37 @@ fn an_asset_base_records_its_meshing_and_check_names_a_change() {
     text += "# the same surface\n";
     std::fs::write(&asset, &text).unwrap();
     let (fresh, again, err) = json(&[]);
-    assert_eq!((fresh, again), (true.into(), true.into()), "{err}");
+    assert_eq!(
+        (fresh, again),
+        (true.into(), false.into()),
+        "a comment leaves the surface: {err}"
+    );
+    let moved = obj(&CUBE_V.map(|p| p.map(|x| 0.1001 * x)), false);
+    std::fs::write(&asset, &moved).unwrap();
+    let (fresh, again, err) = json(&[]);
+    assert_eq!(
+        (fresh, again),
+        (false.into(), true.into()),
+        "moved vertices are meshed again: {err}"
+    );
+    std::fs::write(&asset, &text).unwrap();
     let mut b = dcr_runtime::format::ModesFile::read(&base).unwrap();
+    let surface = b.meta.bake_params["asset_key"]
+        .as_object_mut()
+        .unwrap()
+        .remove("surface")
+        .unwrap();
+    assert!(
+        surface.as_str().unwrap().starts_with("sha256:"),
+        "{surface}"
+    );
+    b.write_atomic(&base).unwrap();
+    let (fresh, again, err) = json(&[]);
+    assert_eq!(
+        (fresh, again),
+        (true.into(), true.into()),
+        "without a recorded surface other bytes are meshed again: {err}"
+    );
     b.meta.bake_params["asset_key"]["bytes"] = (text.len() as u64).into();
     b.meta.bake_params["asset_key"]["sha256"] =
         format!("sha256:{:x}", sha2::Sha256::digest(text.as_bytes())).into();

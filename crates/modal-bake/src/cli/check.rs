@@ -28,9 +28,9 @@ pub struct CheckArgs {
     /// Print one JSON object: {"base", "mesh", "up_to_date", "reason" (up_to_date, missing,
     /// unreadable, tool_changed, geometry_changed, parameters_changed, transfer_table_changed),
     /// "detail" (what differs, by the options that change it; null when up to date or
-    /// missing), "meshed_again" (false when a surface asset's base records the same bytes,
-    /// options, meshers and build, so the asset was not meshed again)} (or {"error"} with
-    /// exit 2).
+    /// missing), "meshed_again" (false when a surface asset's base records the same bytes or
+    /// surface, options, meshers and build, so the asset was not meshed again)} (or {"error"}
+    /// with exit 2).
     #[arg(long)]
     pub json: bool,
 }
@@ -44,7 +44,7 @@ pub fn run(args: &CheckArgs) -> ExitCode {
     let asset = super::bake::asset_for(&args.asset, args.transfer.transfer_h.is_some(), &args.mesh);
     // The options are checked as `bake` checks them, naming the option.
     // An unchanged asset is not meshed again (minutes on a large one) when its base records
-    // the same bytes, options, meshers and build.
+    // the same bytes or surface, options, meshers and build.
     let mut remeshed = true;
     let status = args
         .options
@@ -84,7 +84,7 @@ pub fn run(args: &CheckArgs) -> ExitCode {
                 );
             } else if fresh && !remeshed {
                 outln!(
-                    "{}: up to date (the asset's bytes, options, meshers and build are the base's: not meshed again)",
+                    "{}: up to date (the asset's surface, options, meshers and build are the base's: not meshed again)",
                     args.out.display()
                 );
             } else if fresh {

@@ -1,15 +1,19 @@
 //! When meshing a surface asset again can be skipped: an [`AssetKey`] records what a mesh of
-//! an asset depends on — the asset file's bytes, this build of the meshing chain
-//! ([`BUILD_HASH`]) and the meshers' versions — so that `check` and `batch` find a base of an
-//! unchanged asset up to date without meshing it again (minutes on a large asset), with the
-//! same answer meshing would give.
+//! an asset depends on — the asset file's bytes, the surface the meshers read from them, this
+//! build of the meshing chain ([`BUILD_HASH`]) and the meshers' versions — so that `check` and
+//! `batch` find a base of an unchanged asset up to date without meshing it again (minutes on a
+//! large asset), with the same answer meshing would give.
 //!
 //! Why that answer is the same: the meshers run on one thread with fixed seeds, so the same
-//! asset bytes, options (recorded beside the key: `selection`, `meshing`) and mesher versions
-//! give the same mesh bytes (docs/artist-guide.md; fTetWild only where its fixed-sequence
-//! random device is loaded — a mesh that is not reproducible gets no key). A glTF asset gets a
-//! key only when it is self-contained (a `.glb`'s own binary chunk or `data:` URIs): buffers
-//! read from other files are not covered by the key.
+//! surface, options (recorded beside the key: `selection`, `meshing`) and mesher versions give
+//! the same mesh bytes (docs/artist-guide.md; fTetWild only where its fixed-sequence random
+//! device is loaded — a mesh that is not reproducible gets no key). The surface is what
+//! [`super::mesh_asset`] gives the meshers before scaling (the `--units` are compared apart):
+//! the welded vertices and triangles of the asset's selected object, in order. So an asset
+//! saved again with only a comment, a material, normals or texture coordinates changed is not
+//! meshed again either; its bytes are compared first, and the surface is read only when they
+//! differ. A glTF asset gets a key only when it is self-contained (a `.glb`'s own binary chunk
+//! or `data:` URIs): buffers read from other files are not covered by the bytes.
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -31,6 +35,10 @@ pub struct AssetKey {
     pub sha256: String,
     /// The asset file's size (bytes).
     pub bytes: u64,
+    /// `sha256:<hex>` of the surface the meshers read ([`surface_sha256`]); absent in bases
+    /// written before it was recorded (then only the same bytes match).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub surface: Option<String>,
     /// The [`BUILD_HASH`] of the `modal-bake` that meshed it.
     pub build: String,
     /// The version of each mesher when it was meshed (`gmsh`, `ftetwild`; absent: not
@@ -53,45 +61,86 @@ impl AssetKey {
     /// The key the asset at `path` would get now, with the meshers `params` would run; `None`
     /// for an unreadable file or a glTF asset that reads other files.
     fn now(path: &Path, params: &MeshParams) -> Option<AssetKey> {
-        let bytes = std::fs::read(path).ok()?;
-        if is_gltf(path) && !self_contained_gltf(&bytes) {
-            return None;
-        }
-        let mut meshers = BTreeMap::new();
-        if let Ok(v) = super::gmsh::gmsh_version(params.gmsh.as_deref()) {
-            meshers.insert("gmsh".to_string(), v);
-        }
-        let ftetwild = match params.ftetwild.as_deref() {
-            // A FloatTetwild_bin names no version: its bytes identify it.
-            Some(p) => std::fs::read(p)
-                .ok()
-                .map(|b| format!("FloatTetwild_bin {}", sha256(&b))),
-            None => super::ftetwild::ftetwild_version(None).ok(),
-        };
-        if let Some(v) = ftetwild {
-            meshers.insert("ftetwild".to_string(), v);
-        }
+        let bytes = read_keyable(path)?;
         Some(AssetKey {
             sha256: sha256(&bytes),
             bytes: bytes.len() as u64,
+            surface: surface_sha256(path, params.object.as_deref()),
             build: BUILD_HASH.to_string(),
-            meshers,
+            meshers: meshers_now(params),
         })
     }
 
     /// Whether the asset at `path`, this build and the meshers `params` would run now are
-    /// those of this key (the options are compared apart).
+    /// those of this key (the options are compared apart): the same build and meshers, and
+    /// the same bytes or, failing that, the same recorded surface.
     pub fn matches_now(&self, path: &Path, params: &MeshParams) -> bool {
-        // Cheap tests first: the build, then the size, before hashing the file and asking
-        // the meshers their versions.
+        // Cheap tests first: the build, then the bytes, before asking the meshers their
+        // versions and, only when the bytes differ, reading the surface.
         if self.build != BUILD_HASH {
             return false;
         }
-        if std::fs::metadata(path).map(|m| m.len()).ok() != Some(self.bytes) {
+        let Some(bytes) = read_keyable(path) else {
+            return false;
+        };
+        let same_bytes = bytes.len() as u64 == self.bytes && sha256(&bytes) == self.sha256;
+        if !same_bytes && self.surface.is_none() {
             return false;
         }
-        Self::now(path, params).as_ref() == Some(self)
+        if meshers_now(params) != self.meshers {
+            return false;
+        }
+        same_bytes || surface_sha256(path, params.object.as_deref()) == self.surface
     }
+}
+
+/// The asset's bytes when it can have a key: `None` for an unreadable file or a glTF asset
+/// that reads other files.
+fn read_keyable(path: &Path) -> Option<Vec<u8>> {
+    let bytes = std::fs::read(path).ok()?;
+    (!is_gltf(path) || self_contained_gltf(&bytes)).then_some(bytes)
+}
+
+/// `sha256:<hex>` of the surface the meshers read from the asset at `path` (its `object`, or
+/// all of it), in the file's units: the welded vertex count, each vertex's coordinates as f64
+/// bits (little-endian), the triangle count and each triangle's vertex indices as u64, in the
+/// order [`super::surface::read_surface_object`] gives them. `None` when it cannot be read.
+pub fn surface_sha256(path: &Path, object: Option<&str>) -> Option<String> {
+    let s = super::surface::read_surface_object(path, object).ok()?;
+    let mut h = Sha256::new();
+    h.update((s.vertices.len() as u64).to_le_bytes());
+    for v in &s.vertices {
+        for x in v {
+            h.update(x.to_bits().to_le_bytes());
+        }
+    }
+    h.update((s.triangles.len() as u64).to_le_bytes());
+    for t in &s.triangles {
+        for &i in t {
+            h.update((i as u64).to_le_bytes());
+        }
+    }
+    Some(format!("sha256:{:x}", h.finalize()))
+}
+
+/// The versions of the meshers `params` would run now (`gmsh`, `ftetwild`; absent: not
+/// installed).
+fn meshers_now(params: &MeshParams) -> BTreeMap<String, String> {
+    let mut meshers = BTreeMap::new();
+    if let Ok(v) = super::gmsh::gmsh_version(params.gmsh.as_deref()) {
+        meshers.insert("gmsh".to_string(), v);
+    }
+    let ftetwild = match params.ftetwild.as_deref() {
+        // A FloatTetwild_bin names no version: its bytes identify it.
+        Some(p) => std::fs::read(p)
+            .ok()
+            .map(|b| format!("FloatTetwild_bin {}", sha256(&b))),
+        None => super::ftetwild::ftetwild_version(None).ok(),
+    };
+    if let Some(v) = ftetwild {
+        meshers.insert("ftetwild".to_string(), v);
+    }
+    meshers
 }
 
 fn sha256(bytes: &[u8]) -> String {

@@ -47,7 +47,7 @@ pub mod work;
 use std::path::Path;
 
 pub use asset::mesh_asset;
-pub use asset_key::{AssetKey, BUILD_HASH};
+pub use asset_key::{surface_sha256, AssetKey, BUILD_HASH};
 pub use boundary::extract_surface;
 pub use distance::{surface_distance, SurfaceDistance};
 pub use mesh_error::{Location, MeshError, MeshErrorKind};

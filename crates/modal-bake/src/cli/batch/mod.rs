@@ -293,7 +293,7 @@ fn run_entry(entry: &Entry, tag: &str, start: Instant) -> EntryRecord {
             line(
                 start,
                 &format!(
-                    "{tag} {}: the asset's bytes, options, meshers and build are the base's: not meshed again",
+                    "{tag} {}: the asset's surface, options, meshers and build are the base's: not meshed again",
                     args.out.display()
                 ),
             );
