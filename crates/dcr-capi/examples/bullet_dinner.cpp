@@ -5,7 +5,8 @@
  * "A released C++ engine: Bullet"). The scene is the one of the Bevy example (crates/dcr-bevy/examples/
  * dinner.rs), so the two engines can be compared on the same base.
  *
- *   bullet_dinner TABLE.modes [--steps N] [--frame-dt S] [--fixed-dt S] [--trace] [--no-support]
+ *   bullet_dinner TABLE.modes [--steps N] [--frame-dt S] [--fixed-dt S]
+ *                 [--table-origin Y [--ignore-origin]] [--trace] [--no-support]
  *
  * The scene runs twice in the same process, with the response and without it, and prints one
  * JSON object on stdout:
@@ -35,7 +36,10 @@
  * stepSimulation(S, 16, 0.01) (substeps of 10 ms inside frames of S), instead of one
  * stepSimulation(0.01, 0) per step: the same internal steps, so the same outcome. --fixed-dt S
  * makes Bullet's internal step S instead of the world's h = 0.01 s: dcr_bullet re-derives the
- * responses for it (h_changes in the output).
+ * responses for it (h_changes in the output). --table-origin Y puts the table's body frame Y m
+ * above the mesh's (its shapes shifted down by as much, as a body whose frame is its centre of
+ * mass has them) and tells dcr_bullet where the mesh's frame is in it; --ignore-origin does not,
+ * to see what a base in the wrong frame does (its contacts are not mapped: "unmapped").
  */
 #include <btBulletDynamicsCommon.h>
 
@@ -120,22 +124,25 @@ struct Scene {
     btRigidBody *table = nullptr;
     btRigidBody *plates[NUM_PLATES] = {};
 
-    Scene() {
+    /* The table's body at (0, table_origin, 0) m, its shapes shifted down by as much (a body
+       frame other than the mesh's, as a centre-of-mass frame is). */
+    explicit Scene(double table_origin) {
         /* Several points per convex pair from the first contact (a plate resting flat). */
         config.setConvexConvexMultipointIterations();
         world.setGravity(btVector3(0, btScalar(-GRAVITY), 0));
 
         /* The table in the mesh's frame (y up): its top and four legs, static. */
         auto table = std::make_unique<btCompoundShape>();
+        const btScalar dy = btScalar(-table_origin);
         auto top = box(0.8, 0.02, 0.45);
-        table->addChildShape(btTransform(btQuaternion::getIdentity(), btVector3(0, 0.73f, 0)), top);
+        table->addChildShape(btTransform(btQuaternion::getIdentity(), btVector3(0, 0.73f + dy, 0)), top);
         const double legs[4][2] = {{-0.7, -0.35}, {0.7, -0.35}, {-0.7, 0.35}, {0.7, 0.35}};
         for (const auto &l : legs) {
             table->addChildShape(
-                btTransform(btQuaternion::getIdentity(), btVector3(btScalar(l[0]), 0.355f, btScalar(l[1]))),
+                btTransform(btQuaternion::getIdentity(), btVector3(btScalar(l[0]), 0.355f + dy, btScalar(l[1]))),
                 box(0.03, 0.355, 0.03));
         }
-        this->table = add(std::move(table), 0.0, btVector3(0, 0, 0), 1.0, 1.0);
+        this->table = add(std::move(table), 0.0, btVector3(0, btScalar(table_origin), 0), 1.0, 1.0);
 
         for (int i = 0; i < NUM_PLATES; ++i) {
             auto shape = std::make_unique<btCylinderShape>(btVector3(0.11f, 0.008f, 0.11f));
@@ -244,9 +251,9 @@ void on_tick(btDynamicsWorld *w, btScalar time_step) {
    table is dcr's elastic object (the world's h is H: another fixed_dt is re-derived by
    dcr_bullet). frame_dt 0: stepSimulation(fixed_dt, 0), one step per call; else
    stepSimulation(frame_dt, 16, fixed_dt), as a game steps at its frame rate. */
-int run(const DcrModel *table_model, long steps, double fixed_dt, double frame_dt, bool trace, bool support,
-        Outcome &out) {
-    Scene scene;
+int run(const DcrModel *table_model, long steps, double fixed_dt, double frame_dt, double table_origin,
+        bool pass_origin, bool trace, bool support, Outcome &out) {
+    Scene scene(table_origin);
     std::unique_ptr<dcr_bullet::World> dcr;
     DcrElasticHandle handle = 0;
     if (table_model) {
@@ -263,7 +270,10 @@ int run(const DcrModel *table_model, long steps, double fixed_dt, double frame_d
         desc.response.impact_threshold = 0.5; /* N*s: a plate's weight per step stays below */
         desc.response.max_map_distance = 0.1; /* m */
         DcrStatus st = dcr->status();
-        if (st == DCR_STATUS_OK) st = dcr->add(scene.table, desc, &handle);
+        /* The mesh's frame in the table body's frame. */
+        const btTransform mesh_in_body(btQuaternion::getIdentity(),
+                                       btVector3(0, btScalar(pass_origin ? -table_origin : 0.0), 0));
+        if (st == DCR_STATUS_OK) st = dcr->add(scene.table, desc, mesh_in_body, &handle);
         if (st != DCR_STATUS_OK) {
             std::fprintf(stderr, "bullet_dinner: cannot add the table: %s\n",
                          dcr->error().empty() ? dcr_last_error() : dcr->error().c_str());
@@ -317,7 +327,8 @@ int main(int argc, char **argv) {
     const char *base = nullptr;
     long steps = 150;
     bool trace = false, support = true;
-    double frame_dt = 0.0, fixed_dt = H;
+    double frame_dt = 0.0, fixed_dt = H, table_origin = 0.0;
+    bool pass_origin = true;
     for (int i = 1; i < argc; ++i) {
         if (std::strcmp(argv[i], "--steps") == 0 && i + 1 < argc) {
             char *end = nullptr;
@@ -341,6 +352,16 @@ int main(int argc, char **argv) {
                              argv[i]);
                 return 2;
             }
+        } else if (std::strcmp(argv[i], "--table-origin") == 0 && i + 1 < argc) {
+            char *end = nullptr;
+            table_origin = std::strtod(argv[++i], &end);
+            if (*end != '\0' || !(std::fabs(table_origin) <= 10.0)) {
+                std::fprintf(stderr, "bullet_dinner: --table-origin `%s` must be a number of metres in [-10, 10]\n",
+                             argv[i]);
+                return 2;
+            }
+        } else if (std::strcmp(argv[i], "--ignore-origin") == 0) {
+            pass_origin = false;
         } else if (std::strcmp(argv[i], "--trace") == 0) {
             trace = true;
         } else if (std::strcmp(argv[i], "--no-support") == 0) {
@@ -348,12 +369,14 @@ int main(int argc, char **argv) {
         } else if (argv[i][0] != '-' && !base) {
             base = argv[i];
         } else {
-            std::fprintf(stderr, "usage: %s TABLE.modes [--steps N] [--frame-dt S] [--fixed-dt S] [--trace] [--no-support]\n", argv[0]);
+            std::fprintf(stderr, "usage: %s TABLE.modes [--steps N] [--frame-dt S] [--fixed-dt S] [--table-origin Y [--ignore-origin]]\n"
+                             "       [--trace] [--no-support]\n", argv[0]);
             return 2;
         }
     }
     if (!base) {
-        std::fprintf(stderr, "usage: %s TABLE.modes [--steps N] [--frame-dt S] [--fixed-dt S] [--trace] [--no-support]\n", argv[0]);
+        std::fprintf(stderr, "usage: %s TABLE.modes [--steps N] [--frame-dt S] [--fixed-dt S] [--table-origin Y [--ignore-origin]]\n"
+                             "       [--trace] [--no-support]\n", argv[0]);
         return 2;
     }
     DcrModel *model = nullptr;
@@ -362,8 +385,8 @@ int main(int argc, char **argv) {
     std::unique_ptr<DcrModel, void (*)(DcrModel *)> model_guard(model, dcr_model_free);
 
     Outcome on, off;
-    if (int rc = run(model, steps, fixed_dt, frame_dt, trace, support, on)) return rc;
-    if (int rc = run(nullptr, steps, fixed_dt, frame_dt, false, support, off)) return rc;
+    if (int rc = run(model, steps, fixed_dt, frame_dt, table_origin, pass_origin, trace, support, on)) return rc;
+    if (int rc = run(nullptr, steps, fixed_dt, frame_dt, table_origin, pass_origin, false, support, off)) return rc;
     std::printf("{\"engine\": \"Bullet %d.%02d (%s)\", \"h_s\": %g, \"fixed_dt_s\": %g, \"steps\": %ld, "
                 "\"frame_dt_s\": %g, \"support\": %s, ",
                 BT_BULLET_VERSION / 100, BT_BULLET_VERSION % 100, sizeof(btScalar) == 8 ? "double" : "float", H,

@@ -14,7 +14,10 @@
 //! - stepped as a game steps, `stepSimulation(1/60 s, 16, 10 ms)`, the adapter runs in every
 //!   substep and the outcome is bit-identical to one `stepSimulation(10 ms, 0)` per step;
 //! - a Bullet step other than the world's h (5 ms against 10 ms) is re-derived once
-//!   (`h_changes` 1) and the support compensation follows it (g · 5 ms).
+//!   (`h_changes` 1) and the support compensation follows it (g · 5 ms);
+//! - a table body whose frame is 0.5 m above the mesh's (shapes shifted down, as in a
+//!   centre-of-mass frame) gives the same lift when the adapter is told where the mesh's frame
+//!   is, and no response, every contact unmapped, when it is not.
 //!
 //! The program is built with `-Wall -Wextra -Werror -pedantic` against the static library and
 //! run once more linked to the shared library under AddressSanitizer (no leak, no invalid
@@ -241,6 +244,24 @@ fn bullet_plates_lift_by_what_the_response_asked() {
             "plate {plate}: support {support} m/s at h = 5 ms"
         );
     }
+
+    // The table's body frame 0.5 m above the mesh's: the same outcome when the adapter is told.
+    let shifted = run(&bin, &base, &["--table-origin", "0.5"], false);
+    let lift_shifted = shifted["on"]["lift_mm"].as_f64().unwrap();
+    assert!(
+        (lift_shifted - lift).abs() <= 1e-6 * lift && shifted["on"]["unmapped"] == 0,
+        "{lift_shifted} mm with the body frame shifted, {lift} mm without: {shifted}"
+    );
+    let wrong = run(
+        &bin,
+        &base,
+        &["--table-origin", "0.5", "--ignore-origin"],
+        false,
+    );
+    assert!(
+        wrong["on"]["unmapped"].as_u64().unwrap() > 0 && wrong["on"]["plate_events"] == 0,
+        "a base in the wrong frame: {wrong}"
+    );
 
     // The same run linked to the shared library under AddressSanitizer: the same outcome.
     let asan = dir.path().join("bullet_dinner_asan");

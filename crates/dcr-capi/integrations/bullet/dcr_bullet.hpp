@@ -24,8 +24,9 @@
  * counter kept in the point's m_userPersistentData, which Bullet preserves while it tracks the
  * point), every non-static body of those manifolds a DcrBodyState, and each returned event is
  * applied with btRigidBody::applyImpulse at its point (waking the body). Engine body ids are the
- * bodies' addresses (dcr_bullet::body_id). The base's object frame is the body's frame
- * (btCollisionObject::getWorldTransform); a dynamic elastic object's pose is set every step.
+ * bodies' addresses (dcr_bullet::body_id). The base's object frame is placed in the body's frame
+ * (btCollisionObject::getWorldTransform, the centre-of-mass frame) by add()'s mesh_in_body; a
+ * dynamic elastic object's pose is set every step.
  *
  * Bullet has one internal tick callback: a program with its own passes install_callback =
  * false and calls World::tick(timeStep) from it. m_userPersistentData of the elastic objects'
@@ -58,9 +59,10 @@ inline uint64_t body_id(const btCollisionObject *body) {
     return uint64_t(reinterpret_cast<uintptr_t>(body));
 }
 
-/* A body's world transform as a dcr pose (object frame -> world; quaternion [x, y, z, w], m). */
-inline DcrPose pose_of(const btCollisionObject &body) {
-    const btTransform &t = body.getWorldTransform();
+/* The pose of an object frame placed at `mesh_in_body` in a body's frame (object frame ->
+   world; quaternion [x, y, z, w], m). */
+inline DcrPose pose_of(const btCollisionObject &body, const btTransform &mesh_in_body) {
+    const btTransform t = body.getWorldTransform() * mesh_in_body;
     const btQuaternion q = t.getRotation();
     DcrPose p;
     p.rotation[0] = q.x();
@@ -110,17 +112,21 @@ class World {
     const std::string &error() const { return error_; }
 
     /* Makes `body` an elastic object: desc.body, desc.dynamic (a body that is not static) and
-       desc.pose (its world transform) are set from it; the rest of `desc` (model, response,
-       gain) is the caller's. */
-    DcrStatus add(btRigidBody *body, DcrElasticObjectDesc desc, DcrElasticHandle *out = nullptr) {
+       desc.pose are set from it; the rest of `desc` (model, response, gain) is the caller's.
+       `mesh_in_body` places the base's object frame (the frame of the mesh it was baked from)
+       in the body's frame: Bullet's body frame is its centre of mass, so a body whose shapes
+       were shifted by -c to put the centre of mass at its origin passes a translation by -c
+       (the identity when the body's frame is the mesh's). */
+    DcrStatus add(btRigidBody *body, DcrElasticObjectDesc desc,
+                  const btTransform &mesh_in_body = btTransform::getIdentity(), DcrElasticHandle *out = nullptr) {
         if (!world_) return status_;
         desc.body = body_id(body);
         desc.dynamic = !body->isStaticObject();
-        desc.pose = pose_of(*body);
+        desc.pose = pose_of(*body, mesh_in_body);
         DcrElasticHandle h = 0;
         DcrStatus st = dcr_world_add_object(world_, &desc, &h);
         if (st != DCR_STATUS_OK) return st;
-        objects_.push_back({body, h});
+        objects_.push_back({body, h, mesh_in_body});
         if (out) *out = h;
         return st;
     }
@@ -147,7 +153,7 @@ class World {
         }
         for (const Object &o : objects_) {
             if (!o.body->isStaticObject()) {
-                const DcrPose p = pose_of(*o.body);
+                const DcrPose p = pose_of(*o.body, o.mesh_in_body);
                 dcr_world_set_pose(world_, o.handle, &p);
             }
         }
@@ -208,6 +214,7 @@ class World {
     struct Object {
         btRigidBody *body;
         DcrElasticHandle handle;
+        btTransform mesh_in_body;
     };
 
     static void on_tick(btDynamicsWorld *w, btScalar time_step) {
