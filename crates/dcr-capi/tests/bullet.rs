@@ -21,7 +21,8 @@
 //!
 //! The program is built with `-Wall -Wextra -Werror -pedantic` against the static library and
 //! run once more linked to the shared library under AddressSanitizer (no leak, no invalid
-//! access). Without Bullet the test skips with the command that installs it, and fails instead
+//! access); the first checks are repeated with Bullet built for double precision
+//! (`pkg-config bullet-float64`). Without Bullet the test skips with the command that installs it, and fails instead
 //! under `DCR_REQUIRE_BULLET=1` (as CI sets it).
 
 mod common;
@@ -36,17 +37,20 @@ use common::{workspace, NATIVE_LIBS};
 const G: f64 = 9.81;
 const H: f64 = 0.01;
 
-/// `pkg-config --cflags --libs bullet`, split into compiler and linker flags; `None` (after
+/// `pkg-config --cflags --libs PACKAGE` (`bullet`: float `btScalar`; `bullet-float64`: double,
+/// both in Debian's `libbullet-dev`), split into compiler and linker flags; `None` (after
 /// saying how to install it) when Bullet is missing and `DCR_REQUIRE_BULLET` is not 1.
-fn bullet_flags() -> Option<(Vec<String>, Vec<String>)> {
+fn bullet_flags(package: &str) -> Option<(Vec<String>, Vec<String>)> {
     let o = Command::new("pkg-config")
-        .args(["--cflags", "--libs", "bullet"])
+        .args(["--cflags", "--libs", package])
         .output();
     let flags = match o {
         Ok(o) if o.status.success() => String::from_utf8_lossy(&o.stdout).into_owned(),
         _ => {
-            let msg = "Bullet is not installed (`pkg-config --cflags --libs bullet` failed): \
-                       `apt-get install libbullet-dev pkg-config` (.ci/run installs them)";
+            let msg = format!(
+                "Bullet is not installed (`pkg-config --cflags --libs {package}` failed): \
+                 `apt-get install libbullet-dev pkg-config` (.ci/run installs them)"
+            );
             assert!(
                 std::env::var("DCR_REQUIRE_BULLET").as_deref() != Ok("1"),
                 "{msg}"
@@ -159,15 +163,10 @@ fn first_launches(outcome: &serde_json::Value) -> Vec<(u64, f64, f64, f64, f64)>
     out
 }
 
-#[test]
-fn bullet_plates_lift_by_what_the_response_asked() {
-    let Some(bullet) = bullet_flags() else { return };
-    let dir = tempfile::tempdir().unwrap();
-    let base = bake_table(dir.path());
-    let bin = dir.path().join("bullet_dinner");
-    build(&bin, &bullet, false);
-    let v = run(&bin, &base, &[], false);
-    assert!(v["engine"].as_str().unwrap().starts_with("Bullet "), "{v}");
+/// The checks of one run's output `v` (with and without the response) that hold for every
+/// Bullet build; `support_tol` is the relative tolerance of the support compensation against
+/// g·h. Returns the plates' first launches.
+fn plates_lift_as_asked(v: &serde_json::Value, support_tol: f64) -> Vec<(u64, f64, f64, f64, f64)> {
     let (on, off) = (&v["on"], &v["off"]);
 
     // Without the response: the plates rest (Bullet settles them without a jump).
@@ -194,8 +193,7 @@ fn bullet_plates_lift_by_what_the_response_asked() {
     for &(plate, asked, support, rise, ballistic) in &launches {
         assert!(asked > 0.0, "plate {plate}: asked {asked} m/s");
         assert!(
-            // Bullet's gravity is a float: 9.81 to 1e-7.
-            (support - G * H).abs() < 1e-6 * G * H,
+            (support - G * H).abs() < support_tol * G * H,
             "plate {plate}: support compensation {support} m/s, not g·h = {} m/s",
             G * H
         );
@@ -204,6 +202,24 @@ fn bullet_plates_lift_by_what_the_response_asked() {
             "plate {plate}: rose {rise} mm, free flight from {asked} m/s gives {ballistic} mm"
         );
     }
+    launches
+}
+
+#[test]
+fn bullet_plates_lift_by_what_the_response_asked() {
+    let Some(bullet) = bullet_flags("bullet") else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let base = bake_table(dir.path());
+    let bin = dir.path().join("bullet_dinner");
+    build(&bin, &bullet, false);
+    let v = run(&bin, &base, &[], false);
+    assert!(v["engine"].as_str().unwrap().ends_with("(float)"), "{v}");
+    let (on, off) = (&v["on"], &v["off"]);
+    let lift = on["lift_mm"].as_f64().unwrap();
+    // Bullet's gravity is a float: 9.81 to 1e-7.
+    let launches = plates_lift_as_asked(&v, 1e-6);
 
     // Without the support compensation the same pushes lift the plates at most 80 % as high.
     let bare = run(&bin, &base, &["--no-support"], false);
@@ -268,12 +284,28 @@ fn bullet_plates_lift_by_what_the_response_asked() {
     build(&asan, &bullet, true);
     let va = run(&asan, &base, &[], true);
     assert_eq!(va["on"], *on, "static and shared (sanitized) builds");
+
+    // The same with Bullet built for double precision (its normals under a tilted plate are
+    // not exactly vertical, so the support, g_n h along n, is within 1 % of g h).
+    let Some(bullet64) = bullet_flags("bullet-float64") else {
+        return;
+    };
+    let bin64 = dir.path().join("bullet_dinner64");
+    build(&bin64, &bullet64, false);
+    let v64 = run(&bin64, &base, &[], false);
+    assert!(
+        v64["engine"].as_str().unwrap().ends_with("(double)"),
+        "{v64}"
+    );
+    plates_lift_as_asked(&v64, 1e-2);
 }
 
 /// Usage and load errors exit with their documented codes and say what is wrong.
 #[test]
 fn bullet_example_reports_bad_arguments() {
-    let Some(bullet) = bullet_flags() else { return };
+    let Some(bullet) = bullet_flags("bullet") else {
+        return;
+    };
     let dir = tempfile::tempdir().unwrap();
     let bin = dir.path().join("bullet_dinner");
     build(&bin, &bullet, false);
