@@ -6,7 +6,8 @@
  * dinner.rs), so the two engines can be compared on the same base.
  *
  *   bullet_dinner TABLE.modes [--steps N] [--frame-dt S] [--fixed-dt S]
- *                 [--table-origin Y [--ignore-origin]] [--trace] [--no-support]
+ *                 [--table-origin Y [--ignore-origin]] [--moving-table V] [--min-approach S]
+ *                 [--trace] [--no-support]
  *
  * The scene runs twice in the same process, with the response and without it, and prints one
  * JSON object on stdout:
@@ -40,6 +41,12 @@
  * above the mesh's (its shapes shifted down by as much, as a body whose frame is its centre of
  * mass has them) and tells dcr_bullet where the mesh's frame is in it; --ignore-origin does not,
  * to see what a base in the wrong frame does (its contacts are not mapped: "unmapped").
+ * --moving-table V makes the table a 30 kg dynamic body on a frictionless floor, and it, the
+ * plates and the falling pot start moving along +x at V m/s (V = 0: dynamic, at rest): a
+ * dynamic elastic object whose pose dcr_bullet follows every step (table_moved_m: how far it
+ * went; use a base baked without --fixed, a free object). --min-approach S sets the world's
+ * classify.min_approach_speed (m/s; default dcr_bullet's 2 g h = 0.196 m/s; 1e-9 for
+ * practically none), the closing speed below which a new contact point is not an impact.
  */
 #include <btBulletDynamicsCommon.h>
 
@@ -63,6 +70,7 @@ constexpr double GRAVITY = 9.81;     // m/s^2, along -y
 constexpr double PLATE_Y = 0.758;    // m: plate centres at rest (table top 0.75 + half height)
 constexpr double PLATE_MASS = 0.5;   // kg
 constexpr double POT_MASS = 5.0;     // kg
+constexpr double TABLE_MASS = 30.0;  // kg, when the table moves (--moving-table)
 constexpr double MARGIN = 0.002;     // m: Bullet's collision margin, embedded in the shapes
 constexpr int NUM_PLATES = 6;
 constexpr double PLATES[NUM_PLATES][2] = {{-0.6, -0.25}, {-0.6, 0.25}, {0.6, -0.25},
@@ -88,6 +96,7 @@ struct Outcome {
     double dissipated_j = 0.0;
     uint64_t unmapped = 0;
     uint64_t h_changes = 0;
+    double table_moved_m = 0.0;
     std::vector<Launch> launches;
 };
 
@@ -125,8 +134,10 @@ struct Scene {
     btRigidBody *plates[NUM_PLATES] = {};
 
     /* The table's body at (0, table_origin, 0) m, its shapes shifted down by as much (a body
-       frame other than the mesh's, as a centre-of-mass frame is). */
-    explicit Scene(double table_origin) {
+       frame other than the mesh's, as a centre-of-mass frame is). speed < 0: the table is
+       static; else a 30 kg dynamic body on a frictionless floor, and it and everything on or
+       above it start moving along +x at `speed` m/s. */
+    Scene(double table_origin, double speed) {
         /* Several points per convex pair from the first contact (a plate resting flat). */
         config.setConvexConvexMultipointIterations();
         world.setGravity(btVector3(0, btScalar(-GRAVITY), 0));
@@ -142,7 +153,14 @@ struct Scene {
                 btTransform(btQuaternion::getIdentity(), btVector3(btScalar(l[0]), 0.355f + dy, btScalar(l[1]))),
                 box(0.03, 0.355, 0.03));
         }
-        this->table = add(std::move(table), 0.0, btVector3(0, btScalar(table_origin), 0), 1.0, 1.0);
+        const bool moving = speed >= 0.0;
+        this->table =
+            add(std::move(table), moving ? TABLE_MASS : 0.0, btVector3(0, btScalar(table_origin), 0), 1.0, 1.0);
+        if (moving) {
+            /* The floor, top at y = 0, frictionless (Bullet multiplies the pair's frictions). */
+            add(std::unique_ptr<btCollisionShape>(box_shape(50.0, 0.05, 5.0)), 0.0, btVector3(0, -0.05f, 0), 0.0,
+                1.0);
+        }
 
         for (int i = 0; i < NUM_PLATES; ++i) {
             auto shape = std::make_unique<btCylinderShape>(btVector3(0.11f, 0.008f, 0.11f));
@@ -156,18 +174,28 @@ struct Scene {
         pot_shape->setMargin(MARGIN);
         btRigidBody *pot = add(std::move(pot_shape), POT_MASS, btVector3(0.05f, 1.25f, 0), 0.55, 0.15);
         pot->setLinearVelocity(btVector3(0, -1, 0));
+        if (moving) {
+            for (auto &b : bodies) {
+                if (!b->isStaticObject()) b->setLinearVelocity(b->getLinearVelocity() + btVector3(btScalar(speed), 0, 0));
+            }
+        }
     }
 
     ~Scene() {
         for (auto &b : bodies) world.removeRigidBody(b.get());
     }
 
-    btBoxShape *box(double x, double y, double z) {
-        auto b = std::make_unique<btBoxShape>(btVector3(btScalar(x), btScalar(y), btScalar(z)));
+    /* A box shape owned by the caller (half extents, m). */
+    static btBoxShape *box_shape(double x, double y, double z) {
+        auto *b = new btBoxShape(btVector3(btScalar(x), btScalar(y), btScalar(z)));
         b->setMargin(MARGIN);
-        btBoxShape *raw = b.get();
-        shapes.push_back(std::move(b));
-        return raw;
+        return b;
+    }
+
+    /* A box shape owned by the scene (a child of a compound). */
+    btBoxShape *box(double x, double y, double z) {
+        shapes.emplace_back(box_shape(x, y, z));
+        return static_cast<btBoxShape *>(shapes.back().get());
     }
 
     btRigidBody *add(std::unique_ptr<btCollisionShape> shape, double mass, const btVector3 &at, double friction,
@@ -252,8 +280,9 @@ void on_tick(btDynamicsWorld *w, btScalar time_step) {
    dcr_bullet). frame_dt 0: stepSimulation(fixed_dt, 0), one step per call; else
    stepSimulation(frame_dt, 16, fixed_dt), as a game steps at its frame rate. */
 int run(const DcrModel *table_model, long steps, double fixed_dt, double frame_dt, double table_origin,
-        bool pass_origin, bool trace, bool support, Outcome &out) {
-    Scene scene(table_origin);
+        bool pass_origin, double speed, double min_approach, bool trace, bool support, Outcome &out) {
+    Scene scene(table_origin, speed);
+    const double table_x0 = scene.table->getCenterOfMassPosition().x();
     std::unique_ptr<dcr_bullet::World> dcr;
     DcrElasticHandle handle = 0;
     if (table_model) {
@@ -263,6 +292,7 @@ int run(const DcrModel *table_model, long steps, double fixed_dt, double frame_d
         dcr_world_params_default(&wp);
         wp.h = H;
         if (!support) wp.gravity[0] = wp.gravity[1] = wp.gravity[2] = 0.0;
+        wp.classify.min_approach_speed = min_approach; /* 0: dcr_bullet's 2 g h */
         dcr = std::make_unique<dcr_bullet::World>(scene.world, wp, false);
         DcrElasticObjectDesc desc;
         dcr_elastic_object_desc_default(&desc);
@@ -293,6 +323,7 @@ int run(const DcrModel *table_model, long steps, double fixed_dt, double frame_d
             return 1;
         }
     }
+    out.table_moved_m = scene.table->getCenterOfMassPosition().x() - table_x0;
     if (dcr) {
         DcrObjectStepInfo oi;
         DcrObjectTotals totals;
@@ -308,9 +339,10 @@ int run(const DcrModel *table_model, long steps, double fixed_dt, double frame_d
 
 void print_outcome(const char *name, const Outcome &o, double fixed_dt, bool last) {
     std::printf("\"%s\": {\"lift_mm\": %.17g, \"events\": %llu, \"plate_events\": %llu, \"injected_J\": %.17g, "
-                "\"dissipated_J\": %.17g, \"unmapped\": %llu, \"h_changes\": %llu, \"launches\": [",
+                "\"dissipated_J\": %.17g, \"unmapped\": %llu, \"h_changes\": %llu, \"table_moved_m\": %.17g, "
+                "\"launches\": [",
                 name, o.lift_mm, (unsigned long long)o.events, (unsigned long long)o.plate_events, o.injected_j,
-                o.dissipated_j, (unsigned long long)o.unmapped, (unsigned long long)o.h_changes);
+                o.dissipated_j, (unsigned long long)o.unmapped, (unsigned long long)o.h_changes, o.table_moved_m);
     for (size_t i = 0; i < o.launches.size(); ++i) {
         const Launch &l = o.launches[i];
         std::printf("%s{\"plate\": %d, \"step\": %ld, \"asked_mps\": %.17g, \"support_mps\": %.17g, "
@@ -329,6 +361,7 @@ int main(int argc, char **argv) {
     bool trace = false, support = true;
     double frame_dt = 0.0, fixed_dt = H, table_origin = 0.0;
     bool pass_origin = true;
+    double speed = -1.0, min_approach = 0.0;
     for (int i = 1; i < argc; ++i) {
         if (std::strcmp(argv[i], "--steps") == 0 && i + 1 < argc) {
             char *end = nullptr;
@@ -360,6 +393,20 @@ int main(int argc, char **argv) {
                              argv[i]);
                 return 2;
             }
+        } else if (std::strcmp(argv[i], "--moving-table") == 0 && i + 1 < argc) {
+            char *end = nullptr;
+            speed = std::strtod(argv[++i], &end);
+            if (*end != '\0' || !(speed >= 0.0 && speed <= 10.0)) {
+                std::fprintf(stderr, "bullet_dinner: --moving-table `%s` must be a speed in [0, 10] m/s\n", argv[i]);
+                return 2;
+            }
+        } else if (std::strcmp(argv[i], "--min-approach") == 0 && i + 1 < argc) {
+            char *end = nullptr;
+            min_approach = std::strtod(argv[++i], &end);
+            if (*end != '\0' || !(min_approach > 0.0 && min_approach <= 100.0)) {
+                std::fprintf(stderr, "bullet_dinner: --min-approach `%s` must be a speed in (0, 100] m/s\n", argv[i]);
+                return 2;
+            }
         } else if (std::strcmp(argv[i], "--ignore-origin") == 0) {
             pass_origin = false;
         } else if (std::strcmp(argv[i], "--trace") == 0) {
@@ -370,13 +417,13 @@ int main(int argc, char **argv) {
             base = argv[i];
         } else {
             std::fprintf(stderr, "usage: %s TABLE.modes [--steps N] [--frame-dt S] [--fixed-dt S] [--table-origin Y [--ignore-origin]]\n"
-                             "       [--trace] [--no-support]\n", argv[0]);
+                             "       [--moving-table V] [--min-approach S] [--trace] [--no-support]\n", argv[0]);
             return 2;
         }
     }
     if (!base) {
         std::fprintf(stderr, "usage: %s TABLE.modes [--steps N] [--frame-dt S] [--fixed-dt S] [--table-origin Y [--ignore-origin]]\n"
-                             "       [--trace] [--no-support]\n", argv[0]);
+                             "       [--moving-table V] [--min-approach S] [--trace] [--no-support]\n", argv[0]);
         return 2;
     }
     DcrModel *model = nullptr;
@@ -385,8 +432,8 @@ int main(int argc, char **argv) {
     std::unique_ptr<DcrModel, void (*)(DcrModel *)> model_guard(model, dcr_model_free);
 
     Outcome on, off;
-    if (int rc = run(model, steps, fixed_dt, frame_dt, table_origin, pass_origin, trace, support, on)) return rc;
-    if (int rc = run(nullptr, steps, fixed_dt, frame_dt, table_origin, pass_origin, false, support, off)) return rc;
+    if (int rc = run(model, steps, fixed_dt, frame_dt, table_origin, pass_origin, speed, min_approach, trace, support, on)) return rc;
+    if (int rc = run(nullptr, steps, fixed_dt, frame_dt, table_origin, pass_origin, speed, min_approach, false, support, off)) return rc;
     std::printf("{\"engine\": \"Bullet %d.%02d (%s)\", \"h_s\": %g, \"fixed_dt_s\": %g, \"steps\": %ld, "
                 "\"frame_dt_s\": %g, \"support\": %s, ",
                 BT_BULLET_VERSION / 100, BT_BULLET_VERSION % 100, sizeof(btScalar) == 8 ? "double" : "float", H,

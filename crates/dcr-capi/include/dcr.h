@@ -32,7 +32,7 @@
  * signature or an enumeration code changes. Compare it with `DcrVersion.abi` from
  * `dcr_version` at start-up to catch a header and a library that do not belong together.
  */
-#define DCR_ABI_VERSION 2
+#define DCR_ABI_VERSION 3
 
 /**
  * Largest |translation| component a pose may have (m): beyond it an f64 position resolves
@@ -594,6 +594,14 @@ typedef struct DcrClassifyParams {
    * others with `dcr_world_advance`. Default false (ages).
    */
   bool engine_newness;
+  /**
+   * Smallest approach speed of an impact (m/s, ≥ 0): the normal speed at which the two
+   * bodies closed at the point before its impulse, `k λ − u⁺` from the reported body
+   * states; a fresh contact that closed slower is resting, under either rule. For engines
+   * that re-create the points of sliding contacts (Bullet): 2 g h leaves out the new points
+   * of a resting weight. Per point. Default 0 (no minimum).
+   */
+  double min_approach_speed;
 } DcrClassifyParams;
 
 /**

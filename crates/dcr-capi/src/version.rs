@@ -9,7 +9,7 @@ use crate::status::DcrStatus;
 /// Revision of the C ABI this header describes: bumped whenever a struct layout, a function
 /// signature or an enumeration code changes. Compare it with `DcrVersion.abi` from
 /// `dcr_version` at start-up to catch a header and a library that do not belong together.
-pub const DCR_ABI_VERSION: u32 = 2;
+pub const DCR_ABI_VERSION: u32 = 3;
 
 /// The library's version (semantic versioning of the dcr crates) and ABI revision.
 #[repr(C)]

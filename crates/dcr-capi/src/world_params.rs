@@ -68,7 +68,7 @@ impl From<Pose> for DcrPose {
 /// defaults suit engines that create contacts one step before they carry an impulse (rapier's
 /// predictive contacts).
 #[repr(C)]
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DcrClassifyParams {
     /// Ages rule: a contact can be an impact while its age (steps since it appeared, or last
     /// had zero impulse) is at most this, and it has not been an impact on that object since.
@@ -85,6 +85,12 @@ pub struct DcrClassifyParams {
     /// window (no age table). For callers that report contacts only on some steps and pass the
     /// others with `dcr_world_advance`. Default false (ages).
     pub engine_newness: bool,
+    /// Smallest approach speed of an impact (m/s, ≥ 0): the normal speed at which the two
+    /// bodies closed at the point before its impulse, `k λ − u⁺` from the reported body
+    /// states; a fresh contact that closed slower is resting, under either rule. For engines
+    /// that re-create the points of sliding contacts (Bullet): 2 g h leaves out the new points
+    /// of a resting weight. Per point. Default 0 (no minimum).
+    pub min_approach_speed: f64,
 }
 
 /// Settings of a world (`dcr_world_create`). Fill with `dcr_world_params_default`.
@@ -132,6 +138,7 @@ impl DcrWorldParams {
                 settle_steps: w.classify.settle_steps,
                 new_after_missing_steps: w.classify.new_after_missing_steps,
                 engine_newness: w.classify.engine_newness,
+                min_approach_speed: w.classify.min_approach_speed,
             },
             energy_bound: w.energy_eta.is_some(),
             energy_eta: w.energy_eta.unwrap_or(1.0),
@@ -149,6 +156,7 @@ impl DcrWorldParams {
                 settle_steps: self.classify.settle_steps,
                 new_after_missing_steps: self.classify.new_after_missing_steps,
                 engine_newness: self.classify.engine_newness,
+                min_approach_speed: self.classify.min_approach_speed,
             },
             energy_eta: self.energy_bound.then_some(self.energy_eta),
             max_chain_depth: self.max_chain_depth,

@@ -863,3 +863,49 @@ fn gravity_must_be_given() {
     assert!(DcrWorld::new(WorldParams::with_gravity([0.0; 3])).is_ok());
     assert!(DcrWorld::new(WorldParams::with_gravity([0.0, f64::INFINITY, 0.0])).is_err());
 }
+
+/// `min_approach_speed`: a fresh contact carrying a resting weight's impulse (it closed at
+/// about g·h) is an impact without a minimum and resting with one of 2 g h, while a contact
+/// that closed fast (an impulse stopping a falling body) stays an impact; a negative or
+/// non-finite minimum is refused.
+#[test]
+fn a_minimum_approach_speed_leaves_out_new_points_of_a_resting_weight() {
+    let g_h = 9.81 * 0.01;
+    for (min, weight_fires) in [(0.0, true), (2.0 * g_h, false)] {
+        let mut wp = world_params(None);
+        wp.classify.min_approach_speed = min;
+        let mut w = DcrWorld::new(wp).unwrap();
+        let plate = w
+            .add_object(ElasticObjectDesc::new(model(), PLATE))
+            .unwrap();
+        // A 30 kg body at rest after the step whose new point carries its weight over one step
+        // (λ = m g h = 2.94 N·s, closing at λ/m = g h), and a 1 kg body stopped from 2 m/s
+        // (λ = 2 N·s, closing at 2 m/s).
+        let heavy = body(7, 1.0 / 30.0, [0.5, 0.3, 0.1]);
+        let light = body(9, 1.0, [0.2, 0.2, 0.1]);
+        let at = |id: u64, other: u64, p: [f64; 3], lambda: f64| {
+            on_plate(&Pose::IDENTITY, id, other, p, lambda)
+        };
+        for _ in 0..4 {
+            w.step(&[], &[heavy, light]);
+        }
+        w.step(&[at(1, 7, [0.5, 0.3, 0.0], 30.0 * g_h)], &[heavy, light]);
+        assert_eq!(
+            w.step_info().impacts == 1,
+            weight_fires,
+            "min {min} m/s: the weight's new point"
+        );
+        assert_eq!(w.object_info(plate).resting, u32::from(!weight_fires));
+        w.step(&[at(2, 9, [0.2, 0.2, 0.0], 2.0)], &[heavy, light]);
+        assert_eq!(w.step_info().impacts, 1, "min {min} m/s: the fall");
+    }
+    for bad in [-0.1, f64::NAN, f64::INFINITY] {
+        let mut wp = world_params(None);
+        wp.classify.min_approach_speed = bad;
+        let err = match DcrWorld::new(wp) {
+            Ok(_) => panic!("min_approach_speed {bad} accepted"),
+            Err(e) => e.to_string(),
+        };
+        assert!(err.contains("min_approach_speed"), "{err}");
+    }
+}

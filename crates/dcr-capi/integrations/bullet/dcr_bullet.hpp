@@ -78,7 +78,10 @@ inline DcrPose pose_of(const btCollisionObject &body, const btTransform &mesh_in
 class World {
   public:
     /* Attaches dcr to `dynamics` with `params` (params.h: Bullet's fixed step, s; an unset
-       params.gravity, the default, becomes Bullet's gravity now). Check status(). */
+       params.gravity, the default, becomes Bullet's gravity now; a zero
+       params.classify.min_approach_speed, the default, becomes 2 g h: Bullet re-creates the
+       manifold points of a sliding contact, and the new points of a resting weight, which
+       close at about g h, are no impacts). Check status(). */
     World(btDiscreteDynamicsWorld &dynamics, DcrWorldParams params, bool install_callback = true)
         : dynamics_(dynamics), installed_(install_callback) {
         if (std::isnan(params.gravity[0]) || std::isnan(params.gravity[1]) || std::isnan(params.gravity[2])) {
@@ -86,6 +89,11 @@ class World {
             params.gravity[0] = g.x();
             params.gravity[1] = g.y();
             params.gravity[2] = g.z();
+        }
+        if (params.classify.min_approach_speed == 0.0) {
+            const double g = std::sqrt(params.gravity[0] * params.gravity[0] + params.gravity[1] * params.gravity[1] +
+                                       params.gravity[2] * params.gravity[2]);
+            params.classify.min_approach_speed = 2.0 * g * params.h;
         }
         h_ = params.h;
         if (!check(dcr_world_create(&params, &world_), "dcr_world_create")) {

@@ -98,7 +98,10 @@ struct Slot {
 /// callers that report only some steps, passing the others with [`DcrWorld::advance`]) use
 /// [`crate::world::ClassifyParams::engine_newness`] instead: an impact is a report with
 /// [`ContactReport::is_new`] and impulse > 0 and ≥ the threshold, after the settle window, and
-/// no table is kept.
+/// no table is kept. Under either rule an impact must also have closed at least at
+/// [`crate::world::ClassifyParams::min_approach_speed`] (default 0): engines that re-create the
+/// points of sliding contacts set it so that the new points of a resting weight are not
+/// impacts.
 ///
 /// # Frames
 /// Contacts arrive in the world frame; the response works in the object frame of the base.
@@ -275,6 +278,13 @@ impl DcrWorld {
             return Err(invalid(
                 "gravity",
                 format!("{:?} m/s² (must be finite)", params.gravity),
+            ));
+        }
+        let v = params.classify.min_approach_speed;
+        if !(v.is_finite() && v >= 0.0) {
+            return Err(invalid(
+                "classify.min_approach_speed",
+                format!("{v} m/s (must be finite and ≥ 0)"),
             ));
         }
         if let Some(eta) = params.energy_eta {

@@ -4,7 +4,7 @@
 //! dissipated (the energy bound's budget). The rules are in [`DcrWorld`]'s documentation,
 //! "Impacts and resting contacts".
 
-use super::energy_bound::dissipated;
+use super::energy_bound::{approach_speed, dissipated};
 use super::DcrWorld;
 use crate::math::{scale, sub};
 use crate::response::{Impact, RestingContact};
@@ -89,6 +89,10 @@ impl DcrWorld {
                     }
                 };
             }
+            // Closed fast enough to be an impact (checked only where it could be one).
+            let closing = cp.min_approach_speed <= 0.0
+                || !(fresh_age && valid)
+                || approach_speed(c, bidx, bodies) >= cp.min_approach_speed;
             let mut fired = [false; 2];
             for side in 0..2 {
                 let Some(o) = objs[side] else { continue };
@@ -101,7 +105,7 @@ impl DcrWorld {
                 // enabled again mid-run) belongs to its resting set.
                 let settled = cp.engine_newness
                     || first_seen >= obj.active_since.saturating_add(cp.settle_steps);
-                if fresh_age && settled && !already && valid && lambda >= obj.threshold {
+                if fresh_age && settled && !already && valid && closing && lambda >= obj.threshold {
                     if let Some(f) = fired_before.as_mut() {
                         f[side] = true;
                     }

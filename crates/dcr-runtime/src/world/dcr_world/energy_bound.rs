@@ -109,6 +109,25 @@ fn body_inverse_effective_mass(b: Option<&BodyState>, p: [f64; 3], n: [f64; 3]) 
     }
 }
 
+/// The normal speed at which a contact's bodies closed before its impulse (m/s): `k λ − u⁺`,
+/// with k the pair's inverse effective mass along the normal and u⁺ the separation speed
+/// after the step ([`crate::world::ClassifyParams::min_approach_speed`]).
+pub(super) fn approach_speed(
+    c: &ContactReport,
+    bidx: [Option<u32>; 2],
+    bodies: &[BodyState],
+) -> f64 {
+    let b1 = bidx[0].map(|i| &bodies[i as usize]);
+    let b2 = bidx[1].map(|i| &bodies[i as usize]);
+    let u_plus = dot(
+        sub(velocity_at(b2, c.point2), velocity_at(b1, c.point1)),
+        c.normal,
+    );
+    let k = body_inverse_effective_mass(b1, c.point1, c.normal)
+        + body_inverse_effective_mass(b2, c.point2, c.normal);
+    k * c.impulse - u_plus
+}
+
 /// Energy an impact dissipated (J): `max(0, ½ k λ² − λ u⁺)` (see [`DcrWorld`], "Energy bound").
 pub(super) fn dissipated(c: &ContactReport, bidx: [Option<u32>; 2], bodies: &[BodyState]) -> f64 {
     let b1 = bidx[0].map(|i| &bodies[i as usize]);
