@@ -355,58 +355,52 @@ void print_outcome(const char *name, const Outcome &o, double fixed_dt, bool las
 
 } // namespace
 
+/* The number `text` of option `name` into `out` when it lies in [lo, hi] (an integer when
+   `integer`); otherwise says so on stderr and returns false. */
+bool number(const char *name, const char *text, double lo, double hi, const char *unit, bool integer, double &out) {
+    char *end = nullptr;
+    const double v = std::strtod(text, &end);
+    if (end != text && *end == '\0' && v >= lo && v <= hi && (!integer || v == std::floor(v))) {
+        out = v;
+        return true;
+    }
+    std::fprintf(stderr, "bullet_dinner: %s `%s` must be %s in [%g, %g]%s\n", name, text,
+                 integer ? "an integer" : "a number", lo, hi, unit);
+    return false;
+}
+
+const char *const USAGE = "usage: %s TABLE.modes [--steps N] [--frame-dt S] [--fixed-dt S]\n"
+                          "       [--table-origin Y [--ignore-origin]] [--moving-table V] [--min-approach S]\n"
+                          "       [--trace] [--no-support]\n";
+
 int main(int argc, char **argv) {
     const char *base = nullptr;
-    long steps = 150;
-    bool trace = false, support = true;
-    double frame_dt = 0.0, fixed_dt = H, table_origin = 0.0;
-    bool pass_origin = true;
-    double speed = -1.0, min_approach = 0.0;
+    double steps = 150;
+    bool trace = false, support = true, pass_origin = true;
+    double frame_dt = 0.0, fixed_dt = H, table_origin = 0.0, speed = -1.0, min_approach = 0.0;
+    /* Options with a value: name, range, unit, integer, where it goes. */
+    struct Numeric {
+        const char *name;
+        double lo, hi;
+        const char *unit;
+        bool integer;
+        double *out;
+    };
+    const Numeric numeric[] = {
+        {"--steps", 1, 1e6, "", true, &steps},
+        {"--frame-dt", 1e-4, 1.0, " s", false, &frame_dt},
+        {"--fixed-dt", 1e-4, 0.05, " s", false, &fixed_dt},
+        {"--table-origin", -10.0, 10.0, " m", false, &table_origin},
+        {"--moving-table", 0.0, 10.0, " m/s", false, &speed},
+        {"--min-approach", 1e-12, 100.0, " m/s", false, &min_approach},
+    };
     for (int i = 1; i < argc; ++i) {
-        if (std::strcmp(argv[i], "--steps") == 0 && i + 1 < argc) {
-            char *end = nullptr;
-            steps = std::strtol(argv[++i], &end, 10);
-            if (*end != '\0' || steps < 1 || steps > 1000000) {
-                std::fprintf(stderr, "bullet_dinner: --steps `%s` must be an integer in 1..1000000\n", argv[i]);
-                return 2;
-            }
-        } else if (std::strcmp(argv[i], "--frame-dt") == 0 && i + 1 < argc) {
-            char *end = nullptr;
-            frame_dt = std::strtod(argv[++i], &end);
-            if (*end != '\0' || !(frame_dt > 0.0 && frame_dt <= 1.0)) {
-                std::fprintf(stderr, "bullet_dinner: --frame-dt `%s` must be a number of seconds in (0, 1]\n", argv[i]);
-                return 2;
-            }
-        } else if (std::strcmp(argv[i], "--fixed-dt") == 0 && i + 1 < argc) {
-            char *end = nullptr;
-            fixed_dt = std::strtod(argv[++i], &end);
-            if (*end != '\0' || !(fixed_dt >= 1e-4 && fixed_dt <= 0.05)) {
-                std::fprintf(stderr, "bullet_dinner: --fixed-dt `%s` must be a number of seconds in [1e-4, 0.05]\n",
-                             argv[i]);
-                return 2;
-            }
-        } else if (std::strcmp(argv[i], "--table-origin") == 0 && i + 1 < argc) {
-            char *end = nullptr;
-            table_origin = std::strtod(argv[++i], &end);
-            if (*end != '\0' || !(std::fabs(table_origin) <= 10.0)) {
-                std::fprintf(stderr, "bullet_dinner: --table-origin `%s` must be a number of metres in [-10, 10]\n",
-                             argv[i]);
-                return 2;
-            }
-        } else if (std::strcmp(argv[i], "--moving-table") == 0 && i + 1 < argc) {
-            char *end = nullptr;
-            speed = std::strtod(argv[++i], &end);
-            if (*end != '\0' || !(speed >= 0.0 && speed <= 10.0)) {
-                std::fprintf(stderr, "bullet_dinner: --moving-table `%s` must be a speed in [0, 10] m/s\n", argv[i]);
-                return 2;
-            }
-        } else if (std::strcmp(argv[i], "--min-approach") == 0 && i + 1 < argc) {
-            char *end = nullptr;
-            min_approach = std::strtod(argv[++i], &end);
-            if (*end != '\0' || !(min_approach > 0.0 && min_approach <= 100.0)) {
-                std::fprintf(stderr, "bullet_dinner: --min-approach `%s` must be a speed in (0, 100] m/s\n", argv[i]);
-                return 2;
-            }
+        const Numeric *opt = nullptr;
+        for (const Numeric &n : numeric)
+            if (std::strcmp(argv[i], n.name) == 0) opt = &n;
+        if (opt && i + 1 < argc) {
+            if (!number(opt->name, argv[i + 1], opt->lo, opt->hi, opt->unit, opt->integer, *opt->out)) return 2;
+            ++i;
         } else if (std::strcmp(argv[i], "--ignore-origin") == 0) {
             pass_origin = false;
         } else if (std::strcmp(argv[i], "--trace") == 0) {
@@ -416,14 +410,12 @@ int main(int argc, char **argv) {
         } else if (argv[i][0] != '-' && !base) {
             base = argv[i];
         } else {
-            std::fprintf(stderr, "usage: %s TABLE.modes [--steps N] [--frame-dt S] [--fixed-dt S] [--table-origin Y [--ignore-origin]]\n"
-                             "       [--moving-table V] [--min-approach S] [--trace] [--no-support]\n", argv[0]);
+            std::fprintf(stderr, USAGE, argv[0]);
             return 2;
         }
     }
     if (!base) {
-        std::fprintf(stderr, "usage: %s TABLE.modes [--steps N] [--frame-dt S] [--fixed-dt S] [--table-origin Y [--ignore-origin]]\n"
-                             "       [--moving-table V] [--min-approach S] [--trace] [--no-support]\n", argv[0]);
+        std::fprintf(stderr, USAGE, argv[0]);
         return 2;
     }
     DcrModel *model = nullptr;
@@ -432,12 +424,12 @@ int main(int argc, char **argv) {
     std::unique_ptr<DcrModel, void (*)(DcrModel *)> model_guard(model, dcr_model_free);
 
     Outcome on, off;
-    if (int rc = run(model, steps, fixed_dt, frame_dt, table_origin, pass_origin, speed, min_approach, trace, support, on)) return rc;
-    if (int rc = run(nullptr, steps, fixed_dt, frame_dt, table_origin, pass_origin, speed, min_approach, false, support, off)) return rc;
+    if (int rc = run(model, long(steps), fixed_dt, frame_dt, table_origin, pass_origin, speed, min_approach, trace, support, on)) return rc;
+    if (int rc = run(nullptr, long(steps), fixed_dt, frame_dt, table_origin, pass_origin, speed, min_approach, false, support, off)) return rc;
     std::printf("{\"engine\": \"Bullet %d.%02d (%s)\", \"h_s\": %g, \"fixed_dt_s\": %g, \"steps\": %ld, "
                 "\"frame_dt_s\": %g, \"support\": %s, ",
                 BT_BULLET_VERSION / 100, BT_BULLET_VERSION % 100, sizeof(btScalar) == 8 ? "double" : "float", H,
-                fixed_dt, steps, frame_dt, support ? "true" : "false");
+                fixed_dt, long(steps), frame_dt, support ? "true" : "false");
     print_outcome("on", on, fixed_dt, false);
     print_outcome("off", off, fixed_dt, true);
     std::printf("}\n");

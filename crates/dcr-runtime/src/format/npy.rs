@@ -17,6 +17,7 @@
 use std::io::{Seek, Write};
 
 /// Magic string at the start of every `.npy` file.
+#[cfg(feature = "write")]
 const MAGIC: &[u8] = b"\x93NUMPY";
 
 /// An element type of a `.modes` entry: its NumPy type descriptors and little-endian bytes.

@@ -109,35 +109,35 @@ fn body_inverse_effective_mass(b: Option<&BodyState>, p: [f64; 3], n: [f64; 3]) 
     }
 }
 
-/// The normal speed at which a contact's bodies closed before its impulse (m/s): `k λ − u⁺`,
-/// with k the pair's inverse effective mass along the normal and u⁺ the separation speed
-/// after the step ([`crate::world::ClassifyParams::min_approach_speed`]).
+/// A contact's pair: `(k, u⁺)`, the inverse effective mass along the normal (1/kg) and the
+/// separation speed after the step (m/s), from the reported body states (a body without a
+/// state is immovable and at rest).
+fn pair_terms(c: &ContactReport, bidx: [Option<u32>; 2], bodies: &[BodyState]) -> (f64, f64) {
+    let b1 = bidx[0].map(|i| &bodies[i as usize]);
+    let b2 = bidx[1].map(|i| &bodies[i as usize]);
+    let u_plus = dot(
+        sub(velocity_at(b2, c.point2), velocity_at(b1, c.point1)),
+        c.normal,
+    );
+    let k = body_inverse_effective_mass(b1, c.point1, c.normal)
+        + body_inverse_effective_mass(b2, c.point2, c.normal);
+    (k, u_plus)
+}
+
+/// The normal speed at which a contact's bodies closed before its impulse (m/s): `k λ − u⁺`
+/// ([`crate::world::ClassifyParams::min_approach_speed`]).
 pub(super) fn approach_speed(
     c: &ContactReport,
     bidx: [Option<u32>; 2],
     bodies: &[BodyState],
 ) -> f64 {
-    let b1 = bidx[0].map(|i| &bodies[i as usize]);
-    let b2 = bidx[1].map(|i| &bodies[i as usize]);
-    let u_plus = dot(
-        sub(velocity_at(b2, c.point2), velocity_at(b1, c.point1)),
-        c.normal,
-    );
-    let k = body_inverse_effective_mass(b1, c.point1, c.normal)
-        + body_inverse_effective_mass(b2, c.point2, c.normal);
+    let (k, u_plus) = pair_terms(c, bidx, bodies);
     k * c.impulse - u_plus
 }
 
 /// Energy an impact dissipated (J): `max(0, ½ k λ² − λ u⁺)` (see [`DcrWorld`], "Energy bound").
 pub(super) fn dissipated(c: &ContactReport, bidx: [Option<u32>; 2], bodies: &[BodyState]) -> f64 {
-    let b1 = bidx[0].map(|i| &bodies[i as usize]);
-    let b2 = bidx[1].map(|i| &bodies[i as usize]);
-    let u_plus = dot(
-        sub(velocity_at(b2, c.point2), velocity_at(b1, c.point1)),
-        c.normal,
-    );
-    let k = body_inverse_effective_mass(b1, c.point1, c.normal)
-        + body_inverse_effective_mass(b2, c.point2, c.normal);
+    let (k, u_plus) = pair_terms(c, bidx, bodies);
     let lambda = c.impulse;
     let lost = 0.5 * k * lambda * lambda - lambda * u_plus;
     if lost.is_finite() {
