@@ -6,7 +6,7 @@
  * dinner.rs), so the two engines can be compared on the same base.
  *
  *   bullet_dinner TABLE.modes [--steps N] [--frame-dt S] [--fixed-dt S]
- *                 [--table-origin Y [--ignore-origin]] [--moving-table V] [--min-approach S]
+ *                 [--table-origin Y [--ignore-origin]] [--moving-table V] [--min-approach S] [--remove-at N]
  *                 [--trace] [--no-support]
  *
  * The scene runs twice in the same process, with the response and without it, and prints one
@@ -47,6 +47,8 @@
  * went; use a base baked without --fixed, a free object). --min-approach S sets the world's
  * classify.min_approach_speed (m/s; default dcr_bullet's 2 g h = 0.196 m/s; 1e-9 for
  * practically none), the closing speed below which a new contact point is not an impact.
+ * --remove-at N removes the table's elastic object at step N (dcr_bullet::World::remove; a
+ * second removal must find nothing: "removed" in the output); no response follows.
  */
 #include <btBulletDynamicsCommon.h>
 
@@ -97,6 +99,7 @@ struct Outcome {
     uint64_t unmapped = 0;
     uint64_t h_changes = 0;
     double table_moved_m = 0.0;
+    bool removed = false;
     std::vector<Launch> launches;
 };
 
@@ -224,6 +227,7 @@ struct Run {
     Outcome &out;
     long steps;
     bool trace;
+    long remove_at; /* the step at which the table stops being elastic (-1: never) */
     long step = 0;
 };
 
@@ -235,6 +239,11 @@ void on_tick(btDynamicsWorld *w, btScalar time_step) {
     const long s = r.step++;
     Scene &scene = r.scene;
     Outcome &out = r.out;
+    if (r.dcr && s == r.remove_at) {
+        /* dcr: the table is no longer elastic; a second removal finds nothing. */
+        out.removed = r.dcr->remove(scene.table) == DCR_STATUS_OK &&
+                      r.dcr->remove(scene.table) == DCR_STATUS_NOT_FOUND;
+    }
     if (r.dcr) {
         double plate_asked[NUM_PLATES] = {}, plate_support[NUM_PLATES] = {};
         bool pushed[NUM_PLATES] = {};
@@ -280,7 +289,8 @@ void on_tick(btDynamicsWorld *w, btScalar time_step) {
    dcr_bullet). frame_dt 0: stepSimulation(fixed_dt, 0), one step per call; else
    stepSimulation(frame_dt, 16, fixed_dt), as a game steps at its frame rate. */
 int run(const DcrModel *table_model, long steps, double fixed_dt, double frame_dt, double table_origin,
-        bool pass_origin, double speed, double min_approach, bool trace, bool support, Outcome &out) {
+        bool pass_origin, double speed, double min_approach, long remove_at, bool trace, bool support,
+        Outcome &out) {
     Scene scene(table_origin, speed);
     const double table_x0 = scene.table->getCenterOfMassPosition().x();
     std::unique_ptr<dcr_bullet::World> dcr;
@@ -310,7 +320,7 @@ int run(const DcrModel *table_model, long steps, double fixed_dt, double frame_d
             return 1;
         }
     }
-    Run r{scene, dcr.get(), out, steps, trace};
+    Run r{scene, dcr.get(), out, steps, trace, remove_at};
     scene.world.setInternalTickCallback(on_tick, &r, false);
     while (r.step < steps) {
         if (frame_dt > 0.0) {
@@ -325,13 +335,15 @@ int run(const DcrModel *table_model, long steps, double fixed_dt, double frame_d
     }
     out.table_moved_m = scene.table->getCenterOfMassPosition().x() - table_x0;
     if (dcr) {
+        /* The table's account (none once it was removed: its handle is stale). */
         DcrObjectStepInfo oi;
         DcrObjectTotals totals;
-        dcr_world_object_info(dcr->raw(), handle, &oi);
-        dcr_world_object_totals(dcr->raw(), handle, &totals);
-        out.injected_j = oi.energy.total_injected;
-        out.dissipated_j = oi.energy.total_dissipated;
-        out.unmapped = totals.contacts_unmapped + totals.impacts_unmapped;
+        if (dcr_world_object_info(dcr->raw(), handle, &oi) == DCR_STATUS_OK &&
+            dcr_world_object_totals(dcr->raw(), handle, &totals) == DCR_STATUS_OK) {
+            out.injected_j = oi.energy.total_injected;
+            out.dissipated_j = oi.energy.total_dissipated;
+            out.unmapped = totals.contacts_unmapped + totals.impacts_unmapped;
+        }
         out.h_changes = dcr->h_changes();
     }
     return 0;
@@ -340,9 +352,9 @@ int run(const DcrModel *table_model, long steps, double fixed_dt, double frame_d
 void print_outcome(const char *name, const Outcome &o, double fixed_dt, bool last) {
     std::printf("\"%s\": {\"lift_mm\": %.17g, \"events\": %llu, \"plate_events\": %llu, \"injected_J\": %.17g, "
                 "\"dissipated_J\": %.17g, \"unmapped\": %llu, \"h_changes\": %llu, \"table_moved_m\": %.17g, "
-                "\"launches\": [",
+                "\"removed\": %s, \"launches\": [",
                 name, o.lift_mm, (unsigned long long)o.events, (unsigned long long)o.plate_events, o.injected_j,
-                o.dissipated_j, (unsigned long long)o.unmapped, (unsigned long long)o.h_changes, o.table_moved_m);
+                o.dissipated_j, (unsigned long long)o.unmapped, (unsigned long long)o.h_changes, o.table_moved_m, o.removed ? "true" : "false");
     for (size_t i = 0; i < o.launches.size(); ++i) {
         const Launch &l = o.launches[i];
         std::printf("%s{\"plate\": %d, \"step\": %ld, \"asked_mps\": %.17g, \"support_mps\": %.17g, "
@@ -370,14 +382,14 @@ bool number(const char *name, const char *text, double lo, double hi, const char
 }
 
 const char *const USAGE = "usage: %s TABLE.modes [--steps N] [--frame-dt S] [--fixed-dt S]\n"
-                          "       [--table-origin Y [--ignore-origin]] [--moving-table V] [--min-approach S]\n"
+                          "       [--table-origin Y [--ignore-origin]] [--moving-table V] [--min-approach S] [--remove-at N]\n"
                           "       [--trace] [--no-support]\n";
 
 int main(int argc, char **argv) {
     const char *base = nullptr;
     double steps = 150;
     bool trace = false, support = true, pass_origin = true;
-    double frame_dt = 0.0, fixed_dt = H, table_origin = 0.0, speed = -1.0, min_approach = 0.0;
+    double frame_dt = 0.0, fixed_dt = H, table_origin = 0.0, speed = -1.0, min_approach = 0.0, remove_at = -1.0;
     /* Options with a value: name, range, unit, integer, where it goes. */
     struct Numeric {
         const char *name;
@@ -393,6 +405,7 @@ int main(int argc, char **argv) {
         {"--table-origin", -10.0, 10.0, " m", false, &table_origin},
         {"--moving-table", 0.0, 10.0, " m/s", false, &speed},
         {"--min-approach", 1e-12, 100.0, " m/s", false, &min_approach},
+        {"--remove-at", 0, 1e6, " (a step)", true, &remove_at},
     };
     for (int i = 1; i < argc; ++i) {
         const Numeric *opt = nullptr;
@@ -424,8 +437,8 @@ int main(int argc, char **argv) {
     std::unique_ptr<DcrModel, void (*)(DcrModel *)> model_guard(model, dcr_model_free);
 
     Outcome on, off;
-    if (int rc = run(model, long(steps), fixed_dt, frame_dt, table_origin, pass_origin, speed, min_approach, trace, support, on)) return rc;
-    if (int rc = run(nullptr, long(steps), fixed_dt, frame_dt, table_origin, pass_origin, speed, min_approach, false, support, off)) return rc;
+    if (int rc = run(model, long(steps), fixed_dt, frame_dt, table_origin, pass_origin, speed, min_approach, long(remove_at), trace, support, on)) return rc;
+    if (int rc = run(nullptr, long(steps), fixed_dt, frame_dt, table_origin, pass_origin, speed, min_approach, long(remove_at), false, support, off)) return rc;
     std::printf("{\"engine\": \"Bullet %d.%02d (%s)\", \"h_s\": %g, \"fixed_dt_s\": %g, \"steps\": %ld, "
                 "\"frame_dt_s\": %g, \"support\": %s, ",
                 BT_BULLET_VERSION / 100, BT_BULLET_VERSION % 100, sizeof(btScalar) == 8 ? "double" : "float", H,

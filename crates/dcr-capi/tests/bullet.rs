@@ -22,7 +22,10 @@
 //!   floor keeps every contact mapped: the adapter follows its pose every step;
 //! - the adapter's minimum approach speed (2 g h) leaves out the points Bullet re-creates
 //!   under the sliding legs (fewer than 60 % of the events without it) and nothing of the
-//!   pot's impact on the static table (the same outcome without it).
+//!   pot's impact on the static table (the same outcome without it);
+//! - removing the table's elastic object mid-run (`World::remove`) stops its responses: none
+//!   when removed before the pot lands, only the landing step's when removed after it (also
+//!   under AddressSanitizer), and a second removal finds nothing.
 //!
 //! The program is built with `-Wall -Wextra -Werror -pedantic` against the static library and
 //! run once more linked to the shared library under AddressSanitizer (no leak, no invalid
@@ -337,6 +340,22 @@ fn bullet_plates_lift_by_what_the_response_asked() {
     build(&asan, &bullet, true);
     let va = run(&asan, &base, &[], true);
     assert_eq!(va["on"], *on, "static and shared (sanitized) builds");
+
+    // The table's elastic object removed before the pot lands (step 10) and after (step 21).
+    let early = run(&bin, &base, &["--remove-at", "10"], false);
+    assert_eq!(early["on"]["removed"], true, "{early}");
+    assert_eq!(early["on"]["events"], 0, "{early}");
+    assert!(early["on"]["lift_mm"].as_f64().unwrap() < 0.01, "{early}");
+    let late = run(&asan, &base, &["--remove-at", "21"], true);
+    assert_eq!(late["on"]["removed"], true, "{late}");
+    let (late_events, all_events) = (
+        late["on"]["events"].as_u64().unwrap(),
+        on["events"].as_u64().unwrap(),
+    );
+    assert!(
+        late_events > 0 && late_events < all_events,
+        "{late_events} events removed after the landing, {all_events} kept"
+    );
 
     // The same with Bullet built for double precision (its normals under a tilted plate are
     // not exactly vertical, so the support, g_n h along n, is within 1 % of g h).
