@@ -7,7 +7,7 @@
  *
  *   bullet_dinner TABLE.modes [--steps N] [--frame-dt S] [--fixed-dt S]
  *                 [--table-origin Y [--ignore-origin]] [--moving-table V] [--min-approach S] [--remove-at N]
- *                 [--trace] [--no-support]
+ *                 [--installed-callback] [--trace] [--no-support]
  *
  * The scene runs twice in the same process, with the response and without it, and prints one
  * JSON object on stdout:
@@ -49,6 +49,8 @@
  * practically none), the closing speed below which a new contact point is not an impact.
  * --remove-at N removes the table's elastic object at step N (dcr_bullet::World::remove; a
  * second removal must find nothing: "removed" in the output); no response follows.
+ * --installed-callback lets dcr_bullet install Bullet's tick callback itself (its default) and
+ * measures after each stepSimulation(0.01, 0) call instead: the same outcome.
  */
 #include <btBulletDynamicsCommon.h>
 
@@ -233,22 +235,16 @@ struct Run {
 
 /* Bullet's internal tick callback of a run: dcr's step (dcr_bullet::World::tick), then the
    measurements, for the first `steps` internal steps. */
-void on_tick(btDynamicsWorld *w, btScalar time_step) {
-    Run &r = *static_cast<Run *>(w->getWorldUserInfo());
-    if (r.step >= r.steps) return;
-    const long s = r.step++;
+/* After internal step `s` of `time_step` s and dcr's response to it: counts the events, records
+   the plates that leave and their heights. `before` holds each plate's upward velocity before
+   the step's events (m/s). */
+void measure(Run &r, long s, double time_step, const double before[NUM_PLATES]) {
     Scene &scene = r.scene;
     Outcome &out = r.out;
-    if (r.dcr && s == r.remove_at) {
-        /* dcr: the table is no longer elastic; a second removal finds nothing. */
-        out.removed = r.dcr->remove(scene.table) == DCR_STATUS_OK &&
-                      r.dcr->remove(scene.table) == DCR_STATUS_NOT_FOUND;
-    }
     if (r.dcr) {
-        double plate_asked[NUM_PLATES] = {}, plate_support[NUM_PLATES] = {};
+        double plate_asked[NUM_PLATES], plate_support[NUM_PLATES] = {};
         bool pushed[NUM_PLATES] = {};
-        for (int p = 0; p < NUM_PLATES; ++p) plate_asked[p] = scene.plates[p]->getLinearVelocity().y();
-        r.dcr->tick(time_step); /* dcr: report, step, apply */
+        std::copy(before, before + NUM_PLATES, plate_asked);
         for (const DcrImpulseEvent &e : r.dcr->events()) {
             ++out.events;
             for (int p = 0; p < NUM_PLATES; ++p) {
@@ -267,7 +263,7 @@ void on_tick(btDynamicsWorld *w, btScalar time_step) {
             for (auto &l : out.launches)
                 if (l.plate == p) l.open = false; /* another push ends a flight */
             double v = scene.plates[p]->getLinearVelocity().y();
-            if (v > GRAVITY * double(time_step)) {
+            if (v > GRAVITY * time_step) {
                 out.launches.push_back(
                     Launch{p, s, plate_asked[p], plate_support[p], v, scene.plates[p]->getCenterOfMassPosition().y()});
             }
@@ -284,13 +280,35 @@ void on_tick(btDynamicsWorld *w, btScalar time_step) {
     }
 }
 
+/* Removes the table's elastic object at step `s` when asked (a second removal must find
+   nothing). */
+void maybe_remove(Run &r, long s) {
+    if (r.dcr && s == r.remove_at) {
+        r.out.removed = r.dcr->remove(r.scene.table) == DCR_STATUS_OK &&
+                        r.dcr->remove(r.scene.table) == DCR_STATUS_NOT_FOUND;
+    }
+}
+
+/* The program's internal tick callback: dcr's step (dcr_bullet::World::tick), then the
+   measurements, for the first `steps` internal steps. */
+void on_tick(btDynamicsWorld *w, btScalar time_step) {
+    Run &r = *static_cast<Run *>(w->getWorldUserInfo());
+    if (r.step >= r.steps) return;
+    const long s = r.step++;
+    maybe_remove(r, s);
+    double before[NUM_PLATES];
+    for (int p = 0; p < NUM_PLATES; ++p) before[p] = r.scene.plates[p]->getLinearVelocity().y();
+    if (r.dcr) r.dcr->tick(time_step); /* dcr: report, step, apply */
+    measure(r, s, double(time_step), before);
+}
+
 /* Runs the scene for `steps` internal Bullet steps of `fixed_dt` (s); with `table_model`, the
    table is dcr's elastic object (the world's h is H: another fixed_dt is re-derived by
    dcr_bullet). frame_dt 0: stepSimulation(fixed_dt, 0), one step per call; else
    stepSimulation(frame_dt, 16, fixed_dt), as a game steps at its frame rate. */
 int run(const DcrModel *table_model, long steps, double fixed_dt, double frame_dt, double table_origin,
-        bool pass_origin, double speed, double min_approach, long remove_at, bool trace, bool support,
-        Outcome &out) {
+        bool pass_origin, double speed, double min_approach, long remove_at, bool installed, bool trace,
+        bool support, Outcome &out) {
     Scene scene(table_origin, speed);
     const double table_x0 = scene.table->getCenterOfMassPosition().x();
     std::unique_ptr<dcr_bullet::World> dcr;
@@ -303,7 +321,7 @@ int run(const DcrModel *table_model, long steps, double fixed_dt, double frame_d
         wp.h = H;
         if (!support) wp.gravity[0] = wp.gravity[1] = wp.gravity[2] = 0.0;
         wp.classify.min_approach_speed = min_approach; /* 0: dcr_bullet's 2 g h */
-        dcr = std::make_unique<dcr_bullet::World>(scene.world, wp, false);
+        dcr = std::make_unique<dcr_bullet::World>(scene.world, wp, installed);
         DcrElasticObjectDesc desc;
         dcr_elastic_object_desc_default(&desc);
         desc.model = table_model;
@@ -321,7 +339,26 @@ int run(const DcrModel *table_model, long steps, double fixed_dt, double frame_d
         }
     }
     Run r{scene, dcr.get(), out, steps, trace, remove_at};
-    scene.world.setInternalTickCallback(on_tick, &r, false);
+    if (installed) {
+        /* dcr_bullet's own callback; the measurements after each stepSimulation call, with the
+           plates' velocities before the events taken back out of the events. */
+        while (r.step < steps) {
+            const long s = r.step++;
+            maybe_remove(r, s);
+            scene.world.stepSimulation(btScalar(fixed_dt), 0);
+            static const std::vector<DcrImpulseEvent> none;
+            const std::vector<DcrImpulseEvent> &events = dcr ? dcr->events() : none;
+            double before[NUM_PLATES];
+            for (int p = 0; p < NUM_PLATES; ++p) {
+                before[p] = scene.plates[p]->getLinearVelocity().y();
+                for (const DcrImpulseEvent &e : events)
+                    if (e.body == dcr_bullet::body_id(scene.plates[p])) before[p] -= e.impulse[1] / PLATE_MASS;
+            }
+            measure(r, s, double(btScalar(fixed_dt)), before);
+        }
+    } else {
+        scene.world.setInternalTickCallback(on_tick, &r, false);
+    }
     while (r.step < steps) {
         if (frame_dt > 0.0) {
             scene.world.stepSimulation(btScalar(frame_dt), 16, btScalar(fixed_dt));
@@ -383,12 +420,12 @@ bool number(const char *name, const char *text, double lo, double hi, const char
 
 const char *const USAGE = "usage: %s TABLE.modes [--steps N] [--frame-dt S] [--fixed-dt S]\n"
                           "       [--table-origin Y [--ignore-origin]] [--moving-table V] [--min-approach S] [--remove-at N]\n"
-                          "       [--trace] [--no-support]\n";
+                          "       [--installed-callback] [--trace] [--no-support]\n";
 
 int main(int argc, char **argv) {
     const char *base = nullptr;
     double steps = 150;
-    bool trace = false, support = true, pass_origin = true;
+    bool trace = false, support = true, pass_origin = true, installed = false;
     double frame_dt = 0.0, fixed_dt = H, table_origin = 0.0, speed = -1.0, min_approach = 0.0, remove_at = -1.0;
     /* Options with a value: name, range, unit, integer, where it goes. */
     struct Numeric {
@@ -414,6 +451,8 @@ int main(int argc, char **argv) {
         if (opt && i + 1 < argc) {
             if (!number(opt->name, argv[i + 1], opt->lo, opt->hi, opt->unit, opt->integer, *opt->out)) return 2;
             ++i;
+        } else if (std::strcmp(argv[i], "--installed-callback") == 0) {
+            installed = true;
         } else if (std::strcmp(argv[i], "--ignore-origin") == 0) {
             pass_origin = false;
         } else if (std::strcmp(argv[i], "--trace") == 0) {
@@ -431,14 +470,19 @@ int main(int argc, char **argv) {
         std::fprintf(stderr, USAGE, argv[0]);
         return 2;
     }
+    if (installed && frame_dt > 0.0) {
+        std::fprintf(stderr, "bullet_dinner: --installed-callback measures after each stepSimulation call: "
+                             "it steps one internal step per call (leave out --frame-dt)\n");
+        return 2;
+    }
     DcrModel *model = nullptr;
     DcrStatus st = dcr_model_load(base, &model);
     if (st != DCR_STATUS_OK) return fail("cannot load the table's base", st);
     std::unique_ptr<DcrModel, void (*)(DcrModel *)> model_guard(model, dcr_model_free);
 
     Outcome on, off;
-    if (int rc = run(model, long(steps), fixed_dt, frame_dt, table_origin, pass_origin, speed, min_approach, long(remove_at), trace, support, on)) return rc;
-    if (int rc = run(nullptr, long(steps), fixed_dt, frame_dt, table_origin, pass_origin, speed, min_approach, long(remove_at), false, support, off)) return rc;
+    if (int rc = run(model, long(steps), fixed_dt, frame_dt, table_origin, pass_origin, speed, min_approach, long(remove_at), installed, trace, support, on)) return rc;
+    if (int rc = run(nullptr, long(steps), fixed_dt, frame_dt, table_origin, pass_origin, speed, min_approach, long(remove_at), installed, false, support, off)) return rc;
     std::printf("{\"engine\": \"Bullet %d.%02d (%s)\", \"h_s\": %g, \"fixed_dt_s\": %g, \"steps\": %ld, "
                 "\"frame_dt_s\": %g, \"support\": %s, ",
                 BT_BULLET_VERSION / 100, BT_BULLET_VERSION % 100, sizeof(btScalar) == 8 ? "double" : "float", H,

@@ -11,6 +11,8 @@
 //! - the support compensation is what makes that true: it adds g·h to a plate that leaves, and
 //!   without it (`--no-support`) the same plates rise at most 80 % as high (28–56 % here: the
 //!   loss, g·h of the push, matters most for the small ones);
+//! - with the adapter's own tick callback (its default) the run is the same as through the
+//!   program's;
 //! - stepped as a game steps, `stepSimulation(1/60 s, 16, 10 ms)`, the adapter runs in every
 //!   substep and the outcome is bit-identical to one `stepSimulation(10 ms, 0)` per step;
 //! - a Bullet step other than the world's h (5 ms against 10 ms) is re-derived once
@@ -251,6 +253,20 @@ fn bullet_plates_lift_by_what_the_response_asked() {
              ({ballistic} mm asked)"
         );
     }
+
+    // dcr_bullet's own tick callback (its default) instead of the program's: the same run.
+    let installed = run(&bin, &base, &["--installed-callback"], false);
+    for key in ["lift_mm", "events", "plate_events", "injected_J"] {
+        assert_eq!(
+            installed["on"][key], on[key],
+            "{key} with the installed callback"
+        );
+    }
+    assert_eq!(
+        first_launches(&installed["on"]).len(),
+        launches.len(),
+        "{installed}"
+    );
 
     // Stepped at 60 frames a second with 10 ms substeps: bit-identical.
     let framed = run(&bin, &base, &["--frame-dt", "0.0166666667"], false);
