@@ -29,7 +29,8 @@
 //!   when removed before the pot lands, only the landing step's when removed after it (also
 //!   under AddressSanitizer), and a second removal finds nothing.
 //!
-//! The program is built with `-Wall -Wextra -Werror -pedantic` against the static library and
+//! `tests/c/bullet_alloc.cpp` checks that the adapter's step allocates nothing once its buffers
+//! have grown. The program is built with `-Wall -Wextra -Werror -pedantic` against the static library and
 //! run once more linked to the shared library under AddressSanitizer (no leak, no invalid
 //! access); the first checks are repeated with Bullet built for double precision
 //! (`pkg-config bullet-float64`). Without Bullet the test skips with the command that installs it, and fails instead
@@ -86,6 +87,16 @@ fn bullet_flags(package: &str) -> Option<(Vec<String>, Vec<String>)> {
 /// Builds the example into `out`: statically linked, or linked to the shared library under
 /// AddressSanitizer.
 fn build(out: &Path, bullet: &(Vec<String>, Vec<String>), sanitize: bool) {
+    build_source(
+        &crate_dir().join("examples/bullet_dinner.cpp"),
+        out,
+        bullet,
+        sanitize,
+    );
+}
+
+/// Builds the C++ program `src` into `out` as [`build`] does.
+fn build_source(src: &Path, out: &Path, bullet: &(Vec<String>, Vec<String>), sanitize: bool) {
     let mut cmd = Command::new(cxx());
     cmd.args(["-std=c++17", "-Wall", "-Wextra", "-Werror", "-pedantic"])
         .arg("-I")
@@ -93,7 +104,7 @@ fn build(out: &Path, bullet: &(Vec<String>, Vec<String>), sanitize: bool) {
         .arg("-I")
         .arg(crate_dir().join("integrations/bullet"))
         .args(&bullet.0)
-        .arg(crate_dir().join("examples/bullet_dinner.cpp"))
+        .arg(src)
         .arg("-o")
         .arg(out);
     if sanitize {
@@ -386,6 +397,35 @@ fn bullet_plates_lift_by_what_the_response_asked() {
         "{v64}"
     );
     plates_lift_as_asked(&v64, 1e-2);
+}
+
+/// `tests/c/bullet_alloc.cpp`: once the first drop has grown its buffers, `World::tick`
+/// allocates nothing (a counting global `operator new`) over four more drops with responses.
+#[test]
+fn bullet_adapter_allocates_nothing_after_warm_up() {
+    let Some(bullet) = bullet_flags("bullet") else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let base = bake_table(dir.path(), false);
+    let bin = dir.path().join("bullet_alloc");
+    build_source(
+        &crate_dir().join("tests/c/bullet_alloc.cpp"),
+        &bin,
+        &bullet,
+        false,
+    );
+    let o = Command::new(&bin)
+        .arg(&base)
+        .env_remove("LD_LIBRARY_PATH")
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.success() && text.contains("allocations after warm-up 0"),
+        "{text}{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
 }
 
 /// Usage and load errors exit with their documented codes and say what is wrong.

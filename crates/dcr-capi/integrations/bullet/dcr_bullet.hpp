@@ -35,8 +35,9 @@
  * h re-derives the responses for it (dcr_world_set_h; counted by h_changes()). A failure inside
  * the callback cannot be returned: status() and error() keep the first one, and the response
  * stops. The buffers keep their capacity from step to step: once they have grown to the most
- * contacts seen, a step allocates nothing here (dcr_world_step itself is allocation-free after
- * warm-up). Tested by crates/dcr-capi/tests/bullet.rs through examples/bullet_dinner.cpp.
+ * contacts seen, a step allocates nothing (tests/c/bullet_alloc.cpp counts operator new;
+ * dcr_world_step is tested allocation-free in Rust). Tested by crates/dcr-capi/tests/bullet.rs
+ * through examples/bullet_dinner.cpp and tests/c/bullet_alloc.cpp.
  */
 #ifndef DCR_BULLET_HPP
 #define DCR_BULLET_HPP
