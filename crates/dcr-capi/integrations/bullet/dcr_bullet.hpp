@@ -1,6 +1,6 @@
 /*
  * dcr_bullet.hpp: dcr's distant collision response in a Bullet btDiscreteDynamicsWorld,
- * header-only, over dcr's C ABI (dcr.h). C++17; Bullet 2.8x/3.x (float or double btScalar).
+ * header-only, over dcr's C ABI (dcr.h). C++17; tested with Bullet 3.24 (float and double btScalar).
  *
  *   #include "dcr_bullet.hpp"   // with crates/dcr-capi/include on the include path
  *
