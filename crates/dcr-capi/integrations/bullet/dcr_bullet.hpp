@@ -175,8 +175,8 @@ class World {
             const btCollisionObject *a = pm->getBody0();
             const btCollisionObject *b = pm->getBody1();
             if (pm->getNumContacts() == 0 || (!elastic(a) && !elastic(b))) continue;
-            state(a);
-            state(b);
+            touching(a);
+            touching(b);
             for (int j = 0; j < pm->getNumContacts(); ++j) {
                 btManifoldPoint &pt = pm->getContactPoint(j);
                 if (!pt.m_userPersistentData) {
@@ -194,6 +194,11 @@ class World {
                 contacts_.push_back(c);
             }
         }
+        /* Each touching body once, ordered by address (its id): a state per body, and an
+           event's body found by binary search. */
+        std::sort(bodies_.begin(), bodies_.end());
+        bodies_.erase(std::unique(bodies_.begin(), bodies_.end()), bodies_.end());
+        for (const btRigidBody *b : bodies_) states_.push_back(state_of(*b));
         const DcrImpulseEvent *events = nullptr;
         size_t n = 0;
         if (!check(dcr_world_step(world_, contacts_.data(), contacts_.size(), states_.data(), states_.size(),
@@ -245,30 +250,32 @@ class World {
         return false;
     }
 
-    /* Adds a non-static body's state once per step. */
-    void state(const btCollisionObject *o) {
+    /* Notes a non-static rigid body of a manifold (duplicates are removed after the pass). */
+    void touching(const btCollisionObject *o) {
         const btRigidBody *b = btRigidBody::upcast(o);
-        if (!b || b->isStaticObject()) return;
-        for (const btRigidBody *seen : bodies_)
-            if (seen == b) return;
-        bodies_.push_back(const_cast<btRigidBody *>(b));
-        DcrBodyState s{};
-        s.id = body_id(b);
-        s.inv_mass = b->getInvMass();
-        const btMatrix3x3 &ii = b->getInvInertiaTensorWorld();
-        for (int i = 0; i < 3; ++i)
-            for (int j = 0; j < 3; ++j) s.inv_inertia[i][j] = ii[i][j];
-        set3(s.center_of_mass, b->getCenterOfMassPosition());
-        set3(s.linvel, b->getLinearVelocity());
-        set3(s.angvel, b->getAngularVelocity());
-        states_.push_back(s);
+        if (b && !b->isStaticObject()) bodies_.push_back(const_cast<btRigidBody *>(b));
     }
 
-    /* The body of an event: one whose state this step reported (events go to no other). */
+    /* A body's state as dcr reads it (world frame). */
+    static DcrBodyState state_of(const btRigidBody &b) {
+        DcrBodyState s{};
+        s.id = body_id(&b);
+        s.inv_mass = b.getInvMass();
+        const btMatrix3x3 &ii = b.getInvInertiaTensorWorld();
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) s.inv_inertia[i][j] = ii[i][j];
+        set3(s.center_of_mass, b.getCenterOfMassPosition());
+        set3(s.linvel, b.getLinearVelocity());
+        set3(s.angvel, b.getAngularVelocity());
+        return s;
+    }
+
+    /* The body of an event: one whose state this step reported (events go to no other);
+       `bodies_` is sorted by address. */
     btRigidBody *rigid(uint64_t id) const {
-        for (btRigidBody *b : bodies_)
-            if (body_id(b) == id) return b;
-        return nullptr;
+        auto it = std::lower_bound(bodies_.begin(), bodies_.end(), id,
+                                   [](const btRigidBody *b, uint64_t v) { return body_id(b) < v; });
+        return it != bodies_.end() && body_id(*it) == id ? *it : nullptr;
     }
 
     static void set3(double out[3], const btVector3 &v) {
