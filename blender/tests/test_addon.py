@@ -1,4 +1,5 @@
-"""Headless test of the Modal Bake add-on in the real Blender (the `bpy` module, Blender 4.5 LTS).
+"""Headless test of the Modal Bake add-on in the real Blender (the `bpy` module: Blender 4.5 LTS
+and Blender 5.0, the releases CI runs it on).
 
     python3 blender/tests/test_addon.py [--binary target/release/modal-bake]
 
@@ -71,6 +72,9 @@ def main():
     default_bin = os.path.join(os.environ.get("CARGO_TARGET_DIR", os.path.join(ROOT, "target")),
                                "release", "modal-bake")
     ap.add_argument("--binary", default=default_bin, help="modal-bake executable to test with")
+    ap.add_argument("--blender", metavar="MAJOR.MINOR",
+                    help="fail unless the bpy imported is this Blender release (e.g. 5.0), so a "
+                         "PYTHONPATH that did not take effect is not a silent run on another one")
     args = ap.parse_args()
     exe = os.path.abspath(args.binary)
     if not os.path.isfile(exe):
@@ -95,6 +99,12 @@ def main():
         print("0 passed, 0 failed, 1 skipped")
         return 0
     print(f"Blender {bpy.app.version_string}, modal-bake {exe}", flush=True)
+    have = ".".join(str(v) for v in bpy.app.version[:2])
+    if args.blender and have != args.blender:
+        print(f"FAILED: bpy is Blender {bpy.app.version_string} ({bpy.__file__}), not "
+              f"{args.blender} (--blender): check PYTHONPATH or the installed bpy")
+        print("0 passed, 1 failed, 0 skipped")
+        return 1
 
     zpath = os.path.join(work, "modal_bake.zip")
     with zipfile.ZipFile(zpath, "w") as z:
@@ -383,7 +393,8 @@ def main():
         image.file_format = "PNG"
         image.save()
         mat = bpy.data.materials.new("Painted")
-        mat.use_nodes = True
+        if bpy.app.version < (5, 0, 0):
+            mat.use_nodes = True  # always on (and deprecated) from Blender 5.0
         tex = mat.node_tree.nodes.new("ShaderNodeTexImage")
         tex.image = image
         bsdf = mat.node_tree.nodes["Principled BSDF"]
