@@ -24,7 +24,11 @@
  * it comes down or is pushed again) and ballistic_mm the rise of a free flight under gravity that
  * ends its first step with asked_mps, as Bullet integrates it: what the response asked for. A
  * plate that scrapes the table on the way, or loses g h to gravity in the step it leaves, rises
- * less. --trace prints each step's events on stderr. --no-support runs without the
+ * less. --trace prints each step's events on stderr, the spin of each plate that leaves (about a
+ * horizontal axis: the response's events push it at its contact points, off its centre) and
+ * the table's contact impulse on a plate still rising: a spinning plate whose rim comes back down
+ * on the table before its centre's apex is carried by it (about a fifth of its weight, as a
+ * rocking disc) and rises higher than free flight. --no-support runs without the
  * support compensation (the world's gravity set to zero), to see what it does.
  * Exit status: 0 on success, 1 on an error (message on stderr), 2 on a usage error.
  *
@@ -90,6 +94,7 @@ struct Launch {
     double y0;           // m: the centre's height at launch
     double rise = 0.0;   // m: measured
     bool open = true;    // still in flight
+    bool rising = true;  // its centre not yet past its apex (--trace)
 };
 
 struct Outcome {
@@ -233,6 +238,20 @@ struct Run {
     long step = 0;
 };
 
+/* The sum of the table's contact impulses on `body` in the last step (N*s). */
+double table_impulse(Scene &scene, const btRigidBody *body) {
+    double sum = 0.0;
+    btDispatcher *d = scene.world.getDispatcher();
+    for (int m = 0; m < d->getNumManifolds(); ++m) {
+        const btPersistentManifold *pm = d->getManifoldByIndexInternal(m);
+        if (!((pm->getBody0() == body && pm->getBody1() == scene.table) ||
+              (pm->getBody1() == body && pm->getBody0() == scene.table)))
+            continue;
+        for (int j = 0; j < pm->getNumContacts(); ++j) sum += pm->getContactPoint(j).m_appliedImpulse;
+    }
+    return sum;
+}
+
 /* Bullet's internal tick callback of a run: dcr's step (dcr_bullet::World::tick), then the
    measurements, for the first `steps` internal steps. */
 /* After internal step `s` of `time_step` s and dcr's response to it: counts the events, records
@@ -266,6 +285,11 @@ void measure(Run &r, long s, double time_step, const double before[NUM_PLATES]) 
             if (v > GRAVITY * time_step) {
                 out.launches.push_back(
                     Launch{p, s, plate_asked[p], plate_support[p], v, scene.plates[p]->getCenterOfMassPosition().y()});
+                if (r.trace) {
+                    const btVector3 w = scene.plates[p]->getAngularVelocity();
+                    std::fprintf(stderr, "step %ld plate %d leaves: v_up %.4g m/s, spin %.4g rad/s\n", s, p, v,
+                                 std::hypot(double(w.x()), double(w.z())));
+                }
             }
         }
     }
@@ -274,6 +298,14 @@ void measure(Run &r, long s, double time_step, const double before[NUM_PLATES]) 
         out.lift_mm = std::max(out.lift_mm, (y - PLATE_Y) * 1e3);
         for (auto &l : out.launches) {
             if (l.plate != p || !l.open || l.step == s) continue;
+            if (r.trace && l.rising) {
+                const double j = table_impulse(scene, scene.plates[p]), v = scene.plates[p]->getLinearVelocity().y();
+                if (j > 0.0) {
+                    std::fprintf(stderr, "step %ld plate %d rising: the table's contact impulse %.4g N*s, v_up %.4g m/s\n",
+                                 s, p, j, v);
+                }
+                l.rising = v > 0.0;
+            }
             l.rise = std::max(l.rise, y - l.y0);
             if (y < l.y0) l.open = false; /* came down */
         }
