@@ -9,7 +9,9 @@ Preview Mode animates a key's value through one sine period. The `.modes` base's
 stored on the object as the custom property `modal_bake_modes`.
 
 modal-bake is found in this order: the path in the add-on preferences, `bin/modal-bake` inside
-the add-on folder, `modal-bake` on PATH. Which one ran, and its version, is reported.
+the add-on folder, `modal-bake` on PATH. Which one ran, and its version, is reported. A package
+built by scripts/package_blender_addon.py bundles modal-bake and, as wheels Blender installs,
+gmsh and pytetwild, which modal-bake then runs with Blender's own Python.
 """
 
 import math
@@ -30,6 +32,14 @@ KEY_PREFIX = "Mode "
 def _prefs(context):
     addon = context.preferences.addons.get(__package__)
     return addon.preferences if addon else None
+
+
+def wheel_site_packages():
+    """Where Blender extracts extensions' wheels: `.local/lib/pythonX.Y/site-packages` of the
+    user's extensions folder (on every platform)."""
+    import sys
+    return os.path.join(bpy.utils.user_resource("EXTENSIONS"), ".local", "lib",
+                        "python{}.{}".format(*sys.version_info[:2]), "site-packages")
 
 
 def locate_binary(context):
@@ -54,6 +64,11 @@ class ModalBakePreferences(bpy.types.AddonPreferences):
         try:
             path, where, version = locate_binary(context)
             self.layout.label(text=f"Using {version} ({where}): {path}")
+            bundled = os.path.isdir(os.path.join(ADDON_DIR, "wheels"))
+            self.layout.label(
+                text="Meshers: gmsh and pytetwild bundled with the add-on, run by Blender's Python"
+                if bundled else
+                "Meshers: gmsh and pytetwild as modal-bake finds them (gmsh on PATH, python3)")
         except runner.BakeError as e:
             self.layout.label(text=str(e), icon="ERROR")
 
@@ -210,20 +225,23 @@ def prepare(context, obj):
         paths["fixed"] = os.path.join(folder, stem + "_fixed.obj")
         runner.write_obj(paths["fixed"], *settings.pop("fixed_group"))
         settings["fixed_near"] = paths["fixed"]
+    mesh_extra, env, meshers = runner.bundled_meshers(ADDON_DIR, wheel_site_packages())
     steps = [
-        ("mesh", runner.mesh_command(exe, paths["obj"], paths["msh"], settings)),
+        ("mesh", runner.mesh_command(exe, paths["obj"], paths["msh"], settings, mesh_extra)),
         ("bake", runner.bake_command(exe, paths["msh"], paths["modes"], settings)),
         ("export", runner.export_command(exe, paths["modes"], paths["glb"], paths["obj"],
                                          settings["modes"])),
     ]
     return {"exe": exe, "where": where, "version": version, "paths": paths, "steps": steps,
-            "vertices": len(positions)}
+            "vertices": len(positions), "env": env, "meshers": meshers}
 
 
 def run_steps(job, progress):
     """The CLI part (any thread): runs the steps and reads the GLB back."""
+    if job["meshers"]:
+        progress(f"meshers: {job['meshers']}")
     for what, cmd in job["steps"]:
-        runner.run_step(cmd, what, progress)
+        runner.run_step(cmd, what, progress, job["env"])
     positions, modes, info = runner.read_onto_glb(job["paths"]["glb"])
     if len(positions) != job["vertices"]:
         raise runner.BakeError(

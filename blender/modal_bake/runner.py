@@ -8,6 +8,7 @@ directly and the add-on's operators stay thin.
 import json
 import os
 import shutil
+import stat
 import struct
 import subprocess
 import sys
@@ -43,6 +44,14 @@ def find_binary(preference_path, addon_dir):
         return p, "add-on preference"
     bundled = os.path.join(addon_dir, "bin", EXE)
     if os.path.isfile(bundled):
+        # Blender extracts an extension's zip without the files' Unix modes.
+        if sys.platform != "win32" and not os.access(bundled, os.X_OK):
+            try:
+                os.chmod(bundled, os.stat(bundled).st_mode | stat.S_IXUSR | stat.S_IXGRP
+                         | stat.S_IXOTH)
+            except OSError as e:
+                raise BakeError(f"the bundled {bundled} is not executable and cannot be made "
+                                f"so ({e}): set the add-on preference to a modal-bake") from e
         return bundled, "bundled with the add-on"
     on_path = shutil.which("modal-bake")
     if on_path:
@@ -52,6 +61,59 @@ def find_binary(preference_path, addon_dir):
         f"{os.path.join(addon_dir, 'bin')}, not on PATH. Build it with "
         "`cargo build --release -p modal-bake` and set Preferences > Add-ons > Modal Bake > "
         "modal-bake binary to target/release/modal-bake, or put it on PATH.")
+
+
+def bundled_meshers(addon_dir, site_packages, python=sys.executable):
+    """How modal-bake meshes when this add-on package bundles gmsh and pytetwild as wheels (a
+    `wheels/` folder beside this file, which Blender extracts into `site_packages`, its
+    extensions' `.local/lib/pythonX.Y/site-packages`): returns (mesh arguments, environment
+    additions, description) that make it run exactly those with Blender's own Python —
+    `--gmsh FOLDER`, `MODAL_BAKE_PYTHON` and `PYTHONPATH` — or ([], {}, None) for a package
+    without wheels, where modal-bake finds gmsh and pytetwild itself.
+
+    Raises BakeError when the package has wheels that Blender did not install.
+    """
+    if not os.path.isdir(os.path.join(addon_dir, "wheels")):
+        return [], {}, None
+    for name, rel in (("gmsh", "gmsh.py"), ("pytetwild", os.path.join("pytetwild", "__init__.py"))):
+        if not os.path.isfile(os.path.join(site_packages, rel)):
+            raise BakeError(
+                f"this Modal Bake package bundles {name} (wheels/), but Blender has not installed "
+                f"it into {site_packages}: reinstall the extension (Edit > Preferences > Get "
+                f"Extensions), which installs its wheels")
+    _place_gmsh_library(site_packages)
+    paths = [site_packages] + ([os.environ["PYTHONPATH"]] if os.environ.get("PYTHONPATH") else [])
+    env = {"MODAL_BAKE_PYTHON": python, "PYTHONPATH": os.pathsep.join(paths)}
+    what = f"gmsh and pytetwild bundled with the add-on ({site_packages}), run by {python}"
+    return ["--gmsh", site_packages], env, what
+
+
+def _place_gmsh_library(site_packages):
+    """Puts gmsh's shared library beside gmsh.py, where gmsh.py looks first.
+
+    The gmsh wheel ships it as a data file (`gmsh-X.data/data/lib/libgmsh.so.X`), which pip
+    installs into the prefix's lib/ but Blender's wheel extraction leaves under
+    `site-packages/gmsh-X.data/` (gmsh.py then finds no library: "undefined symbol:
+    gmshInitialize"). Copied once (atomically), and again when the wheel's copy changes size."""
+    for data in sorted(os.listdir(site_packages)):
+        if not (data.startswith("gmsh-") and data.endswith(".data")):
+            continue
+        top = os.path.join(site_packages, data, "data")
+        for sub in (os.listdir(top) if os.path.isdir(top) else []):
+            folder = os.path.join(top, sub)
+            for name in (os.listdir(folder) if os.path.isdir(folder) else []):
+                if not (name.startswith(("libgmsh", "gmsh-")) and
+                        (".so" in name or name.endswith((".dylib", ".dll")))):
+                    continue
+                src, dst = os.path.join(folder, name), os.path.join(site_packages, name)
+                if os.path.isfile(dst) and os.path.getsize(dst) == os.path.getsize(src):
+                    continue
+                try:
+                    shutil.copy2(src, dst + ".partial")
+                    os.replace(dst + ".partial", dst)
+                except OSError as e:
+                    raise BakeError(f"cannot place gmsh's library {src} beside gmsh.py in "
+                                    f"{site_packages}: {e}") from e
 
 
 def binary_version(path):
@@ -82,10 +144,10 @@ def num(x):
     return f"{float(x):.7g}"
 
 
-def mesh_command(exe, obj, msh, settings):
+def mesh_command(exe, obj, msh, settings, extra=()):
     """`modal-bake mesh` arguments for `settings` (a dict: order, size_m, uniform_size,
-    mesher)."""
-    cmd = [exe, "mesh", obj, "-o", msh, "--order", str(settings["order"])]
+    mesher), then `extra` (the bundled meshers' `--gmsh`)."""
+    cmd = [exe, "mesh", obj, "-o", msh, "--order", str(settings["order"]), *extra]
     if settings.get("size_m"):
         cmd += ["--size", num(settings["size_m"])]
     if settings.get("uniform_size"):
@@ -130,14 +192,14 @@ def _unknown_option(stderr):
     return None
 
 
-def run_step(cmd, what, progress):
-    """Runs one modal-bake step, passing each stderr/stdout line to `progress(text)` as it
-    comes (long bakes report their stages), and raises BakeError with the tool's own message
-    on failure. Returns the full stdout."""
+def run_step(cmd, what, progress, env=None):
+    """Runs one modal-bake step (with the environment additions `env`), passing each
+    stderr/stdout line to `progress(text)` as it comes (long bakes report their stages), and
+    raises BakeError with the tool's own message on failure. Returns the full stdout."""
     progress(f"{what}: {' '.join(cmd)}")
     try:
         proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
-                                bufsize=1, env=dict(os.environ, NO_COLOR="1"))
+                                bufsize=1, env=dict(os.environ, NO_COLOR="1", **(env or {})))
     except OSError as e:
         raise BakeError(f"cannot run {cmd[0]}: {e}") from e
     lines = []

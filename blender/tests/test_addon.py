@@ -24,13 +24,19 @@ user folder, enables it, points its preference at the modal-bake binary, and:
   torus with `modal-bake mesh`: the same closed solid as Blender's OBJ export of it;
 - bakes a textured sphere with a shape key and its animation under a scaled, rotated empty from
   Blender's .gltf, and `export --onto`s it: imported back, the object tree, image, key and
-  action are there and each mode key's world displacement peaks at scale × diagonal.
+  action are there and each mode key's world displacement peaks at scale × diagonal;
+- builds the packaged extension (scripts/package_blender_addon.py: modal-bake in bin/, gmsh and
+  pytetwild as wheels), installs it over the add-on with no binary preference, and bakes the
+  default cube (gmsh from the wheel, run by this Python; the CLI's frequencies) and an open box
+  (fTetWild from the wheel) with it.
 
 Prints one line per check and "N passed, N failed, N skipped"; exits 1 on a failure. Without
 bpy it skips, except with DCR_REQUIRE_BPY=1 (CI), where that is a failure.
 """
 
 import argparse
+import contextlib
+import io
 import json
 import os
 import re
@@ -443,6 +449,66 @@ def main():
 
     check("export --onto Blender's .gltf keeps its object tree, texture, shape key and animation",
           gltf_onto)
+
+    def packaged():
+        # scripts/package_blender_addon.py: one zip with modal-bake in bin/ and gmsh and
+        # pytetwild as wheels. Installed over the plain add-on with no binary preference, it
+        # bakes with nothing but itself: its own modal-bake, and the wheels' gmsh and pytetwild
+        # run by Blender's Python.
+        out = subprocess.run([sys.executable, os.path.join(ROOT, "scripts",
+                                                           "package_blender_addon.py"),
+                              "--binary", exe, "--out", os.path.join(work, "package")],
+                             capture_output=True, text=True)
+        assert out.returncode == 0, f"package_blender_addon.py:\n{out.stdout}{out.stderr}"
+        zpath = out.stdout.strip().splitlines()[-1]
+        print(f"  {os.path.basename(zpath)}: {os.path.getsize(zpath) / 2**20:.1f} MiB",
+              flush=True)
+        bpy.ops.wm.read_factory_settings()
+        res = bpy.ops.extensions.package_install_files(
+            filepath=zpath, repo="user_default", enable_on_install=True)
+        assert res == {"FINISHED"}, f"extension install: {res}"
+        bpy.context.preferences.addons[pkg].preferences.binary = ""
+        site = os.path.join(bpy.utils.user_resource("EXTENSIONS"), ".local", "lib",
+                            "python{}.{}".format(*sys.version_info[:2]), "site-packages")
+
+        def bake_logged(obj, *a):
+            log = io.StringIO()
+            with contextlib.redirect_stdout(log):
+                keys = bake_and_check(obj, *a)
+            sys.stdout.write(log.getvalue())
+            text = log.getvalue()
+            assert "(bundled with the add-on)" in obj["modal_bake_binary"], \
+                obj["modal_bake_binary"]
+            assert f"meshers: gmsh and pytetwild bundled with the add-on ({site})" in text, text
+            return keys, text
+
+        cube = bpy.data.objects["Cube"]
+        cube.modal_bake.order = "2"
+        cube.modal_bake.modes = 6
+        cube.modal_bake.fixed = "below"
+        cube.modal_bake.fixed_height = -0.9
+        cube.modal_bake.output_dir = os.path.join(work, "packaged_cube")
+        _, text = bake_logged(cube, 6, ["--fixed-below=z=-0.9"])
+        assert f"backend: gmsh 4.15.2 ({sys.executable} + gmsh module in {site})" in text, text
+        # An open box (the top face removed): auto meshes it with fTetWild, from the wheel.
+        bpy.ops.mesh.primitive_cube_add(size=0.2, location=(1.0, 0.0, 0.0))
+        box = bpy.context.active_object
+        box.name = "OpenBox"
+        top = [p.index for p in box.data.polygons if p.normal.z > 0.5]
+        import bmesh
+        bm = bmesh.new()
+        bm.from_mesh(box.data)
+        bm.faces.ensure_lookup_table()
+        bmesh.ops.delete(bm, geom=[bm.faces[i] for i in top], context="FACES_ONLY")
+        bm.to_mesh(box.data)
+        bm.free()
+        box.modal_bake.modes = 4
+        box.modal_bake.output_dir = os.path.join(work, "packaged_box")
+        _, text = bake_logged(box, 4, [])
+        assert f"backend: fTetWild 0.4.2 ({sys.executable} + pytetwild 0.4.2)" in text, text
+
+    check("packaged extension: its own modal-bake, gmsh and pytetwild, nothing else installed",
+          packaged)
 
     print(f"{results['passed']} passed, {results['failed']} failed, "
           f"{results['skipped']} skipped", flush=True)

@@ -619,3 +619,74 @@ fn auto_falls_back_to_ftetwild_when_gmsh_fails() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(stderr.contains("falling back to fTetWild"), "{stderr}");
 }
+
+/// `MODAL_BAKE_PYTHON` is the Python both Python launchers run (gmsh's module, pytetwild): a
+/// missing interpreter is named in the not-found error of each (not a silent fall back to
+/// `python3`), and a real one (this machine's `python3`, by its full path) meshes the open box
+/// with fTetWild and is named in the backend line.
+#[test]
+fn modal_bake_python_names_the_interpreter_of_the_python_meshers() {
+    if !have_ftetwild("modal_bake_python_names_the_interpreter_of_the_python_meshers") {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let (v, t) = cube([0.0; 3], 0.2);
+    let t: Vec<[usize; 3]> = t
+        .into_iter()
+        .enumerate()
+        .filter(|(i, _)| !matches!(i, 2 | 3))
+        .map(|(_, t)| t)
+        .collect();
+    let asset = write_obj(dir.path(), "open_box.obj", &surface(&[(v, t)]));
+    let msh = dir.path().join("open_box.msh");
+    let missing = dir.path().join("no-such-python");
+    // A folder holding a gmsh.py: the Python launcher of `--gmsh` (the file is never read).
+    let gmsh_dir = dir.path().join("gmsh_module");
+    std::fs::create_dir(&gmsh_dir).unwrap();
+    std::fs::write(gmsh_dir.join("gmsh.py"), "").unwrap();
+    // gmsh is only run on a closed surface: the cube with its top.
+    let closed = write_obj(dir.path(), "cube.obj", &surface(&[cube([0.0; 3], 0.2)]));
+    for (mesher, input, needle) in [
+        ("ftetwild", &asset, "fTetWild not found"),
+        ("gmsh", &closed, "gmsh not found"),
+    ] {
+        let out = bin()
+            .arg("mesh")
+            .arg(input)
+            .arg("-o")
+            .arg(&msh)
+            .args(["--mesher", mesher, "--gmsh"])
+            .arg(&gmsh_dir)
+            .env("MODAL_BAKE_PYTHON", &missing)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{mesher}: {err}");
+        assert!(err.contains(needle), "{mesher}: {err}");
+        assert!(err.contains(&*missing.to_string_lossy()), "{mesher}: {err}");
+        assert!(!msh.exists(), "{mesher}: a mesh was written");
+    }
+    let which = Command::new("sh")
+        .args(["-c", "command -v python3"])
+        .output()
+        .unwrap();
+    let python = String::from_utf8(which.stdout).unwrap().trim().to_string();
+    assert!(python.starts_with('/'), "no python3 on PATH: {python}");
+    let out = bin()
+        .arg("mesh")
+        .arg(&asset)
+        .arg("-o")
+        .arg(&msh)
+        .args(["--mesher", "ftetwild"])
+        .env("MODAL_BAKE_PYTHON", &python)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    let report = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        report.contains(&format!("({python} + pytetwild ")),
+        "the backend line names {python}: {report}"
+    );
+    assert!(msh.is_file());
+}

@@ -106,12 +106,13 @@ pub struct AssetOptions {
     /// triangles [default: 1/1000 of the bounding-box diagonal].
     #[arg(long, value_name = "M")]
     pub envelope: Option<f64>,
-    /// Surface assets: the gmsh to run: an executable, or the PyPI package's gmsh.py
-    /// [default: `gmsh` on PATH, else python3's gmsh module].
+    /// Surface assets: the gmsh to run: an executable, or the PyPI package's gmsh.py (or the
+    /// folder holding it) [default: `gmsh` on PATH, else python3's gmsh module; the Python is
+    /// $MODAL_BAKE_PYTHON when set].
     #[arg(long, value_name = "PATH")]
     pub gmsh: Option<PathBuf>,
     /// Surface assets: a FloatTetwild_bin executable to run for fTetWild [default: python3
-    /// with the PyPI package pytetwild].
+    /// (or $MODAL_BAKE_PYTHON) with the PyPI package pytetwild].
     #[arg(long, value_name = "PATH")]
     pub ftetwild: Option<PathBuf>,
     /// Surface assets: gmsh keeps the asset's triangles as the boundary instead of remeshing

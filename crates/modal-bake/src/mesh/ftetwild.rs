@@ -23,7 +23,7 @@ use std::process::Command;
 use std::time::Duration;
 
 use super::surface::SurfaceMesh;
-use super::work::{run_child, WorkDir};
+use super::work::{python_interpreter, run_child, WorkDir};
 use super::{MeshError, TetMesh};
 
 /// How to install fTetWild, for the error when it is not found.
@@ -125,7 +125,7 @@ if shim:
     ctypes.CDLL(shim, mode=ctypes.RTLD_GLOBAL)
 spec = importlib.util.find_spec("pytetwild")
 if spec is None:
-    sys.stderr.write("python3 has no module pytetwild\n")
+    sys.stderr.write("%s has no module pytetwild\n" % sys.executable)
     sys.exit(3)
 from importlib.metadata import version
 if sys.argv[2] == "--version":
@@ -162,7 +162,7 @@ fn diagonal(bbox: [[f64; 3]; 2]) -> f64 {
 }
 
 fn python(shim: &Path) -> Command {
-    let mut c = Command::new("python3");
+    let mut c = Command::new(python_interpreter());
     c.arg("-c").arg(PY).arg(shim);
     c
 }
@@ -185,7 +185,7 @@ pub fn ftetwild_version(program: Option<&Path>) -> Result<String, FtetwildError>
         .arg("--version")
         .output()
         .map_err(|e| FtetwildError::NotFound {
-            detail: format!("python3: {e}"),
+            detail: format!("{}: {e}", python_interpreter().display()),
         })?;
     let text = String::from_utf8_lossy(&out.stdout).trim().to_string();
     if out.status.success() && !text.is_empty() {
@@ -260,7 +260,10 @@ pub fn tetrahedralize(
             c.arg("run")
                 .arg(format!("{size:?}"))
                 .arg(format!("{:?}", envelope / diag));
-            (c, format!("python3 + pytetwild {version}"))
+            (
+                c,
+                format!("{} + pytetwild {version}", python_interpreter().display()),
+            )
         }
         Some(bin) => {
             use std::fmt::Write;

@@ -24,7 +24,7 @@ use std::process::Command;
 use std::time::Duration;
 
 use super::surface::SurfaceMesh;
-use super::work::{run_child, run_child_watched, WorkDir, DEFAULT_TIMEOUT_S};
+use super::work::{python_interpreter, run_child, run_child_watched, WorkDir, DEFAULT_TIMEOUT_S};
 use super::{MeshError, TetMesh};
 
 /// How to install gmsh, for the error when none is found.
@@ -197,7 +197,7 @@ impl Launcher {
         match self {
             Launcher::Binary(p) => Command::new(p),
             Launcher::Python(dir) => {
-                let mut c = Command::new("python3");
+                let mut c = Command::new(python_interpreter());
                 c.arg("-c").arg(script).arg(
                     dir.as_ref()
                         .map(|d| d.display().to_string())
@@ -211,8 +211,12 @@ impl Launcher {
     fn describe(&self) -> String {
         match self {
             Launcher::Binary(p) => p.display().to_string(),
-            Launcher::Python(Some(d)) => format!("python3 + gmsh module in {}", d.display()),
-            Launcher::Python(None) => "python3 + gmsh module".into(),
+            Launcher::Python(Some(d)) => format!(
+                "{} + gmsh module in {}",
+                python_interpreter().display(),
+                d.display()
+            ),
+            Launcher::Python(None) => format!("{} + gmsh module", python_interpreter().display()),
         }
     }
 

@@ -18,6 +18,21 @@ use std::time::{Duration, Instant};
 /// Default time limit of one mesher run (s).
 pub const DEFAULT_TIMEOUT_S: f64 = 600.0;
 
+/// The environment variable naming the Python interpreter that runs gmsh's Python module and
+/// pytetwild ([`python_interpreter`]).
+pub const PYTHON_ENV: &str = "MODAL_BAKE_PYTHON";
+
+/// The Python interpreter the meshers' Python launchers run: `$MODAL_BAKE_PYTHON` when it is
+/// set and not empty (an application's own Python, e.g. Blender's, whose add-on bundles gmsh
+/// and pytetwild as wheels and puts them on the child's `PYTHONPATH`), else `python3` on
+/// `PATH`.
+pub fn python_interpreter() -> PathBuf {
+    match std::env::var_os(PYTHON_ENV) {
+        Some(p) if !p.is_empty() => PathBuf::from(p),
+        _ => PathBuf::from("python3"),
+    }
+}
+
 /// Work folders alive in this process.
 static DIRS: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 /// Mesher children running in this process, and whether [`abort_meshing`] has run (no child
