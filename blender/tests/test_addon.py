@@ -177,12 +177,18 @@ def main():
               f"(= CLI bake of {os.path.basename(obj_path)})", flush=True)
         return keys
 
-    cube = bpy.data.objects["Cube"]
-    cube.modal_bake.order = "2"
-    cube.modal_bake.modes = 6
-    cube.modal_bake.fixed = "below"
-    cube.modal_bake.fixed_height = -0.9
-    cube.modal_bake.output_dir = os.path.join(work, "cube")
+    def default_cube(folder):
+        """The scene's default cube set up for the cube bakes: order 2, 6 modes, fixed below
+        z = -0.9 m, output in `work/folder`."""
+        cube = bpy.data.objects["Cube"]
+        cube.modal_bake.order = "2"
+        cube.modal_bake.modes = 6
+        cube.modal_bake.fixed = "below"
+        cube.modal_bake.fixed_height = -0.9
+        cube.modal_bake.output_dir = os.path.join(work, folder)
+        return cube
+
+    cube = default_cube("cube")
 
     def cube_bake():
         bake_and_check(cube, 6, ["--fixed-below=z=-0.9"])
@@ -482,13 +488,7 @@ def main():
             assert f"meshers: gmsh and pytetwild bundled with the add-on ({site})" in text, text
             return keys, text
 
-        cube = bpy.data.objects["Cube"]
-        cube.modal_bake.order = "2"
-        cube.modal_bake.modes = 6
-        cube.modal_bake.fixed = "below"
-        cube.modal_bake.fixed_height = -0.9
-        cube.modal_bake.output_dir = os.path.join(work, "packaged_cube")
-        _, text = bake_logged(cube, 6, ["--fixed-below=z=-0.9"])
+        _, text = bake_logged(default_cube("packaged_cube"), 6, ["--fixed-below=z=-0.9"])
         assert f"backend: gmsh 4.15.2 ({sys.executable} + gmsh module in {site})" in text, text
         # An open box (the top face removed): auto meshes it with fTetWild, from the wheel.
         bpy.ops.mesh.primitive_cube_add(size=0.2, location=(1.0, 0.0, 0.0))

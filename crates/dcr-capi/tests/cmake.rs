@@ -8,7 +8,7 @@ mod common;
 use std::path::Path;
 use std::process::Command;
 
-use common::{bake_cube, crate_dir, run_ok, shared_lib, static_lib, workspace};
+use common::{bake_cube, crate_dir, run_ok, run_world, shared_lib, static_lib, workspace};
 
 fn cmake() -> &'static str {
     let ok = Command::new("cmake")
@@ -74,18 +74,11 @@ fn cmake_snippet_builds_and_runs_the_world_example() {
                 .arg("-DCMAKE_BUILD_TYPE=Release"),
         );
         run_ok(Command::new(cmake).arg("--build").arg(&build));
-        let o = run_ok(
-            Command::new(build.join("world"))
-                .arg(&base)
-                .arg("10")
-                .env_remove("LD_LIBRARY_PATH"),
+        run_world(
+            &build.join("world"),
+            &base,
+            &format!("static {static_link}"),
         );
-        let out = String::from_utf8(o.stdout).unwrap();
-        let steps = out.lines().filter(|l| l.starts_with("step ")).count();
-        let events: Vec<&str> = out.lines().filter(|l| l.starts_with("event ")).collect();
-        assert_eq!(steps, 10, "static {static_link}: {out}");
-        assert_eq!(events.len(), 1, "static {static_link}: {out}");
-        assert!(events[0].starts_with("event 7 "), "{}", events[0]);
         // The shared build really loads the shared library.
         if !static_link {
             let ldd = Command::new("ldd").arg(build.join("world")).output();

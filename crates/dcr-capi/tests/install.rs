@@ -19,7 +19,8 @@ mod common;
 use std::path::Path;
 use std::process::Command;
 
-use common::{bake_cube, cc, crate_dir, cxx, profile_dir, run_ok, workspace, NATIVE_LIBS};
+use common::NATIVE_LIBS;
+use common::{bake_cube, cc, crate_dir, cxx, profile_dir, run_ok, run_world, workspace};
 
 /// The pinned cargo-c release: the newest whose embedded cargo builds with Rust 1.95 (the
 /// workspace's highest `rust-version`).
@@ -73,24 +74,6 @@ fn needed(bin: &Path) -> String {
         .filter(|l| l.contains("(NEEDED)") || l.contains("(SONAME)"))
         .collect::<Vec<_>>()
         .join("\n")
-}
-
-/// Runs the world example `bin` on `base` for 10 steps and checks the documented outcome;
-/// returns its output.
-fn run_world(bin: &Path, base: &Path, what: &str) -> String {
-    let o = run_ok(
-        Command::new(bin)
-            .arg(base)
-            .arg("10")
-            .env_remove("LD_LIBRARY_PATH"),
-    );
-    let out = String::from_utf8(o.stdout).unwrap();
-    let steps = out.lines().filter(|l| l.starts_with("step ")).count();
-    let events: Vec<&str> = out.lines().filter(|l| l.starts_with("event ")).collect();
-    assert_eq!(steps, 10, "{what}: {out}");
-    assert_eq!(events.len(), 1, "{what}: {out}");
-    assert!(events[0].starts_with("event 7 "), "{what}: {}", events[0]);
-    out
 }
 
 #[test]

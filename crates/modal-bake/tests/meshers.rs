@@ -220,6 +220,19 @@ fn json_of(out: &Output) -> serde_json::Value {
     serde_json::from_slice(&out.stdout).unwrap()
 }
 
+/// A 0.2 m cube without its top face: an open box with 4 open edges.
+fn open_box() -> SurfaceMesh {
+    let (v, t) = cube([0.0; 3], 0.2);
+    // Quads are (bottom, top, ...): the top's two triangles are 2 and 3.
+    let t: Vec<[usize; 3]> = t
+        .into_iter()
+        .enumerate()
+        .filter(|(i, _)| !matches!(i, 2 | 3))
+        .map(|(_, t)| t)
+        .collect();
+    surface(&[(v, t)])
+}
+
 /// A cube with its top face removed (an open box, 0.2 m): auto picks fTetWild for the open
 /// edges, says what solid it made (the winding-number filter closes the box across its top),
 /// and reports the distance to the asset both ways.
@@ -229,15 +242,7 @@ fn auto_meshes_an_open_surface_with_ftetwild_and_reports_the_distance() {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
-    let (v, t) = cube([0.0; 3], 0.2);
-    // Quads are (bottom, top, ...): the top's two triangles are 2 and 3.
-    let t: Vec<[usize; 3]> = t
-        .into_iter()
-        .enumerate()
-        .filter(|(i, _)| !matches!(i, 2 | 3))
-        .map(|(_, t)| t)
-        .collect();
-    let open = surface(&[(v, t)]);
+    let open = open_box();
     assert_eq!(inspect_surface(&open).open_edges, 4);
     let asset = write_obj(dir.path(), "open_box.obj", &open);
     let msh = dir.path().join("open_box.msh");
@@ -630,14 +635,7 @@ fn modal_bake_python_names_the_interpreter_of_the_python_meshers() {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
-    let (v, t) = cube([0.0; 3], 0.2);
-    let t: Vec<[usize; 3]> = t
-        .into_iter()
-        .enumerate()
-        .filter(|(i, _)| !matches!(i, 2 | 3))
-        .map(|(_, t)| t)
-        .collect();
-    let asset = write_obj(dir.path(), "open_box.obj", &surface(&[(v, t)]));
+    let asset = write_obj(dir.path(), "open_box.obj", &open_box());
     let msh = dir.path().join("open_box.msh");
     let missing = dir.path().join("no-such-python");
     // A folder holding a gmsh.py: the Python launcher of `--gmsh` (the file is never read).

@@ -223,6 +223,25 @@ fn is_fresh(bin: &Path) -> bool {
     built > t
 }
 
+/// Runs the world example `bin` (`examples/world.c` built) on `base` (a [`bake_cube`] base)
+/// for 10 steps and checks the documented outcome: 10 step lines and one impulse event, at the
+/// impact step 7. Returns its output; `what` names the build in a failure.
+pub fn run_world(bin: &Path, base: &Path, what: &str) -> String {
+    let o = run_ok(
+        Command::new(bin)
+            .arg(base)
+            .arg("10")
+            .env_remove("LD_LIBRARY_PATH"),
+    );
+    let out = String::from_utf8(o.stdout).unwrap();
+    let steps = out.lines().filter(|l| l.starts_with("step ")).count();
+    let events: Vec<&str> = out.lines().filter(|l| l.starts_with("event ")).collect();
+    assert_eq!(steps, 10, "{what}: {out}");
+    assert_eq!(events.len(), 1, "{what}: {out}");
+    assert!(events[0].starts_with("event 7 "), "{what}: {}", events[0]);
+    out
+}
+
 /// A small free-free base baked from `data/meshes/cube_v41.msh` (unit cube, 8 modes) into
 /// `dir`.
 pub fn bake_cube(dir: &Path) -> PathBuf {
