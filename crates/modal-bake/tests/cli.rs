@@ -568,3 +568,56 @@ fn units_mm_bakes_the_metre_mesh_and_check_needs_the_same_units() {
         assert!((x - y).abs() <= 1e-12 * x.abs(), "{x} vs {y}");
     }
 }
+
+/// `modal-bake --help` names every environment variable the program reads: each string literal
+/// passed to `env::var` / `env::var_os` in its sources (and `PYTHON_ENV`'s value), found by
+/// scanning them, so a new variable cannot be added without its line in the help.
+#[test]
+fn help_lists_every_environment_variable_the_program_reads() {
+    let help = String::from_utf8(run(&["--help"]).stdout).unwrap();
+    let env_part = help
+        .split("Environment:")
+        .nth(1)
+        .unwrap_or_else(|| panic!("no Environment section in --help:\n{help}"));
+    fn sources(dir: &Path, out: &mut Vec<PathBuf>) {
+        for e in std::fs::read_dir(dir).unwrap().flatten() {
+            let p = e.path();
+            if p.is_dir() {
+                sources(&p, out);
+            } else if p.extension().is_some_and(|x| x == "rs") {
+                out.push(p);
+            }
+        }
+    }
+    let mut files = Vec::new();
+    sources(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("src"),
+        &mut files,
+    );
+    let mut names = Vec::new();
+    for f in files {
+        let text = std::fs::read_to_string(&f).unwrap();
+        for pat in ["env::var(\"", "env::var_os(\"", "_ENV: &str = \""] {
+            for part in text.split(pat).skip(1) {
+                let name = part.split('"').next().unwrap().to_string();
+                if !name.is_empty() {
+                    names.push(name);
+                }
+            }
+        }
+    }
+    for n in ["MODAL_BAKE_PYTHON", "MODAL_BAKE_PROGRESS_EVERY", "PATH"] {
+        assert!(
+            names.iter().any(|m| m == n),
+            "the scan missed {n}: {names:?}"
+        );
+    }
+    // TMPDIR is read through std::env::temp_dir; the shard variables by name at run time.
+    names.extend(["TMPDIR", "JOB_COMPLETION_INDEX", "SLURM_ARRAY_TASK_ID"].map(String::from));
+    for n in &names {
+        assert!(
+            env_part.contains(n.as_str()),
+            "{n} is read but not in --help:\n{env_part}"
+        );
+    }
+}
