@@ -80,6 +80,21 @@ def program_version(binary):
     return words[1]
 
 
+def glibc_needed(binary):
+    """The newest glibc symbol version the program links (`objdump -T`), e.g. "2.34", or None
+    when objdump is missing: the oldest Linux the package runs on."""
+    if not shutil.which("objdump"):
+        return None
+    out = subprocess.run(["objdump", "-T", binary], capture_output=True, text=True)
+    found = set()
+    for w in out.stdout.split():
+        w = w.strip("()")
+        v = w[len("GLIBC_"):]
+        if w.startswith("GLIBC_") and v.replace(".", "").isdigit():
+            found.add(tuple(int(x) for x in v.split(".")))
+    return ".".join(map(str, max(found))) if found else None
+
+
 def download_wheels(dest):
     cmd = [sys.executable, "-m", "pip", "download", "--quiet", "--no-deps",
            "--only-binary=:all:", "--python-version", PYTHON_VERSION, "--dest", dest]
@@ -166,6 +181,10 @@ def main():
             os.replace(partial, zpath)
         size = os.path.getsize(zpath) / 2**20
         log(f"wrote {zpath} ({size:.1f} MiB: modal-bake {version}, {', '.join(wheels)})")
+        glibc = glibc_needed(binary)
+        log(f"the bundled modal-bake needs glibc {glibc} or newer (the Linux it was built on "
+            "sets this: build on an older one for older systems)" if glibc else
+            "the glibc the bundled modal-bake needs is not known (objdump from binutils reads it)")
         print(zpath)
         return 0
     except Failure as e:
