@@ -9,17 +9,20 @@
 //   period, and a clamped base's fixed vertices are drawn;
 // - in an asset kept by `export --onto ASSET.glb` the modes are dcr's animations after the
 //   asset's own, the selected one moves the surface, and the fixed vertices are drawn.
-// Needs target/release/dcr-scenes and modal-bake (cargo build --release) and `npm ci` here.
+// Needs target/release/dcr-scenes and modal-bake (cargo build --release; under $CARGO_TARGET_DIR
+// when set) and `npm ci` here.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { execFileSync } from 'node:child_process';
 import { existsSync, mkdirSync, writeFileSync } from 'node:fs';
-import { join } from 'node:path';
+import { join, resolve } from 'node:path';
 import { validateFile } from './validate.mjs';
 import { ROOT, serve, launch, openViewer, canvasPixels, pixelStats } from './harness.mjs';
 
 const OUT = join(ROOT, 'out', 'browser-test');
-const bin = (name) => join(ROOT, 'target', 'release', name);
+// Cargo's target folder: $CARGO_TARGET_DIR when set (relative to the repository root, where
+// .ci/run runs cargo), else target/.
+const bin = (name) => join(resolve(ROOT, process.env.CARGO_TARGET_DIR || 'target'), 'release', name);
 let server, browser;
 const files = {};
 
