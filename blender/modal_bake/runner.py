@@ -75,12 +75,29 @@ def bundled_meshers(addon_dir, site_packages, python=sys.executable):
     """
     if not os.path.isdir(os.path.join(addon_dir, "wheels")):
         return [], {}, None
+    here = "cp{}{}".format(*sys.version_info[:2])
     for name, rel in (("gmsh", "gmsh.py"), ("pytetwild", os.path.join("pytetwild", "__init__.py"))):
-        if not os.path.isfile(os.path.join(site_packages, rel)):
+        if os.path.isfile(os.path.join(site_packages, rel)):
+            continue
+        wheels = sorted(w for w in os.listdir(os.path.join(addon_dir, "wheels"))
+                        if w.startswith(name + "-"))
+        # A wheel's python and ABI tags: cp311-cp311 is for 3.11 only, cp312-abi3 for 3.12 on.
+        tags = [w.split("-")[2:4] for w in wheels]
+        tags = [t for t in tags if len(t) == 2 and t[0].startswith("cp") and t[0][2:].isdigit()]
+        fits = any(py == here or (abi == "abi3" and int(py[2:]) <= int(here[2:]))
+                   for py, abi in tags)
+        if tags and not fits:
+            tags = {py if abi != "abi3" else py + "+" for py, abi in tags}
             raise BakeError(
-                f"this Modal Bake package bundles {name} (wheels/), but Blender has not installed "
-                f"it into {site_packages}: reinstall the extension (Edit > Preferences > Get "
-                f"Extensions), which installs its wheels")
+                f"this Modal Bake package bundles {name} for {', '.join(sorted(tags))} only "
+                f"({', '.join(wheels)}), and this Blender runs Python "
+                f"{sys.version_info[0]}.{sys.version_info[1]}: build the package for it with "
+                f"scripts/package_blender_addon.py, or use the add-on alone with gmsh and "
+                f"pytetwild installed")
+        raise BakeError(
+            f"this Modal Bake package bundles {name} (wheels/), but Blender has not installed "
+            f"it into {site_packages}: reinstall the extension (Edit > Preferences > Get "
+            f"Extensions), which installs its wheels")
     _place_gmsh_library(site_packages)
     paths = [site_packages] + ([os.environ["PYTHONPATH"]] if os.environ.get("PYTHONPATH") else [])
     env = {"MODAL_BAKE_PYTHON": python, "PYTHONPATH": os.pathsep.join(paths)}

@@ -28,7 +28,7 @@ user folder, enables it, points its preference at the modal-bake binary, and:
 - builds the packaged extension (scripts/package_blender_addon.py: modal-bake in bin/, gmsh and
   pytetwild as wheels), installs it over the add-on with no binary preference, and bakes the
   default cube (gmsh from the wheel, run by this Python; the CLI's frequencies) and an open box
-  (fTetWild from the wheel) with it.
+  (fTetWild from the wheel) with it; a package whose wheels are for another Python says so.
 
 Prints one line per check and "N passed, N failed, N skipped"; exits 1 on a failure. Without
 bpy it skips, except with DCR_REQUIRE_BPY=1 (CI), where that is a failure.
@@ -36,6 +36,7 @@ bpy it skips, except with DCR_REQUIRE_BPY=1 (CI), where that is a failure.
 
 import argparse
 import contextlib
+import importlib.util
 import io
 import json
 import os
@@ -509,6 +510,41 @@ def main():
 
     check("packaged extension: its own modal-bake, gmsh and pytetwild, nothing else installed",
           packaged)
+
+    def wheels_for_another_python():
+        # A package whose pytetwild wheel this Python cannot use (a Blender on another Python)
+        # says so and how to fix it, rather than asking to reinstall; an abi3 wheel from this
+        # Python's version down fits, and a fitting wheel Blender did not extract asks for a
+        # reinstall. Plain Python: runner.py does not import bpy.
+        spec = importlib.util.spec_from_file_location("mb_runner",
+                                                      os.path.join(ADDON_SRC, "runner.py"))
+        runner = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(runner)
+        here = "{}{}".format(*sys.version_info[:2])
+        other = "310" if here != "310" else "311"
+        for n, (wheel, says) in enumerate([
+                (f"pytetwild-0.4.2-cp{other}-cp{other}-manylinux2014_x86_64.whl",
+                 f"for cp{other} only"),
+                (f"pytetwild-0.4.2-cp{int(here) + 1}-abi3-manylinux2014_x86_64.whl",
+                 f"for cp{int(here) + 1}+ only"),
+                (f"pytetwild-0.4.2-cp{here}-abi3-manylinux2014_x86_64.whl", "reinstall"),
+                (f"pytetwild-0.4.2-cp{here}-cp{here}-manylinux2014_x86_64.whl", "reinstall")]):
+            pkg_dir = os.path.join(work, f"wheels_case_{n}")
+            site = os.path.join(pkg_dir, "site-packages")
+            os.makedirs(os.path.join(pkg_dir, "wheels"))
+            os.makedirs(site)
+            for w in ("gmsh-4.15.2-py2.py3-none-manylinux_2_24_x86_64.whl", wheel):
+                open(os.path.join(pkg_dir, "wheels", w), "w").close()
+            open(os.path.join(site, "gmsh.py"), "w").close()
+            try:
+                runner.bundled_meshers(pkg_dir, site)
+            except runner.BakeError as e:
+                assert says in str(e), (wheel, str(e))
+            else:
+                raise AssertionError(f"{wheel}: no error without pytetwild in {site}")
+
+    check("packaged extension on another Python: the error names the wheels' Python",
+          wheels_for_another_python)
 
     print(f"{results['passed']} passed, {results['failed']} failed, "
           f"{results['skipped']} skipped", flush=True)
