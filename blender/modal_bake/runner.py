@@ -5,6 +5,7 @@ Everything here is plain Python (subprocess, json, struct), so the test suite ca
 directly and the add-on's operators stay thin.
 """
 
+import glob
 import json
 import os
 import shutil
@@ -75,21 +76,15 @@ def bundled_meshers(addon_dir, site_packages, python=sys.executable):
     """
     if not os.path.isdir(os.path.join(addon_dir, "wheels")):
         return [], {}, None
-    here = "cp{}{}".format(*sys.version_info[:2])
     for name, rel in (("gmsh", "gmsh.py"), ("pytetwild", os.path.join("pytetwild", "__init__.py"))):
         if os.path.isfile(os.path.join(site_packages, rel)):
             continue
         wheels = sorted(w for w in os.listdir(os.path.join(addon_dir, "wheels"))
                         if w.startswith(name + "-"))
-        # A wheel's python and ABI tags: cp311-cp311 is for 3.11 only, cp312-abi3 for 3.12 on.
-        tags = [w.split("-")[2:4] for w in wheels]
-        tags = [t for t in tags if len(t) == 2 and t[0].startswith("cp") and t[0][2:].isdigit()]
-        fits = any(py == here or (abi == "abi3" and int(py[2:]) <= int(here[2:]))
-                   for py, abi in tags)
-        if tags and not fits:
-            tags = {py if abi != "abi3" else py + "+" for py, abi in tags}
+        others = _wheel_pythons_other_than_this(wheels)
+        if others:
             raise BakeError(
-                f"this Modal Bake package bundles {name} for {', '.join(sorted(tags))} only "
+                f"this Modal Bake package bundles {name} for {', '.join(others)} only "
                 f"({', '.join(wheels)}), and this Blender runs Python "
                 f"{sys.version_info[0]}.{sys.version_info[1]}: build the package for it with "
                 f"scripts/package_blender_addon.py, or use the add-on alone with gmsh and "
@@ -105,6 +100,18 @@ def bundled_meshers(addon_dir, site_packages, python=sys.executable):
     return ["--gmsh", site_packages], env, what
 
 
+def _wheel_pythons_other_than_this(wheels):
+    """The CPython tags of `wheels` ("cp310", "cp312+" for an abi3 wheel, which serves 3.12 on)
+    when none of them fits this Python, else []: pure-Python wheels (py3-none) say nothing."""
+    here = int("{}{}".format(*sys.version_info[:2]))  # cp311: 311
+    tags = [w.split("-")[2:4] for w in wheels]
+    tags = [(int(py[2:]), abi) for py, abi in (t for t in tags if len(t) == 2)
+            if py.startswith("cp") and py[2:].isdigit()]
+    if not tags or any(v == here or (abi == "abi3" and v <= here) for v, abi in tags):
+        return []
+    return sorted({f"cp{v}" + ("+" if abi == "abi3" else "") for v, abi in tags})
+
+
 def _place_gmsh_library(site_packages):
     """Puts gmsh's shared library beside gmsh.py, where gmsh.py looks first.
 
@@ -112,25 +119,21 @@ def _place_gmsh_library(site_packages):
     installs into the prefix's lib/ but Blender's wheel extraction leaves under
     `site-packages/gmsh-X.data/` (gmsh.py then finds no library: "undefined symbol:
     gmshInitialize"). Copied once (atomically), and again when the wheel's copy changes size."""
-    for data in sorted(os.listdir(site_packages)):
-        if not (data.startswith("gmsh-") and data.endswith(".data")):
+    pattern = os.path.join(glob.escape(site_packages), "gmsh-*.data", "data", "*", "*gmsh*")
+    for src in sorted(glob.glob(pattern)):
+        name = os.path.basename(src)
+        if not (name.startswith(("libgmsh", "gmsh-")) and
+                (".so" in name or name.endswith((".dylib", ".dll")))):
             continue
-        top = os.path.join(site_packages, data, "data")
-        for sub in (os.listdir(top) if os.path.isdir(top) else []):
-            folder = os.path.join(top, sub)
-            for name in (os.listdir(folder) if os.path.isdir(folder) else []):
-                if not (name.startswith(("libgmsh", "gmsh-")) and
-                        (".so" in name or name.endswith((".dylib", ".dll")))):
-                    continue
-                src, dst = os.path.join(folder, name), os.path.join(site_packages, name)
-                if os.path.isfile(dst) and os.path.getsize(dst) == os.path.getsize(src):
-                    continue
-                try:
-                    shutil.copy2(src, dst + ".partial")
-                    os.replace(dst + ".partial", dst)
-                except OSError as e:
-                    raise BakeError(f"cannot place gmsh's library {src} beside gmsh.py in "
-                                    f"{site_packages}: {e}") from e
+        dst = os.path.join(site_packages, name)
+        if os.path.isfile(dst) and os.path.getsize(dst) == os.path.getsize(src):
+            continue
+        try:
+            shutil.copy2(src, dst + ".partial")
+            os.replace(dst + ".partial", dst)
+        except OSError as e:
+            raise BakeError(f"cannot place gmsh's library {src} beside gmsh.py in "
+                            f"{site_packages}: {e}") from e
 
 
 def binary_version(path):
