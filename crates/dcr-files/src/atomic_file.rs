@@ -68,10 +68,12 @@ fn is_pending(path: &Path) -> bool {
     PENDING.lock().is_ok_and(|p| p.iter().any(|q| q == path))
 }
 
-/// This host's name reduced to `[A-Za-z0-9_]` (at most 32 characters; `host` if unknown).
+/// This host's name reduced to `[A-Za-z0-9_]` (at most 32 characters; `host` if unknown):
+/// Linux's `/proc/sys/kernel/hostname`, else `$HOSTNAME`, else (Windows) `%COMPUTERNAME%`.
 fn host_tag() -> String {
     let raw = std::fs::read_to_string("/proc/sys/kernel/hostname")
         .or_else(|_| std::env::var("HOSTNAME"))
+        .or_else(|_| std::env::var("COMPUTERNAME"))
         .unwrap_or_default();
     let tag: String = raw
         .trim()

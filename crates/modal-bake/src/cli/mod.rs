@@ -48,10 +48,10 @@ struct Cli {
 
 /// The environment variables modal-bake reads, for `--help`.
 const ENVIRONMENT: &str = "Environment:\n  \
-     MODAL_BAKE_PYTHON           the Python that runs gmsh's module and pytetwild (default: python3 on PATH)\n  \
-     PATH                        where `gmsh` and `python3` are found\n  \
+     MODAL_BAKE_PYTHON           the Python that runs gmsh's module and pytetwild (default: python3 on PATH; python on Windows)\n  \
+     PATH                        where `gmsh` and `python3` (Windows: `python`) are found\n  \
      MODAL_BAKE_PROGRESS_EVERY   seconds between progress lines in a log that is not a terminal (default 5; 0: every event)\n  \
-     TMPDIR                      where the meshers' work folders are made (removed on exit)\n  \
+     TMPDIR                      where the meshers' work folders are made (removed on exit; Windows: TMP, TEMP)\n  \
      JOB_COMPLETION_INDEX, SLURM_ARRAY_TASK_ID (and _MIN, _COUNT)\n  \
      \x20                           batch --shard env:NAME/N: the shard index a Kubernetes Job or Slurm array gives";
 

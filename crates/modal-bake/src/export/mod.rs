@@ -102,6 +102,17 @@ fn format_sig(x: f64, digits: i32) -> String {
     format!("{:.*}", decimals, x)
 }
 
+/// The weight of an animated mode at keyframe `i` of `k` per period: sin 2πi/k, the keyframes
+/// of one sine period (`i` = 0 and `k` give 0).
+///
+/// Computed with the `libm` crate's `sin` (the same bits on every platform): a C library's
+/// `sin` need not be, and MinGW's, which a Windows build links, differs from glibc's in the
+/// last bits near multiples of π (1.22464e-16 against 1.22465e-16 at π), so the glTF exports
+/// of the two builds would differ in a few bytes.
+pub(crate) fn loop_weight(i: usize, k: usize) -> f32 {
+    libm::sin(std::f64::consts::TAU * i as f64 / k as f64) as f32
+}
+
 /// The default number of exported modes: every mode of the base up to 20.
 pub const DEFAULT_EXPORT_MODES: usize = 20;
 

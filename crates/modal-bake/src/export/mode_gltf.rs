@@ -198,7 +198,7 @@ pub(super) fn morph_scene(
     for (j, (label, _)) in targets.iter().enumerate() {
         let mut w = vec![0.0f32; (k + 1) * n];
         for i in 0..=k {
-            w[i * n + j] = (std::f64::consts::TAU * i as f64 / k as f64).sin() as f32;
+            w[i * n + j] = super::loop_weight(i, k);
         }
         let output = b.scalars(&w, false);
         b.root.push(json::Animation {

@@ -521,8 +521,7 @@ fn add_mode_animations(
             for &(node, first, total) in animated {
                 let mut w = vec![0.0f32; (k + 1) * total];
                 for i in 0..=k {
-                    w[i * total + first + j] =
-                        (std::f64::consts::TAU * i as f64 / k as f64).sin() as f32;
+                    w[i * total + first + j] = super::loop_weight(i, k);
                 }
                 let output = doc.floats(&w, false, None);
                 channels.push(json!({ "sampler": samplers.len(),

@@ -24,14 +24,19 @@ pub const PYTHON_ENV: &str = "MODAL_BAKE_PYTHON";
 
 /// The Python interpreter the meshers' Python launchers run: `$MODAL_BAKE_PYTHON` when it is
 /// set and not empty (an application's own Python, e.g. Blender's, whose add-on bundles gmsh
-/// and pytetwild as wheels and puts them on the child's `PYTHONPATH`), else `python3` on
-/// `PATH`.
+/// and pytetwild as wheels and puts them on the child's `PYTHONPATH`), else
+/// [`DEFAULT_PYTHON`] on `PATH`.
 pub fn python_interpreter() -> PathBuf {
     match std::env::var_os(PYTHON_ENV) {
         Some(p) if !p.is_empty() => PathBuf::from(p),
-        _ => PathBuf::from("python3"),
+        _ => PathBuf::from(DEFAULT_PYTHON),
     }
 }
+
+/// The interpreter [`python_interpreter`] runs when `MODAL_BAKE_PYTHON` is not set: `python3`,
+/// and on Windows `python` (python.org's installer puts `python.exe` on `PATH`, not
+/// `python3.exe`).
+pub const DEFAULT_PYTHON: &str = if cfg!(windows) { "python" } else { "python3" };
 
 /// Work folders alive in this process.
 static DIRS: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());

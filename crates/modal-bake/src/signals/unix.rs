@@ -1,25 +1,18 @@
-//! Signal handling for the command-line tool: on SIGINT, SIGTERM or SIGHUP the temporaries
-//! being written ([`dcr_files::AtomicFile`]) are removed, the mesher child processes
-//! are ended and their work folders removed ([`crate::mesh::work::abort_meshing`]), then the process ends as
-//! the signal's default action would (a shell sees it killed by that signal). Without this the
-//! default action would end the process at once and leave a partial `.NAME.tmp-…` beside the
-//! output. SIGKILL cannot be caught; the next write of the same output removes what it left.
-//!
-//! The three signals are blocked in the thread that installs this (and so in every thread it
-//! starts afterwards) and taken by one thread with `sigwait`, so no signal handler runs for
-//! them in those threads. A handler would not be safe: METIS (the bake's fill-reducing
-//! ordering) installs its own process-wide SIGTERM handler while it orders a matrix, one that
-//! `longjmp`s into the ordering thread's stack, and a SIGTERM that ran it on another thread
-//! crashed a terminated batch with SIGSEGV (two of 40 runs under load). Threads started before
-//! the install (a test harness's main thread) keep the signals unblocked; a small handler there
-//! forwards them to the waiting thread.
+//! Unix: the three signals are blocked in the thread that installs this (and so in every
+//! thread it starts afterwards) and taken by one thread with `sigwait`, so no signal handler
+//! runs for them in those threads. A handler would not be safe: METIS (the bake's
+//! fill-reducing ordering) installs its own process-wide SIGTERM handler while it orders a
+//! matrix, one that `longjmp`s into the ordering thread's stack, and a SIGTERM that ran it on
+//! another thread crashed a terminated batch with SIGSEGV (two of 40 runs under load). Threads
+//! started before the install (a test harness's main thread) keep the signals unblocked; a
+//! small handler there forwards them to the waiting thread.
 //!
 //! [`kill_process_group`] ends a mesher child with the processes it started: each child leads
 //! its own process group (`crate::mesh::work`), and std signals single processes only.
 //!
-//! Written on `libc` (its signal mask, `sigwait`, `sigaction`, `pthread_kill`, `kill`), the
-//! second module after `ordering/metis.rs` allowed `unsafe`: std has no signal API, and
-//! signal-hook delivers through a handler, which is what METIS replaces.
+//! Written on `libc` (its signal mask, `sigwait`, `sigaction`, `pthread_kill`, `kill`), one of
+//! the modules allowed `unsafe`: std has no signal API, and signal-hook delivers through a
+//! handler, which is what METIS replaces.
 #![allow(unsafe_code)]
 
 use std::mem::MaybeUninit;
