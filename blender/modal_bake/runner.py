@@ -16,6 +16,11 @@ import sys
 
 EXE = "modal-bake.exe" if sys.platform == "win32" else "modal-bake"
 
+# Blender is a window program: on Windows a console program it starts opens a console window of
+# its own unless started without one (the program and the meshers it starts then share a hidden
+# console, which also carries Ctrl-C to them).
+NO_WINDOW = {"creationflags": subprocess.CREATE_NO_WINDOW} if sys.platform == "win32" else {}
+
 # Material presets the panel offers; passed as `--material NAME` (a newer modal-bake option).
 MATERIALS = [
     "oak", "pine", "steel", "aluminium", "brass", "cast-iron", "glass", "ceramic", "concrete",
@@ -139,7 +144,8 @@ def _place_gmsh_library(site_packages):
 def binary_version(path):
     """`modal-bake --version` (e.g. "modal-bake 0.1.0"), or raises BakeError."""
     try:
-        out = subprocess.run([path, "--version"], capture_output=True, text=True, timeout=30)
+        out = subprocess.run([path, "--version"], capture_output=True, text=True, timeout=30,
+                             encoding="utf-8", errors="replace", **NO_WINDOW)
     except OSError as e:
         raise BakeError(f"cannot run {path}: {e}") from e
     if out.returncode != 0:
@@ -219,7 +225,8 @@ def run_step(cmd, what, progress, env=None):
     progress(f"{what}: {' '.join(cmd)}")
     try:
         proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
-                                bufsize=1, env=dict(os.environ, NO_COLOR="1", **(env or {})))
+                                encoding="utf-8", errors="replace", bufsize=1, env=dict(os.environ, NO_COLOR="1", **(env or {})),
+                                **NO_WINDOW)
     except OSError as e:
         raise BakeError(f"cannot run {cmd[0]}: {e}") from e
     lines = []
