@@ -10,14 +10,12 @@ it, under Wine on this Linux machine, against the Linux build of the same source
 
 1. the program imports Windows' own DLLs only (no MinGW runtime DLL to ship beside it);
 2. `--version` answers the workspace's version;
-3. bases baked by it (a P1 table with a transfer table, a P2 mesh in single precision, under a
-   folder whose name has a space and non-ASCII letters) hold the same bytes as the Linux
-   program's in every entry but `surface_order` (METIS's nested dissection draws from the C
-   library's `rand`, which differs between Windows and glibc: there the two orders must be
-   permutations of the same vertices), the Linux program's `check` finds them up to date, and
-   their glTF exports are byte-identical; a larger P2 mesh (the committed asset hp_body.obj
-   meshed by gmsh, 50k dofs), where the solver's order comes from METIS too, gives
-   eigenvalues and modes equal to rounding (1e-10) and exports equal to rounding;
+3. bases baked by it (a P1 table with a transfer table, a P2 mesh in single precision, and a
+   larger P2 mesh, the committed asset hp_body.obj meshed by gmsh, 50k dofs, where METIS
+   orders the solver's unknowns too; under a folder whose name has a space and non-ASCII
+   letters) are byte for byte the Linux program's bases (METIS draws from the program's own
+   `rand`, glibc's generator on every platform: `modal_bake::ordering::c_rand`), the Linux
+   program's `check` finds them up to date, and their glTF exports are byte-identical;
 4. interrupting it (Ctrl-C: the console event Wine raises for SIGINT) while a mesher runs ends
    that mesher, removes its work folder, writes nothing and exits with STATUS_CONTROL_C_EXIT;
 5. without a Python it says which interpreter it looked for (`python`, Windows' name);
@@ -37,7 +35,6 @@ printed), 2 on a usage error.
 """
 
 import argparse
-import io
 import os
 import re
 import shutil
@@ -155,83 +152,14 @@ def entries(path):
         return {i.filename: z.read(i.filename) for i in z.infolist()}
 
 
-def npy_array(data):
-    """The values of a `.npy` entry (numpy array)."""
-    import numpy as np
-    return np.load(io.BytesIO(data))
-
-
-# The eigensolver's outputs: equal to rounding, not bit for bit, when the fill-reducing order of
-# the volume (METIS, on large meshes) differs between the two builds.
-SOLVER = ["eigenvalues.npy", "frequencies_hz.npy", "modes.npy", "edge_modes.npy",
-          "residuals.npy"]
-
-
-def compare_bases(name, linux_base, windows_base, to_rounding=()):
-    """Every entry byte-identical but `surface_order` (two valid orders) and the entries in
-    `to_rounding`, which must agree to rounding: 1e-10 of their largest value (residuals, all
-    near rounding themselves: 1e-9 absolute)."""
+def compare_bases(name, linux_base, windows_base):
+    """Every entry of the two bases byte-identical."""
     a, b = entries(linux_base), entries(windows_base)
     if not check(sorted(a) == sorted(b), f"{name}: the same {len(a)} entries"):
         return
     differ = [k for k in a if a[k] != b[k]]
-    loose = ["surface_order.npy", *to_rounding]
-    check(all(k in loose for k in differ),
-          f"{name}: every entry but {', '.join(k[:-4] for k in loose)} byte-identical to the "
-          f"Linux bake" + (f" (differ: {', '.join(differ)})" if differ else ""))
-    for k in (k for k in to_rounding if k in differ):
-        x, y = npy_array(a[k]), npy_array(b[k])
-        gap = float(abs(x - y).max()) if x.shape == y.shape else float("inf")
-        scale = 1.0 if k == "residuals.npy" else float(abs(x).max())
-        bound = 1e-9 if k == "residuals.npy" else 1e-10
-        check(gap <= bound * scale,
-              f"{name}: {k[:-4]} agrees to rounding ({gap / scale:.1e}"
-              + (" absolute" if k == "residuals.npy" else " of its largest value") + ")")
-    if "surface_order.npy" in a:
-        la, lb = npy_array(a["surface_order.npy"]), npy_array(b["surface_order.npy"])
-        n = len(la)
-        check(len(lb) == n and sorted(la.tolist()) == list(range(n))
-              and sorted(lb.tolist()) == list(range(n)),
-              f"{name}: both surface orders are permutations of the {n} surface vertices "
-              f"({int((la != lb).sum())} positions differ)")
-
-
-def json_close(x, y, rel=1e-9):
-    """The same JSON document but for numbers, which agree to `rel` relative."""
-    if isinstance(x, dict) and isinstance(y, dict):
-        return x.keys() == y.keys() and all(json_close(x[k], y[k], rel) for k in x)
-    if isinstance(x, list) and isinstance(y, list):
-        return len(x) == len(y) and all(json_close(u, v, rel) for u, v in zip(x, y))
-    if isinstance(x, float) or isinstance(y, float):
-        return isinstance(x, (int, float)) and isinstance(y, (int, float)) and \
-            abs(x - y) <= rel * max(abs(x), abs(y))
-    return x == y
-
-
-def glb_agree(a, b):
-    """Two GLB files whose JSON chunks are the same document but for numbers that agree to
-    1e-9 relative (the bases' frequencies and eigenvalues in `extras`, accessors' bounds) and
-    whose binary chunks have one length, their differing 4-byte words agreeing, as float32, to
-    1e-6 of the largest magnitude."""
-    import json
-    import numpy as np
-    if len(a) < 20 or len(b) < 20:
-        return False
-    la, lb = int.from_bytes(a[12:16], "little"), int.from_bytes(b[12:16], "little")
-    if not json_close(json.loads(a[20:20 + la]), json.loads(b[20:20 + lb])):
-        return False
-    ba, bb = a[20 + la + 8:], b[20 + lb + 8:]
-    if len(ba) != len(bb):
-        return False
-    n = len(ba) // 4 * 4
-    wa = np.frombuffer(ba[:n], dtype="<u4")
-    wb = np.frombuffer(bb[:n], dtype="<u4")
-    diff = wa != wb
-    if not diff.any():
-        return True
-    fa, fb = wa.view("<f4"), wb.view("<f4")
-    scale = float(np.abs(fa[np.isfinite(fa)]).max())
-    return bool(np.all(np.abs(fa[diff] - fb[diff]) <= 1e-6 * scale))
+    check(not differ, f"{name}: every entry byte-identical to the Linux bake"
+          + (f" (differ: {', '.join(differ)})" if differ else ""))
 
 
 def check_bakes(wine, linux, work):
@@ -269,7 +197,7 @@ def check_bakes(wine, linux, work):
                      f"({time.monotonic() - t:.1f} s, into a folder named 'bases für Windows')"):
             log((p.stdout + p.stderr)[-2000:])
             continue
-        compare_bases(name, lin, win, SOLVER if "hp_body" in name else ())
+        compare_bases(name, lin, win)
         p = subprocess.run([linux, "check", local, win, *opts], capture_output=True, text=True)
         check(p.returncode == 0, f"{name}: the Linux program's `check` finds the Windows base "
                                  f"up to date (exit {p.returncode})")
@@ -279,12 +207,9 @@ def check_bakes(wine, linux, work):
         if pl.returncode != 0 or pw.returncode != 0 or not os.path.isfile(glb_w):
             check(False, f"{name}: `export --gltf` runs on both")
             continue
-        bl, bw = open(glb_l, "rb").read(), open(glb_w, "rb").read()
-        if "hp_body" not in name:
-            check(bl == bw, f"{name}: `export --gltf` byte-identical to the Linux export")
-        else:
-            check(glb_agree(bl, bw), f"{name}: `export --gltf` the same document, its numbers "
-                                     "equal to rounding (1e-9 in the JSON, float32 data)")
+        with open(glb_l, "rb") as fl, open(glb_w, "rb") as fw:
+            same = fl.read() == fw.read()
+        check(same, f"{name}: `export --gltf` byte-identical to the Linux export")
 
 
 def check_interrupt(wine, work):

@@ -9,9 +9,10 @@
 
 /// METIS nested-dissection order of the symmetric graph whose adjacency is the CSC pattern
 /// (`col_ptr`, `row_idx`; a self-loop on the diagonal is ignored): `order[k]` is the vertex
-/// eliminated k-th. Deterministic for a given graph and platform (METIS's default seed; calls
-/// are serialised because METIS draws from libc's global `rand` state, which concurrent calls
-/// would interleave). `None` if METIS fails or the graph exceeds its 32-bit indices.
+/// eliminated k-th. Deterministic for a given graph (METIS's default seed; calls are serialised
+/// because METIS draws from the C library's global `rand` state, which concurrent calls would
+/// interleave; in the `modal-bake` program that `rand` is [`super::c_rand`]'s, the same on every
+/// platform). `None` if METIS fails or the graph exceeds its 32-bit indices.
 pub fn nested_dissection(col_ptr: &[usize], row_idx: &[usize]) -> Option<Vec<usize>> {
     use metis_sys::idx_t;
     let n = col_ptr.len().checked_sub(1)?;
@@ -31,8 +32,9 @@ pub fn nested_dissection(col_ptr: &[usize], row_idx: &[usize]) -> Option<Vec<usi
     }
     let mut nvtxs = idx_t::try_from(n).ok()?;
     let (mut perm, mut iperm) = (vec![0 as idx_t; n], vec![0 as idx_t; n]);
-    static METIS: std::sync::Mutex<()> = std::sync::Mutex::new(());
-    let _one_at_a_time = METIS.lock().unwrap_or_else(|e| e.into_inner());
+    let _one_at_a_time = super::c_rand::C_RAND_USERS
+        .lock()
+        .unwrap_or_else(|e| e.into_inner());
     // SAFETY: xadj has n + 1 entries, adjncy xadj[n] entries (all < n), perm and iperm n
     // entries each; null weights and options select METIS's defaults. METIS only reads the
     // graph arrays and writes the two permutations within those bounds.
