@@ -74,8 +74,10 @@ def check(ok, what):
 
 
 def ensure_tools():
-    need = [pkg for tool, pkg in (("wine", "wine64"), (MINGW_GCC, "gcc-mingw-w64-x86-64"))
-            if not shutil.which(tool)]
+    # Debian: `wine` holds the commands (wine, wineboot, wineserver), `wine64` the 64-bit loader.
+    need = [pkg for tool, pkgs in (("wineboot", "wine wine64"),
+                                   (MINGW_GCC, "gcc-mingw-w64-x86-64"))
+            if not shutil.which(tool) for pkg in pkgs.split()]
     if not need:
         return
     if shutil.which("apt-get") and os.geteuid() == 0:
