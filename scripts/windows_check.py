@@ -18,6 +18,7 @@ it, under Wine on this Linux machine, against the Linux build of the same source
    program's `check` finds them up to date, and their glTF exports are byte-identical;
 4. interrupting it (Ctrl-C: the console event Wine raises for SIGINT) while a mesher runs ends
    that mesher, removes its work folder, writes nothing and exits with STATUS_CONTROL_C_EXIT;
+   ending it from outside (TerminateProcess; SIGKILL of its Wine process) ends the mesher too;
 5. without a Python it says which interpreter it looked for (`python`, Windows' name);
 6. the C library built beside it (dcr_capi.dll, libdcr_capi.a): the world example
    (crates/dcr-capi/examples/world.c) built with MinGW gcc against the DLL and statically
@@ -121,8 +122,8 @@ class Wine:
                               text=True, encoding="utf-8", errors="replace", timeout=timeout,
                               env=dict(self.env, **(env or {})))
 
-    def popen(self, args, cwd, env=None):
-        return subprocess.Popen(["wine", self.exe, *args], cwd=cwd, stdout=subprocess.PIPE,
+    def popen(self, args, cwd, env=None, stdout=subprocess.PIPE):
+        return subprocess.Popen(["wine", self.exe, *args], cwd=cwd, stdout=stdout,
                                 stderr=subprocess.STDOUT, text=True, encoding="utf-8",
                                 errors="replace", env=dict(self.env, **(env or {})))
 
@@ -214,18 +215,17 @@ def check_bakes(wine, linux, work):
         check(same, f"{name}: `export --gltf` byte-identical to the Linux export")
 
 
-def check_interrupt(wine, work):
-    """Ctrl-C while the (stand-in) gmsh Python runs: the child ends, its work folder goes, no
-    output, STATUS_CONTROL_C_EXIT."""
-    folder = os.path.join(work, "interrupt")
+def start_hanging_mesher(wine, folder, what, stdout=subprocess.PIPE):
+    """Starts `modal-bake.exe mesh` on the committed hp_body.obj with the stand-in Python
+    (output to `stdout`) and waits until the mesher runs in its work folder: (process, work
+    folders), or None."""
     os.makedirs(folder)
-    failed_before = len(failures)
     asset = os.path.join(folder, "hp_body.obj")
     shutil.copy2(os.path.join(ROOT, "data", "assets", "hp_body.obj"), asset)
     before = set(wine.temp_dirs("modal-bake-"))
     proc = wine.popen(["mesh", wine.path(asset), "--mesher", "gmsh", "-o",
                        wine.path(os.path.join(folder, "hp_body.msh"))], cwd=folder,
-                      env={"MODAL_BAKE_PYTHON": wine.path(wine.fake_python)})
+                      env={"MODAL_BAKE_PYTHON": wine.path(wine.fake_python)}, stdout=stdout)
     # Wait for the mesher's work folder: the stand-in Python then hangs in the meshing run.
     work_dirs, deadline = [], time.monotonic() + 120
     while time.monotonic() < deadline and proc.poll() is None:
@@ -233,11 +233,23 @@ def check_interrupt(wine, work):
         if work_dirs:
             break
         time.sleep(0.5)
-    if not check(bool(work_dirs), "interrupt: modal-bake.exe starts the mesher in a work folder"):
+    if not check(bool(work_dirs), f"{what}: modal-bake.exe starts the mesher in a work folder"):
         proc.kill()
-        log(proc.communicate()[0][-2000:])
-        return
+        log((proc.communicate()[0] or "")[-2000:])
+        return None
     time.sleep(1.0)
+    return proc, work_dirs
+
+
+def check_interrupt(wine, work):
+    """Ctrl-C while the (stand-in) gmsh Python runs: the child ends, its work folder goes, no
+    output, STATUS_CONTROL_C_EXIT."""
+    folder = os.path.join(work, "interrupt")
+    failed_before = len(failures)
+    started = start_hanging_mesher(wine, folder, "interrupt")
+    if started is None:
+        return
+    proc, work_dirs = started
     children = fake_python_pids()
     os.kill(proc.pid, signal.SIGINT)
     try:
@@ -257,6 +269,29 @@ def check_interrupt(wine, work):
           f"interrupt: nothing written beside the asset ({sorted(os.listdir(folder))})")
     if len(failures) > failed_before:
         log(text[-2000:])
+
+
+def check_hard_kill(wine, work):
+    """modal-bake.exe ended from outside (TerminateProcess: here SIGKILL of its Wine process)
+    while the stand-in Python runs: the mesher ends with it (the job object). Its output goes to
+    a file: under Wine a child holding a pipe whose reader is gone ends anyway, which would
+    hide a missing job."""
+    with open(os.path.join(work, "hard_kill.log"), "w", encoding="utf-8") as out:
+        started = start_hanging_mesher(wine, os.path.join(work, "hard_kill"), "hard kill", out)
+        if started is None:
+            return
+        proc = started[0]
+        children = fake_python_pids()
+        proc.kill()
+        proc.wait()
+    deadline = time.monotonic() + 20
+    while time.monotonic() < deadline and set(children) & set(fake_python_pids()):
+        time.sleep(0.5)
+    check(bool(children) and not (set(children) & set(fake_python_pids())),
+          f"hard kill: the mesher child ended with modal-bake.exe ({len(children)} running "
+          "before)")
+    for pid in fake_python_pids():
+        os.kill(pid, signal.SIGKILL)
 
 
 def fake_python_pids():
@@ -395,6 +430,7 @@ def main():
                   f"--version answers `modal-bake {version}` ({p.stdout.strip() or p.stderr[-300:]})")
             check_bakes(wine, os.path.abspath(a.linux), work)
             check_interrupt(wine, work)
+            check_hard_kill(wine, work)
             check_missing_python(wine, work)
             check_capi(wine, work, os.path.dirname(os.path.abspath(a.exe)),
                        os.path.dirname(os.path.abspath(a.linux)), os.path.abspath(a.linux))
