@@ -67,7 +67,7 @@ pub(crate) fn factor_entries(g: &SymbolicSparseColMat<usize>, fwd: &[usize]) -> 
 /// allowed and ignored). `fwd[k]`: the vertex placed at position k. `None` when the graph does
 /// not fit METIS's 32-bit indices or METIS fails (out of memory): callers fall back to AMD.
 /// The one METIS call site is [`crate::ordering::nested_dissection`] (it serialises calls:
-/// METIS uses libc's global random state).
+/// METIS uses the C library's global `rand` state, in the program `ordering::c_rand`'s).
 pub(crate) fn metis_nested_dissection(g: &SymbolicSparseColMat<usize>) -> Option<Vec<usize>> {
     crate::ordering::nested_dissection(g.col_ptr(), g.row_idx())
 }

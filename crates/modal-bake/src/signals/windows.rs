@@ -48,7 +48,12 @@ pub fn remove_temporaries_on_signals() -> std::io::Result<()> {
     if unsafe { SetConsoleCtrlHandler(Some(on_console_event), 1) } == 0 {
         return Err(std::io::Error::last_os_error());
     }
-    end_children_with_this_process()
+    end_children_with_this_process().map_err(|e| {
+        std::io::Error::new(
+            e.kind(),
+            format!("no job object for the meshers, which would outlive a forced end: {e}"),
+        )
+    })
 }
 
 /// Puts this process in a new job object with `JOB_OBJECT_LIMIT_KILL_ON_JOB_CLOSE`. The job's
