@@ -335,7 +335,7 @@ def check_capi(wine, work, win_lib, linux_lib, linux):
                            os.path.join(linux_lib, "libdcr_capi.so")) if not os.path.isfile(p)]
     if not check(not missing, "C library: the Windows and Linux builds are there"
                  + (f" (missing {', '.join(missing)}: bash scripts/build_windows.sh; cargo "
-                    "build --release -p dcr-capi)" if missing else "")):
+                    "build --release --workspace --lib)" if missing else "")):
         return
     folder = os.path.join(work, "capi")
     os.makedirs(folder)
@@ -410,7 +410,7 @@ def main():
     ap.add_argument("--linux", default=os.path.join(TARGET_DIR, "release", "modal-bake"),
                     help="the Linux program of the same sources (cargo build --release -p "
                          "modal-bake); the Linux libdcr_capi.so is taken from its folder "
-                         "(cargo test --release --workspace builds it)")
+                         "(cargo build --release --workspace --lib builds it)")
     ap.add_argument("--no-package", action="store_true",
                     help="skip the Blender package check")
     a = ap.parse_args()
