@@ -30,7 +30,9 @@ user folder, enables it, points its preference at the modal-bake binary, and:
   default cube (gmsh from the wheel, run by this Python; the CLI's frequencies) and an open box
   (fTetWild from the wheel) with it; a package whose wheels are for another Python says so.
 
-Prints one line per check and "N passed, N failed, N skipped"; exits 1 on a failure. Without
+Prints one line per check and "N passed, N failed, N skipped"; exits 1 on a failure. The work
+folder (about 320 MB) is removed after a passing run and kept, with its path printed, after a
+failing one or with --keep. Without
 bpy it skips, except with DCR_REQUIRE_BPY=1 (CI), where that is a failure.
 """
 
@@ -41,6 +43,7 @@ import io
 import json
 import os
 import re
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -79,6 +82,9 @@ def main():
     default_bin = os.path.join(os.environ.get("CARGO_TARGET_DIR", os.path.join(ROOT, "target")),
                                "release", "modal-bake")
     ap.add_argument("--binary", default=default_bin, help="modal-bake executable to test with")
+    ap.add_argument("--keep", action="store_true",
+                    help="keep the work folder (the private Blender user folder, the bakes, the "
+                         "package: about 320 MB) after a passing run; a failing run always keeps it")
     ap.add_argument("--blender", metavar="MAJOR.MINOR",
                     help="fail unless the bpy imported is this Blender release (e.g. 5.0), so a "
                          "PYTHONPATH that did not take effect is not a silent run on another one")
@@ -90,6 +96,20 @@ def main():
         return 1
 
     work = tempfile.mkdtemp(prefix="modal_bake_addon_test_")
+    try:
+        rc = run(args, exe, work)
+    except BaseException:
+        print(f"work folder kept: {work}", flush=True)
+        raise
+    if rc == 0 and not args.keep:
+        shutil.rmtree(work, ignore_errors=True)
+    else:
+        print(f"work folder kept: {work}", flush=True)
+    return rc
+
+
+def run(args, exe, work):
+    """The tests, in the work folder `work`; returns the exit status."""
     # A private Blender user folder: nothing is installed into the user's own.
     for var, sub in (("BLENDER_USER_CONFIG", "config"), ("BLENDER_USER_SCRIPTS", "scripts"),
                      ("BLENDER_USER_EXTENSIONS", "extensions")):
