@@ -7,8 +7,9 @@
 //! not two processes with one pid on two hosts sharing a file system. The name says who wrote
 //! it, which is how temporaries of writers that died (SIGKILL, power loss) are found: every new
 //! [`AtomicFile`] for a destination first removes its stale temporaries — those of a process
-//! on this host that no longer runs, and any older than [`STALE_AFTER`] (a writer on another
-//! host, whose liveness cannot be seen, or a pid since reused).
+//! on this host that no longer runs (Linux: `/proc`; Windows: `OpenProcess`; elsewhere every
+//! writer counts as running), and any older than [`STALE_AFTER`] (a writer on another host,
+//! whose liveness cannot be seen, or a pid since reused).
 //!
 //! Signals: the temporaries being written are registered process-wide; a signal handler (the
 //! tools install `modal_bake::signals::remove_temporaries_on_signals` for SIGINT, SIGTERM and
@@ -115,13 +116,39 @@ fn parse_temp(suffix: &str) -> Option<(Option<&str>, u32)> {
     }
 }
 
-/// Whether process `pid` runs on this host (unknown: assumed running).
+/// Whether process `pid` runs on this host (unknown: assumed running): on Linux whether
+/// `/proc/PID` exists, on Windows whether the process can be opened and has no exit code yet.
 fn process_alive(pid: u32) -> bool {
-    let proc = Path::new("/proc");
-    if proc.join("self").exists() {
-        proc.join(pid.to_string()).exists()
-    } else {
-        true
+    #[cfg(windows)]
+    {
+        use windows_sys::Win32::Foundation::{
+            CloseHandle, GetLastError, ERROR_INVALID_PARAMETER, STILL_ACTIVE,
+        };
+        use windows_sys::Win32::System::Threading::{
+            GetExitCodeProcess, OpenProcess, PROCESS_QUERY_LIMITED_INFORMATION,
+        };
+        // SAFETY: plain Win32 calls; the handle is closed once, the exit code is writable.
+        #[allow(unsafe_code)]
+        unsafe {
+            let handle = OpenProcess(PROCESS_QUERY_LIMITED_INFORMATION, 0, pid);
+            if handle.is_null() {
+                // No such process; anything else (access denied) means one runs.
+                return GetLastError() != ERROR_INVALID_PARAMETER;
+            }
+            let mut code = 0u32;
+            let answered = GetExitCodeProcess(handle, &mut code) != 0;
+            CloseHandle(handle);
+            !answered || code == STILL_ACTIVE as u32
+        }
+    }
+    #[cfg(not(windows))]
+    {
+        let proc = Path::new("/proc");
+        if proc.join("self").exists() {
+            proc.join(pid.to_string()).exists()
+        } else {
+            true
+        }
     }
 }
 
@@ -351,11 +378,29 @@ mod tests {
         drop(b);
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
 
-        // A process that has exited: its pid names a dead writer on this host.
-        let mut child = std::process::Command::new("true").spawn().unwrap();
+        // A process that has exited (this test program, asked to run no test): its pid names
+        // a dead writer on this host; one still running (the same program waiting on its
+        // standard input) a live one.
+        let this = std::env::current_exe().unwrap();
+        let mut child = std::process::Command::new(&this)
+            .args(["--exact", "no test has this name"])
+            .stdout(std::process::Stdio::null())
+            .spawn()
+            .unwrap();
         let dead = child.id();
         child.wait().unwrap();
-        let alive = std::os::unix::process::parent_id();
+        let mut waiting = std::process::Command::new(&this)
+            .args([
+                "--exact",
+                "atomic_file::tests::waits_for_stdin",
+                "--ignored",
+            ])
+            .env("DCR_FILES_TEST_WAIT", "1")
+            .stdin(std::process::Stdio::piped())
+            .stdout(std::process::Stdio::null())
+            .spawn()
+            .unwrap();
+        let alive = waiting.id();
         let touch = |n: &str| {
             let p = dir.path().join(n);
             std::fs::write(&p, b"partial").unwrap();
@@ -383,12 +428,28 @@ mod tests {
             assert!(p.exists(), "{} should stay", p.display());
         }
         assert_eq!(std::fs::read(&dest).unwrap(), b"complete");
+        drop(waiting.stdin.take());
+        assert!(waiting.wait().unwrap().success());
+        // Once it has ended, its temporary is stale too.
+        write_atomic(&dest, b"again").unwrap();
+        assert!(!live.exists(), "{} should be removed", live.display());
+    }
+
+    /// The live writer of `temporaries_are_unique_and_stale_ones_are_removed`: with
+    /// `DCR_FILES_TEST_WAIT` set it runs until its standard input closes.
+    #[test]
+    #[ignore = "a helper process, started by temporaries_are_unique_and_stale_ones_are_removed"]
+    fn waits_for_stdin() {
+        if std::env::var_os("DCR_FILES_TEST_WAIT").is_some() {
+            std::io::copy(&mut std::io::stdin(), &mut std::io::sink()).unwrap();
+        }
     }
 
     // Regression: `-o` onto a character device replaced the device node with the base (as
     // root, exit 0). Writes replace regular files only; a symbolic link to `/dev/null` is
     // refused as the device it names, and the link and the device survive.
     #[test]
+    #[cfg(unix)]
     fn writes_never_replace_what_is_not_a_regular_file() {
         use std::os::unix::fs::FileTypeExt;
         let dir = tempfile::tempdir().unwrap();
@@ -425,5 +486,20 @@ mod tests {
             .is_char_device());
         // Only the FIFO, the folder, the link and nothing else: no temporary left behind.
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 3);
+    }
+
+    // A folder where the file would go is refused on every platform, and nothing is left.
+    #[test]
+    fn writes_never_replace_a_folder() {
+        let dir = tempfile::tempdir().unwrap();
+        let sub = dir.path().join("sub.modes");
+        std::fs::create_dir(&sub).unwrap();
+        let err = write_atomic(&sub, b"bytes").unwrap_err();
+        assert!(
+            matches!(&err, WriteError::Clobber { what, .. } if *what == "a directory"),
+            "{err}"
+        );
+        assert!(sub.is_dir());
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
     }
 }

@@ -1,8 +1,8 @@
 //! The output policy every writing command applies before it writes anything: all of a
 //! command's outputs are declared together with its inputs in an [`OutputPlan`], which refuses
 //! (naming the option and the path)
-//! - an output that is one of the inputs (same device and inode: a hard link, a symbolic link
-//!   to it or another spelling such as `./sub/../BASE` count),
+//! - an output that is one of the inputs (the same file: a hard link, a symbolic link to it or
+//!   another spelling such as `./sub/../BASE`, or on Windows `BASE.MODES`, count),
 //! - an output that exists as anything but a regular file (a folder, a device, a FIFO, a
 //!   socket: renaming a file over a device node would replace the node),
 //! - a path that names no file (`.`, `..`, a trailing `/`) or whose nearest existing ancestor
@@ -15,7 +15,7 @@
 use std::collections::HashMap;
 use std::path::{Component, Path, PathBuf};
 
-use crate::file_type::describe_file_type;
+use crate::file_type::{describe_file_type, file_id, FileId};
 
 /// Why an output path is refused ([`OutputPlan::output`]).
 #[derive(Debug, thiserror::Error)]
@@ -223,29 +223,6 @@ impl OutputPlan {
     }
 }
 
-/// The identity of an existing file (device and inode on Unix, the canonical path elsewhere;
-/// links followed): two paths of one file have one identity, as `same_file` decides.
-#[derive(Clone, Debug, PartialEq, Eq, Hash)]
-enum FileId {
-    #[cfg(unix)]
-    Inode(u64, u64),
-    #[cfg(not(unix))]
-    Path(PathBuf),
-}
-
-fn file_id(path: &Path) -> Option<FileId> {
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::MetadataExt;
-        let m = std::fs::metadata(path).ok()?;
-        Some(FileId::Inode(m.dev(), m.ino()))
-    }
-    #[cfg(not(unix))]
-    {
-        path.canonicalize().ok().map(FileId::Path)
-    }
-}
-
 /// Checks one output path: not `input` (what, path: the input it is the same file as, if
 /// any), not an existing non-regular file, names a file, its nearest existing ancestor a
 /// folder.
@@ -255,7 +232,10 @@ fn check_output_path(
     input: Option<&(String, PathBuf)>,
 ) -> Result<(), OutputError> {
     let names_file = !path.as_os_str().is_empty()
-        && !path.as_os_str().to_string_lossy().ends_with('/')
+        && !path
+            .as_os_str()
+            .to_string_lossy()
+            .ends_with(std::path::is_separator)
         && matches!(path.components().next_back(), Some(Component::Normal(_)));
     if !names_file {
         return Err(OutputError::NoFileName {
@@ -401,6 +381,24 @@ mod tests {
                 Err(OutputError::IsInput { .. })
             ));
         }
+        // A hard link is the input under another name (Unix and Windows alike).
+        std::fs::hard_link(&base, d.join("hard.modes")).unwrap();
+        assert!(matches!(
+            plan.output("-o", &d.join("hard.modes")),
+            Err(OutputError::IsInput { .. })
+        ));
+        // On Windows the letter case does not name another file.
+        #[cfg(windows)]
+        assert!(matches!(
+            plan.output("-o", &d.join("B.MODES")),
+            Err(OutputError::IsInput { .. })
+        ));
+        // A trailing separator (`/`, and `\` on Windows) names a folder, not a file.
+        let trailing = format!("{}{}", d.join("new").display(), std::path::MAIN_SEPARATOR);
+        assert!(matches!(
+            plan.output("-o", Path::new(&trailing)),
+            Err(OutputError::NoFileName { .. })
+        ));
         assert!(plan.output_folder("--out", &base).is_err());
         assert!(plan.output_folder("--out", &d.join("new/deeper")).is_ok());
     }
