@@ -50,8 +50,40 @@ static CHILDREN: Mutex<Children> = Mutex::new(Children {
 
 /// The contents of [`CHILDREN`].
 struct Children {
-    running: Vec<Child>,
+    running: Vec<Running>,
     aborted: bool,
+}
+
+/// A mesher child and, on Windows, the job holding it and what it starts
+/// ([`crate::signals::ChildJob`]; `None` when Windows refused one, said once on stderr).
+struct Running {
+    child: Child,
+    #[cfg(windows)]
+    job: Option<crate::signals::ChildJob>,
+}
+
+impl Running {
+    fn new(child: Child) -> Running {
+        #[cfg(windows)]
+        let job = match crate::signals::ChildJob::for_child(&child) {
+            Ok(job) => Some(job),
+            Err(e) => {
+                static SAID: std::sync::Once = std::sync::Once::new();
+                SAID.call_once(|| {
+                    eprintln!(
+                        "warning: no job object for the mesher ({e}): a process it starts \
+                         may outlive it until modal-bake ends"
+                    );
+                });
+                None
+            }
+        };
+        Running {
+            child,
+            #[cfg(windows)]
+            job,
+        }
+    }
 }
 
 fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
@@ -102,7 +134,7 @@ pub fn abort_meshing() -> usize {
     children.aborted = true;
     for c in children.running.iter_mut() {
         kill_group(c);
-        let _ = c.wait();
+        let _ = c.child.wait();
     }
     lock(&DIRS)
         .iter()
@@ -110,14 +142,19 @@ pub fn abort_meshing() -> usize {
         .count()
 }
 
-/// Kills `child` and every process in its process group (on Unix each mesher child leads its
-/// own group, [`run_child_watched`]), so a process it started cannot outlive it holding its
-/// output open. After the child has been reaped the group may be empty (nothing is signalled)
-/// or hold what it left running (ended too); its number is not reused while any member lives.
-fn kill_group(child: &mut Child) {
+/// Kills a mesher child and every process in its process group (Unix: each mesher child
+/// leads its own group, [`run_child_watched`]) or its job (Windows), so a process it started
+/// cannot outlive it holding its output open. After the child has been reaped the group may
+/// be empty (nothing is signalled) or hold what it left running (ended too); its number is not
+/// reused while any member lives.
+fn kill_group(running: &mut Running) {
     #[cfg(unix)]
-    crate::signals::kill_process_group(child.id());
-    let _ = child.kill();
+    crate::signals::kill_process_group(running.child.id());
+    #[cfg(windows)]
+    if let Some(job) = &running.job {
+        job.end();
+    }
+    let _ = running.child.kill();
 }
 
 /// How a child run ended.
@@ -151,11 +188,12 @@ pub fn run_child(
 /// arrives (within about 20 ms): the child is killed as soon as `stop` returns true
 /// (`stopped`, `status: None`).
 ///
-/// On Unix the child leads its own process group, and whenever the run ends — at `stop`, at
-/// the time limit or when the child exits — what is left of the group is killed, so a process
-/// the child started (a launcher's mesher, a background helper) neither outlives the run nor
-/// keeps it waiting on an output pipe it holds open. The group also means a terminal's Ctrl-C
-/// reaches the child through the `modal-bake` binary's handler ([`abort_meshing`]).
+/// The child leads its own process group (Unix) or job (Windows), and whenever the run ends —
+/// at `stop`, at the time limit or when the child exits — what is left of it is killed, so a
+/// process the child started (a launcher's interpreter, a background helper) neither outlives
+/// the run nor keeps it waiting on an output pipe it holds open. The group also means a
+/// terminal's Ctrl-C reaches the child through the `modal-bake` binary's handler
+/// ([`abort_meshing`]).
 ///
 /// # Errors
 /// When the program cannot be started.
@@ -183,7 +221,7 @@ pub fn run_child_watched(
         let mut child = cmd.spawn()?;
         let pipes = (child.stdout.take(), child.stderr.take());
         let id = child.id();
-        children.running.push(child);
+        children.running.push(Running::new(child));
         (id, pipes.0, pipes.1)
     };
     let drain = |r: Option<Box<dyn Read + Send>>, into: std::sync::Arc<Mutex<Vec<u8>>>| {
@@ -226,27 +264,27 @@ pub fn run_child_watched(
         }
         {
             let mut children = lock(&CHILDREN);
-            let Some(i) = children.running.iter().position(|c| c.id() == id) else {
+            let Some(i) = children.running.iter().position(|c| c.child.id() == id) else {
                 break None;
             };
-            match children.running[i].try_wait() {
+            match children.running[i].child.try_wait() {
                 Ok(Some(s)) if !stopped => {
                     // Already reaped by try_wait; wait returns its status at once.
                     let mut c = children.running.remove(i);
                     kill_group(&mut c);
-                    let _ = c.wait();
+                    let _ = c.child.wait();
                     break Some(s);
                 }
                 Ok(_) if stopped || t.elapsed() >= timeout => {
                     let mut c = children.running.remove(i);
                     kill_group(&mut c);
-                    let _ = c.wait();
+                    let _ = c.child.wait();
                     break None;
                 }
                 Ok(_) => {}
                 Err(_) => {
                     let mut c = children.running.remove(i);
-                    let status = c.wait().ok();
+                    let status = c.child.wait().ok();
                     kill_group(&mut c);
                     break status;
                 }
@@ -282,60 +320,5 @@ pub fn timeout_of(seconds: f64) -> Result<Duration, String> {
         Err(format!(
             "--mesher-timeout must be a positive number of seconds below 1e9, got {seconds}"
         ))
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    // Expectation: the watcher sees the child's lines as they come and stops it at once; a
-    // watcher that never fires leaves the run as `run_child`'s (status, all the output).
-    #[test]
-    fn the_watcher_stops_the_child_at_the_line_it_waits_for() {
-        let mut cmd = Command::new("sh");
-        cmd.args(["-c", "echo one; echo 'Info : two 7'; exec sleep 30"]);
-        let seen = std::cell::RefCell::new(Vec::new());
-        let out = run_child_watched(cmd, Duration::from_secs(60), &|_| {}, &|l| {
-            seen.borrow_mut().push(l.to_string());
-            l.contains("two 7")
-        })
-        .unwrap();
-        assert!(out.stopped && out.status.is_none());
-        assert!(out.seconds < 20.0, "stopped after {} s", out.seconds);
-        assert_eq!(*seen.borrow(), ["one", "Info : two 7"]);
-        let mut cmd = Command::new("sh");
-        cmd.args(["-c", "echo one; echo two >&2; exit 3"]);
-        let out = run_child_watched(cmd, Duration::from_secs(60), &|_| {}, &|_| false).unwrap();
-        assert!(!out.stopped);
-        assert_eq!(out.status.and_then(|s| s.code()), Some(3));
-        assert_eq!(out.text, "one\ntwo\n");
-    }
-
-    // Expectation: processes the child started go with it — stopped by the watcher, at the
-    // time limit, or left running by a child that exited — so none keeps the run waiting on
-    // the output pipe it holds (each `sleep 30` here would hold it 30 s).
-    #[test]
-    fn what_the_child_started_ends_with_the_run() {
-        let run = |script: &str, timeout: f64, stop: &dyn Fn(&str) -> bool| {
-            let mut cmd = Command::new("sh");
-            cmd.args(["-c", script]);
-            run_child_watched(cmd, Duration::from_secs_f64(timeout), &|_| {}, stop).unwrap()
-        };
-        let out = run("echo one; echo ready; sleep 30 & wait", 60.0, &|l| {
-            l == "ready"
-        });
-        assert!(
-            out.stopped && out.seconds < 20.0,
-            "stopped after {} s",
-            out.seconds
-        );
-        let out = run("sleep 30 & sleep 30 & wait", 0.5, &|_| false);
-        assert!(out.status.is_none() && !out.stopped);
-        assert!(out.seconds < 20.0, "timed out after {} s", out.seconds);
-        let out = run("sleep 30 & echo done", 60.0, &|_| false);
-        assert_eq!(out.status.and_then(|s| s.code()), Some(0));
-        assert_eq!(out.text, "done\n");
-        assert!(out.seconds < 20.0, "returned after {} s", out.seconds);
     }
 }

@@ -16,7 +16,7 @@ pub use unix::{kill_process_group, remove_temporaries_on_signals};
 #[cfg(windows)]
 mod windows;
 #[cfg(windows)]
-pub use windows::remove_temporaries_on_signals;
+pub use windows::{remove_temporaries_on_signals, ChildJob};
 
 /// Nothing to install on a platform that is neither Unix nor Windows.
 ///

@@ -9,15 +9,22 @@
 //! handle closes, which is when `modal-bake` ends, however it ends: its children and theirs
 //! (a launcher shim's interpreter) are in the job too.
 //!
+//! A mesher child gets a job of its own too ([`ChildJob`], nested in the program's): ending
+//! that job ends the child with what it started, as ending its process group does on Unix, so
+//! a launcher's interpreter holding the child's output open cannot keep the run waiting.
+//!
 //! Written on `windows-sys` (the maintained binding of the Win32 API; std has no console-event
 //! API), one of the modules allowed `unsafe`.
 #![allow(unsafe_code)]
 
+use std::os::windows::io::AsRawHandle;
+
 use windows_sys::core::BOOL;
+use windows_sys::Win32::Foundation::{CloseHandle, HANDLE};
 use windows_sys::Win32::System::Console::SetConsoleCtrlHandler;
 use windows_sys::Win32::System::JobObjects::{
     AssignProcessToJobObject, CreateJobObjectW, JobObjectExtendedLimitInformation,
-    SetInformationJobObject, JOBOBJECT_EXTENDED_LIMIT_INFORMATION,
+    SetInformationJobObject, TerminateJobObject, JOBOBJECT_EXTENDED_LIMIT_INFORMATION,
     JOB_OBJECT_LIMIT_KILL_ON_JOB_CLOSE,
 };
 use windows_sys::Win32::System::Threading::GetCurrentProcess;
@@ -60,9 +67,20 @@ pub fn remove_temporaries_on_signals() -> std::io::Result<()> {
 /// one handle is never closed by this program: Windows closes it when the process ends, and
 /// then ends every process left in the job (the children started since, which inherit it).
 fn end_children_with_this_process() -> std::io::Result<()> {
-    // SAFETY: plain Win32 calls on handles this function owns (the new job) or that are always
-    // valid (the current-process pseudo-handle); `info` outlives the call that reads it and has
-    // the size passed with it.
+    let job = kill_on_close_job()?;
+    // SAFETY: `job` is a job handle this function owns; the current-process pseudo-handle is
+    // always valid.
+    if unsafe { AssignProcessToJobObject(job, GetCurrentProcess()) } == 0 {
+        return Err(std::io::Error::last_os_error());
+    }
+    Ok(())
+}
+
+/// A new job object with `JOB_OBJECT_LIMIT_KILL_ON_JOB_CLOSE` (every process in it ends when
+/// its last handle closes); the caller owns the handle.
+fn kill_on_close_job() -> std::io::Result<HANDLE> {
+    // SAFETY: plain Win32 calls on the handle created here (closed again on failure); `info`
+    // outlives the call that reads it and has the size passed with it.
     unsafe {
         let job = CreateJobObjectW(std::ptr::null(), std::ptr::null());
         if job.is_null() {
@@ -76,9 +94,51 @@ fn end_children_with_this_process() -> std::io::Result<()> {
             std::ptr::from_ref(&info).cast(),
             std::mem::size_of::<JOBOBJECT_EXTENDED_LIMIT_INFORMATION>() as u32,
         );
-        if set == 0 || AssignProcessToJobObject(job, GetCurrentProcess()) == 0 {
+        if set == 0 {
+            let e = std::io::Error::last_os_error();
+            CloseHandle(job);
+            return Err(e);
+        }
+        Ok(job)
+    }
+}
+
+/// A job object holding one mesher child and every process it starts, nested in the
+/// program's own job (Windows 8 and later): [`ChildJob::end`] ends them all, and so does
+/// dropping it (the job ends its processes when its handle closes). A process the child
+/// starts in the moment between its start and [`ChildJob::for_child`] stays outside (the
+/// program's own job still ends it when the program ends).
+#[derive(Debug)]
+pub struct ChildJob(HANDLE);
+
+// SAFETY: a job handle may be used and closed from any thread; `ChildJob` owns its handle.
+unsafe impl Send for ChildJob {}
+
+impl ChildJob {
+    /// Puts `child` (just started) in a job of its own.
+    ///
+    /// # Errors
+    /// When Windows refuses the job or the assignment (no nested jobs before Windows 8, or a
+    /// job that forbids them).
+    pub fn for_child(child: &std::process::Child) -> std::io::Result<ChildJob> {
+        let job = ChildJob(kill_on_close_job()?);
+        // SAFETY: both handles are open: the job owned by `job`, the process by `child`.
+        if unsafe { AssignProcessToJobObject(job.0, child.as_raw_handle()) } == 0 {
             return Err(std::io::Error::last_os_error());
         }
+        Ok(job)
     }
-    Ok(())
+
+    /// Ends every process in the job (exit code 1).
+    pub fn end(&self) {
+        // SAFETY: the handle is open for as long as `self` lives.
+        unsafe { TerminateJobObject(self.0, 1) };
+    }
+}
+
+impl Drop for ChildJob {
+    fn drop(&mut self) {
+        // SAFETY: closes the handle this value owns, once.
+        unsafe { CloseHandle(self.0) };
+    }
 }
