@@ -1,4 +1,7 @@
 //! `dcr-scenes`: run a scene headless, or print Table 1 with our numbers beside the paper's.
+//!
+//! Defines the C library's `rand` and `srand` for the METIS it links through `modal-bake`
+//! (`modal_bake::c_rand_symbols!`: the bases it bakes are `modal-bake`'s on every platform).
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -581,3 +584,5 @@ fn main() -> ExitCode {
         }
     }
 }
+
+modal_bake::c_rand_symbols!();

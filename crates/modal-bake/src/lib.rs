@@ -19,3 +19,8 @@ pub mod ordering;
 pub mod signals;
 pub mod target_error;
 pub mod transfer;
+
+// The unit tests' program draws METIS's random numbers from the same generator as the tools
+// (`ordering::c_rand`), so their orders are the tools' on every platform.
+#[cfg(test)]
+c_rand_symbols!();

@@ -5,9 +5,11 @@
 //! each compute a different sequence, so the same mesh got another fill-reducing order on each
 //! platform, and with it another stored `surface_order` and, where the eigensolver's order is
 //! METIS's, eigenvalues and modes differing at rounding level (1e-12 relative on a 50k-dof
-//! mesh). The `modal-bake` program defines the two C symbols itself (`main.rs`) with this
-//! generator, so the static METIS it links draws the same numbers on every platform, and
-//! they are glibc's: on Linux its bases are bit for bit what they were with glibc's `rand`.
+//! mesh). The programs that link this library (`modal-bake`, `dcr-lab`, `dcr-scenes`, and this
+//! crate's unit tests) define the two C symbols themselves with this generator
+//! ([`c_rand_symbols!`](crate::c_rand_symbols)), so the static METIS they link draws the same
+//! numbers on every platform, and they are glibc's: on Linux the bases are bit for bit what
+//! they were with glibc's `rand`.
 //! (Building METIS with its own generator, `USE_GKRAND`, would do as well but `metis-sys`
 //! offers no way to set it.)
 //!
@@ -94,9 +96,36 @@ pub fn rand() -> i32 {
     g.get_or_insert_with(|| GlibcRand::new(1)).next_rand()
 }
 
+/// Defines C's `rand` and `srand` as [`rand`] and [`srand`] (`#[unsafe(no_mangle)]`), for the
+/// static METIS a program links: invoke it once, at the top level of the program's own crate
+/// (its `main.rs`). The program's own object is read by the linker before METIS's archive and
+/// the C library, so METIS's references bind to these; a library's object would not be (it
+/// is read only for symbols already wanted when the linker reaches it).
+#[macro_export]
+macro_rules! c_rand_symbols {
+    () => {
+        /// C's `rand`, for METIS: [`modal_bake::ordering::c_rand::rand`].
+        #[allow(unsafe_code)]
+        #[unsafe(no_mangle)]
+        pub extern "C" fn rand() -> ::std::ffi::c_int {
+            $crate::ordering::c_rand::rand()
+        }
+
+        /// C's `srand`, for METIS: [`modal_bake::ordering::c_rand::srand`].
+        #[allow(unsafe_code)]
+        #[unsafe(no_mangle)]
+        pub extern "C" fn srand(seed: ::std::ffi::c_uint) {
+            $crate::ordering::c_rand::srand(seed)
+        }
+    };
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    // Equality with glibc's own `rand` is tests/c_rand.rs: this test program defines `rand`
+    // itself (lib.rs), so the C library's is not reachable here.
 
     /// glibc's own sequence for `srand(1)` (the C standard's unseeded `rand`), as printed by
     /// `for (i = 0; i < 5; i++) printf("%d\n", rand());` with glibc 2.36.
@@ -117,35 +146,5 @@ mod tests {
         // srand(0) is srand(1).
         let mut z = GlibcRand::new(0);
         assert_eq!(z.next_rand(), 1_804_289_383);
-    }
-
-    /// Equal to the C library's `rand` where that is glibc's, over METIS's seed and seeds that
-    /// exercise the unsigned-to-signed edges, 2,000 draws each.
-    #[cfg(all(target_os = "linux", target_env = "gnu"))]
-    #[test]
-    fn equals_glibc_rand() {
-        for seed in [
-            4321u32,
-            1,
-            0,
-            2,
-            12_345,
-            127_773,
-            2_147_483_647,
-            2_147_483_648,
-            u32::MAX,
-        ] {
-            let mut g = GlibcRand::new(seed);
-            let _alone = C_RAND_USERS.lock().unwrap_or_else(|e| e.into_inner());
-            // SAFETY: srand/rand touch only libc's own generator state, which every other
-            // user in this crate (METIS) draws from under the same lock.
-            #[allow(unsafe_code)]
-            let theirs: Vec<i32> = unsafe {
-                libc::srand(seed);
-                (0..2000).map(|_| libc::rand()).collect()
-            };
-            let ours: Vec<i32> = (0..2000).map(|_| g.next_rand()).collect();
-            assert_eq!(ours, theirs, "seed {seed}");
-        }
     }
 }
