@@ -2,6 +2,9 @@
 //! `cmake/CMakeLists.txt` verbatim, configures, builds `examples/world.c` against the static
 //! and the shared library found with `find_path` / `find_library` under a dcr checkout's
 //! layout, and the program runs. Fails (never skips) when cmake is missing: CI installs it.
+//! Unix (the shared library's name and links); the Windows build of the example is
+//! `scripts/windows_check.py`'s.
+#![cfg(unix)]
 
 mod common;
 

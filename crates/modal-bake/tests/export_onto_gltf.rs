@@ -342,7 +342,8 @@ fn targets_in_each_primitives_frame_move_the_placed_vertices_as_the_modes_and_th
         for i in 0..k {
             for t in 0..1 + m {
                 let want = if t == 1 + j {
-                    (std::f64::consts::TAU * i as f64 / (k - 1) as f64).sin() as f32
+                    // `libm`'s sin, as the exporter's: the C library's differs by platform.
+                    libm::sin(std::f64::consts::TAU * i as f64 / (k - 1) as f64) as f32
                 } else {
                     0.0
                 };

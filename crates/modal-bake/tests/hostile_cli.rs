@@ -179,6 +179,7 @@ fn bake_to(out: &Path, mesh: &Path) -> Output {
 // Regression: `-o` equal to the input mesh overwrote the mesh with the base; `-o` onto a device
 // replaced the device node. Both are refused before baking, naming `-o`, and nothing changes.
 #[test]
+#[cfg(unix)]
 fn output_onto_an_input_or_a_non_file_is_refused() {
     let dir = tempfile::tempdir().unwrap();
     let mesh = dir.path().join("m.msh");

@@ -479,6 +479,7 @@ fn helper_runs(dir: &Path) -> bool {
     })
 }
 
+#[cfg(unix)]
 fn work_dirs(tmp: &Path) -> Vec<String> {
     std::fs::read_dir(tmp)
         .unwrap()

@@ -4,6 +4,7 @@
 //! option, and the input and the node survive untouched. Negative numbers given to options
 //! reach the option's range check.
 
+#[cfg(unix)]
 use std::os::unix::fs::FileTypeExt;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -41,11 +42,13 @@ fn beam_base(dir: &Path) -> PathBuf {
     out
 }
 
+#[cfg(unix)]
 fn mkfifo(p: &Path) {
     let st = Command::new("mkfifo").arg(p).status().unwrap();
     assert!(st.success(), "mkfifo");
 }
 
+#[cfg(unix)]
 fn refused(args: &[&str], needles: &[&str]) {
     let o = run(args);
     let err = String::from_utf8_lossy(&o.stderr);
@@ -61,6 +64,7 @@ fn refused(args: &[&str], needles: &[&str]) {
 // and through a symbolic link), `--gltf FIFO` replaced the FIFO with a file, and
 // `--vtu x --gltf x --png x` kept only the last. Each exporter refuses each of them.
 #[test]
+#[cfg(unix)]
 fn every_exporter_refuses_the_input_a_fifo_and_a_shared_path() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
@@ -131,6 +135,7 @@ fn every_exporter_refuses_the_input_a_fifo_and_a_shared_path() {
 // A device node survives: `/dev/null` is a character device every machine has (as root the
 // rename used to replace it with a regular file).
 #[test]
+#[cfg(unix)]
 fn a_device_node_is_refused_by_every_exporter_and_by_mesh_and_bake() {
     let dir = tempfile::tempdir().unwrap();
     let base = beam_base(dir.path());
@@ -209,6 +214,7 @@ fn check_names_the_material_option_as_bake_does() {
 // symbolic link (`out.x` → `/dev/null`) and a FIFO: the command fails naming the option, and
 // the link, the device, the FIFO and the input survive unchanged.
 #[test]
+#[cfg(unix)]
 fn every_output_refuses_a_linked_device_and_a_fifo_and_the_input_survives() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();

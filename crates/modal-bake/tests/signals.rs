@@ -5,6 +5,10 @@
 //! The writer is this test binary run again as a child (`child_writer` with
 //! `DCR_SIGNAL_CHILD_DIR` set): it installs the CLI's handler, starts an atomic write, prints
 //! `ready` and waits to be signalled.
+//!
+//! Unix signals only: Windows' console events and forced ends are checked on the Windows build
+//! under Wine by `scripts/windows_check.py`.
+#![cfg(unix)]
 
 use std::io::{BufRead, BufReader, Write};
 use std::os::unix::process::ExitStatusExt;

@@ -5,7 +5,7 @@
 //! says); ASCII STL as exporters write it (no solid name, blank lines, upper case); only
 //! regular files opened.
 
-use modal_bake::mesh::surface::{read_surface, read_surface_bytes, SurfaceError};
+use modal_bake::mesh::surface::{read_surface_bytes, SurfaceError};
 
 #[path = "common/unit_cube.rs"]
 mod unit_cube;
@@ -167,6 +167,7 @@ fn ply_with_more_faces_than_declared_is_refused_with_the_line() {
 // Regression: a surface asset that is a FIFO blocked forever and `/dev/zero` was read to
 // 2 GB; neither is opened.
 #[test]
+#[cfg(unix)]
 fn non_regular_surface_assets_are_refused_before_opening() {
     let dir = tempfile::tempdir().unwrap();
     let fifo = dir.path().join("f.stl");
@@ -178,7 +179,9 @@ fn non_regular_surface_assets_are_refused_before_opening() {
     let link = dir.path().join("zero.obj");
     std::os::unix::fs::symlink("/dev/zero", &link).unwrap();
     for p in [fifo.as_path(), link.as_path(), dir.path()] {
-        let err = read_surface(p).unwrap_err().to_string();
+        let err = modal_bake::mesh::surface::read_surface(p)
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("not a regular file"), "{}: {err}", p.display());
     }
 }

@@ -524,14 +524,23 @@ fn content_out_of_range_is_refused_naming_entry_index_and_range() {
 }
 
 // Regression: reading a `.modes` path that is a device, FIFO or directory opened it (a FIFO
-// blocks, `/dev/zero` never ends); it is refused by name before opening.
+// blocks, `/dev/zero` never ends); it is refused by name before opening. On Windows its
+// devices (`NUL`; `CON`, whose reading would wait for the console) are refused too: Windows
+// answers their type with an error, which is the message.
 #[test]
 fn only_regular_files_are_read() {
     let dir = tempfile::tempdir().unwrap();
-    for path in [Path::new("/dev/zero"), dir.path()] {
+    #[cfg(unix)]
+    let devices = [Path::new("/dev/zero")];
+    #[cfg(windows)]
+    let devices = [Path::new("NUL"), Path::new("CON"), Path::new(r"\\.\NUL")];
+    #[cfg(not(any(unix, windows)))]
+    let devices: [&Path; 0] = [];
+    for path in devices.into_iter().chain([dir.path()]) {
         let err = ModesFile::read(path).unwrap_err().to_string();
+        assert!(err.starts_with(&path.display().to_string()), "{err}");
         assert!(
-            err.starts_with(&path.display().to_string()) && err.contains("not a regular file"),
+            (cfg!(windows) && path != dir.path()) || err.contains("not a regular file"),
             "{err}"
         );
     }
@@ -540,6 +549,7 @@ fn only_regular_files_are_read() {
 // Regression: `-o` onto a character device replaced the device node with the base (as root,
 // exit 0). Writes replace regular files only.
 #[test]
+#[cfg(unix)]
 fn writes_never_replace_what_is_not_a_regular_file() {
     let dir = tempfile::tempdir().unwrap();
     let fifo = dir.path().join("pipe.modes");

@@ -370,7 +370,10 @@ mod tests {
                                     .fold(0.0f64, |acc, j| {
                                         let (x, y) = (b[j * nb + c], v[j * stride + k]);
                                         if fma {
-                                            x.mul_add(y, acc)
+                                            // Correctly rounded in software: the C library's
+                                            // `fma` behind `mul_add` is not always (MinGW's
+                                            // is off by an ulp on these inputs).
+                                            libm::fma(x, y, acc)
                                         } else {
                                             acc + x * y
                                         }
