@@ -15,7 +15,20 @@
 # and 11 as they are.
 # `python3 scripts/windows_check.py` runs it under Wine; `scripts/package_blender_addon.py
 # --binary` on it builds the Windows package of the Blender extension.
+#
+#     bash scripts/build_windows.sh --tests
+#
+# also builds the test programs of the crates whose tests run on Windows (dcr-files,
+# dcr-runtime, modal-bake) and prints, after the program's path, one line per test program:
+# its package's folder, a tab, the program (windows_check.py runs them under Wine).
 set -euo pipefail
+TESTS=0
+case "${1:-}" in
+  "") ;;
+  --tests) TESTS=1 ;;
+  -h|--help) sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//'; exit 0 ;;
+  *) echo "error: unknown argument '$1' (usage: bash scripts/build_windows.sh [--tests])" >&2; exit 2 ;;
+esac
 cd "$(dirname "$0")/.."
 TARGET=x86_64-pc-windows-gnu
 
@@ -41,3 +54,14 @@ fi
 export CARGO_TARGET_X86_64_PC_WINDOWS_GNU_LINKER=x86_64-w64-mingw32-gcc
 cargo build --release --locked --target "$TARGET" -p modal-bake -p dcr-capi >&2
 echo "${CARGO_TARGET_DIR:-target}/$TARGET/release/modal-bake.exe"
+if [ "$TESTS" = 1 ]; then
+  cargo test --release --locked --target "$TARGET" -p dcr-files -p dcr-runtime -p modal-bake \
+    --no-run --message-format=json-render-diagnostics |
+    python3 -c '
+import json, os, sys
+for line in sys.stdin:
+    m = json.loads(line)
+    if m.get("reason") == "compiler-artifact" and m.get("profile", {}).get("test") \
+            and m.get("executable"):
+        print(os.path.dirname(m["manifest_path"]) + "\t" + m["executable"])'
+fi

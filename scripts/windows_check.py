@@ -5,6 +5,7 @@ it, under Wine on this Linux machine, against the Linux build of the same source
     bash scripts/build_windows.sh
     python3 scripts/windows_check.py [--exe target/x86_64-pc-windows-gnu/release/modal-bake.exe]
                                      [--linux target/release/modal-bake] [--no-package]
+                                     [--no-tests]
 
 (the C library's files are taken from the folders of the two programs).
 
@@ -27,7 +28,12 @@ it, under Wine on this Linux machine, against the Linux build of the same source
 7. the Blender extension packaged from it (scripts/package_blender_addon.py) is a
    `windows-x64` package with `bin/modal-bake.exe` and Windows wheels, which Blender's own
    validator accepts (skipped with --no-package, or when bpy is not installed unless
-   DCR_REQUIRE_BPY=1).
+   DCR_REQUIRE_BPY=1);
+8. the test programs of dcr-files, dcr-runtime and modal-bake built for Windows
+   (`bash scripts/build_windows.sh --tests`) pass under Wine, each run from its package's
+   folder as `cargo test` runs it (skipped with --no-tests). Tests that need a Unix facility
+   (FIFOs, /dev devices, signals, a shell) are compiled out there; those that need Python
+   (meshio, vtk, gmsh) skip or are ignored with the reason: no Windows Python runs here.
 
 Needs Wine (Debian: wine64) and the MinGW-w64 gcc (it builds two small helpers into a scratch
 folder: a ProcessPrng for Wine 8, which lacks it, and a stand-in Python). Installs them with apt
@@ -371,6 +377,38 @@ def check_capi(wine, work, win_lib, linux_lib, linux):
               f"({len(ref.stdout.splitlines())} lines)")
 
 
+def check_tests(wine):
+    """The Windows test programs of dcr-files, dcr-runtime and modal-bake, under Wine."""
+    built = subprocess.run(["bash", os.path.join(ROOT, "scripts", "build_windows.sh"),
+                            "--tests"], capture_output=True, text=True)
+    programs = [line.split("\t") for line in built.stdout.splitlines()[1:] if "\t" in line]
+    if not check(built.returncode == 0 and programs,
+                 f"tests: {len(programs)} Windows test programs built"):
+        log(built.stderr[-3000:])
+        return
+    # The test programs and the modal-bake.exe they start find the ProcessPrng stand-in on
+    # WINEPATH. No Python runs here, so the tests that require one under CI are told not to.
+    env = {k: v for k, v in wine.env.items() if k != "CI" and not k.startswith("DCR_REQUIRE_")}
+    env.update(WINEPATH=wine.path(wine.bin),
+               WINEDLLOVERRIDES=wine.env["WINEDLLOVERRIDES"] + ";bcryptprimitives=n,b")
+    for folder, program in programs:
+        name = f"{os.path.basename(folder)}/{os.path.basename(program).rsplit('-', 1)[0]}"
+        start = time.monotonic()
+        try:
+            p = subprocess.run(["wine", program], cwd=folder, env=env, capture_output=True,
+                               text=True, encoding="utf-8", errors="replace", timeout=1800,
+                               stdin=subprocess.DEVNULL)
+        except subprocess.TimeoutExpired:
+            check(False, f"tests: {name} ended within 30 min")
+            continue
+        summary = [line for line in p.stdout.splitlines()
+                   if line.startswith("test result:") or re.match(r"^\S+: \d+ passed$", line)]
+        if not check(p.returncode == 0 and summary,
+                     f"tests: {name} under Wine ({(summary or ['no summary'])[-1]}; "
+                     f"{time.monotonic() - start:.0f} s)"):
+            log((p.stdout + p.stderr)[-4000:])
+
+
 def check_package(exe, work, version):
     try:
         import bpy  # noqa: F401  (the builder comes with it)
@@ -411,6 +449,9 @@ def main():
                     help="the Linux program of the same sources (cargo build --release -p "
                          "modal-bake); the Linux libdcr_capi.so is taken from its folder "
                          "(cargo build --release --workspace --lib builds it)")
+    ap.add_argument("--no-tests", action="store_true",
+                    help="skip the test programs under Wine (they are built first: minutes "
+                         "on a cold target)")
     ap.add_argument("--no-package", action="store_true",
                     help="skip the Blender package check")
     a = ap.parse_args()
@@ -434,6 +475,8 @@ def main():
             check_missing_python(wine, work)
             check_capi(wine, work, os.path.dirname(os.path.abspath(a.exe)),
                        os.path.dirname(os.path.abspath(a.linux)), os.path.abspath(a.linux))
+            if not a.no_tests:
+                check_tests(wine)
         finally:
             wine.close()
         if not a.no_package:
