@@ -34,8 +34,9 @@ pub fn describe_file_type(t: FileType) -> &'static str {
     }
 }
 
-/// Whether `a` and `b` name the same existing file ([`FileId`]: hard links, symbolic links
-/// and other spellings of one file count). `false` when either does not exist.
+/// Whether `a` and `b` name the same existing file: the same device and inode on Unix, the
+/// same volume and file index on Windows (hard links, symbolic links and other spellings of
+/// one file count). `false` when either does not exist.
 pub fn same_file(a: &Path, b: &Path) -> bool {
     match (file_id(a), file_id(b)) {
         (Some(x), Some(y)) => x == y,
