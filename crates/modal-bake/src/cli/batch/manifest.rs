@@ -463,7 +463,11 @@ fn read_entry(
     let mut items = fields(value, at, &["mesh", "out", "options"])?;
     let path_field =
         |items: &mut Vec<(String, Value)>, key: &str, what: &str| match take(items, key) {
-            Some(Value::String(s)) if !s.is_empty() => Ok(dir.join(s)),
+            // Rebuilt from its components: `/` in a manifest is the platform's separator in
+            // the paths the batch shows (Windows: `C:\farm\bases\chair.modes`).
+            Some(Value::String(s)) if !s.is_empty() => {
+                Ok(dir.join(Path::new(&s).components().collect::<PathBuf>()))
+            }
             Some(Value::String(_)) => bail!("{at}.{key} is empty; give the path of {what}"),
             Some(other) => bail!(
                 "{at}.{key} must be a string (the path of {what}), not {}",
