@@ -33,6 +33,11 @@ use crate::WriteError;
 /// Age after which a temporary is stale whoever wrote it (a write takes seconds, not hours).
 pub const STALE_AFTER: Duration = Duration::from_secs(3600);
 
+/// Windows: how long [`AtomicFile::commit`] keeps retrying the rename while the destination is
+/// held open by another program (an indexer or a virus scanner opens a new file for a moment
+/// after it is written) before it reports [`WriteError::InUse`]: 2 s.
+pub const RENAME_PATIENCE: Duration = Duration::from_secs(2);
+
 /// Temporaries being written by this process (removed by [`remove_pending_temporaries`]).
 static PENDING: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 
@@ -273,7 +278,7 @@ impl AtomicFile {
             file.sync_all()?;
             drop(file);
             check_replaceable(&self.dest).map_err(|e| std::io::Error::other(e.to_string()))?;
-            std::fs::rename(&self.tmp, &self.dest)
+            rename_patiently(&self.tmp, &self.dest)
         })();
         match result {
             Ok(()) => {
@@ -284,10 +289,39 @@ impl AtomicFile {
                 }
                 Ok(())
             }
+            Err(source) if held_open(&source) => Err(WriteError::InUse {
+                path: self.dest.clone(),
+                source,
+            }),
             Err(source) => Err(WriteError::Io {
                 path: self.dest.clone(),
                 source,
             }),
+        }
+    }
+}
+
+/// Whether a refused rename means the destination is held open by another program (or is
+/// read-only): Windows' access-denied, sharing-violation and lock-violation errors; never
+/// elsewhere, where a rename replaces an open file.
+fn held_open(e: &std::io::Error) -> bool {
+    cfg!(windows)
+        && (e.kind() == std::io::ErrorKind::PermissionDenied
+            || matches!(e.raw_os_error(), Some(32 | 33)))
+}
+
+/// `std::fs::rename`, retried while [`held_open`] refuses it, for up to [`RENAME_PATIENCE`]
+/// (waits of 10 ms doubling to 200 ms); returns the last result.
+fn rename_patiently(from: &Path, to: &Path) -> std::io::Result<()> {
+    let start = std::time::Instant::now();
+    let mut wait = Duration::from_millis(10);
+    loop {
+        match std::fs::rename(from, to) {
+            Err(e) if held_open(&e) && start.elapsed() < RENAME_PATIENCE => {
+                std::thread::sleep(wait);
+                wait = (wait * 2).min(Duration::from_millis(200));
+            }
+            result => return result,
         }
     }
 }
@@ -486,6 +520,47 @@ mod tests {
             .is_char_device());
         // Only the FIFO, the folder, the link and nothing else: no temporary left behind.
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 3);
+    }
+
+    // Windows: a destination another program holds open (no delete sharing) is waited for
+    // while it is released within RENAME_PATIENCE; held throughout, the write fails naming it,
+    // the destination keeps its bytes and no temporary is left.
+    #[test]
+    #[cfg(windows)]
+    fn a_destination_held_open_is_waited_for_then_named() {
+        use std::os::windows::fs::OpenOptionsExt;
+        const FILE_SHARE_READ: u32 = 1;
+        let dir = tempfile::tempdir().unwrap();
+        let dest = dir.path().join("x.modes");
+        std::fs::write(&dest, b"old").unwrap();
+        let hold = || {
+            std::fs::OpenOptions::new()
+                .read(true)
+                .share_mode(FILE_SHARE_READ)
+                .open(&dest)
+                .unwrap()
+        };
+        let held = hold();
+        let release = std::thread::spawn(move || {
+            std::thread::sleep(Duration::from_millis(300));
+            drop(held);
+        });
+        let start = std::time::Instant::now();
+        write_atomic(&dest, b"new").unwrap();
+        release.join().unwrap();
+        assert!(start.elapsed() >= Duration::from_millis(250));
+        assert_eq!(std::fs::read(&dest).unwrap(), b"new");
+
+        let held = hold();
+        let err = write_atomic(&dest, b"newer").unwrap_err();
+        assert!(matches!(err, WriteError::InUse { .. }), "{err}");
+        assert!(
+            err.to_string().contains("another program has it open"),
+            "{err}"
+        );
+        drop(held);
+        assert_eq!(std::fs::read(&dest).unwrap(), b"new");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
     }
 
     // A folder where the file would go is refused on every platform, and nothing is left.

@@ -37,7 +37,9 @@ mod file_type;
 mod output_plan;
 mod write_error;
 
-pub use atomic_file::{remove_pending_temporaries, write_atomic, AtomicFile, STALE_AFTER};
+pub use atomic_file::{
+    remove_pending_temporaries, write_atomic, AtomicFile, RENAME_PATIENCE, STALE_AFTER,
+};
 pub use file_type::{describe_file_type, same_file};
 pub use output_plan::{OutputError, OutputPlan};
-pub use write_error::WriteError;
+pub use write_error::{WriteError, IN_USE_HINT};

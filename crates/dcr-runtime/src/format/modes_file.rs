@@ -279,6 +279,13 @@ impl From<dcr_files::WriteError> for FormatError {
         match e {
             dcr_files::WriteError::Clobber { path, what } => FormatError::Clobber { path, what },
             dcr_files::WriteError::Io { path, source } => FormatError::Io { path, source },
+            dcr_files::WriteError::InUse { path, source } => FormatError::Io {
+                path,
+                source: std::io::Error::new(
+                    source.kind(),
+                    format!("cannot be replaced ({source}): {}", dcr_files::IN_USE_HINT),
+                ),
+            },
             // `WriteError` is non-exhaustive: a future kind keeps its message.
             other => FormatError::Io {
                 path: PathBuf::new(),
