@@ -2,16 +2,15 @@
 //! thread of its own, not by interrupting one, so it may do the clean-up itself and end the
 //! process; METIS's SIGTERM handler (see the Unix module) is never run by a console event.
 //!
-//! A mesher child is ended with `Child::kill` (`TerminateProcess`): there is no process group
-//! to end. What the handler cannot see — `modal-bake` itself ended by `TerminateProcess` (Task
-//! Manager, a host application closing) — would leave a running mesher behind, so the install
-//! also puts the process in a job object that ends every process in it when the job's last
-//! handle closes, which is when `modal-bake` ends, however it ends: its children and theirs
-//! (a launcher shim's interpreter) are in the job too.
-//!
-//! A mesher child gets a job of its own too ([`ChildJob`], nested in the program's): ending
-//! that job ends the child with what it started, as ending its process group does on Unix, so
-//! a launcher's interpreter holding the child's output open cannot keep the run waiting.
+//! Windows has no process groups; job objects do their work. A mesher child gets a job of its
+//! own ([`ChildJob`]): ending that job ends the child with what it started, as ending its
+//! process group does on Unix, so a launcher's interpreter holding the child's output open
+//! cannot keep the run waiting. What the handler cannot see — `modal-bake` itself ended by
+//! `TerminateProcess` (Task Manager, a host application closing) — would leave a running
+//! mesher behind, so the install also puts the process in a job object that ends every
+//! process in it when the job's last handle closes, which is when `modal-bake` ends, however
+//! it ends: its children and theirs are in that job too (the children's jobs are nested in
+//! it).
 //!
 //! Written on `windows-sys` (the maintained binding of the Win32 API; std has no console-event
 //! API), one of the modules allowed `unsafe`.
@@ -68,10 +67,14 @@ pub fn remove_temporaries_on_signals() -> std::io::Result<()> {
 /// then ends every process left in the job (the children started since, which inherit it).
 fn end_children_with_this_process() -> std::io::Result<()> {
     let job = kill_on_close_job()?;
-    // SAFETY: `job` is a job handle this function owns; the current-process pseudo-handle is
-    // always valid.
-    if unsafe { AssignProcessToJobObject(job, GetCurrentProcess()) } == 0 {
-        return Err(std::io::Error::last_os_error());
+    // SAFETY: `job` is a job handle this function owns (closed again when the assignment
+    // fails); the current-process pseudo-handle is always valid.
+    unsafe {
+        if AssignProcessToJobObject(job, GetCurrentProcess()) == 0 {
+            let e = std::io::Error::last_os_error();
+            CloseHandle(job);
+            return Err(e);
+        }
     }
     Ok(())
 }
