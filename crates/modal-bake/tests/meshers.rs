@@ -465,18 +465,32 @@ fn hanging_gmsh(dir: &Path) -> PathBuf {
     p
 }
 
-/// Whether the process the fake gmsh started (its pid in `DIR/helper.pid`) still runs (a
-/// zombie waiting for its reaper counts as ended).
+/// Whether the process the fake gmsh started (its pid in `DIR/helper.pid`) is still running
+/// 2 s after the call; false as soon as it has ended (a zombie waiting for its reaper counts
+/// as ended). The grace is for the
+/// kernel: a SIGKILL sent just before modal-bake exits takes effect when the killed process is
+/// next scheduled, which on a loaded machine can be after the test looks; a helper left
+/// running would live its 60 s.
 #[cfg(unix)]
 fn helper_runs(dir: &Path) -> bool {
-    let Ok(pid) = std::fs::read_to_string(dir.join("helper.pid")) else {
-        return false;
+    let runs = || {
+        let Ok(pid) = std::fs::read_to_string(dir.join("helper.pid")) else {
+            return false;
+        };
+        std::fs::read_to_string(format!("/proc/{}/stat", pid.trim())).is_ok_and(|stat| {
+            stat.rsplit(')')
+                .next()
+                .is_some_and(|rest| !rest.trim_start().starts_with('Z'))
+        })
     };
-    std::fs::read_to_string(format!("/proc/{}/stat", pid.trim())).is_ok_and(|stat| {
-        stat.rsplit(')')
-            .next()
-            .is_some_and(|rest| !rest.trim_start().starts_with('Z'))
-    })
+    let start = std::time::Instant::now();
+    while runs() {
+        if start.elapsed() > std::time::Duration::from_secs(2) {
+            return true;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    false
 }
 
 #[cfg(unix)]
