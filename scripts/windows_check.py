@@ -5,9 +5,10 @@ it, under Wine on this Linux machine, against the Linux build of the same source
     bash scripts/build_windows.sh
     python3 scripts/windows_check.py [--exe target/x86_64-pc-windows-gnu/release/modal-bake.exe]
                                      [--linux target/release/modal-bake] [--no-package]
-                                     [--no-tests]
+                                     [--linux-lib target/release/libdcr_capi.so] [--no-tests]
 
-(the C library's files are taken from the folders of the two programs).
+(the Windows C library's files are taken from the Windows program's folder; the Linux
+libdcr_capi.so from the Linux program's unless --linux-lib names it).
 
 1. the program imports Windows' own DLLs only (no MinGW runtime DLL to ship beside it);
 2. `--version` answers the workspace's version;
@@ -341,7 +342,8 @@ def check_capi(wine, work, win_lib, linux_lib, linux):
                            os.path.join(linux_lib, "libdcr_capi.so")) if not os.path.isfile(p)]
     if not check(not missing, "C library: the Windows and Linux builds are there"
                  + (f" (missing {', '.join(missing)}: bash scripts/build_windows.sh; cargo "
-                    "build --release --workspace --lib)" if missing else "")):
+                    "build --release -p dcr-capi; or name the Linux library with --linux-lib)"
+                    if missing else "")):
         return
     folder = os.path.join(work, "capi")
     os.makedirs(folder)
@@ -447,8 +449,11 @@ def main():
                     help="the Windows program (default: what scripts/build_windows.sh builds)")
     ap.add_argument("--linux", default=os.path.join(TARGET_DIR, "release", "modal-bake"),
                     help="the Linux program of the same sources (cargo build --release -p "
-                         "modal-bake); the Linux libdcr_capi.so is taken from its folder "
-                         "(cargo build --release --workspace --lib builds it)")
+                         "modal-bake)")
+    ap.add_argument("--linux-lib", default=None,
+                    help="the Linux C library of the same sources, libdcr_capi.so (default: "
+                         "beside --linux, where `cargo build --release -p dcr-capi` puts it; "
+                         "`cargo test` leaves it in release/deps)")
     ap.add_argument("--no-tests", action="store_true",
                     help="skip the test programs under Wine (they are built first: minutes "
                          "on a cold target)")
@@ -460,6 +465,10 @@ def main():
         if not os.path.isfile(path):
             print(f"error: no {path}: build it with `{how}`", file=sys.stderr)
             return 2
+    if a.linux_lib and os.path.basename(a.linux_lib) != "libdcr_capi.so":
+        print(f"error: --linux-lib {a.linux_lib}: expected a file named libdcr_capi.so (the C "
+              "example links it as -ldcr_capi)", file=sys.stderr)
+        return 2
     ensure_tools()
     version = source_version()
     with tempfile.TemporaryDirectory(prefix="dcr_windows_") as work:
@@ -473,8 +482,10 @@ def main():
             check_interrupt(wine, work)
             check_hard_kill(wine, work)
             check_missing_python(wine, work)
-            check_capi(wine, work, os.path.dirname(os.path.abspath(a.exe)),
-                       os.path.dirname(os.path.abspath(a.linux)), os.path.abspath(a.linux))
+            linux_lib = (os.path.dirname(os.path.abspath(a.linux_lib)) if a.linux_lib
+                         else os.path.dirname(os.path.abspath(a.linux)))
+            check_capi(wine, work, os.path.dirname(os.path.abspath(a.exe)), linux_lib,
+                       os.path.abspath(a.linux))
             if not a.no_tests:
                 check_tests(wine)
         finally:
